@@ -1,0 +1,114 @@
+"""Problem data of Examples 7.1 and 7.2, transcribed from shared/PAPER-NOTES.md.
+
+Written independently of the Rust code on purpose: the cross-check is only worth something if the
+data enter twice, once on each side. `check_ex71_data` verifies the transcribed f and g against
+NGSolve's symbolic derivative of the exact solution, so a typo here cannot hide.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+from ngsolve import CF, IfPos, exp, x, y
+
+# Relative size of the deliberate data perturbation used by `crosscheck.py selftest`.
+PERTURBATION = 1e-6
+
+
+@dataclass
+class Problem:
+    name: str
+    mu: float
+    zeta: float  # Lame's lambda; called zeta as in the paper to keep lambda for the contact force
+    f: CF | None  # volume load (None: zero)
+    g: CF | None  # traction on the "neumann" boundary (None: zero)
+    u_dirichlet: tuple  # constant Dirichlet value on the "dirichlet" boundary
+    normal: tuple  # outward unit normal of the (straight, axis-parallel) contact boundary
+    chi: object  # gap function: numpy (x, y) -> array
+    exact: CF | None  # exact displacement, if known
+
+    @property
+    def normal_component(self):
+        """Index and sign such that u . n = sign * u[index] (the contact normals are axis-parallel)."""
+        k = int(np.argmax(np.abs(self.normal)))
+        return k, float(np.sign(self.normal[k]))
+
+
+def ex71_exact():
+    return CF((y**2 * (y - 1), exp(y) * (1 - y) * y * (x - 2)))
+
+
+def ex71_f():
+    return CF((2 * exp(y) * (y**2 + y - 1) - 6 * y + 2, 3 * y * (x - 2) * (y + 3) * exp(y)))
+
+
+def ex71_g():
+    """sigma(u) n on the sides; the Neumann boundary is x = 0 (n = (-1,0)) and x = 1 (n = (1,0))."""
+    g_left = CF((2 * (1 - y - y**2) * exp(y), y * (2 - 3 * y + (y - 1) * exp(y))))
+    g_right = CF(((y**2 + y - 1) * exp(y), y * (3 * y - 2 - (y - 1) * exp(y))))
+    return IfPos(x - 0.5, g_right, g_left)
+
+
+def problem(name, perturb=None):
+    """The problem's data; perturb = "f" or "dirichlet" scales that datum by 1 + PERTURBATION
+    (only where the datum is nonzero: f for ex71, the Dirichlet value for ex72)."""
+    fscale = 1 + PERTURBATION if perturb == "f" else 1.0
+    dscale = 1 + PERTURBATION if perturb == "dirichlet" else 1.0
+    if perturb not in (None, "f", "dirichlet"):
+        raise ValueError(f"unknown perturbation {perturb!r}")
+    if name == "ex71":
+        return Problem(
+            name="ex71", mu=1.0, zeta=1.0,
+            f=fscale * ex71_f(), g=ex71_g(),
+            u_dirichlet=(0.0 * dscale, 0.0 * dscale),
+            normal=(0.0, -1.0),
+            chi=lambda px, py: np.zeros_like(px),
+            exact=ex71_exact(),
+        )
+    if name == "ex72":
+        E, nu = 500.0, 0.3
+        return Problem(
+            name="ex72",
+            mu=E / (2 * (1 + nu)),
+            zeta=E * nu / ((1 + nu) * (1 - 2 * nu)),
+            f=None, g=None,
+            u_dirichlet=(0.1 * dscale, 0.0),
+            normal=(1.0, 0.0),
+            chi=lambda px, py: -0.2 + 0.5 * np.abs(py - 0.5),
+            exact=None,
+        )
+    raise ValueError(f"unknown problem {name!r} (expected ex71 or ex72)")
+
+
+def stress(p, grad_u):
+    """sigma(u) = 2 mu eps(u) + zeta tr(eps(u)) I, for a 2x2 gradient coefficient function."""
+    from ngsolve import Id, Trace
+    eps = 0.5 * (grad_u + grad_u.trans)
+    return 2 * p.mu * eps + p.zeta * Trace(eps) * Id(2)
+
+
+def check_ex71_data(mesh):
+    """Max deviation of the transcribed f and g from -div sigma(u) and sigma(u) n of the exact u.
+
+    NGSolve differentiates the exact coefficient function symbolically (CF.Diff), which is an
+    independent route to the same formulas. Returns (err_f, err_g, err_contact) where err_contact is
+    the deviation of the tangential stress on y = 0 from 0 and of sigma_nn from 3x - 6 (PAPER-NOTES).
+    """
+    p = problem("ex71")
+    u = p.exact
+    grad_u = CF((u[0].Diff(x), u[0].Diff(y), u[1].Diff(x), u[1].Diff(y)), dims=(2, 2))
+    s = stress(p, grad_u)
+    div_s = CF((s[0, 0].Diff(x) + s[0, 1].Diff(y), s[1, 0].Diff(x) + s[1, 1].Diff(y)))
+    pts = np.linspace(0.0, 1.0, 21)
+    err_f = err_g = err_c = 0.0
+    for px in pts:
+        for py in pts:
+            mp = mesh(px, py)
+            err_f = max(err_f, np.max(np.abs(np.array(p.f(mp)) + np.array(div_s(mp)))))
+    for py in pts:
+        for px, n in ((0.0, (-1.0, 0.0)), (1.0, (1.0, 0.0))):
+            mp = mesh(px, py)
+            sn = np.array(s(mp)).reshape(2, 2) @ np.array(n)
+            err_g = max(err_g, np.max(np.abs(np.array(p.g(mp)) - sn)))
+    for px in pts:
+        sm = np.array(s(mesh(px, 0.0))).reshape(2, 2)
+        err_c = max(err_c, abs(sm[0, 1]), abs(sm[1, 1] - (3 * px - 6)))
+    return err_f, err_g, err_c

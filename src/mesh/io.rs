@@ -1,0 +1,1 @@
+//! Mesh and field output (VTU).

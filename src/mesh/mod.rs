@@ -1,0 +1,409 @@
+//! Triangle meshes with tagged boundary edges and the P2 node numbering.
+//!
+//! A [`Mesh`] holds vertices, counter-clockwise triangles and every boundary edge with the part of
+//! the boundary it belongs to (Dirichlet, Neumann or contact). [`P2Nodes`] numbers the P2 nodes:
+//! the mesh vertices first (node `v` is vertex `v`), then one midpoint per edge.
+
+pub mod io;
+pub mod refine;
+
+use std::collections::HashMap;
+use std::fmt;
+
+/// The part of the boundary an edge belongs to (paper Section 1: Gamma_D, Gamma_N, Gamma_C).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Part {
+    Dirichlet,
+    Neumann,
+    Contact,
+}
+
+impl Part {
+    /// Integer code used in VTU files (0 is reserved for triangles).
+    pub fn code(self) -> i32 {
+        match self {
+            Part::Dirichlet => 1,
+            Part::Neumann => 2,
+            Part::Contact => 3,
+        }
+    }
+}
+
+/// A boundary edge `v[0] -> v[1]` (counter-clockwise along the boundary) and its part.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoundaryEdge {
+    pub v: [usize; 2],
+    pub part: Part,
+}
+
+/// A conforming triangulation with tagged boundary.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    pub vertices: Vec<[f64; 2]>,
+    /// Counter-clockwise vertex triples.
+    pub triangles: Vec<[usize; 3]>,
+    pub boundary: Vec<BoundaryEdge>,
+}
+
+/// What is wrong with a mesh.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("malformed mesh description '{0}': expected 'structured:N' or 'symmetric:N' with N a positive integer (N even keeps y = 0.5 a vertex)")]
+    BadSpec(String),
+    #[error("triangle {t} has non-positive area {area:e} (vertices must be counter-clockwise and distinct)")]
+    NonPositiveArea { t: usize, area: f64 },
+    #[error("mesh is not conforming: edge ({a}, {b}) is shared by {count} triangles")]
+    NonConforming { a: usize, b: usize, count: usize },
+    #[error("boundary edge ({a}, {b}) has no tag (every boundary edge must be Dirichlet, Neumann or contact)")]
+    UntaggedBoundary { a: usize, b: usize },
+    #[error("tagged edge ({a}, {b}) is not a boundary edge of the mesh")]
+    TagNotOnBoundary { a: usize, b: usize },
+    #[error("triangle {t} refers to vertex {v}, but the mesh has {n} vertices")]
+    BadVertex { t: usize, v: usize, n: usize },
+    #[error("required vertex ({x}, {y}) (a kink of the obstacle) is not a mesh vertex")]
+    MissingVertex { x: f64, y: f64 },
+}
+
+/// How a mesh is described on the command line and in manifests.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshSpec {
+    /// The unit square, N x N squares, each cut by the diagonal from lower-left to upper-right.
+    Structured(usize),
+    /// The unit square with the structured mesh on the lower half mirrored onto the upper half:
+    /// symmetric about y = 0.5 (N even).
+    Symmetric(usize),
+}
+
+impl MeshSpec {
+    pub fn parse(s: &str) -> Result<Self, MeshError> {
+        let bad = || MeshError::BadSpec(s.to_string());
+        let (kind, n) = s.split_once(':').ok_or_else(bad)?;
+        let n: usize = n.trim().parse().map_err(|_| bad())?;
+        match kind.trim() {
+            "structured" if n >= 1 => Ok(MeshSpec::Structured(n)),
+            "symmetric" if n >= 2 && n % 2 == 0 => Ok(MeshSpec::Symmetric(n)),
+            _ => Err(bad()),
+        }
+    }
+
+    /// Build the mesh, tagging each boundary edge by `part_of(edge midpoint)`.
+    pub fn build(&self, part_of: &dyn Fn([f64; 2]) -> Part) -> Mesh {
+        match *self {
+            MeshSpec::Structured(n) => Mesh::unit_square(n, false, part_of),
+            MeshSpec::Symmetric(n) => Mesh::unit_square(n, true, part_of),
+        }
+    }
+}
+
+impl fmt::Display for MeshSpec {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MeshSpec::Structured(n) => write!(f, "structured:{n}"),
+            MeshSpec::Symmetric(n) => write!(f, "symmetric:{n}"),
+        }
+    }
+}
+
+impl Mesh {
+    /// The unit square cut into n x n squares. Each square is split by its lower-left to
+    /// upper-right diagonal; with `mirror`, squares in the upper half use the other diagonal so
+    /// the mesh is symmetric about y = 0.5. Triangles are listed with the diagonal as the edge
+    /// opposite their first vertex (the refinement edge of newest-vertex bisection).
+    pub fn unit_square(n: usize, mirror: bool, part_of: &dyn Fn([f64; 2]) -> Part) -> Mesh {
+        let idx = |i: usize, j: usize| j * (n + 1) + i;
+        let h = 1.0 / n as f64;
+        let mut vertices = Vec::with_capacity((n + 1) * (n + 1));
+        for j in 0..=n {
+            for i in 0..=n {
+                vertices.push([i as f64 * h, j as f64 * h]);
+            }
+        }
+        // exact 0.5 etc. for nice coordinates on symmetric meshes
+        let mut triangles = Vec::with_capacity(2 * n * n);
+        for j in 0..n {
+            for i in 0..n {
+                let (a, b, c, d) = (idx(i, j), idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1));
+                let upper = mirror && 2 * j >= n;
+                if !upper {
+                    // diagonal a-c; vertex opposite it first, counter-clockwise
+                    triangles.push([b, c, a]);
+                    triangles.push([d, a, c]);
+                } else {
+                    // diagonal d-b
+                    triangles.push([a, b, d]);
+                    triangles.push([c, d, b]);
+                }
+            }
+        }
+        let mut boundary = Vec::with_capacity(4 * n);
+        for i in 0..n {
+            boundary.push((idx(i, 0), idx(i + 1, 0))); // bottom, left to right
+            boundary.push((idx(n, i), idx(n, i + 1))); // right, upwards
+            boundary.push((idx(i + 1, n), idx(i, n))); // top, right to left
+            boundary.push((idx(0, i + 1), idx(0, i))); // left, downwards
+        }
+        let boundary = boundary
+            .into_iter()
+            .map(|(a, b)| {
+                let m = [0.5 * (vertices[a][0] + vertices[b][0]), 0.5 * (vertices[a][1] + vertices[b][1])];
+                BoundaryEdge { v: [a, b], part: part_of(m) }
+            })
+            .collect();
+        Mesh { vertices, triangles, boundary }
+    }
+
+    pub fn n_vertices(&self) -> usize {
+        self.vertices.len()
+    }
+
+    pub fn n_triangles(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Vertex coordinates of triangle `t`.
+    #[inline]
+    pub fn corners(&self, t: usize) -> [[f64; 2]; 3] {
+        let [a, b, c] = self.triangles[t];
+        [self.vertices[a], self.vertices[b], self.vertices[c]]
+    }
+
+    /// Signed area of triangle `t` (positive for counter-clockwise).
+    pub fn area(&self, t: usize) -> f64 {
+        let [a, b, c] = self.corners(t);
+        0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+    }
+
+    /// Diameter of triangle `t` (its longest edge).
+    pub fn diameter(&self, t: usize) -> f64 {
+        let p = self.corners(t);
+        (0..3).map(|i| dist(p[i], p[(i + 1) % 3])).fold(0.0, f64::max)
+    }
+
+    /// (h_min, h_max) over the triangles' diameters (paper Section 3).
+    pub fn h_range(&self) -> (f64, f64) {
+        (0..self.n_triangles()).map(|t| self.diameter(t)).fold((f64::INFINITY, 0.0), |(lo, hi), d| (lo.min(d), hi.max(d)))
+    }
+
+    /// Smallest interior angle over all triangles, in degrees.
+    pub fn min_angle_degrees(&self) -> f64 {
+        let mut min = f64::INFINITY;
+        for t in 0..self.n_triangles() {
+            let p = self.corners(t);
+            for i in 0..3 {
+                let (a, b, c) = (p[i], p[(i + 1) % 3], p[(i + 2) % 3]);
+                let u = [b[0] - a[0], b[1] - a[1]];
+                let v = [c[0] - a[0], c[1] - a[1]];
+                let cos = (u[0] * v[0] + u[1] * v[1]) / (dist(a, b) * dist(a, c));
+                min = min.min(cos.clamp(-1.0, 1.0).acos().to_degrees());
+            }
+        }
+        min
+    }
+
+    /// Check positive areas, conformity (every edge in one or two triangles), and that the tagged
+    /// edges are exactly the boundary edges.
+    pub fn check(&self) -> Result<(), MeshError> {
+        let n = self.n_vertices();
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for &v in tri {
+                if v >= n {
+                    return Err(MeshError::BadVertex { t, v, n });
+                }
+            }
+            let area = self.area(t);
+            if !(area > 0.0) {
+                return Err(MeshError::NonPositiveArea { t, area });
+            }
+        }
+        let mut count: HashMap<(usize, usize), usize> = HashMap::new();
+        for tri in &self.triangles {
+            for [i, j] in crate::element::EDGE_VERTICES {
+                *count.entry(key(tri[i], tri[j])).or_default() += 1;
+            }
+        }
+        let tagged: HashMap<(usize, usize), Part> = self.boundary.iter().map(|e| (key(e.v[0], e.v[1]), e.part)).collect();
+        let mut edges: Vec<_> = count.iter().collect();
+        edges.sort(); // deterministic error messages
+        for (&(a, b), &c) in edges {
+            if c > 2 {
+                return Err(MeshError::NonConforming { a, b, count: c });
+            }
+            if c == 1 && !tagged.contains_key(&(a, b)) {
+                return Err(MeshError::UntaggedBoundary { a, b });
+            }
+        }
+        for e in &self.boundary {
+            let k = key(e.v[0], e.v[1]);
+            if count.get(&k) != Some(&1) {
+                return Err(MeshError::TagNotOnBoundary { a: k.0, b: k.1 });
+            }
+        }
+        // no hanging nodes: a vertex lying inside another triangle's edge would make that edge
+        // appear once only, but on the interior; the tag check above catches it because such an
+        // edge is not tagged.
+        Ok(())
+    }
+
+    /// Check that each given point is a mesh vertex (e.g. the kink of the obstacle).
+    pub fn check_vertices(&self, points: &[[f64; 2]]) -> Result<(), MeshError> {
+        for p in points {
+            if !self.vertices.iter().any(|v| dist(*v, *p) < 1e-12) {
+                return Err(MeshError::MissingVertex { x: p[0], y: p[1] });
+            }
+        }
+        Ok(())
+    }
+}
+
+#[inline]
+pub fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
+}
+
+/// Undirected edge key.
+#[inline]
+pub fn key(a: usize, b: usize) -> (usize, usize) {
+    if a < b { (a, b) } else { (b, a) }
+}
+
+/// The P2 node numbering of a mesh: vertices first, then one node per edge (its midpoint).
+#[derive(Clone, Debug)]
+pub struct P2Nodes {
+    pub n_vertices: usize,
+    /// Edges as sorted vertex pairs; node `n_vertices + e` is the midpoint of edge `e`.
+    pub edges: Vec<[usize; 2]>,
+    /// Per triangle, its six nodes `[v0, v1, v2, m01, m12, m20]`.
+    pub elements: Vec<[usize; 6]>,
+    /// Coordinates of every node.
+    pub coords: Vec<[f64; 2]>,
+    /// The boundary part of every node: `None` inside; on a corner shared by two parts the
+    /// strongest one in the order Dirichlet > Contact > Neumann (nodes on the closure of
+    /// Gamma_D are Dirichlet nodes, PAPER-NOTES.md).
+    pub part: Vec<Option<Part>>,
+    /// Per boundary edge of the mesh (same order as `Mesh::boundary`), its three nodes
+    /// `[a, b, midpoint]`.
+    pub boundary_nodes: Vec<[usize; 3]>,
+    /// Per triangle, for each local edge, `Some(index into Mesh::boundary)` if it is a boundary edge.
+    pub element_boundary: Vec<[Option<usize>; 3]>,
+    /// Per triangle and local edge, the neighbouring triangle across that edge (None on the boundary).
+    pub neighbours: Vec<[Option<usize>; 3]>,
+}
+
+impl P2Nodes {
+    pub fn new(mesh: &Mesh) -> Self {
+        let nv = mesh.n_vertices();
+        let mut edge_index: HashMap<(usize, usize), usize> = HashMap::with_capacity(3 * mesh.n_triangles());
+        let mut edges = Vec::new();
+        let mut elements = Vec::with_capacity(mesh.n_triangles());
+        let mut edge_owner: Vec<[Option<(usize, usize)>; 2]> = Vec::new();
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            let mut nodes = [tri[0], tri[1], tri[2], 0, 0, 0];
+            for (le, [i, j]) in crate::element::EDGE_VERTICES.iter().enumerate() {
+                let k = key(tri[*i], tri[*j]);
+                let e = *edge_index.entry(k).or_insert_with(|| {
+                    edges.push([k.0, k.1]);
+                    edge_owner.push([None, None]);
+                    edges.len() - 1
+                });
+                if edge_owner[e][0].is_none() {
+                    edge_owner[e][0] = Some((t, le));
+                } else {
+                    edge_owner[e][1] = Some((t, le));
+                }
+                nodes[3 + le] = nv + e;
+            }
+            elements.push(nodes);
+        }
+        let mut neighbours = vec![[None; 3]; mesh.n_triangles()];
+        for owners in &edge_owner {
+            if let [Some((t1, l1)), Some((t2, l2))] = owners {
+                neighbours[*t1][*l1] = Some(*t2);
+                neighbours[*t2][*l2] = Some(*t1);
+            }
+        }
+        let mut coords = mesh.vertices.clone();
+        for [a, b] in &edges {
+            let (pa, pb) = (mesh.vertices[*a], mesh.vertices[*b]);
+            coords.push([0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1])]);
+        }
+        let rank = |p: Part| match p {
+            Part::Dirichlet => 3,
+            Part::Contact => 2,
+            Part::Neumann => 1,
+        };
+        let mut part: Vec<Option<Part>> = vec![None; coords.len()];
+        let mut boundary_nodes = Vec::with_capacity(mesh.boundary.len());
+        let mut element_boundary = vec![[None; 3]; mesh.n_triangles()];
+        for (bi, be) in mesh.boundary.iter().enumerate() {
+            let e = edge_index[&key(be.v[0], be.v[1])];
+            let m = nv + e;
+            boundary_nodes.push([be.v[0], be.v[1], m]);
+            for node in [be.v[0], be.v[1], m] {
+                if part[node].is_none_or(|q| rank(be.part) > rank(q)) {
+                    part[node] = Some(be.part);
+                }
+            }
+            if let Some((t, le)) = edge_owner[e][0] {
+                element_boundary[t][le] = Some(bi);
+            }
+        }
+        P2Nodes { n_vertices: nv, edges, elements, coords, part, boundary_nodes, element_boundary, neighbours }
+    }
+
+    pub fn len(&self) -> usize {
+        self.coords.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.coords.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tag(x: [f64; 2]) -> Part {
+        if x[1] < 1e-12 { Part::Contact } else if x[1] > 1.0 - 1e-12 { Part::Dirichlet } else { Part::Neumann }
+    }
+
+    #[test]
+    fn structured_mesh_counts_and_checks() {
+        let m = Mesh::unit_square(4, false, &tag);
+        assert_eq!(m.n_vertices(), 25);
+        assert_eq!(m.n_triangles(), 32);
+        m.check().unwrap();
+        let p2 = P2Nodes::new(&m);
+        assert_eq!(p2.len(), 81); // (2N+1)^2
+        let total: f64 = (0..m.n_triangles()).map(|t| m.area(t)).sum();
+        assert!((total - 1.0).abs() < 1e-14);
+        // corners of the contact boundary touching Dirichlet? none here: y=0 vs y=1
+        assert_eq!(p2.part[0], Some(Part::Contact));
+        assert_eq!(p2.part[24], Some(Part::Dirichlet));
+    }
+
+    #[test]
+    fn symmetric_mesh_is_symmetric() {
+        let m = Mesh::unit_square(4, true, &tag);
+        m.check().unwrap();
+        let p2 = P2Nodes::new(&m);
+        for p in &p2.coords {
+            let q = [p[0], 1.0 - p[1]];
+            assert!(p2.coords.iter().any(|c| dist(*c, q) < 1e-14));
+        }
+    }
+
+    #[test]
+    fn checks_catch_bad_meshes() {
+        let mut m = Mesh::unit_square(2, false, &tag);
+        m.triangles[0].swap(1, 2);
+        assert!(matches!(m.check(), Err(MeshError::NonPositiveArea { .. })));
+        let mut m = Mesh::unit_square(2, false, &tag);
+        m.boundary.pop();
+        assert!(matches!(m.check(), Err(MeshError::UntaggedBoundary { .. })));
+        assert!(MeshSpec::parse("structured:x").is_err());
+        assert!(MeshSpec::parse("structured").is_err());
+        assert!(MeshSpec::parse("cube:4").is_err());
+        assert_eq!(MeshSpec::parse("structured:8").unwrap(), MeshSpec::Structured(8));
+    }
+}

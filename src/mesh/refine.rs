@@ -1,0 +1,1 @@
+//! Conforming refinement by newest-vertex bisection (being written; see issue 3).
