@@ -1,5 +1,16 @@
 //! signorini: a P2 finite element harness for the Signorini contact problem and its
 //! supremum-norm a posteriori error estimator (Khandelwal, Porwal, Wadhawan).
+//!
+//! Data flows one way: `problems` and `mesh` describe a case, `assembly` builds the linear
+//! elasticity system, `contact` solves the discrete variational inequality (paper eq. 3.4),
+//! `solve` ties them into the SOLVE step, `norms` measures errors.
 
+pub mod assembly;
+pub mod contact;
 pub mod element;
 pub mod mesh;
+pub mod norms;
+pub mod problems;
+pub mod records;
+pub mod report;
+pub mod solve;

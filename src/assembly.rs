@@ -1,0 +1,399 @@
+//! Assembly of the P2 plane-elasticity system a(u, v) = L(v) (paper Section 1, eq. 1.8 and 3.4).
+//!
+//! Unknowns are the free nodal values (Dirichlet nodes carry their data and are eliminated).
+//! At a contact node the two unknowns are taken in the local frame (u.n, u.t), t = (-n_2, n_1),
+//! so the contact constraint u(p).n <= chi_h(p) acts on a single unknown for any normal.
+//! The unknowns are numbered so that every contact normal unknown comes last (the block `C`);
+//! the contact solver relies on that to work on a small Schur complement.
+
+use crate::element::{self, Affine, N_NODES};
+use crate::mesh::{Mesh, P2Nodes, Part};
+use crate::problems::{Material, Problem};
+use rayon::prelude::*;
+
+/// Marks a node component that is not an unknown (a Dirichlet value).
+pub const FIXED: usize = usize::MAX;
+
+/// Quadrature degree for the body force (smooth data such as Example 7.1's exponentials:
+/// the load error is far below the discretisation error and the cross-check's tolerance).
+pub const LOAD_DEGREE: usize = 10;
+/// Gauss points per edge for Neumann loads.
+pub const EDGE_POINTS: usize = 8;
+
+/// A contact node: the P2 node, its outward unit normal and chi_h(p) = chi(p).
+#[derive(Clone, Copy, Debug)]
+pub struct ContactNode {
+    pub node: usize,
+    pub normal: [f64; 2],
+    pub gap: f64,
+}
+
+/// Which unknown belongs to which node component.
+#[derive(Clone, Debug)]
+pub struct DofMap {
+    /// Per node, the unknowns of its two local components (Cartesian, or (normal, tangential) at
+    /// contact nodes); `FIXED` at Dirichlet nodes.
+    pub dof: Vec<[usize; 2]>,
+    pub n_free: usize,
+    /// Unknowns `0..n_interior` are not contact normals; `n_interior + k` is the normal unknown
+    /// of `contact[k]`.
+    pub n_interior: usize,
+    pub contact: Vec<ContactNode>,
+    /// Per node, its index in `contact`.
+    pub contact_index: Vec<Option<usize>>,
+}
+
+impl DofMap {
+    /// Contact nodes are the nodes on Gamma_C not on the closure of Gamma_D (the Dirichlet part
+    /// wins at shared corners, see `P2Nodes::part`).
+    pub fn new(nodes: &P2Nodes, problem: &dyn Problem) -> Self {
+        let n = nodes.len();
+        let mut dof = vec![[FIXED; 2]; n];
+        let mut contact = Vec::new();
+        let mut contact_index = vec![None; n];
+        let mut next = 0;
+        for p in 0..n {
+            match nodes.part[p] {
+                Some(Part::Dirichlet) => {}
+                Some(Part::Contact) => {
+                    let x = nodes.coords[p];
+                    contact_index[p] = Some(contact.len());
+                    contact.push(ContactNode { node: p, normal: problem.contact_normal(x), gap: problem.gap(x) });
+                    dof[p][1] = next; // tangential unknown among the interior ones
+                    next += 1;
+                }
+                _ => {
+                    dof[p] = [next, next + 1];
+                    next += 2;
+                }
+            }
+        }
+        let n_interior = next;
+        for (k, c) in contact.iter().enumerate() {
+            dof[c.node][0] = n_interior + k;
+        }
+        DofMap { dof, n_free: n_interior + contact.len(), n_interior, contact, contact_index }
+    }
+
+    /// The rotation taking Cartesian components to the node's local ones (identity off contact).
+    #[inline]
+    pub fn frame(&self, p: usize) -> Option<[[f64; 2]; 2]> {
+        self.contact_index[p].map(|k| {
+            let n = self.contact[k].normal;
+            [[n[0], n[1]], [-n[1], n[0]]]
+        })
+    }
+
+    /// Full Cartesian nodal displacements from the unknowns and the Dirichlet values.
+    pub fn displacement(&self, free: &[f64], dirichlet: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        (0..self.dof.len())
+            .map(|p| {
+                let d = self.dof[p];
+                if d[0] == FIXED {
+                    return dirichlet[p];
+                }
+                let local = [free[d[0]], free[d[1]]];
+                match self.frame(p) {
+                    // u = R^T local
+                    Some(r) => [r[0][0] * local[0] + r[1][0] * local[1], r[0][1] * local[0] + r[1][1] * local[1]],
+                    None => local,
+                }
+            })
+            .collect()
+    }
+}
+
+/// A symmetric sparse matrix stored as its lower triangle (diagonal included), compressed by
+/// columns with sorted row indices.
+#[derive(Clone, Debug)]
+pub struct SymCsc {
+    pub n: usize,
+    pub col_ptr: Vec<usize>,
+    pub row_idx: Vec<usize>,
+    pub values: Vec<f64>,
+}
+
+impl SymCsc {
+    /// A faer view of the lower triangle.
+    pub fn as_faer(&self) -> faer::sparse::SparseColMatRef<'_, usize, f64> {
+        // SAFETY: col_ptr is non-decreasing from 0 to nnz and row indices are sorted and < n by
+        // construction in `pattern` (checked in debug builds below).
+        debug_assert!(self.col_ptr.windows(2).all(|w| w[0] <= w[1]));
+        let sym = unsafe { faer::sparse::SymbolicSparseColMatRef::new_unchecked(self.n, self.n, &self.col_ptr, None, &self.row_idx) };
+        faer::sparse::SparseColMatRef::new(sym, &self.values)
+    }
+
+    /// Position of entry (row, col), row >= col, in `values`.
+    #[inline]
+    pub fn position(&self, row: usize, col: usize) -> usize {
+        let (lo, hi) = (self.col_ptr[col], self.col_ptr[col + 1]);
+        lo + self.row_idx[lo..hi].binary_search(&row).expect("entry outside the sparsity pattern")
+    }
+
+    /// y = A x using the lower triangle for both halves.
+    pub fn mul(&self, x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; self.n];
+        for j in 0..self.n {
+            for k in self.col_ptr[j]..self.col_ptr[j + 1] {
+                let (i, a) = (self.row_idx[k], self.values[k]);
+                y[i] += a * x[j];
+                if i != j {
+                    y[j] += a * x[i];
+                }
+            }
+        }
+        y
+    }
+
+    /// The diagonal.
+    pub fn diagonal(&self) -> Vec<f64> {
+        (0..self.n).map(|j| self.values[self.col_ptr[j]]).collect()
+    }
+}
+
+/// The assembled system: K u = F on the unknowns, with Dirichlet values eliminated.
+#[derive(Clone, Debug)]
+pub struct System {
+    pub matrix: SymCsc,
+    pub rhs: Vec<f64>,
+    /// Dirichlet values (P2 interpolant of the data) at every node; zero off Gamma_D.
+    pub dirichlet: Vec<[f64; 2]>,
+}
+
+/// The 12 x 12 element stiffness of P2 plane elasticity on one triangle, local unknown order
+/// `2 a + i` (node a, Cartesian component i):
+/// K[(a,i),(b,j)] = int mu (delta_ij grad phi_a . grad phi_b + d_j phi_a d_i phi_b) + zeta d_i phi_a d_j phi_b.
+pub fn element_stiffness(map: &Affine, material: Material, rule: &element::Rule<2>) -> [[f64; 12]; 12] {
+    let mut k = [[0.0; 12]; 12];
+    let area = map.det.abs();
+    for (q, w) in rule.points.iter().zip(&rule.weights) {
+        let rg = element::p2_gradients(q[0], q[1]);
+        let g: [[f64; 2]; N_NODES] = std::array::from_fn(|a| map.grad(rg[a]));
+        let w = w * area;
+        for a in 0..N_NODES {
+            for b in 0..N_NODES {
+                let dot = g[a][0] * g[b][0] + g[a][1] * g[b][1];
+                for i in 0..2 {
+                    for j in 0..2 {
+                        let mut v = material.mu * g[a][j] * g[b][i] + material.zeta * g[a][i] * g[b][j];
+                        if i == j {
+                            v += material.mu * dot;
+                        }
+                        k[2 * a + i][2 * b + j] += w * v;
+                    }
+                }
+            }
+        }
+    }
+    k
+}
+
+/// The sparsity pattern of the lower triangle on the unknowns: (row, col) is present when the
+/// two nodes share an element.
+fn pattern(nodes: &P2Nodes, dofs: &DofMap) -> SymCsc {
+    let n_nodes = nodes.len();
+    // node adjacency, as sorted unique lists
+    let mut count = vec![0usize; n_nodes + 1];
+    for el in &nodes.elements {
+        for &p in el {
+            count[p + 1] += N_NODES;
+        }
+    }
+    for i in 0..n_nodes {
+        count[i + 1] += count[i];
+    }
+    let mut adj = vec![0usize; count[n_nodes]];
+    let mut fill = count.clone();
+    for el in &nodes.elements {
+        for &p in el {
+            for &q in el {
+                adj[fill[p]] = q;
+                fill[p] += 1;
+            }
+        }
+    }
+    let lists: Vec<Vec<usize>> = (0..n_nodes)
+        .into_par_iter()
+        .map(|p| {
+            let mut l = adj[count[p]..count[p + 1]].to_vec();
+            l.sort_unstable();
+            l.dedup();
+            l
+        })
+        .collect();
+    // each unknown's owner node
+    let n = dofs.n_free;
+    let mut owner = vec![0usize; n];
+    for p in 0..n_nodes {
+        for &d in &dofs.dof[p] {
+            if d != FIXED {
+                owner[d] = p;
+            }
+        }
+    }
+    let columns: Vec<Vec<usize>> = (0..n)
+        .into_par_iter()
+        .map(|j| {
+            let mut rows: Vec<usize> = lists[owner[j]]
+                .iter()
+                .flat_map(|&q| dofs.dof[q])
+                .filter(|&d| d != FIXED && d >= j)
+                .collect();
+            rows.sort_unstable();
+            rows
+        })
+        .collect();
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    col_ptr.push(0);
+    for c in &columns {
+        col_ptr.push(col_ptr.last().unwrap() + c.len());
+    }
+    let row_idx: Vec<usize> = columns.into_iter().flatten().collect();
+    let nnz = row_idx.len();
+    SymCsc { n, col_ptr, row_idx, values: vec![0.0; nnz] }
+}
+
+/// Assemble stiffness and loads: body force f, Neumann traction g, Dirichlet data eliminated.
+pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem) -> System {
+    let material = problem.material();
+    let mut matrix = pattern(nodes, dofs);
+    let mut rhs = vec![0.0; dofs.n_free];
+    let dirichlet: Vec<[f64; 2]> = (0..nodes.len())
+        .map(|p| if nodes.part[p] == Some(Part::Dirichlet) { problem.dirichlet(nodes.coords[p]) } else { [0.0, 0.0] })
+        .collect();
+    let stiff_rule = element::triangle_rule(2);
+    let load_rule = element::triangle_rule(LOAD_DEGREE);
+    let load_basis: Vec<[f64; N_NODES]> = load_rule.points.iter().map(|q| element::p2_values(q[0], q[1])).collect();
+
+    // Element matrices and loads in parallel (in chunks, to bound memory); scattered in element
+    // order so the sums are the same on any number of threads.
+    const CHUNK: usize = 16384;
+    let n_el = mesh.n_triangles();
+    for start in (0..n_el).step_by(CHUNK) {
+        let end = (start + CHUNK).min(n_el);
+        let local: Vec<([[f64; 12]; 12], [f64; 12])> = (start..end)
+            .into_par_iter()
+            .map(|t| {
+                let map = Affine::new(mesh.corners(t));
+                let mut k = element_stiffness(&map, material, &stiff_rule);
+                let mut f = [0.0; 12];
+                let area = map.det.abs();
+                for ((q, w), phi) in load_rule.points.iter().zip(&load_rule.weights).zip(&load_basis) {
+                    let fx = problem.body_force(map.map(*q));
+                    for a in 0..N_NODES {
+                        f[2 * a] += w * area * fx[0] * phi[a];
+                        f[2 * a + 1] += w * area * fx[1] * phi[a];
+                    }
+                }
+                rotate(&mut k, &mut f, &nodes.elements[t], dofs);
+                (k, f)
+            })
+            .collect();
+        for (t, (k, f)) in (start..end).zip(local) {
+            scatter(&mut matrix, &mut rhs, &k, &f, &nodes.elements[t], dofs, &dirichlet);
+        }
+    }
+    neumann_load(mesh, nodes, dofs, problem, &mut rhs);
+    System { matrix, rhs, dirichlet }
+}
+
+/// Take the element matrix and load to the local frames of its contact nodes:
+/// K' = T K T^T, f' = T f with T block diagonal (rotation at contact nodes, identity elsewhere).
+fn rotate(k: &mut [[f64; 12]; 12], f: &mut [f64; 12], el: &[usize; 6], dofs: &DofMap) {
+    for (a, &p) in el.iter().enumerate() {
+        let Some(r) = dofs.frame(p) else { continue };
+        let (i0, i1) = (2 * a, 2 * a + 1);
+        // rows
+        for c in 0..12 {
+            let (x, y) = (k[i0][c], k[i1][c]);
+            k[i0][c] = r[0][0] * x + r[0][1] * y;
+            k[i1][c] = r[1][0] * x + r[1][1] * y;
+        }
+        // columns
+        for row in k.iter_mut() {
+            let (x, y) = (row[i0], row[i1]);
+            row[i0] = r[0][0] * x + r[0][1] * y;
+            row[i1] = r[1][0] * x + r[1][1] * y;
+        }
+        let (x, y) = (f[i0], f[i1]);
+        f[i0] = r[0][0] * x + r[0][1] * y;
+        f[i1] = r[1][0] * x + r[1][1] * y;
+    }
+}
+
+fn scatter(
+    matrix: &mut SymCsc,
+    rhs: &mut [f64],
+    k: &[[f64; 12]; 12],
+    f: &[f64; 12],
+    el: &[usize; 6],
+    dofs: &DofMap,
+    dirichlet: &[[f64; 2]],
+) {
+    let global: [usize; 12] = std::array::from_fn(|l| dofs.dof[el[l / 2]][l % 2]);
+    for r in 0..12 {
+        let gr = global[r];
+        if gr == FIXED {
+            continue;
+        }
+        rhs[gr] += f[r];
+        for c in 0..12 {
+            let gc = global[c];
+            if gc == FIXED {
+                // Dirichlet nodes are never rotated: their local components are Cartesian
+                rhs[gr] -= k[r][c] * dirichlet[el[c / 2]][c % 2];
+            } else if gr >= gc {
+                let pos = matrix.position(gr, gc);
+                matrix.values[pos] += k[r][c];
+            }
+        }
+    }
+}
+
+/// The P2 basis on an edge, parameter s in [0, 1] from a to b, nodes [a, b, midpoint].
+#[inline]
+pub fn edge_basis(s: f64) -> [f64; 3] {
+    [(1.0 - s) * (1.0 - 2.0 * s), s * (2.0 * s - 1.0), 4.0 * s * (1.0 - s)]
+}
+
+/// Outward unit normal and length of a counter-clockwise boundary edge from a to b.
+#[inline]
+pub fn edge_normal(a: [f64; 2], b: [f64; 2]) -> ([f64; 2], f64) {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
+    ([d[1] / len, -d[0] / len], len)
+}
+
+fn neumann_load(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem, rhs: &mut [f64]) {
+    let gauss = element::gauss_legendre(EDGE_POINTS);
+    for (be, bn) in mesh.boundary.iter().zip(&nodes.boundary_nodes) {
+        if be.part != Part::Neumann {
+            continue;
+        }
+        let (a, b) = (mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
+        let (normal, len) = edge_normal(a, b);
+        let mut load = [[0.0; 2]; 3];
+        for (s, w) in gauss.points.iter().zip(&gauss.weights) {
+            let s = s[0];
+            let x = [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])];
+            let g = problem.traction(x, normal);
+            let phi = edge_basis(s);
+            for i in 0..3 {
+                load[i][0] += w * len * g[0] * phi[i];
+                load[i][1] += w * len * g[1] * phi[i];
+            }
+        }
+        for (i, &p) in bn.iter().enumerate() {
+            let l = match dofs.frame(p) {
+                Some(r) => [r[0][0] * load[i][0] + r[0][1] * load[i][1], r[1][0] * load[i][0] + r[1][1] * load[i][1]],
+                None => load[i],
+            };
+            for c in 0..2 {
+                let d = dofs.dof[p][c];
+                if d != FIXED {
+                    rhs[d] += l[c];
+                }
+            }
+        }
+    }
+}

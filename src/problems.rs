@@ -1,0 +1,289 @@
+//! The contact problems as data: material, loads, boundary parts, obstacle, exact solution.
+//!
+//! A problem is data, not branches in the solver: every problem implements [`Problem`] and the
+//! solver, estimator and studies only ever call the trait. Known problems are listed by
+//! [`KNOWN`] and built by [`by_name`].
+
+use crate::mesh::Part;
+
+/// Plane elasticity with Lamé constants: sigma(u) = 2 mu eps(u) + zeta tr(eps(u)) I
+/// (paper Section 1; the paper writes zeta for Lamé's lambda).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Material {
+    pub mu: f64,
+    pub zeta: f64,
+}
+
+impl Material {
+    /// From Young's modulus and Poisson's ratio (plane strain):
+    /// zeta = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)).
+    pub fn from_young(e: f64, nu: f64) -> Self {
+        Material { mu: e / (2.0 * (1.0 + nu)), zeta: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)) }
+    }
+
+    /// Stress from a displacement gradient `g[i][j] = d u_i / d x_j`, as (s11, s12, s22).
+    #[inline]
+    pub fn stress(&self, g: [[f64; 2]; 2]) -> [f64; 3] {
+        let tr = g[0][0] + g[1][1];
+        let s12 = self.mu * (g[0][1] + g[1][0]);
+        [2.0 * self.mu * g[0][0] + self.zeta * tr, s12, 2.0 * self.mu * g[1][1] + self.zeta * tr]
+    }
+
+    /// Traction sigma(u) n from a displacement gradient and a unit normal.
+    #[inline]
+    pub fn traction(&self, g: [[f64; 2]; 2], n: [f64; 2]) -> [f64; 2] {
+        let s = self.stress(g);
+        [s[0] * n[0] + s[1] * n[1], s[1] * n[0] + s[2] * n[1]]
+    }
+}
+
+/// An exact solution, where one is known.
+pub trait Exact: Send + Sync {
+    fn u(&self, x: [f64; 2]) -> [f64; 2];
+    /// `grad[i][j] = d u_i / d x_j`.
+    fn grad(&self, x: [f64; 2]) -> [[f64; 2]; 2];
+}
+
+/// A 2D frictionless unilateral contact problem on the unit square (paper eq. 1.1–1.8).
+pub trait Problem: Send + Sync {
+    /// Short name used on the command line and in manifests.
+    fn name(&self) -> &'static str;
+    fn description(&self) -> &'static str;
+    fn material(&self) -> Material;
+    /// The boundary part containing boundary point `x` (an edge midpoint).
+    fn part_of(&self, x: [f64; 2]) -> Part;
+    /// Body force f.
+    fn body_force(&self, x: [f64; 2]) -> [f64; 2];
+    /// Neumann traction g at `x` on Gamma_N with outward unit normal `n`.
+    fn traction(&self, x: [f64; 2], n: [f64; 2]) -> [f64; 2];
+    /// Dirichlet value on Gamma_D.
+    fn dirichlet(&self, x: [f64; 2]) -> [f64; 2];
+    /// Outward unit normal of Gamma_C at `x`.
+    fn contact_normal(&self, x: [f64; 2]) -> [f64; 2];
+    /// The gap chi: the constraint is u . n <= chi on Gamma_C.
+    fn gap(&self, x: [f64; 2]) -> f64;
+    /// Points that must be mesh vertices (kinks of chi), so that chi_h interpolates chi well.
+    fn required_vertices(&self) -> Vec<[f64; 2]> {
+        Vec::new()
+    }
+    fn exact(&self) -> Option<&dyn Exact> {
+        None
+    }
+}
+
+/// The names `by_name` knows.
+pub const KNOWN: [&str; 3] = ["ex71", "ex72", "patch"];
+
+#[derive(Debug, thiserror::Error)]
+#[error("unknown problem '{0}'; known problems: {known}", known = KNOWN.join(", "))]
+pub struct UnknownProblem(pub String);
+
+pub fn by_name(name: &str) -> Result<Box<dyn Problem>, UnknownProblem> {
+    match name {
+        "ex71" => Ok(Box::new(Ex71)),
+        "ex72" => Ok(Box::new(Ex72)),
+        "patch" => Ok(Box::new(Patch::default())),
+        _ => Err(UnknownProblem(name.to_string())),
+    }
+}
+
+const EPS: f64 = 1e-12;
+
+/// Example 7.1: smooth manufactured solution u = (y^2 (y - 1), e^y (1 - y) y (x - 2)),
+/// zeta = mu = 1, Gamma_C the bottom (n = (0, -1), chi = 0), Gamma_D the top, Gamma_N the sides.
+/// The exact solution is in contact along the whole of Gamma_C (sigma_nn = 3x - 6 < 0).
+pub struct Ex71;
+
+impl Exact for Ex71 {
+    fn u(&self, x: [f64; 2]) -> [f64; 2] {
+        let (x, y) = (x[0], x[1]);
+        [y * y * (y - 1.0), y.exp() * (1.0 - y) * y * (x - 2.0)]
+    }
+    fn grad(&self, x: [f64; 2]) -> [[f64; 2]; 2] {
+        let (x, y) = (x[0], x[1]);
+        let e = y.exp();
+        [[0.0, 3.0 * y * y - 2.0 * y], [e * (1.0 - y) * y, (x - 2.0) * e * (1.0 - y - y * y)]]
+    }
+}
+
+impl Problem for Ex71 {
+    fn name(&self) -> &'static str {
+        "ex71"
+    }
+    fn description(&self) -> &'static str {
+        "Example 7.1: smooth manufactured solution, contact along the whole bottom edge"
+    }
+    fn material(&self) -> Material {
+        Material { mu: 1.0, zeta: 1.0 }
+    }
+    fn part_of(&self, x: [f64; 2]) -> Part {
+        if x[1] < EPS {
+            Part::Contact
+        } else if x[1] > 1.0 - EPS {
+            Part::Dirichlet
+        } else {
+            Part::Neumann
+        }
+    }
+    /// f = -div sigma(u) = (2 e^y (y^2 + y - 1) - 6 y + 2, 3 y (x - 2)(y + 3) e^y) (PAPER-NOTES.md,
+    /// checked against finite differences of the exact stress in tests/problems.rs).
+    fn body_force(&self, x: [f64; 2]) -> [f64; 2] {
+        let (x, y) = (x[0], x[1]);
+        let e = y.exp();
+        [2.0 * e * (y * y + y - 1.0) - 6.0 * y + 2.0, 3.0 * y * (x - 2.0) * (y + 3.0) * e]
+    }
+    /// g = sigma(u) n from the exact stress.
+    fn traction(&self, x: [f64; 2], n: [f64; 2]) -> [f64; 2] {
+        self.material().traction(self.grad(x), n)
+    }
+    fn dirichlet(&self, x: [f64; 2]) -> [f64; 2] {
+        self.u(x)
+    }
+    fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, -1.0]
+    }
+    fn gap(&self, _x: [f64; 2]) -> f64 {
+        0.0
+    }
+    fn exact(&self) -> Option<&dyn Exact> {
+        Some(self)
+    }
+}
+
+/// Example 7.2: contact with a rigid wedge. E = 500, nu = 0.3, f = g = 0, u = (0.1, 0) on
+/// Gamma_D = {x = 0}, Gamma_C = {x = 1} with n = (1, 0) and chi(y) = -0.2 + 0.5 |y - 0.5|,
+/// Gamma_N the top and bottom. chi has a kink at y = 0.5, which must be a mesh vertex.
+pub struct Ex72;
+
+impl Problem for Ex72 {
+    fn name(&self) -> &'static str {
+        "ex72"
+    }
+    fn description(&self) -> &'static str {
+        "Example 7.2: contact with a rigid wedge (no exact solution)"
+    }
+    fn material(&self) -> Material {
+        Material::from_young(500.0, 0.3)
+    }
+    fn part_of(&self, x: [f64; 2]) -> Part {
+        if x[0] > 1.0 - EPS {
+            Part::Contact
+        } else if x[0] < EPS {
+            Part::Dirichlet
+        } else {
+            Part::Neumann
+        }
+    }
+    fn body_force(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn traction(&self, _x: [f64; 2], _n: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn dirichlet(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.1, 0.0]
+    }
+    fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+        [1.0, 0.0]
+    }
+    fn gap(&self, x: [f64; 2]) -> f64 {
+        -0.2 + 0.5 * (x[1] - 0.5).abs()
+    }
+    fn required_vertices(&self) -> Vec<[f64; 2]> {
+        vec![[1.0, 0.5]]
+    }
+}
+
+/// A quadratic displacement (in the P2 space) with its own constant f and linear g, and the
+/// obstacle far away (no active contact): the discrete solution must equal it to round-off.
+/// Boundary parts as in Example 7.2: contact on the right (n = (1, 0)), Dirichlet at the left,
+/// Neumann top and bottom.
+pub struct Patch {
+    pub material: Material,
+    /// u_i = sum_k c[i][k] m_k(x, y) with monomials m = (1, x, y, x^2, xy, y^2).
+    pub c: [[f64; 6]; 2],
+    pub gap: f64,
+}
+
+impl Default for Patch {
+    fn default() -> Self {
+        Patch::traction_free_right(Material::from_young(7.0, 0.27), [0.03, 0.05, 0.02, -0.02, -0.03, 0.04])
+    }
+}
+
+impl Patch {
+    /// The quadratic displacement with free coefficients `(a2, a3, a5, b2, b3, b5)` and the other
+    /// six chosen so that sigma(u) n = 0 on x = 1: with the contact inactive, Gamma_C is then
+    /// traction free for the exact solution too, so it solves the discrete problem exactly.
+    pub fn traction_free_right(material: Material, free: [f64; 6]) -> Self {
+        let (mu, zeta) = (material.mu, material.zeta);
+        let [a2, a3, a5, b2, b3, b5] = free;
+        // sigma_12(1, y) = 0:  a2 + a4 + b1 + 2 b3 = 0 and 2 a5 + b4 = 0
+        // sigma_11(1, y) = 0:  (2mu+zeta)(a1 + 2 a3) + zeta (b2 + b4) = 0 and (2mu+zeta) a4 + 2 zeta b5 = 0
+        let b4 = -2.0 * a5;
+        let a4 = -2.0 * zeta * b5 / (2.0 * mu + zeta);
+        let a1 = -2.0 * a3 - zeta * (b2 + b4) / (2.0 * mu + zeta);
+        let b1 = -a2 - a4 - 2.0 * b3;
+        Patch { material, c: [[0.01, a1, a2, a3, a4, a5], [-0.02, b1, b2, b3, b4, b5]], gap: 10.0 }
+    }
+}
+
+impl Exact for Patch {
+    fn u(&self, x: [f64; 2]) -> [f64; 2] {
+        let m = [1.0, x[0], x[1], x[0] * x[0], x[0] * x[1], x[1] * x[1]];
+        let dot = |c: &[f64; 6]| c.iter().zip(&m).map(|(a, b)| a * b).sum();
+        [dot(&self.c[0]), dot(&self.c[1])]
+    }
+    fn grad(&self, x: [f64; 2]) -> [[f64; 2]; 2] {
+        let g = |c: &[f64; 6]| [c[1] + 2.0 * c[3] * x[0] + c[4] * x[1], c[2] + c[4] * x[0] + 2.0 * c[5] * x[1]];
+        [g(&self.c[0]), g(&self.c[1])]
+    }
+}
+
+impl Problem for Patch {
+    fn name(&self) -> &'static str {
+        "patch"
+    }
+    fn description(&self) -> &'static str {
+        "Patch test: a quadratic displacement with its own f and g, obstacle far away"
+    }
+    fn material(&self) -> Material {
+        self.material
+    }
+    fn part_of(&self, x: [f64; 2]) -> Part {
+        if x[0] > 1.0 - EPS {
+            Part::Contact
+        } else if x[0] < EPS {
+            Part::Dirichlet
+        } else {
+            Part::Neumann
+        }
+    }
+    /// f = -div sigma(u), constant for quadratic u.
+    fn body_force(&self, _x: [f64; 2]) -> [f64; 2] {
+        let (mu, zeta) = (self.material.mu, self.material.zeta);
+        let [a, b] = self.c;
+        // second derivatives: u_i,xx = 2 c[i][3], u_i,xy = c[i][4], u_i,yy = 2 c[i][5]
+        let (u1xx, u1xy, u1yy) = (2.0 * a[3], a[4], 2.0 * a[5]);
+        let (u2xx, u2xy, u2yy) = (2.0 * b[3], b[4], 2.0 * b[5]);
+        // div sigma = mu Laplace u + (mu + zeta) grad div u
+        let div1 = mu * (u1xx + u1yy) + (mu + zeta) * (u1xx + u2xy);
+        let div2 = mu * (u2xx + u2yy) + (mu + zeta) * (u1xy + u2yy);
+        [-div1, -div2]
+    }
+    fn traction(&self, x: [f64; 2], n: [f64; 2]) -> [f64; 2] {
+        self.material.traction(self.grad(x), n)
+    }
+    fn dirichlet(&self, x: [f64; 2]) -> [f64; 2] {
+        self.u(x)
+    }
+    fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+        [1.0, 0.0]
+    }
+    fn gap(&self, _x: [f64; 2]) -> f64 {
+        self.gap
+    }
+    fn exact(&self) -> Option<&dyn Exact> {
+        Some(self)
+    }
+}

@@ -1,0 +1,201 @@
+//! The SOLVE step: one discrete Signorini solution (paper eq. 3.4) on a given mesh, with the
+//! discrete contact force (eq. 4.5) and its KKT report.
+
+use crate::assembly::{self, DofMap, System};
+use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, Termination, Timings};
+use crate::element::{self, Affine};
+use crate::mesh::{Mesh, MeshError, P2Nodes};
+use crate::problems::Problem;
+use std::time::Instant;
+
+#[derive(Debug, thiserror::Error)]
+pub enum SolveError {
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    #[error(transparent)]
+    Contact(#[from] ContactError),
+}
+
+/// A discrete solution and everything computed on the way.
+pub struct DiscreteSolution {
+    pub nodes: P2Nodes,
+    pub dofs: DofMap,
+    /// Cartesian displacement at every P2 node.
+    pub u: Vec<[f64; 2]>,
+    /// Nodal contact force lambda_p = L(phi_p n) - a(u_h, phi_p n) per contact node (in the order
+    /// of `dofs.contact`), computed from the assembled residual (eq. 4.5 / Lemma 5.2).
+    pub lambda: Vec<f64>,
+    /// Active contact nodes (u_h(p).n = chi_h(p) enforced).
+    pub active: Vec<bool>,
+    pub pdas: Vec<PdasIteration>,
+    pub termination: Termination,
+    /// Complementarity constant used.
+    pub c: f64,
+    /// Largest |F - K u| over the unknowns other than contact normals, relative to max |F|.
+    pub free_residual: f64,
+    pub timings: SolveTimings,
+}
+
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct SolveTimings {
+    pub assembly: f64,
+    #[serde(flatten)]
+    pub contact: Timings,
+    pub total: f64,
+}
+
+/// The KKT conditions at the contact nodes.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct Kkt {
+    /// max_p (u_h(p).n - chi_h(p))^+
+    pub max_penetration: f64,
+    /// min_p lambda_p
+    pub min_lambda: f64,
+    /// max_p |lambda_p (chi_h(p) - u_h(p).n)|
+    pub max_complementarity: f64,
+    /// max |lambda_p| over inactive nodes
+    pub max_inactive_lambda: f64,
+    /// Scale of lambda (max |lambda_p|), for relative checks.
+    pub lambda_scale: f64,
+}
+
+/// Assemble, factorise and solve the contact problem on `mesh`.
+pub fn solve(
+    mesh: &Mesh,
+    problem: &dyn Problem,
+    options: &PdasOptions,
+    observe: &mut dyn FnMut(&PdasIteration),
+) -> Result<DiscreteSolution, SolveError> {
+    mesh.check()?;
+    mesh.check_vertices(&problem.required_vertices())?;
+    let t_all = Instant::now();
+    let t0 = Instant::now();
+    let nodes = P2Nodes::new(mesh);
+    let dofs = DofMap::new(&nodes, problem);
+    let System { matrix, rhs, dirichlet } = assembly::assemble(mesh, &nodes, &dofs, problem);
+    let assembly_time = t0.elapsed().as_secs_f64();
+    let mut solver = ContactSolver::new(&matrix, dofs.n_interior)?;
+    let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
+    let out = solver.solve_contact(&rhs, &gap, options, observe)?;
+    // the residual F - K u: zero at free unknowns, lambda_p at contact normals
+    let ku = matrix.mul(&out.u);
+    let r: Vec<f64> = rhs.iter().zip(&ku).map(|(f, k)| f - k).collect();
+    let f_scale = rhs.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
+    let free_residual = r[..dofs.n_interior].iter().fold(0.0f64, |a, v| a.max(v.abs())) / f_scale;
+    let lambda = r[dofs.n_interior..].to_vec();
+    let u = dofs.displacement(&out.u, &dirichlet);
+    let timings = SolveTimings { assembly: assembly_time, contact: solver.timings.clone(), total: t_all.elapsed().as_secs_f64() };
+    Ok(DiscreteSolution {
+        nodes,
+        dofs,
+        u,
+        lambda,
+        active: out.active,
+        pdas: out.iterations,
+        termination: out.termination,
+        c: out.c,
+        free_residual,
+        timings,
+    })
+}
+
+impl DiscreteSolution {
+    /// u_h(p).n at contact node k.
+    pub fn normal_displacement(&self, k: usize) -> f64 {
+        let c = &self.dofs.contact[k];
+        let u = self.u[c.node];
+        u[0] * c.normal[0] + u[1] * c.normal[1]
+    }
+
+    pub fn kkt(&self) -> Kkt {
+        let mut k = Kkt {
+            max_penetration: 0.0,
+            min_lambda: f64::INFINITY,
+            max_complementarity: 0.0,
+            max_inactive_lambda: 0.0,
+            lambda_scale: 0.0,
+        };
+        for (i, c) in self.dofs.contact.iter().enumerate() {
+            let gap = c.gap - self.normal_displacement(i);
+            let l = self.lambda[i];
+            k.max_penetration = k.max_penetration.max(-gap);
+            k.min_lambda = k.min_lambda.min(l);
+            k.max_complementarity = k.max_complementarity.max((l * gap).abs());
+            k.lambda_scale = k.lambda_scale.max(l.abs());
+            if !self.active[i] {
+                k.max_inactive_lambda = k.max_inactive_lambda.max(l.abs());
+            }
+        }
+        if self.dofs.contact.is_empty() {
+            k.min_lambda = 0.0;
+        }
+        k
+    }
+
+    pub fn active_count(&self) -> usize {
+        self.active.iter().filter(|a| **a).count()
+    }
+
+    /// [min, max] of the tangential coordinate over active contact nodes (y on a vertical
+    /// contact boundary, x on a horizontal one).
+    pub fn contact_zone(&self) -> Option<[f64; 2]> {
+        let mut zone: Option<[f64; 2]> = None;
+        for (i, c) in self.dofs.contact.iter().enumerate() {
+            if !self.active[i] {
+                continue;
+            }
+            let x = self.nodes.coords[c.node];
+            let s = if c.normal[0].abs() > c.normal[1].abs() { x[1] } else { x[0] };
+            zone = Some(match zone {
+                None => [s, s],
+                Some([a, b]) => [a.min(s), b.max(s)],
+            });
+        }
+        zone
+    }
+
+    /// Values of u_h at the reference points `refs` of triangle `t`.
+    pub fn eval_element(&self, mesh: &Mesh, t: usize, refs: &[[f64; 2]]) -> Vec<([f64; 2], [f64; 2])> {
+        let map = Affine::new(mesh.corners(t));
+        let el = &self.nodes.elements[t];
+        refs.iter()
+            .map(|r| {
+                let phi = element::p2_values(r[0], r[1]);
+                let mut v = [0.0; 2];
+                for a in 0..element::N_NODES {
+                    v[0] += phi[a] * self.u[el[a]][0];
+                    v[1] += phi[a] * self.u[el[a]][1];
+                }
+                (map.map(*r), v)
+            })
+            .collect()
+    }
+
+    /// u_h at a physical point, or None outside the mesh.
+    pub fn probe(&self, mesh: &Mesh, x: [f64; 2]) -> Option<[f64; 2]> {
+        (0..mesh.n_triangles()).find_map(|t| {
+            let r = Affine::new(mesh.corners(t)).inverse(x);
+            let tol = 1e-12;
+            (r[0] >= -tol && r[1] >= -tol && r[0] + r[1] <= 1.0 + tol).then(|| self.eval_element(mesh, t, &[r])[0].1)
+        })
+    }
+}
+
+/// The discrete contact force density lambda_h(p) = lambda_p / int psi_p ds (eq. 4.5, 4.6):
+/// int psi_p ds is a quarter of the adjacent contact edge lengths for a vertex, half of its edge
+/// for an edge midpoint.
+pub fn contact_density(mesh: &Mesh, sol: &DiscreteSolution) -> Vec<f64> {
+    let mut weight = vec![0.0; sol.dofs.contact.len()];
+    for (be, bn) in mesh.boundary.iter().zip(&sol.nodes.boundary_nodes) {
+        if be.part != crate::mesh::Part::Contact {
+            continue;
+        }
+        let len = crate::mesh::dist(mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
+        for (i, &p) in bn.iter().enumerate() {
+            if let Some(k) = sol.dofs.contact_index[p] {
+                weight[k] += if i < 2 { 0.25 * len } else { 0.5 * len };
+            }
+        }
+    }
+    sol.lambda.iter().zip(&weight).map(|(l, w)| l / w).collect()
+}
