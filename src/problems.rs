@@ -203,6 +203,9 @@ pub struct Patch {
     /// u_i = sum_k c[i][k] m_k(x, y) with monomials m = (1, x, y, x^2, xy, y^2).
     pub c: [[f64; 6]; 2],
     pub gap: f64,
+    /// The contact normal used for the constraint (the boundary is x = 1 whatever it says):
+    /// tests set an oblique one to exercise the local frames of contact nodes.
+    pub normal: [f64; 2],
 }
 
 impl Default for Patch {
@@ -224,7 +227,7 @@ impl Patch {
         let a4 = -2.0 * zeta * b5 / (2.0 * mu + zeta);
         let a1 = -2.0 * a3 - zeta * (b2 + b4) / (2.0 * mu + zeta);
         let b1 = -a2 - a4 - 2.0 * b3;
-        Patch { material, c: [[0.01, a1, a2, a3, a4, a5], [-0.02, b1, b2, b3, b4, b5]], gap: 10.0 }
+        Patch { material, c: [[0.01, a1, a2, a3, a4, a5], [-0.02, b1, b2, b3, b4, b5]], gap: 10.0, normal: [1.0, 0.0] }
     }
 }
 
@@ -278,7 +281,7 @@ impl Problem for Patch {
         self.u(x)
     }
     fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
-        [1.0, 0.0]
+        self.normal
     }
     fn gap(&self, _x: [f64; 2]) -> f64 {
         self.gap
