@@ -15,7 +15,14 @@
 //! where lambda_p = L(phi_p n) - a(u_h, phi_p n) is the discrete nodal contact force
 //! (eq. 4.5, Lemma 5.2). Each active-set iteration is a dense solve on the inactive nodes;
 //! one more sparse solve recovers the whole displacement. The sparse matrix is factorised once
-//! per mesh, whatever the number of iterations.
+//! per mesh, whatever the number of iterations ([`Strategy::Schur`]).
+//!
+//! The dense trailing block costs O(m^3): when adaptivity puts thousands of nodes on Gamma_C
+//! (Example 7.1 refines along it) the solver switches to [`Strategy::Refactor`]: the
+//! constraints of the active nodes are imposed by values on the fixed sparsity pattern (row and
+//! column of an active normal unknown replaced by its diagonal entry, explicit zeros kept), so
+//! the symbolic factorisation is computed once and every iteration is one numeric
+//! refactorisation. Both strategies share one active-set driver ([`pdas`]).
 
 use crate::assembly::SymCsc;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -26,7 +33,6 @@ use faer::sparse::linalg::cholesky::{
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::{SupernodalThreshold, amd};
 use faer::{Conj, Mat, Par, Side, Spec};
-use std::collections::HashSet;
 use std::time::Instant;
 
 /// Why the contact solve failed.
@@ -52,11 +58,13 @@ pub struct PdasOptions {
     pub c_scale: f64,
     /// Warm start: the initial active set, one flag per contact node.
     pub initial_active: Option<Vec<bool>>,
+    /// How the linear algebra is done; None chooses by the number of contact nodes.
+    pub strategy: Option<Strategy>,
 }
 
 impl Default for PdasOptions {
     fn default() -> Self {
-        PdasOptions { max_iterations: 50, tolerance: 1e-9, c_scale: 1.0, initial_active: None }
+        PdasOptions { max_iterations: 50, tolerance: 1e-9, c_scale: 1.0, initial_active: None, strategy: None }
     }
 }
 
@@ -85,6 +93,7 @@ pub enum Termination {
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct Timings {
     pub symbolic: f64,
+    /// numeric factorisations (all of them: one for Schur, one per iteration for Refactor)
     pub numeric: f64,
     pub schur: f64,
     pub solves: f64,
@@ -104,47 +113,115 @@ pub struct PdasOutput {
     pub c: f64,
 }
 
-/// The factorised stiffness with its contact Schur complement. Owns the ordering (fill-reducing
-/// on `I`, then `C`) and the factorisation: symbolic once per mesh, numeric once per matrix.
+/// How the complementarity problem is solved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Strategy {
+    /// One factorisation with the contact normals last; active-set iterations on the dense Schur
+    /// complement.
+    Schur,
+    /// Constraints by values on the fixed pattern; one numeric refactorisation per iteration.
+    Refactor,
+}
+
+/// Above this many contact nodes the dense Schur complement (O(m^3)) costs more than a few
+/// sparse refactorisations on the meshes of our studies.
+pub const SCHUR_MAX_CONTACT: usize = 1500;
+
+impl Strategy {
+    pub fn auto(n_contact: usize) -> Self {
+        if n_contact <= SCHUR_MAX_CONTACT { Strategy::Schur } else { Strategy::Refactor }
+    }
+}
+
+/// The factorised stiffness, with its contact Schur complement ([`Strategy::Schur`]) or the
+/// bookkeeping to impose constraints by values ([`Strategy::Refactor`]). Owns the ordering and
+/// the factorisation: symbolic once per mesh, numeric once per matrix (Schur) or per iteration
+/// (Refactor).
 pub struct ContactSolver {
     n: usize,
     n_interior: usize,
+    strategy: Strategy,
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
-    /// S = L_CC L_CC^T (m x m).
+    /// S = L_CC L_CC^T (m x m), Schur strategy only.
     schur: Mat<f64>,
+    /// Refactor strategy: per contact node, the (column, position) of the off-diagonal entries
+    /// of its normal unknown's row that lie in earlier columns.
+    row_entries: Vec<Vec<(usize, usize)>>,
     pub timings: Timings,
 }
 
 impl ContactSolver {
-    /// Order, factorise and form the Schur complement of the unknowns `n_interior..n`.
+    /// Order, factorise and prepare the contact unknowns `n_interior..n`, with the strategy
+    /// chosen by the number of contact nodes.
     pub fn new(matrix: &SymCsc, n_interior: usize) -> Result<Self, ContactError> {
+        Self::with_strategy(matrix, n_interior, Strategy::auto(matrix.n - n_interior))
+    }
+
+    pub fn with_strategy(matrix: &SymCsc, n_interior: usize, strategy: Strategy) -> Result<Self, ContactError> {
         let mut timings = Timings::default();
         let t0 = Instant::now();
-        let symbolic = symbolic_factorisation(matrix, n_interior)?;
+        let symbolic = symbolic_factorisation(matrix, n_interior, strategy)?;
+        let row_entries = match strategy {
+            Strategy::Schur => Vec::new(),
+            Strategy::Refactor => {
+                let mut rows = vec![Vec::new(); matrix.n - n_interior];
+                for j in 0..matrix.n {
+                    for k in matrix.col_ptr[j]..matrix.col_ptr[j + 1] {
+                        let i = matrix.row_idx[k];
+                        if i >= n_interior && i != j {
+                            rows[i - n_interior].push((j, k));
+                        }
+                    }
+                }
+                rows
+            }
+        };
         timings.symbolic = t0.elapsed().as_secs_f64();
         let mut solver = ContactSolver {
             n: matrix.n,
             n_interior,
+            strategy,
             l_values: vec![0.0; symbolic.len_val()],
             symbolic,
             schur: Mat::zeros(0, 0),
+            row_entries,
             timings,
         };
         solver.refactor(matrix)?;
         Ok(solver)
     }
 
-    /// Numeric factorisation of a matrix with the same pattern, and its Schur complement.
+    pub fn strategy(&self) -> Strategy {
+        self.strategy
+    }
+
+    /// Numeric factorisation of a matrix with the same pattern (and, for the Schur strategy, its
+    /// Schur complement).
     pub fn refactor(&mut self, matrix: &SymCsc) -> Result<(), ContactError> {
+        self.timings.numeric = 0.0;
+        self.factor_values(matrix, &matrix.values)?;
+        if self.strategy == Strategy::Schur {
+            let t0 = Instant::now();
+            let lcc = self.trailing_factor_block()?;
+            self.schur = &lcc * lcc.transpose();
+            self.timings.schur = t0.elapsed().as_secs_f64();
+        }
+        Ok(())
+    }
+
+    /// Numeric factorisation of the pattern of `matrix` with the given values.
+    fn factor_values(&mut self, matrix: &SymCsc, values: &[f64]) -> Result<(), ContactError> {
         let t0 = Instant::now();
         let par = Par::Seq; // faster than two threads for faer's sparse Cholesky (PERF-NOTES.md)
         let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(par, Spec::default());
         let mut mem = MemBuffer::try_new(req).map_err(|e| ContactError::Factorisation(format!("{e:?}")))?;
+        let sym = matrix.as_faer().symbolic();
         self.symbolic
             .factorize_numeric_llt(
                 &mut self.l_values,
-                matrix.as_faer(),
+                faer::sparse::SparseColMatRef::new(sym, values),
                 Side::Lower,
                 LltRegularization::default(),
                 par,
@@ -152,11 +229,7 @@ impl ContactSolver {
                 Spec::default(),
             )
             .map_err(|e| ContactError::NotPositiveDefinite(format!("{e:?}")))?;
-        self.timings.numeric = t0.elapsed().as_secs_f64();
-        let t0 = Instant::now();
-        let lcc = self.trailing_factor_block()?;
-        self.schur = &lcc * lcc.transpose();
-        self.timings.schur = t0.elapsed().as_secs_f64();
+        self.timings.numeric += t0.elapsed().as_secs_f64();
         Ok(())
     }
 
@@ -164,7 +237,7 @@ impl ContactSolver {
         self.n - self.n_interior
     }
 
-    /// The Schur complement S of the contact normal unknowns.
+    /// The Schur complement S of the contact normal unknowns (Schur strategy).
     pub fn schur(&self) -> &Mat<f64> {
         &self.schur
     }
@@ -199,7 +272,7 @@ impl ContactSolver {
         Ok(lcc)
     }
 
-    /// Solve K x = b.
+    /// Solve with the current factorisation.
     pub fn solve(&mut self, b: &[f64]) -> Vec<f64> {
         let t0 = Instant::now();
         let mut x = Mat::<f64>::from_fn(self.n, 1, |i, _| b[i]);
@@ -211,10 +284,11 @@ impl ContactSolver {
     }
 
     /// Solve the discrete Signorini problem K u = F - E lambda with u_C <= gap, lambda >= 0,
-    /// complementarity (E places lambda on the contact normal unknowns). `observe` sees every
-    /// iteration as it ends.
+    /// complementarity (E places lambda on the contact normal unknowns). `matrix` is the one the
+    /// solver was built with. `observe` sees every iteration as it ends.
     pub fn solve_contact(
         &mut self,
+        matrix: &SymCsc,
         rhs: &[f64],
         gap: &[f64],
         options: &PdasOptions,
@@ -222,34 +296,119 @@ impl ContactSolver {
     ) -> Result<PdasOutput, ContactError> {
         let (ni, m) = (self.n_interior, self.n_contact());
         assert_eq!(gap.len(), m);
-        let y = self.solve(rhs);
         if m == 0 {
-            return Ok(PdasOutput { u: y, lambda: vec![], active: vec![], iterations: vec![], termination: Termination::NoContact, c: 0.0 });
+            let u = self.solve(rhs);
+            return Ok(PdasOutput { u, lambda: vec![], active: vec![], iterations: vec![], termination: Termination::NoContact, c: 0.0 });
         }
-        let yc = &y[ni..];
         let t_pdas = Instant::now();
-        let (u_c, lambda, active, iterations, c) = pdas(&self.schur, yc, gap, options, observe)?;
-        self.timings.active_set = t_pdas.elapsed().as_secs_f64();
+        let (solves0, numeric0) = (self.timings.solves, self.timings.numeric);
+        let out = match self.strategy {
+            Strategy::Schur => self.solve_schur(rhs, gap, options, observe),
+            Strategy::Refactor => self.solve_refactor(matrix, rhs, gap, options, observe),
+        };
+        // the rest of the contact solve: dense active-set work (Schur) or bookkeeping (Refactor)
+        let inner = (self.timings.solves - solves0) + (self.timings.numeric - numeric0);
+        self.timings.active_set = t_pdas.elapsed().as_secs_f64() - inner;
+        let (mut u, lambda, active, iterations, c) = out?;
+        for k in 0..m {
+            if active[k] {
+                u[ni + k] = gap[k]; // the constraint holds exactly, not to solver round-off
+            }
+        }
+        Ok(PdasOutput { u, lambda, active, iterations, termination: Termination::Converged, c })
+    }
+
+    fn solve_schur(&mut self, rhs: &[f64], gap: &[f64], options: &PdasOptions, observe: &mut dyn FnMut(&PdasIteration)) -> Result<PdasResult, ContactError> {
+        let (ni, m) = (self.n_interior, self.n_contact());
+        let y = self.solve(rhs);
+        let yc = &y[ni..];
+        let s = &self.schur;
+        let c = options.c_scale * (0..m).map(|i| s[(i, i)]).sum::<f64>() / m as f64;
+        let initial = options.initial_active.clone().filter(|a| a.len() == m).unwrap_or_else(|| (0..m).map(|i| yc[i] > gap[i]).collect());
+        let mut step = |active: &[bool]| -> Result<(Vec<f64>, Vec<f64>), ContactError> {
+            let inact: Vec<usize> = (0..m).filter(|&i| !active[i]).collect();
+            let act: Vec<usize> = (0..m).filter(|&i| active[i]).collect();
+            let mut u: Vec<f64> = (0..m).map(|i| if active[i] { gap[i] } else { 0.0 }).collect();
+            if !inact.is_empty() {
+                // lambda_I = 0:  S_II z = S_IA (y_A - g_A),  u_I = y_I + z
+                let sii = Mat::<f64>::from_fn(inact.len(), inact.len(), |a, b| s[(inact[a], inact[b])]);
+                let r = Mat::<f64>::from_fn(inact.len(), 1, |a, _| act.iter().map(|&j| s[(inact[a], j)] * (yc[j] - gap[j])).sum::<f64>());
+                let llt = sii.llt(Side::Lower).map_err(|e| ContactError::NotPositiveDefinite(format!("Schur block: {e:?}")))?;
+                let z = llt.solve(&r);
+                for (a, &i) in inact.iter().enumerate() {
+                    u[i] = yc[i] + z[(a, 0)];
+                }
+            }
+            // lambda = S (y - u); zero off the active set by construction
+            let lambda = (0..m).map(|i| if active[i] { (0..m).map(|j| s[(i, j)] * (yc[j] - u[j])).sum() } else { 0.0 }).collect();
+            Ok((u, lambda))
+        };
+        let (_, lambda, active, iterations) = pdas(gap, c, initial, options, observe, &mut step)?;
         // u = K^{-1} (F - E lambda)
         let mut b = rhs.to_vec();
         for k in 0..m {
             b[ni + k] -= lambda[k];
         }
-        let mut u = self.solve(&b);
-        // the sparse solve reproduces u_C; keep the exact constraint values on active nodes
-        for k in 0..m {
-            if active[k] {
-                debug_assert!((u[ni + k] - u_c[k]).abs() <= 1e-6 * (1.0 + u_c[k].abs()));
-                u[ni + k] = gap[k];
+        let u = self.solve(&b);
+        Ok((u, lambda, active, iterations, c))
+    }
+
+    fn solve_refactor(&mut self, matrix: &SymCsc, rhs: &[f64], gap: &[f64], options: &PdasOptions, observe: &mut dyn FnMut(&PdasIteration)) -> Result<PdasResult, ContactError> {
+        let (ni, m) = (self.n_interior, self.n_contact());
+        let diag = |k: usize| matrix.values[matrix.col_ptr[ni + k]];
+        let c = options.c_scale * (0..m).map(diag).sum::<f64>() / m as f64;
+        let initial = match options.initial_active.clone().filter(|a| a.len() == m) {
+            Some(a) => a,
+            None => {
+                // the unconstrained solution, with the factorisation of K built in `new`
+                let y = self.solve(rhs);
+                (0..m).map(|i| y[ni + i] > gap[i]).collect()
             }
-        }
-        Ok(PdasOutput { u, lambda, active, iterations, termination: Termination::Converged, c })
+        };
+        let mut last_u = Vec::new();
+        let mut step = |active: &[bool]| -> Result<(Vec<f64>, Vec<f64>), ContactError> {
+            let mut values = matrix.values.clone();
+            let mut b = rhs.to_vec();
+            for k in (0..m).filter(|&k| active[k]) {
+                let col = ni + k;
+                // column entries below the diagonal, then row entries left of it: move the known
+                // value to the right-hand side and keep an explicit zero in the pattern
+                for pos in matrix.col_ptr[col] + 1..matrix.col_ptr[col + 1] {
+                    b[matrix.row_idx[pos]] -= matrix.values[pos] * gap[k];
+                    values[pos] = 0.0;
+                }
+                for &(j, pos) in &self.row_entries[k] {
+                    b[j] -= matrix.values[pos] * gap[k];
+                    values[pos] = 0.0;
+                }
+            }
+            for k in (0..m).filter(|&k| active[k]) {
+                b[ni + k] = diag(k) * gap[k];
+            }
+            self.factor_values(matrix, &values)?;
+            let u = self.solve(&b);
+            let ku = matrix.mul(&u);
+            let lambda: Vec<f64> = (0..m).map(|k| if active[k] { rhs[ni + k] - ku[ni + k] } else { 0.0 }).collect();
+            let uc = u[ni..].to_vec();
+            last_u = u;
+            Ok((uc, lambda))
+        };
+        let (_, lambda, active, iterations) = pdas(gap, c, initial, options, observe, &mut step)?;
+        Ok((last_u, lambda, active, iterations, c))
     }
 }
 
-/// Symbolic Cholesky with a custom ordering: AMD on the leading block `I`, then `C` in place.
-/// The supernodal variant is forced so that the trailing block of L can be read.
-fn symbolic_factorisation(matrix: &SymCsc, ni: usize) -> Result<SymbolicCholesky<usize>, ContactError> {
+/// Symbolic Cholesky. Schur: a custom ordering, AMD on the leading block `I` then `C` in place,
+/// and the supernodal variant forced so that the trailing block of L can be read. Refactor:
+/// AMD on the whole matrix.
+fn symbolic_factorisation(matrix: &SymCsc, ni: usize, strategy: Strategy) -> Result<SymbolicCholesky<usize>, ContactError> {
+    let factorise = |ord, params| {
+        faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(matrix.as_faer().symbolic(), Side::Lower, ord, params)
+            .map_err(|e| ContactError::Factorisation(format!("{e:?}")))
+    };
+    if strategy == Strategy::Refactor {
+        return factorise(SymmetricOrdering::Amd, CholeskySymbolicParams::default());
+    }
     let n = matrix.n;
     // pattern of K_II (lower triangle): rows are sorted, so rows < ni form a prefix of each column
     let mut col_ptr = Vec::with_capacity(ni + 1);
@@ -281,84 +440,58 @@ fn symbolic_factorisation(matrix: &SymCsc, ni: usize) -> Result<SymbolicCholesky
         supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
         ..Default::default()
     };
-    faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
-        matrix.as_faer().symbolic(),
-        Side::Lower,
-        SymmetricOrdering::Custom(perm),
-        params,
-    )
-    .map_err(|e| ContactError::Factorisation(format!("{e:?}")))
+    factorise(SymmetricOrdering::Custom(perm), params)
 }
 
 type PdasResult = (Vec<f64>, Vec<f64>, Vec<bool>, Vec<PdasIteration>, f64);
 
-/// The primal–dual active set iteration on lambda = S (y - u), u <= g, lambda >= 0.
-/// Active set A = {p : lambda_p + c (u_p - g_p) > 0}; on A, u = g; off A, lambda = 0, i.e.
-/// S_II (y_I - u_I) + S_IA (y_A - g_A) = 0. Stops when A repeats and the NCP residual is below
-/// tolerance; a set seen before (not the previous one) means cycling.
+/// The primal–dual active set iteration, whatever solves its linear systems.
+/// Active set A = {p : lambda_p + c (u_p - g_p) > 0}; `step(A)` returns (u_C, lambda) with
+/// u = g on A and lambda = 0 off A. Stops when A repeats and the NCP residual
+/// max |min(lambda, c (g - u))| / (c max(|u|, |g|)) is below tolerance; an active set seen
+/// before (other than the previous one) means cycling.
 pub fn pdas(
-    s: &Mat<f64>,
-    y: &[f64],
     g: &[f64],
+    c: f64,
+    initial: Vec<bool>,
     options: &PdasOptions,
     observe: &mut dyn FnMut(&PdasIteration),
-) -> Result<PdasResult, ContactError> {
-    let m = y.len();
-    let c = options.c_scale * (0..m).map(|i| s[(i, i)]).sum::<f64>() / m as f64;
-    let scale = c * y.iter().chain(g).fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
-    let mut active: Vec<bool> = match &options.initial_active {
-        Some(a) if a.len() == m => a.clone(),
-        // lambda = 0, u = y: active where the unconstrained solution penetrates
-        _ => (0..m).map(|i| y[i] > g[i]).collect(),
-    };
-    let mut seen: HashSet<Vec<bool>> = HashSet::new();
-    let mut first_seen: Vec<(Vec<bool>, usize)> = Vec::new();
+    step: &mut dyn FnMut(&[bool]) -> Result<(Vec<f64>, Vec<f64>), ContactError>,
+) -> Result<(Vec<f64>, Vec<f64>, Vec<bool>, Vec<PdasIteration>), ContactError> {
+    let m = g.len();
+    let mut active = initial;
+    let mut seen: Vec<(Vec<bool>, usize)> = Vec::new();
     let mut iterations = Vec::new();
-    let mut u = vec![0.0; m];
-    let mut lambda = vec![0.0; m];
     for it in 1..=options.max_iterations {
         let t0 = Instant::now();
-        let inact: Vec<usize> = (0..m).filter(|&i| !active[i]).collect();
-        let act: Vec<usize> = (0..m).filter(|&i| active[i]).collect();
-        for &i in &act {
-            u[i] = g[i];
-        }
-        if !inact.is_empty() {
-            // S_II z = S_IA (y_A - g_A);  u_I = y_I + z
-            let sii = Mat::<f64>::from_fn(inact.len(), inact.len(), |a, b| s[(inact[a], inact[b])]);
-            let rhs = Mat::<f64>::from_fn(inact.len(), 1, |a, _| act.iter().map(|&j| s[(inact[a], j)] * (y[j] - g[j])).sum::<f64>());
-            let llt = sii.llt(Side::Lower).map_err(|e| ContactError::NotPositiveDefinite(format!("Schur block: {e:?}")))?;
-            let z = llt.solve(&rhs);
-            for (a, &i) in inact.iter().enumerate() {
-                u[i] = y[i] + z[(a, 0)];
-            }
-        }
-        // lambda = S (y - u); exactly zero off the active set by construction
-        for i in 0..m {
-            lambda[i] = if active[i] { (0..m).map(|j| s[(i, j)] * (y[j] - u[j])).sum() } else { 0.0 };
-        }
+        let (u, lambda) = step(&active)?;
+        let scale = c * u.iter().chain(g).fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
         let next: Vec<bool> = (0..m).map(|i| lambda[i] + c * (u[i] - g[i]) > 0.0).collect();
         let residual = (0..m).map(|i| lambda[i].min(c * (g[i] - u[i])).abs()).fold(0.0, f64::max) / scale;
-        let added = (0..m).filter(|&i| next[i] && !active[i]).count();
-        let removed = (0..m).filter(|&i| !next[i] && active[i]).count();
-        let record = PdasIteration { iteration: it, active: act.len(), added, removed, residual, seconds: t0.elapsed().as_secs_f64() };
+        let record = PdasIteration {
+            iteration: it,
+            active: active.iter().filter(|a| **a).count(),
+            added: (0..m).filter(|&i| next[i] && !active[i]).count(),
+            removed: (0..m).filter(|&i| !next[i] && active[i]).count(),
+            residual,
+            seconds: t0.elapsed().as_secs_f64(),
+        };
         observe(&record);
         iterations.push(record);
         if next == active && residual <= options.tolerance {
-            return Ok((u, lambda, active, iterations, c));
+            return Ok((u, lambda, active, iterations));
         }
-        seen.insert(active.clone());
-        first_seen.push((active.clone(), it));
-        if next != active && seen.contains(&next) {
-            let first = first_seen.iter().find(|(a, _)| *a == next).map(|(_, k)| *k).unwrap_or(0);
-            return Err(ContactError::Cycling { iterations: it, first_seen: first, residual });
+        if next != active {
+            if let Some((_, first_seen)) = seen.iter().find(|(a, _)| *a == next) {
+                return Err(ContactError::Cycling { iterations: it, first_seen: *first_seen, residual });
+            }
         }
+        seen.push((active.clone(), it));
         active = next;
     }
-    let residual = iterations.last().map(|r: &PdasIteration| r.residual).unwrap_or(f64::NAN);
     Err(ContactError::NotConverged {
         iterations: options.max_iterations,
-        residual,
+        residual: iterations.last().map(|r| r.residual).unwrap_or(f64::NAN),
         tolerance: options.tolerance,
         active: active.iter().filter(|a| **a).count(),
     })

@@ -5,9 +5,11 @@
 //! elasticity system, `contact` solves the discrete variational inequality (paper eq. 3.4),
 //! `solve` ties them into the SOLVE step, `norms` measures errors.
 
+pub mod adapt;
 pub mod assembly;
 pub mod contact;
 pub mod element;
+pub mod estimate;
 pub mod mesh;
 pub mod norms;
 pub mod problems;

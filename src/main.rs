@@ -4,6 +4,9 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use signorini::contact::PdasOptions;
 use signorini::mesh::MeshSpec;
+use signorini::adapt::{self, AdaptConfig, Refine};
+use signorini::estimate::{self, ContactTerm, EstimatorConfig, LogFactor};
+use signorini::norms::Sampling;
 use signorini::{norms, problems, report, solve};
 use std::process::ExitCode;
 
@@ -18,6 +21,8 @@ struct Cli {
 enum Command {
     /// One solve (no adaptivity) on a structured mesh.
     Solve(SolveArgs),
+    /// The adaptive loop SOLVE -> ESTIMATE -> MARK -> REFINE, one table row per level.
+    Adapt(AdaptArgs),
     /// Solve and write the mesh and solution for the NGSolve cross-check (mesh.vtu, case.json).
     Export {
         #[command(flatten)]
@@ -26,6 +31,75 @@ enum Command {
         #[arg(long)]
         out: std::path::PathBuf,
     },
+}
+
+#[derive(clap::Args)]
+struct EstimatorArgs {
+    /// Estimator constant C_0 (estimate = C_0 eta_h).
+    #[arg(long, default_value_t = 0.45)]
+    c0: f64,
+    /// eta_5 over all contact nodes (as-written) or without full-contact nodes.
+    #[arg(long, value_enum, default_value = "as-written")]
+    contact_term: ContactTermArg,
+    /// The log factor l_h.
+    #[arg(long, value_enum, default_value = "squared")]
+    log_factor: LogFactorArg,
+    /// Points the L-infinity norms are taken over.
+    #[arg(long, value_enum, default_value = "quadrature")]
+    sampling: SamplingArg,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum ContactTermArg { AsWritten, WithoutFullContact }
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum LogFactorArg { Squared, Linear, One }
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum SamplingArg { Quadrature, Dense }
+
+impl EstimatorArgs {
+    fn config(&self) -> Result<EstimatorConfig> {
+        if !(self.c0 > 0.0) {
+            bail!("--c0 must be a positive number, got {}", self.c0);
+        }
+        Ok(EstimatorConfig {
+            c0: self.c0,
+            contact_term: match self.contact_term {
+                ContactTermArg::AsWritten => ContactTerm::AsWritten,
+                ContactTermArg::WithoutFullContact => ContactTerm::WithoutFullContact,
+            },
+            log_factor: match self.log_factor {
+                LogFactorArg::Squared => LogFactor::Squared,
+                LogFactorArg::Linear => LogFactor::Linear,
+                LogFactorArg::One => LogFactor::One,
+            },
+            sampling: match self.sampling {
+                SamplingArg::Quadrature => Sampling::Quadrature,
+                SamplingArg::Dense => Sampling::Dense,
+            },
+        })
+    }
+}
+
+#[derive(clap::Args)]
+struct AdaptArgs {
+    #[arg(long)]
+    problem: String,
+    /// Initial mesh.
+    #[arg(long, default_value = "structured:4")]
+    mesh: String,
+    #[arg(long, default_value_t = 20)]
+    levels: usize,
+    /// Marking parameter of the maximum strategy.
+    #[arg(long, default_value_t = 0.5)]
+    theta: f64,
+    /// Refine every element instead of marking.
+    #[arg(long)]
+    uniform: bool,
+    /// Stop before a level with more unknowns than this.
+    #[arg(long)]
+    max_ndof: Option<usize>,
+    #[command(flatten)]
+    estimator: EstimatorArgs,
 }
 
 #[derive(clap::Args)]
@@ -48,6 +122,11 @@ struct SolveArgs {
     /// Log every active-set iteration on stderr.
     #[arg(long, short)]
     verbose: bool,
+    /// Marking parameter (reported only: one solve marks nothing).
+    #[arg(long)]
+    theta: Option<f64>,
+    #[command(flatten)]
+    estimator: EstimatorArgs,
 }
 
 fn parse_probe(s: &str) -> Result<[f64; 2]> {
@@ -77,9 +156,40 @@ fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::Discrete
     };
     let sol = solve::solve(&mesh, problem.as_ref(), &options, &mut log)
         .with_context(|| format!("solving {} on {}", problem.name(), spec))?;
-    let error = problem.exact().map(|e| norms::linf_error(&mesh, &sol, e));
-    let report = report::SolveReport::new(problem.name(), &spec.to_string(), &mesh, &sol, error, &probes);
+    let error = problem.exact().map(|e| norms::linf_error(&mesh, &sol, &|x| e.u(x)));
+    let est = estimate::estimate(&mesh, problem.as_ref(), &sol, &args.estimator.config()?);
+    let report = report::SolveReport::new(problem.name(), &spec.to_string(), &mesh, &sol, error, &est, &probes);
     Ok((mesh, sol, report))
+}
+
+fn run_adapt(args: &AdaptArgs) -> Result<()> {
+    let problem = problems::by_name(&args.problem)?;
+    let spec = MeshSpec::parse(&args.mesh)?;
+    if !(args.theta > 0.0 && args.theta <= 1.0) {
+        bail!("--theta must be in (0, 1], got {}", args.theta);
+    }
+    let config = AdaptConfig {
+        levels: args.levels,
+        max_ndof: args.max_ndof,
+        refine: if args.uniform { Refine::Uniform } else { Refine::Adaptive },
+        theta: args.theta,
+        estimator: args.estimator.config()?,
+        ..Default::default()
+    };
+    let mesh = spec.build(&|x| problem.part_of(x));
+    let exact = problem.exact();
+    let reference = exact.map(|e| move |x: [f64; 2]| e.u(x));
+    println!("{:>3} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>6} {:>4} {:>7}", "lvl", "ndof", "h_min", "error", "estimate", "eff", "eta1", "eta2", "eta3", "eta4", "eta5", "eta6+7", "active", "its", "time");
+    adapt::run(problem.as_ref(), mesh, &config, reference.as_ref().map(|r| r as norms::Reference), &mut |l| {
+        let r = l.record;
+        println!(
+            "{:>3} {:>8} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>6} {:>4} {:>7.3}",
+            r.level, r.ndof, r.h_min, r.err_quadrature.unwrap_or(f64::NAN), r.estimate, r.efficiency.unwrap_or(f64::NAN),
+            r.eta1, r.eta2, r.eta3, r.eta4, r.eta5, r.eta6 + r.eta7, r.active_nodes, r.pdas_iterations, r.t_level
+        );
+        std::ops::ControlFlow::Continue(())
+    })?;
+    Ok(())
 }
 
 fn main() -> ExitCode {
@@ -92,6 +202,7 @@ fn main() -> ExitCode {
                 print!("{}", r.summary());
             }
         }),
+        Command::Adapt(args) => run_adapt(args),
         Command::Export { args, out } => run_solve(args).and_then(|(mesh, sol, r)| report::export_case(out, &mesh, &sol, &r)),
     };
     match result {

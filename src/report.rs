@@ -2,6 +2,7 @@
 //! a case for the NGSolve cross-check.
 
 use crate::contact::PdasIteration;
+use crate::estimate::{Estimate, EstimatorConfig, Terms};
 use crate::mesh::{Mesh, io};
 use crate::norms::LinfError;
 use crate::records;
@@ -38,6 +39,9 @@ pub struct SolveReport {
     pub free_residual: f64,
     pub error: Option<LinfError>,
     pub error_sampling: ErrorSampling,
+    pub estimator: Terms,
+    pub estimator_config: EstimatorConfig,
+    pub full_contact_nodes: usize,
     pub probes: Vec<Probe>,
     pub pdas_log: Vec<PdasIteration>,
     pub timings: SolveTimings,
@@ -51,7 +55,7 @@ pub struct ErrorSampling {
 }
 
 impl SolveReport {
-    pub fn new(problem: &str, mesh_name: &str, mesh: &Mesh, sol: &DiscreteSolution, error: Option<LinfError>, probes: &[[f64; 2]]) -> Self {
+    pub fn new(problem: &str, mesh_name: &str, mesh: &Mesh, sol: &DiscreteSolution, error: Option<LinfError>, estimate: &Estimate, probes: &[[f64; 2]]) -> Self {
         let (h_min, h_max) = mesh.h_range();
         SolveReport {
             problem: problem.to_string(),
@@ -72,6 +76,9 @@ impl SolveReport {
                 quadrature: crate::norms::Sampling::Quadrature.describe(),
                 dense: crate::norms::Sampling::Dense.describe(),
             },
+            estimator: estimate.terms,
+            estimator_config: estimate.config,
+            full_contact_nodes: estimate.full_contact_nodes,
             probes: probes.iter().map(|p| Probe { x: p[0], y: p[1], u: sol.probe(mesh, *p) }).collect(),
             pdas_log: sol.pdas.clone(),
             timings: sol.timings.clone(),
@@ -87,6 +94,8 @@ impl SolveReport {
         if let Some(e) = &self.error {
             let _ = writeln!(s, "error Linf: quadrature {:.4e}, dense {:.4e}, nodal {:.4e}", e.linf_quadrature, e.linf_dense, e.linf_nodal);
         }
+        let e = &self.estimator;
+        let _ = writeln!(s, "estimator: eta1..7 = {:.3e} {:.3e} {:.3e} {:.3e} {:.3e} {:.3e} {:.3e}, l_h {:.3}, eta_h {:.4e}, estimate (C0 = {}) {:.4e}", e.eta1, e.eta2, e.eta3, e.eta4, e.eta5, e.eta6, e.eta7, e.l_h, e.eta_h, e.c0, e.estimate);
         for p in &self.probes {
             let _ = writeln!(s, "u({}, {}) = {:?}", p.x, p.y, p.u);
         }

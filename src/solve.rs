@@ -2,7 +2,7 @@
 //! discrete contact force (eq. 4.5) and its KKT report.
 
 use crate::assembly::{self, DofMap, System};
-use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, Termination, Timings};
+use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, Strategy, Termination, Timings};
 use crate::element::{self, Affine};
 use crate::mesh::{Mesh, MeshError, P2Nodes};
 use crate::problems::Problem;
@@ -33,6 +33,9 @@ pub struct DiscreteSolution {
     pub c: f64,
     /// Largest |F - K u| over the unknowns other than contact normals, relative to max |F|.
     pub free_residual: f64,
+    /// max(|F|, |K u|): the scale of nodal forces, against which lambda_p's round-off is judged.
+    pub force_scale: f64,
+    pub strategy: Strategy,
     pub timings: SolveTimings,
 }
 
@@ -55,8 +58,8 @@ pub struct Kkt {
     pub max_complementarity: f64,
     /// max |lambda_p| over inactive nodes
     pub max_inactive_lambda: f64,
-    /// Scale of lambda (max |lambda_p|), for relative checks.
-    pub lambda_scale: f64,
+    /// Scale of nodal forces max(|F|, |K u_h|), for relative checks.
+    pub force_scale: f64,
 }
 
 /// Assemble, factorise and solve the contact problem on `mesh`.
@@ -74,13 +77,15 @@ pub fn solve(
     let dofs = DofMap::new(&nodes, problem);
     let System { matrix, rhs, dirichlet } = assembly::assemble(mesh, &nodes, &dofs, problem);
     let assembly_time = t0.elapsed().as_secs_f64();
-    let mut solver = ContactSolver::new(&matrix, dofs.n_interior)?;
+    let strategy = options.strategy.unwrap_or(Strategy::auto(dofs.contact.len()));
+    let mut solver = ContactSolver::with_strategy(&matrix, dofs.n_interior, strategy)?;
     let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
-    let out = solver.solve_contact(&rhs, &gap, options, observe)?;
+    let out = solver.solve_contact(&matrix, &rhs, &gap, options, observe)?;
     // the residual F - K u: zero at free unknowns, lambda_p at contact normals
     let ku = matrix.mul(&out.u);
     let r: Vec<f64> = rhs.iter().zip(&ku).map(|(f, k)| f - k).collect();
     let f_scale = rhs.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
+    let force_scale = ku.iter().fold(f_scale, |a, v| a.max(v.abs()));
     let free_residual = r[..dofs.n_interior].iter().fold(0.0f64, |a, v| a.max(v.abs())) / f_scale;
     let lambda = r[dofs.n_interior..].to_vec();
     let u = dofs.displacement(&out.u, &dirichlet);
@@ -95,6 +100,8 @@ pub fn solve(
         termination: out.termination,
         c: out.c,
         free_residual,
+        force_scale,
+        strategy,
         timings,
     })
 }
@@ -113,7 +120,7 @@ impl DiscreteSolution {
             min_lambda: f64::INFINITY,
             max_complementarity: 0.0,
             max_inactive_lambda: 0.0,
-            lambda_scale: 0.0,
+            force_scale: self.force_scale,
         };
         for (i, c) in self.dofs.contact.iter().enumerate() {
             let gap = c.gap - self.normal_displacement(i);
@@ -121,7 +128,6 @@ impl DiscreteSolution {
             k.max_penetration = k.max_penetration.max(-gap);
             k.min_lambda = k.min_lambda.min(l);
             k.max_complementarity = k.max_complementarity.max((l * gap).abs());
-            k.lambda_scale = k.lambda_scale.max(l.abs());
             if !self.active[i] {
                 k.max_inactive_lambda = k.max_inactive_lambda.max(l.abs());
             }

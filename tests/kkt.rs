@@ -12,9 +12,9 @@ fn check(problem: &dyn Problem, spec: &str) {
     let name = format!("{} on {spec}", problem.name());
     // displacement scale 0.1-1: round-off level
     assert!(k.max_penetration <= 1e-12, "{name}: penetration {:e}", k.max_penetration);
-    assert!(k.min_lambda >= -1e-10 * k.lambda_scale, "{name}: min lambda {:e} (scale {:e})", k.min_lambda, k.lambda_scale);
-    assert!(k.max_inactive_lambda <= 1e-10 * k.lambda_scale, "{name}: lambda off the active set {:e}", k.max_inactive_lambda);
-    assert!(k.max_complementarity <= 1e-10 * k.lambda_scale, "{name}: complementarity {:e}", k.max_complementarity);
+    assert!(k.min_lambda >= -1e-10 * k.force_scale, "{name}: min lambda {:e} (scale {:e})", k.min_lambda, k.force_scale);
+    assert!(k.max_inactive_lambda <= 1e-10 * k.force_scale, "{name}: lambda off the active set {:e}", k.max_inactive_lambda);
+    assert!(k.max_complementarity <= 1e-10 * k.force_scale, "{name}: complementarity {:e}", k.max_complementarity);
     assert!(sol.free_residual < 1e-10, "{name}: equations at free nodes {:e}", sol.free_residual);
     // active nodes are exactly in contact
     for (i, c) in sol.dofs.contact.iter().enumerate() {

@@ -104,7 +104,7 @@ fn main() -> Result<()> {
             solver.refactor(&sys.matrix)?;
             let (numeric_warm, schur) = (solver.timings.numeric, solver.timings.schur);
             let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
-            let out = solver.solve_contact(&sys.rhs, &gap, &PdasOptions::default(), &mut |_| {})?;
+            let out = solver.solve_contact(&sys.matrix, &sys.rhs, &gap, &PdasOptions::default(), &mut |_| {})?;
             let t = &solver.timings;
             unknowns = sys.matrix.n;
             m = dofs.contact.len();

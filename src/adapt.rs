@@ -1,0 +1,235 @@
+//! The adaptive loop of Section 7: SOLVE -> ESTIMATE -> MARK -> REFINE, one level per turn,
+//! with an observer that sees every level (what the study runner records).
+
+use crate::contact::PdasOptions;
+use crate::estimate::{self, Estimate, EstimatorConfig};
+use crate::mesh::refine::{self, Refinement};
+use crate::mesh::Mesh;
+use crate::norms::{self, Reference};
+use crate::problems::Problem;
+use crate::solve::{self, DiscreteSolution, SolveError};
+use serde::{Deserialize, Serialize};
+use std::ops::ControlFlow;
+use std::time::Instant;
+
+/// How the mesh is refined from level to level.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Refine {
+    /// Maximum strategy: mark T if eta_T >= theta max eta_T (Section 7, [35]).
+    Adaptive,
+    /// Mark every element (one newest-vertex bisection each, so NDF about doubles per level).
+    Uniform,
+}
+
+/// Settings of the loop.
+#[derive(Clone, Debug)]
+pub struct AdaptConfig {
+    /// Number of levels solved (level 0 is the initial mesh).
+    pub levels: usize,
+    /// Stop before solving a level with more unknowns than this.
+    pub max_ndof: Option<usize>,
+    pub refine: Refine,
+    pub theta: f64,
+    pub estimator: EstimatorConfig,
+    pub pdas: PdasOptions,
+    /// Start each level's active-set method from the previous level's active set.
+    pub warm_start: bool,
+}
+
+impl Default for AdaptConfig {
+    fn default() -> Self {
+        AdaptConfig {
+            levels: 20,
+            max_ndof: None,
+            refine: Refine::Adaptive,
+            theta: 0.5,
+            estimator: EstimatorConfig::default(),
+            pdas: PdasOptions::default(),
+            warm_start: true,
+        }
+    }
+}
+
+/// Everything a study stores about one level: the one record type behind JSON, CSV, drift and
+/// plots. Flat, so that it is also one CSV row. Fields starting with `t_` are timings (seconds),
+/// never compared by the drift check.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LevelRecord {
+    pub level: usize,
+    /// 2 x number of P2 nodes, Dirichlet nodes included (CONTRACT.md).
+    pub ndof: usize,
+    pub ndof_free: usize,
+    pub n_elements: usize,
+    pub h_min: f64,
+    pub h_max: f64,
+    pub min_angle: f64,
+    pub contact_nodes: usize,
+    pub active_nodes: usize,
+    pub full_contact_nodes: usize,
+    pub pdas_iterations: usize,
+    pub zone_min: Option<f64>,
+    pub zone_max: Option<f64>,
+    pub eta1: f64,
+    pub eta2: f64,
+    pub eta3: f64,
+    pub eta4: f64,
+    pub eta5: f64,
+    pub eta6: f64,
+    pub eta7: f64,
+    pub l_h: f64,
+    pub psi: f64,
+    pub eta_h: f64,
+    pub c0: f64,
+    pub estimate: f64,
+    /// ||u - u_h||_Linf at the quadrature points (the paper's way), where u is known.
+    pub err_quadrature: Option<f64>,
+    pub err_dense: Option<f64>,
+    pub err_nodal: Option<f64>,
+    /// estimate / err_quadrature
+    pub efficiency: Option<f64>,
+    /// Elements marked for refinement at this level (0 at the last level).
+    pub marked: usize,
+    pub t_assembly: f64,
+    pub t_factorisation: f64,
+    pub t_active_set: f64,
+    pub t_solve: f64,
+    pub t_estimate: f64,
+    pub t_refine: f64,
+    pub t_level: f64,
+}
+
+/// What the observer sees at each level.
+pub struct Level<'a> {
+    pub record: &'a LevelRecord,
+    pub mesh: &'a Mesh,
+    pub solution: &'a DiscreteSolution,
+    pub estimate: &'a Estimate,
+}
+
+/// Mark by the maximum strategy: eta_T >= theta max eta_T.
+pub fn mark_maximum(indicators: &[f64], theta: f64) -> Vec<bool> {
+    let max = indicators.iter().cloned().fold(0.0, f64::max);
+    indicators.iter().map(|&e| max > 0.0 && e >= theta * max).collect()
+}
+
+/// Active set for the refined mesh: a new contact node starts active where the previous level's
+/// discrete solution (transferred exactly, P2 in P2) touches the obstacle.
+fn transfer_active_set(old_mesh: &Mesh, old: &DiscreteSolution, refinement: &Refinement, problem: &dyn Problem) -> Vec<bool> {
+    let new_nodes = crate::mesh::P2Nodes::new(&refinement.mesh);
+    let u = refine::transfer_p2(old_mesh, &old.nodes, &old.u, refinement, &new_nodes);
+    let dofs = crate::assembly::DofMap::new(&new_nodes, problem);
+    let scale = u.iter().fold(0.0f64, |a, v| a.max(v[0].abs()).max(v[1].abs())).max(f64::MIN_POSITIVE);
+    dofs.contact
+        .iter()
+        .map(|c| {
+            let v = u[c.node];
+            v[0] * c.normal[0] + v[1] * c.normal[1] >= c.gap - 1e-10 * scale
+        })
+        .collect()
+}
+
+/// Run the loop from `mesh`. `reference` gives the displacement errors are measured against
+/// (an exact solution or a reference solution), if any. The observer may stop the loop.
+pub fn run(
+    problem: &dyn Problem,
+    mut mesh: Mesh,
+    config: &AdaptConfig,
+    reference: Option<Reference>,
+    observer: &mut dyn FnMut(Level) -> ControlFlow<()>,
+) -> Result<Vec<LevelRecord>, SolveError> {
+    let mut records = Vec::new();
+    let mut initial_active: Option<Vec<bool>> = None;
+    for level in 0..config.levels {
+        if let Some(max) = config.max_ndof {
+            let ndof = 2 * (mesh.n_vertices() + crate::mesh::P2Nodes::new(&mesh).edges.len());
+            if level > 0 && ndof > max {
+                break;
+            }
+        }
+        let t_level = Instant::now();
+        let mut options = config.pdas.clone();
+        if config.warm_start {
+            options.initial_active = initial_active.take();
+        }
+        let t0 = Instant::now();
+        let sol = solve::solve(&mesh, problem, &options, &mut |_| {})?;
+        let t_solve = t0.elapsed().as_secs_f64();
+        let t0 = Instant::now();
+        let est = estimate::estimate(&mesh, problem, &sol, &config.estimator);
+        let t_estimate = t0.elapsed().as_secs_f64();
+        let error = reference.map(|r| norms::linf_error(&mesh, &sol, r));
+        let last = level + 1 == config.levels;
+        let marks = match config.refine {
+            Refine::Adaptive => mark_maximum(&est.element, config.theta),
+            Refine::Uniform => vec![true; mesh.n_triangles()],
+        };
+        let marked = if last { 0 } else { marks.iter().filter(|m| **m).count() };
+        let (h_min, h_max) = mesh.h_range();
+        let zone = sol.contact_zone();
+        let t = &est.terms;
+        let ct = &sol.timings.contact;
+        let mut record = LevelRecord {
+            level,
+            ndof: 2 * sol.nodes.len(),
+            ndof_free: sol.dofs.n_free,
+            n_elements: mesh.n_triangles(),
+            h_min,
+            h_max,
+            min_angle: mesh.min_angle_degrees(),
+            contact_nodes: sol.dofs.contact.len(),
+            active_nodes: sol.active_count(),
+            full_contact_nodes: est.full_contact_nodes,
+            pdas_iterations: sol.pdas.len(),
+            zone_min: zone.map(|z| z[0]),
+            zone_max: zone.map(|z| z[1]),
+            eta1: t.eta1,
+            eta2: t.eta2,
+            eta3: t.eta3,
+            eta4: t.eta4,
+            eta5: t.eta5,
+            eta6: t.eta6,
+            eta7: t.eta7,
+            l_h: t.l_h,
+            psi: t.psi,
+            eta_h: t.eta_h,
+            c0: t.c0,
+            estimate: t.estimate,
+            err_quadrature: error.map(|e| e.linf_quadrature),
+            err_dense: error.map(|e| e.linf_dense),
+            err_nodal: error.map(|e| e.linf_nodal),
+            efficiency: error.map(|e| t.estimate / e.linf_quadrature),
+            marked,
+            t_assembly: sol.timings.assembly,
+            t_factorisation: ct.symbolic + ct.numeric + ct.schur,
+            t_active_set: ct.active_set,
+            t_solve,
+            t_estimate,
+            t_refine: 0.0,
+            t_level: 0.0,
+        };
+        let next = if last {
+            None
+        } else {
+            let t0 = Instant::now();
+            let refinement = refine::refine(&mesh, &marks);
+            let active = config.warm_start.then(|| transfer_active_set(&mesh, &sol, &refinement, problem));
+            record.t_refine = t0.elapsed().as_secs_f64();
+            Some((refinement.mesh, active))
+        };
+        record.t_level = t_level.elapsed().as_secs_f64();
+        let flow = observer(Level { record: &record, mesh: &mesh, solution: &sol, estimate: &est });
+        records.push(record);
+        if flow.is_break() {
+            break;
+        }
+        match next {
+            Some((m, active)) => {
+                mesh = m;
+                initial_active = active;
+            }
+            None => break,
+        }
+    }
+    Ok(records)
+}
