@@ -13,6 +13,7 @@ build:
 # Unit and integration tests (release mode: the convergence tests solve real systems).
 test: build
 	$(CARGO) test --release --locked
+	crosscheck/run.sh
 
 figures: build
 	@echo "figures: not generated yet (they come with the studies, issue 4); nothing to do."
@@ -23,11 +24,13 @@ reproduce: build
 drift: build
 	@echo "drift: no stored results yet (issue 5); nothing to compare."
 
+# NGSolve cross-check: creates crosscheck/.venv from the pinned requirements on first use.
 crosscheck: build
-	@echo "crosscheck: see crosscheck/README.md (issue 6)."
+	crosscheck/run.sh
 
 bench: build
 	$(CARGO) run --release --locked --bin bench
+	crosscheck/setup.sh && crosscheck/.venv/bin/python crosscheck/crosscheck.py --out-dir results/bench bench --sizes 32,64,128,256
 
 clean:
 	$(CARGO) clean

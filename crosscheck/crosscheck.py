@@ -1,0 +1,308 @@
+"""Independent NGSolve cross-check of the Rust Signorini solver (see README.md).
+
+    crosscheck.py compare DIR [DIR...]       same mesh, same data, our own PDAS: u and active set must match
+    crosscheck.py rates DIR [DIR...]         ex71 on structured:N: L-infinity errors and rates vs case.json
+    crosscheck.py bench [--sizes 32,64,...]  NGSolve timings of Example 7.2's linear elasticity system
+    crosscheck.py selftest [DIR...]          shows that `compare` fails when one side's data are perturbed
+
+Results go to results/crosscheck/ (JSON + Markdown, written atomically). Exit status 1 on any failure.
+"""
+import argparse
+import json
+import math
+import os
+import statistics
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+import ngsolve as ng  # noqa: E402
+
+import fem  # noqa: E402
+import make_case  # noqa: E402
+import problems  # noqa: E402
+
+RESULTS = os.path.join(os.path.dirname(HERE), "results", "crosscheck")
+TOL_U = 1e-8  # nodal displacements, relative to max |u|
+TOL_LAMBDA = 1e-8  # nodal contact forces, relative to max |lambda| (a residual: its round-off grows ~1/h^2)
+TOL_RATE = 0.02
+
+
+# -- output --------------------------------------------------------------------------------------
+def write_atomic(path, text):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), prefix=".tmp-")
+    with os.fdopen(fd, "w") as fh:
+        fh.write(text)
+    os.replace(tmp, path)
+
+
+def markdown_table(columns, rows):
+    fmt = lambda v: f"{v:.3e}" if isinstance(v, float) else "" if v is None else str(v)  # noqa: E731
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(fmt(r.get(c, "")) for c in columns) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def report(name, title, columns, rows, extra, out_dir):
+    """Print a table and write it as NAME.json and NAME.md under out_dir."""
+    table = markdown_table(columns, rows)
+    print(table)
+    if out_dir:
+        doc = {"title": title, "ngsolve": ng.__version__, "rows": rows, **extra}
+        write_atomic(os.path.join(out_dir, name + ".json"), json.dumps(doc, indent=1) + "\n")
+        write_atomic(os.path.join(out_dir, name + ".md"), f"# {title}\n\nNGSolve {ng.__version__}\n\n{table}")
+
+
+# -- compare -------------------------------------------------------------------------------------
+def compare_case(path, perturb=None):
+    """Solve the case with NGSolve and compare with the exported solution; returns a table row."""
+    case = fem.read_case(path)
+    disc, res, seconds = fem.solve_case(case, perturb)
+    npts, pd = disc.npts, case.point_data
+    ours_nodal = res["U"].reshape(2, npts).T
+    ours_eval = disc.point_values(res["U"])  # same function through NGSolve's own basis
+    theirs = np.asarray(pd["u"])[:, :2]
+    scale_u = np.linalg.norm(ours_nodal, axis=1).max()
+    du = max(np.linalg.norm(ours_nodal - theirs, axis=1).max(), np.linalg.norm(ours_eval - theirs, axis=1).max())
+
+    active = np.zeros(npts, bool)
+    active[disc.contact_nodes[res["active"]]] = True
+    contact = np.zeros(npts, bool)
+    contact[disc.contact_nodes] = True
+    lam = np.zeros(npts)
+    lam[disc.contact_nodes] = res["lambda"]
+    scale_l = np.abs(lam).max()
+    # How decisively each contact node is classified (lambda on active nodes, the gap on inactive
+    # ones, both relative): a tiny margin would explain an active-set mismatch by round-off.
+    k, sign = disc.prob.normal_component
+    gap = sign * res["U"][k * npts + disc.contact_nodes] - disc.chi
+    margins = np.where(res["active"], res["lambda"] / max(scale_l, 1e-300), -gap / max(scale_u, 1e-300))
+    dl = np.abs(lam - np.asarray(pd["lambda"])).max()
+
+    row = {
+        "case": os.path.basename(os.path.normpath(path)),
+        "problem": case.meta["problem"],
+        "mesh": case.meta.get("mesh", "?"),
+        "ndof": 2 * npts,
+        "pdas_its_rust": case.meta.get("pdas_iterations", "?"),
+        "pdas_its_ngsolve": res["iterations"],
+        "active_rust": int(np.sum(np.asarray(pd["active"]) != 0)),
+        "active_ngsolve": int(active.sum()),
+        "u_rel_diff": float(du / scale_u) if scale_u > 0 else float(du),
+        "lambda_rel_diff": float(dl / scale_l) if scale_l > 0 else float(dl),
+        "active_mismatch": int(np.sum(active != (np.asarray(pd["active"]) != 0))),
+        "contact_mismatch": int(np.sum(contact != (np.asarray(pd["contact"]) != 0))),
+        "active_margin": float(margins.min()) if len(margins) else None,
+        "basis_change_err": disc.basis_change_error,
+        "kkt": res["kkt"],
+        "seconds": round(seconds, 3),
+    }
+    failures = []
+    if row["ndof"] != case.meta.get("ndof", row["ndof"]):
+        failures.append(f"ndof {case.meta['ndof']} != 2 x nodes {row['ndof']}")
+    if not row["u_rel_diff"] <= TOL_U:
+        failures.append(f"u differs by {row['u_rel_diff']:.2e} > {TOL_U:g}")
+    if not row["lambda_rel_diff"] <= TOL_LAMBDA:
+        failures.append(f"lambda differs by {row['lambda_rel_diff']:.2e} > {TOL_LAMBDA:g}")
+    if row["active_mismatch"]:
+        failures.append(f"active sets differ at {row['active_mismatch']} nodes")
+    if row["contact_mismatch"]:
+        failures.append(f"contact node sets differ at {row['contact_mismatch']} nodes")
+    row["result"] = "PASS" if not failures else "FAIL: " + "; ".join(failures)
+    return row
+
+
+COMPARE_COLUMNS = ["case", "problem", "mesh", "ndof", "pdas_its_rust", "pdas_its_ngsolve", "active_rust",
+                   "active_ngsolve", "u_rel_diff", "lambda_rel_diff", "active_mismatch", "active_margin", "seconds",
+                   "result"]
+
+
+def cmd_compare(args):
+    rows = [compare_case(d) for d in args.dirs]
+    tol = {"u_rel": TOL_U, "lambda_rel": TOL_LAMBDA, "active": "identical", "contact": "identical"}
+    report("compare", "NGSolve cross-check: same mesh, same data, independent PDAS", COMPARE_COLUMNS, rows,
+           {"tolerances": tol}, args.out_dir)
+    return all(r["result"] == "PASS" for r in rows)
+
+
+# -- rates ---------------------------------------------------------------------------------------
+def observed_rates(ns, errs):
+    """Rates in h = 1/N between consecutive meshes: log(e_i / e_i+1) / log(N_i+1 / N_i)."""
+    return [None] + [math.log(errs[i] / errs[i + 1]) / math.log(ns[i + 1] / ns[i]) for i in range(len(ns) - 1)]
+
+
+def cmd_rates(args):
+    cases = []
+    for d in args.dirs:
+        case = fem.read_case(d)
+        kind, _, n = case.meta.get("mesh", "").partition(":")
+        if case.meta["problem"] != "ex71" or kind != "structured":
+            sys.exit(f"rates: {d} is not an ex71 case on a structured:N mesh")
+        disc, res, _ = fem.solve_case(case)
+        cases.append((int(n), d, case.meta.get("error", {}), disc.errors(res["U"])))
+    cases.sort()
+    ns = [c[0] for c in cases]
+    rows = [{"case": os.path.basename(os.path.normpath(d)), "N": n} for n, d, _, _ in cases]
+    ok = True
+    for key in ("linf_nodal", "linf_dense"):
+        ours = [c[3][key] for c in cases]
+        r_ours = observed_rates(ns, ours)
+        have = all(key in c[2] for c in cases)
+        theirs = [c[2][key] for c in cases] if have else [None] * len(cases)
+        r_theirs = observed_rates(ns, theirs) if have else [None] * len(cases)
+        for row, e_o, e_t, q_o, q_t in zip(rows, ours, theirs, r_ours, r_theirs):
+            row[f"{key}_ngsolve"], row[f"{key}_rust"] = e_o, e_t
+            row[f"rate_{key}_ngsolve"], row[f"rate_{key}_rust"] = q_o, q_t
+            if q_o is not None and q_t is not None and abs(q_o - q_t) > TOL_RATE:
+                ok = False
+                row["result"] = f"FAIL: {key} rate {q_t:.3f} vs {q_o:.3f}"
+        if not have:
+            print(f"rates: case.json lacks error.{key} in some case: not compared")
+    for row in rows:
+        row.setdefault("result", "PASS")
+    cols = ["case", "N"] + [f"{p}{k}_{s}" for k in ("linf_nodal", "linf_dense")
+                            for p in ("", "rate_") for s in ("rust", "ngsolve")] + ["result"]
+    report("rates", "Example 7.1: L-infinity errors and observed rates (in h), Rust vs NGSolve", cols, rows,
+           {"tolerance_rate": TOL_RATE,
+            "norm": "max over points and both components of |u - u_h|; "
+                    "dense = barycentric lattice of order 6 per triangle (as src/norms.rs)"},
+           args.out_dir)
+    return ok
+
+
+# -- bench ---------------------------------------------------------------------------------------
+def bench_once(mesh, prob):
+    """One assembly + factorisation + solve of Example 7.2 without contact; returns (times, fes, err)."""
+    t0 = time.perf_counter()
+    fes = ng.VectorH1(mesh, order=2, dirichlet="dirichlet")
+    a = fem.stiffness_form(fes, prob).Assemble()
+    f = fem.load_form(fes, prob).Assemble()
+    t1 = time.perf_counter()
+    inv = a.mat.Inverse(fes.FreeDofs(), inverse=fem.INVERSE)
+    t2 = time.perf_counter()
+    gf = ng.GridFunction(fes)
+    gf.Set(ng.CF(prob.u_dirichlet), definedon=mesh.Boundaries("dirichlet"))
+    r = f.vec.CreateVector()
+    r.data = f.vec - a.mat * gf.vec
+    gf.vec.data += inv * r
+    t3 = time.perf_counter()
+    # Without contact the exact solution is the translation u_D: a cheap sanity check.
+    err = ng.Integrate(ng.Norm(gf - ng.CF(prob.u_dirichlet)), mesh, order=4)
+    return (t1 - t0, t2 - t1, t3 - t2), fes, err
+
+
+def cmd_bench(args):
+    sizes = [int(s) for s in args.sizes.split(",")]
+    threads = args.threads or os.cpu_count()
+    ng.SetNumThreads(threads)
+    prob = problems.problem("ex72")
+    rows = []
+    load_before = os.getloadavg()[0]  # timings on a busy machine are not worth much: record it
+    with ng.TaskManager():
+        for n in sizes:
+            vertices, tris = make_case.structured_triangles(n)
+            segs, parts = make_case.boundary_segments(vertices, tris, make_case.SIDES["ex72"])
+            mesh = fem.build_ngmesh(vertices, tris, segs, parts)
+            runs = [bench_once(mesh, prob) for _ in range(args.repeats)]
+            fes, err = runs[-1][1], runs[-1][2]
+            med = [statistics.median(r[0][i] for r in runs) for i in range(3)]
+            rows.append({"N": n, "ndof": fes.ndof, "ndof_free": sum(fes.FreeDofs()),
+                         "assembly_s": med[0], "factorisation_s": med[1], "solve_s": med[2],
+                         "total_s": sum(med), "l1_error_vs_translation": err})
+            if err > 1e-8:
+                print(f"bench: N={n}: solution is not the translation (L1 error {err:g})")
+                return False
+        used = ng.GetNumThreads()  # inside the TaskManager: the threads actually used
+    cols = ["N", "ndof", "ndof_free", "assembly_s", "factorisation_s", "solve_s", "total_s"]
+    table = markdown_table(cols, rows)
+    print(table)
+    doc = {"title": "NGSolve: Example 7.2 linear elasticity (no contact), P2, structured:N",
+           "ngsolve": ng.__version__, "inverse": fem.INVERSE, "threads": used, "repeats": args.repeats,
+           "cpu_count": os.cpu_count(), "loadavg_1min_before": load_before,
+           "loadavg_1min_after": os.getloadavg()[0],
+           "statistic": "median", "mesh": "structured:N, diagonal lower-left to upper-right",
+           "timed": {"assembly": "space + stiffness matrix + load vector",
+                     "factorisation": "sparse factorisation on the free dofs",
+                     "solve": "Dirichlet values, residual, forward/back substitution"},
+           "rows": rows}
+    if args.out_dir:
+        write_atomic(os.path.join(args.out_dir, "ngsolve_bench.json"), json.dumps(doc, indent=1) + "\n")
+    return True
+
+
+# -- selftest ------------------------------------------------------------------------------------
+# The datum we perturb for each problem: one that is nonzero there.
+PERTURB = {"ex71": "f", "ex72": "dirichlet"}
+
+
+def cmd_selftest(args):
+    ok = True
+    mesh = fem.build_ngmesh(*_unit_square_for_data_check())
+    ef, eg, ec = problems.check_ex71_data(mesh)
+    print(f"ex71 data vs symbolic derivatives of the exact u: f {ef:.1e}, g {eg:.1e}, contact stress {ec:.1e}")
+    rows = [{"case": "ex71 data", "check": "f, g, sigma on Gamma_C vs exact u", "value": max(ef, eg, ec),
+             "result": "PASS" if max(ef, eg, ec) < 1e-10 else "FAIL"}]
+
+    with tempfile.TemporaryDirectory() as tmp:
+        dirs = args.dirs
+        if not dirs:  # no Rust export given: make cases holding our own solution
+            dirs = []
+            for prob in ("ex71", "ex72"):
+                d = os.path.join(tmp, f"{prob}-structured-8")
+                make_case.make_case(prob, "structured:8", d, solve=True)
+                dirs.append(d)
+        for d in dirs:
+            name = os.path.basename(os.path.normpath(d))
+            base = compare_case(d)
+            rows.append({"case": name, "check": "unperturbed compare passes", "value": base["u_rel_diff"],
+                         "result": "PASS" if base["result"] == "PASS" else "FAIL: " + base["result"]})
+            kind = PERTURB[fem.read_case(d).meta["problem"]]
+            pert = compare_case(d, perturb=kind)
+            rows.append({"case": name, "check": f"{kind} x (1+{problems.PERTURBATION:g}): compare fails",
+                         "value": pert["u_rel_diff"],
+                         "result": "PASS" if pert["result"] != "PASS" else "FAIL: perturbation went unnoticed"})
+    ok = all(r["result"] == "PASS" for r in rows)
+    report("selftest", "NGSolve cross-check self-test: the comparison can fail", ["case", "check", "value", "result"],
+           rows, {}, args.out_dir)
+    return ok
+
+
+def _unit_square_for_data_check():
+    vertices, tris = make_case.structured_triangles(4)
+    segs, parts = make_case.boundary_segments(vertices, tris, make_case.SIDES["ex71"])
+    return vertices, tris, segs, parts
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out-dir", default=RESULTS, help="where to write results (default results/crosscheck; '' for none)")
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    p = sub.add_parser("compare")
+    p.add_argument("dirs", nargs="+")
+    p.set_defaults(func=cmd_compare)
+    p = sub.add_parser("rates")
+    p.add_argument("dirs", nargs="+")
+    p.set_defaults(func=cmd_rates)
+    p = sub.add_parser("bench")
+    p.add_argument("--sizes", default="32,64,128,256")
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--threads", type=int, default=0, help="NGSolve threads (default: all cores)")
+    p.set_defaults(func=cmd_bench)
+    p = sub.add_parser("selftest")
+    p.add_argument("dirs", nargs="*", help="exported cases to perturb (default: generated structured:8 cases)")
+    p.set_defaults(func=cmd_selftest)
+    args = ap.parse_args()
+    ok = args.func(args)
+    if not ok:
+        print(f"crosscheck {args.cmd}: FAILED")
+    sys.exit(0 if ok else 1)
+
+
+if __name__ == "__main__":
+    main()

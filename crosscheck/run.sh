@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# `make crosscheck`: export cases with the Rust binary, then run the NGSolve self-test, comparison
+# and rate check on them. Every step runs even if an earlier one failed (all tables get printed);
+# the exit status is non-zero if any failed. Results: results/crosscheck/{selftest,compare,rates}.*
+set -uo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+root="$(dirname "$here")"
+bin="${SIGNORINI:-$root/target/release/signorini}"
+cases="$root/target/crosscheck"  # scratch space, under the ignored target/
+
+"$here/setup.sh" || exit 1
+py="$here/.venv/bin/python"
+rm -rf "$cases" && mkdir -p "$cases"
+all=() ex71=()
+for spec in ex71:8 ex71:16 ex71:32 ex71:64 ex72:8 ex72:16 ex72:32; do
+    p="${spec%%:*}" n="${spec##*:}"
+    dir="$cases/$p-structured-$n"
+    "$bin" export --problem "$p" --mesh "structured:$n" --out "$dir" || exit 1
+    all+=("$dir")
+    [ "$p" = ex71 ] && ex71+=("$dir")
+done
+
+status=0
+"$py" "$here/crosscheck.py" selftest "$cases/ex71-structured-8" "$cases/ex72-structured-8" || status=1
+"$py" "$here/crosscheck.py" compare "${all[@]}" || status=1
+"$py" "$here/crosscheck.py" rates "${ex71[@]}" || status=1
+exit $status

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Create crosscheck/.venv with the pinned requirements. Idempotent: does nothing when the venv
+# exists and is at least as new as requirements.txt; otherwise rebuilds it from scratch (--clear),
+# so a changed requirements.txt never leaves stale packages behind. Needs python3 (>= 3.10) and PyPI.
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+venv="$here/.venv"
+req="$here/requirements.txt"
+stamp="$venv/.requirements.stamp"
+
+if [ -x "$venv/bin/python" ] && [ -f "$stamp" ] && [ ! "$req" -nt "$stamp" ]; then
+    exit 0
+fi
+echo "crosscheck/setup.sh: creating $venv from requirements.txt"
+rm -f "$stamp"
+python3 -m venv --clear "$venv"
+"$venv/bin/python" -m pip install --disable-pip-version-check --quiet -r "$req"
+"$venv/bin/python" -c "import ngsolve, meshio, numpy" # fail here, not in the first check
+touch "$stamp"
