@@ -24,3 +24,198 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Resul
     s.push('\n');
     write_atomic(path, s.as_bytes())
 }
+
+use crate::adapt::{LevelRecord, Refine};
+use crate::estimate::EstimatorConfig;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// One run of a study: a problem, an initial mesh and every choice that affects the numbers.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunSpec {
+    /// Unique within the study; names the run's record file.
+    pub id: String,
+    pub problem: String,
+    pub mesh: String,
+    pub refine: Refine,
+    pub theta: f64,
+    pub levels: usize,
+    pub max_ndof: Option<usize>,
+    pub estimator: EstimatorConfig,
+    /// Example 7.2 has no exact solution: errors are measured against a reference solution
+    /// computed on a finer mesh (see `study::reference`), if this is set.
+    pub reference: Option<ReferenceSpec>,
+    /// Levels whose mesh and fields are written as VTU (and as JSON for the mesh figure).
+    pub save_levels: Vec<usize>,
+}
+
+/// How a reference solution is computed: continue adaptive refinement from the initial mesh
+/// with `theta` until the unknowns exceed `factor` times the run's final NDF.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceSpec {
+    pub factor: f64,
+    pub theta: f64,
+}
+
+/// The record of one finished run: its spec and one `LevelRecord` per level.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunRecord {
+    pub study: String,
+    pub run: RunSpec,
+    pub levels: Vec<LevelRecord>,
+    /// NDF of the reference solution, when errors are against one.
+    pub reference_ndof: Option<usize>,
+}
+
+/// A mesh snapshot for the mesh figure: vertices, triangles, and the contact nodes (active or not).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MeshSnapshot {
+    pub study: String,
+    pub run: String,
+    pub level: usize,
+    pub ndof: usize,
+    pub vertices: Vec<[f64; 2]>,
+    pub triangles: Vec<[usize; 3]>,
+    /// Coordinates of the contact nodes and whether each is active.
+    pub contact_nodes: Vec<([f64; 2], bool)>,
+    /// Points the problem requires as vertices (the obstacle's kink).
+    pub kinks: Vec<[f64; 2]>,
+}
+
+/// Where a study's records live: `results/STUDY/`.
+#[derive(Clone, Debug)]
+pub struct StudyDir {
+    pub root: PathBuf,
+}
+
+impl StudyDir {
+    pub fn new(results: &Path, study: &str) -> Self {
+        StudyDir { root: results.join(study) }
+    }
+    /// `runs/RUN.json`, one per run.
+    pub fn run_file(&self, run: &str) -> PathBuf {
+        self.root.join("runs").join(format!("{run}.json"))
+    }
+    /// `levels.csv`, one row per level of every run.
+    pub fn csv_file(&self) -> PathBuf {
+        self.root.join("levels.csv")
+    }
+    pub fn provenance_file(&self) -> PathBuf {
+        self.root.join("provenance.json")
+    }
+    /// `meshes/RUN_levelL.vtu` and `.json`.
+    pub fn mesh_file(&self, run: &str, level: usize, ext: &str) -> PathBuf {
+        self.root.join("meshes").join(format!("{run}_level{level}.{ext}"))
+    }
+
+    /// Every finished run of the study, in file-name order.
+    pub fn read_runs(&self) -> std::io::Result<Vec<RunRecord>> {
+        let dir = self.root.join("runs");
+        let mut files: Vec<PathBuf> = match std::fs::read_dir(&dir) {
+            Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|e| e == "json")).collect(),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+            Err(e) => return Err(e),
+        };
+        files.sort();
+        files
+            .iter()
+            .map(|f| {
+                let text = std::fs::read_to_string(f)?;
+                serde_json::from_str(&text).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display())))
+            })
+            .collect()
+    }
+
+    pub fn read_run(&self, run: &str) -> std::io::Result<Option<RunRecord>> {
+        let f = self.run_file(run);
+        match std::fs::read_to_string(&f) {
+            Ok(text) => serde_json::from_str(&text).map(Some).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display()))),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+            Err(e) => Err(e),
+        }
+    }
+
+    pub fn read_mesh(&self, run: &str, level: usize) -> std::io::Result<MeshSnapshot> {
+        let f = self.mesh_file(run, level, "json");
+        let text = std::fs::read_to_string(&f)?;
+        serde_json::from_str(&text).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display())))
+    }
+
+    /// Rewrite `levels.csv` from the run records: columns `run`, `problem`, `refine`, `theta`,
+    /// `contact_term`, `log_factor`, `sampling`, then every `LevelRecord` field in its order.
+    /// (The csv crate cannot serialise flattened structs, so rows go through serde_json values,
+    /// whose maps keep field order.)
+    pub fn write_csv(&self, runs: &[RunRecord]) -> std::io::Result<()> {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let mut header_written = false;
+        let text = |v: &serde_json::Value| match v {
+            serde_json::Value::Null => String::new(),
+            serde_json::Value::String(s) => s.clone(),
+            other => other.to_string(),
+        };
+        for r in runs {
+            let e = &r.run.estimator;
+            let prefix = serde_json::json!({
+                "run": r.run.id, "problem": r.run.problem, "refine": r.run.refine, "theta": r.run.theta,
+                "contact_term": e.contact_term, "log_factor": e.log_factor, "sampling": e.sampling,
+            });
+            for l in &r.levels {
+                let mut row = prefix.as_object().cloned().unwrap_or_default();
+                if let serde_json::Value::Object(fields) = serde_json::to_value(l).map_err(std::io::Error::other)? {
+                    row.extend(fields);
+                }
+                if !header_written {
+                    w.write_record(row.keys()).map_err(std::io::Error::other)?;
+                    header_written = true;
+                }
+                w.write_record(row.values().map(text)).map_err(std::io::Error::other)?;
+            }
+        }
+        let bytes = w.into_inner().map_err(std::io::Error::other)?;
+        write_atomic(&self.csv_file(), &bytes)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_has_one_row_per_level_with_run_columns() {
+        let dir = std::env::temp_dir().join(format!("signorini-csv-{}", std::process::id()));
+        let study = StudyDir::new(&dir, "s");
+        let level: LevelRecord = serde_json::from_value(serde_json::json!({
+            "level": 0, "ndof": 10, "ndof_free": 8, "n_elements": 2, "h_min": 0.5, "h_max": 1.0, "min_angle": 45.0,
+            "contact_nodes": 3, "active_nodes": 1, "full_contact_nodes": 0, "pdas_iterations": 2, "zone_min": null, "zone_max": null,
+            "eta1": 1.0, "eta2": 2.0, "eta3": 3.0, "eta4": 4.0, "eta5": 5.0, "eta6": 6.0, "eta7": 7.0, "l_h": 1.5, "psi": 15.0,
+            "eta_h": 30.0, "c0": 0.45, "estimate": 13.5, "err_quadrature": 0.1, "err_dense": 0.11, "err_nodal": null,
+            "efficiency": 135.0, "marked": 1, "t_assembly": 0.0, "t_factorisation": 0.0, "t_active_set": 0.0, "t_solve": 0.0,
+            "t_estimate": 0.0, "t_refine": 0.0, "t_level": 0.0
+        }))
+        .unwrap();
+        let run = RunRecord {
+            study: "s".into(),
+            run: RunSpec {
+                id: "a".into(),
+                problem: "ex71".into(),
+                mesh: "structured:4".into(),
+                refine: Refine::Adaptive,
+                theta: 0.5,
+                levels: 2,
+                max_ndof: None,
+                estimator: EstimatorConfig::default(),
+                reference: None,
+                save_levels: vec![],
+            },
+            levels: vec![level.clone(), LevelRecord { level: 1, ..level }],
+            reference_ndof: None,
+        };
+        study.write_csv(&[run]).unwrap();
+        let text = std::fs::read_to_string(study.csv_file()).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), 3);
+        assert!(lines[0].starts_with("run,problem,refine,theta,contact_term,log_factor,sampling,level,ndof"), "{}", lines[0]);
+        assert!(lines[1].starts_with("a,ex71,adaptive,0.5,as_written,squared,quadrature,0,10"), "{}", lines[1]);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
