@@ -16,3 +16,4 @@ pub mod problems;
 pub mod records;
 pub mod report;
 pub mod solve;
+pub mod study;

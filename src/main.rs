@@ -7,7 +7,7 @@ use signorini::mesh::MeshSpec;
 use signorini::adapt::{self, AdaptConfig, Refine};
 use signorini::estimate::{self, ContactTerm, EstimatorConfig, LogFactor};
 use signorini::norms::Sampling;
-use signorini::{norms, problems, report, solve};
+use signorini::{norms, problems, report, solve, study};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -23,6 +23,28 @@ enum Command {
     Solve(SolveArgs),
     /// The adaptive loop SOLVE -> ESTIMATE -> MARK -> REFINE, one table row per level.
     Adapt(AdaptArgs),
+    /// Run a declared study (experiments/STUDY.toml) into results/STUDY/.
+    Run {
+        /// The study manifest(s).
+        #[arg(required = true)]
+        manifests: Vec<std::path::PathBuf>,
+        /// The short form: the first quick_levels levels of every run (an exact prefix).
+        /// Written to target/quick-results/ unless --results is given.
+        #[arg(long)]
+        quick: bool,
+        /// Threads for assembly, estimator and errors (results do not depend on it).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Run every N-th run only: K/N, 1 <= K <= N (cluster job arrays); shards merge by run id.
+        #[arg(long)]
+        shard: Option<String>,
+        /// Start over instead of resuming after the runs already finished.
+        #[arg(long)]
+        fresh: bool,
+        /// Results root.
+        #[arg(long)]
+        results: Option<std::path::PathBuf>,
+    },
     /// Solve and write the mesh and solution for the NGSolve cross-check (mesh.vtu, case.json).
     Export {
         #[command(flatten)]
@@ -192,6 +214,25 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
     Ok(())
 }
 
+fn run_studies(manifests: &[std::path::PathBuf], quick: bool, jobs: Option<usize>, shard: Option<&str>, fresh: bool, results: Option<std::path::PathBuf>) -> Result<()> {
+    if let Some(j) = jobs {
+        if j == 0 {
+            bail!("--jobs must be at least 1");
+        }
+        rayon::ThreadPoolBuilder::new().num_threads(j).build_global().context("setting the thread count")?;
+    }
+    let shard = shard.map(study::parse_shard).transpose()?;
+    let results = results.unwrap_or_else(|| if quick { "target/quick-results".into() } else { "results".into() });
+    // parse every manifest first: a typo in the last one should not cost the first one's run
+    let parsed = manifests.iter().map(|m| study::manifest::Manifest::load(m)).collect::<Result<Vec<_>, _>>()?;
+    for manifest in &parsed {
+        let options = study::RunOptions { quick, shard, fresh, results: results.clone(), progress: true };
+        let executed = study::run_study(manifest, &options)?;
+        eprintln!("{}: {} run(s) executed, results in {}", manifest.study, executed.len(), results.join(&manifest.study).display());
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
@@ -203,6 +244,7 @@ fn main() -> ExitCode {
             }
         }),
         Command::Adapt(args) => run_adapt(args),
+        Command::Run { manifests, quick, jobs, shard, fresh, results } => run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, results.clone()),
         Command::Export { args, out } => run_solve(args).and_then(|(mesh, sol, r)| report::export_case(out, &mesh, &sol, &r)),
     };
     match result {

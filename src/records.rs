@@ -49,12 +49,13 @@ pub struct RunSpec {
     pub save_levels: Vec<usize>,
 }
 
-/// How a reference solution is computed: continue adaptive refinement from the initial mesh
-/// with `theta` until the unknowns exceed `factor` times the run's final NDF.
+/// How a reference solution is computed: adaptive refinement (default estimator, maximum
+/// strategy with `theta`) from the run's initial mesh until the NDF reaches `min_ndof`. Fixed
+/// by the manifest, not by the run's length, so the quick form measures the same errors.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ReferenceSpec {
-    pub factor: f64,
     pub theta: f64,
+    pub min_ndof: usize,
 }
 
 /// The record of one finished run: its spec and one `LevelRecord` per level.

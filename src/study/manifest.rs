@@ -1,0 +1,240 @@
+//! Study manifests: `experiments/STUDY.toml`.
+//!
+//! ```toml
+//! description = "Example 7.1, adaptive and uniform"
+//!
+//! [defaults]                 # every run starts from these
+//! problem = "ex71"
+//! mesh = "structured:4"
+//! levels = 24
+//! quick_levels = 8           # the --quick form: the first levels of the same runs
+//! theta = 0.5
+//! refine = "adaptive"        # or "uniform"
+//! max_ndof = 2000000         # optional
+//! save_levels = []           # levels written as VTU (and mesh JSON)
+//! [defaults.estimator]
+//! c0 = 0.45
+//! contact_term = "as_written"   # or "without_full_contact"
+//! log_factor = "squared"        # or "linear", "one"
+//! sampling = "quadrature"       # or "dense"
+//! [defaults.reference]       # optional: errors against a finer adaptive solution
+//! theta = 0.5
+//! min_ndof = 640000
+//!
+//! [[run]]                    # each run overrides what it names
+//! id = "adaptive"
+//! [[run]]
+//! id = "uniform"
+//! refine = "uniform"
+//! levels = 9
+//!
+//! [drift]                    # tolerances of the drift check
+//! default = { rel = 1e-9, abs = 1e-14 }
+//! fields = { err_quadrature = { rel = 1e-6, abs = 0.0 } }
+//! ```
+//!
+//! Every error names the file, the key and what was expected.
+
+use crate::adapt::Refine;
+use crate::estimate::{ContactTerm, EstimatorConfig, LogFactor};
+use crate::mesh::MeshSpec;
+use crate::norms::Sampling;
+use crate::records::{ReferenceSpec, RunSpec};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum ManifestError {
+    #[error("{file}: cannot read: {source}")]
+    Read { file: PathBuf, source: std::io::Error },
+    #[error("{file}: {message}")]
+    Syntax { file: PathBuf, message: String },
+    #[error("{file}: key `{key}`: expected {expected}, got {got}")]
+    Invalid { file: PathBuf, key: String, expected: String, got: String },
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EstimatorOverrides {
+    c0: Option<f64>,
+    contact_term: Option<ContactTerm>,
+    log_factor: Option<LogFactor>,
+    sampling: Option<Sampling>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ReferenceToml {
+    theta: f64,
+    min_ndof: usize,
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RunToml {
+    id: Option<String>,
+    problem: Option<String>,
+    mesh: Option<String>,
+    levels: Option<usize>,
+    quick_levels: Option<usize>,
+    theta: Option<f64>,
+    refine: Option<Refine>,
+    max_ndof: Option<usize>,
+    save_levels: Option<Vec<usize>>,
+    estimator: Option<EstimatorOverrides>,
+    reference: Option<ReferenceToml>,
+    /// `reference = false` in a run drops the defaults' reference.
+    no_reference: Option<bool>,
+}
+
+/// A tolerance: |fresh - stored| <= abs + rel |stored|.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Tolerance {
+    pub rel: f64,
+    pub abs: f64,
+}
+
+/// Tolerances of the drift check, per field, with a default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriftSpec {
+    pub default: Tolerance,
+    #[serde(default)]
+    pub fields: BTreeMap<String, Tolerance>,
+}
+
+impl Default for DriftSpec {
+    fn default() -> Self {
+        DriftSpec { default: Tolerance { rel: 1e-9, abs: 1e-14 }, fields: BTreeMap::new() }
+    }
+}
+
+impl DriftSpec {
+    pub fn tolerance(&self, field: &str) -> Tolerance {
+        self.fields.get(field).copied().unwrap_or(self.default)
+    }
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ManifestToml {
+    description: Option<String>,
+    defaults: Option<RunToml>,
+    run: Vec<RunToml>,
+    drift: Option<DriftSpec>,
+}
+
+/// One declared run with its quick form.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedRun {
+    pub spec: RunSpec,
+    /// Levels of the `--quick` form (a prefix of the full run: same meshes, same numbers).
+    pub quick_levels: usize,
+}
+
+/// A parsed and validated manifest.
+#[derive(Clone, Debug)]
+pub struct Manifest {
+    /// The study's name: the manifest's file stem.
+    pub study: String,
+    pub file: PathBuf,
+    pub description: String,
+    pub runs: Vec<PlannedRun>,
+    pub drift: DriftSpec,
+    /// The manifest's bytes (hashed into the provenance).
+    pub bytes: Vec<u8>,
+}
+
+impl Manifest {
+    pub fn load(path: &Path) -> Result<Self, ManifestError> {
+        let bytes = std::fs::read(path).map_err(|source| ManifestError::Read { file: path.to_path_buf(), source })?;
+        let text = String::from_utf8_lossy(&bytes);
+        Self::parse(path, &text).map(|mut m| {
+            m.bytes = bytes.clone();
+            m
+        })
+    }
+
+    pub fn parse(path: &Path, text: &str) -> Result<Self, ManifestError> {
+        let file = path.to_path_buf();
+        let raw: ManifestToml = toml::from_str(text).map_err(|e| ManifestError::Syntax { file: file.clone(), message: e.to_string().trim_end().to_string() })?;
+        let study = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let invalid = |key: String, expected: &str, got: String| ManifestError::Invalid { file: file.clone(), key, expected: expected.to_string(), got };
+        if raw.run.is_empty() {
+            return Err(invalid("run".into(), "at least one [[run]] table", "none".into()));
+        }
+        let d = raw.defaults.clone().unwrap_or_default();
+        let mut runs = Vec::new();
+        let mut ids = std::collections::BTreeSet::new();
+        for (i, r) in raw.run.iter().enumerate() {
+            let key = |k: &str| format!("run[{i}].{k}");
+            let id = r.id.clone().ok_or_else(|| invalid(key("id"), "a run name (string)", "nothing".into()))?;
+            if id.is_empty() || !id.chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) {
+                return Err(invalid(key("id"), "a name of letters, digits, '_', '-', '.'", format!("{id:?}")));
+            }
+            if !ids.insert(id.clone()) {
+                return Err(invalid(key("id"), "a name unique within the study", format!("{id:?} twice")));
+            }
+            let problem = r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid(key("problem"), "a problem name", "nothing".into()))?;
+            if crate::problems::by_name(&problem).is_err() {
+                return Err(invalid(key("problem"), &format!("one of {}", crate::problems::KNOWN.join(", ")), format!("{problem:?}")));
+            }
+            let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| "structured:4".into());
+            MeshSpec::parse(&mesh).map_err(|_| invalid(key("mesh"), "'structured:N' or 'symmetric:N'", format!("{mesh:?}")))?;
+            let levels = r.levels.or(d.levels).ok_or_else(|| invalid(key("levels"), "a number of levels >= 1", "nothing".into()))?;
+            if levels == 0 {
+                return Err(invalid(key("levels"), "a number of levels >= 1", "0".into()));
+            }
+            let quick_levels = r.quick_levels.or(d.quick_levels).unwrap_or(levels.min(6));
+            if quick_levels == 0 || quick_levels > levels {
+                return Err(invalid(key("quick_levels"), &format!("a number in 1..={levels} (levels)"), quick_levels.to_string()));
+            }
+            let theta = r.theta.or(d.theta).unwrap_or(0.5);
+            if !(theta > 0.0 && theta <= 1.0) {
+                return Err(invalid(key("theta"), "a number in (0, 1]", theta.to_string()));
+            }
+            let e = EstimatorConfig::default();
+            let (eo, ed) = (r.estimator.clone().unwrap_or_default(), d.estimator.clone().unwrap_or_default());
+            let estimator = EstimatorConfig {
+                c0: eo.c0.or(ed.c0).unwrap_or(e.c0),
+                contact_term: eo.contact_term.or(ed.contact_term).unwrap_or(e.contact_term),
+                log_factor: eo.log_factor.or(ed.log_factor).unwrap_or(e.log_factor),
+                sampling: eo.sampling.or(ed.sampling).unwrap_or(e.sampling),
+            };
+            if !(estimator.c0 > 0.0) {
+                return Err(invalid(key("estimator.c0"), "a positive number", estimator.c0.to_string()));
+            }
+            let reference = if r.no_reference == Some(true) { None } else { r.reference.clone().or(d.reference.clone()) };
+            if let Some(rf) = &reference {
+                if !(rf.theta > 0.0 && rf.theta <= 1.0) {
+                    return Err(invalid(key("reference.theta"), "a number in (0, 1]", rf.theta.to_string()));
+                }
+            }
+            runs.push(PlannedRun {
+                spec: RunSpec {
+                    id,
+                    problem,
+                    mesh,
+                    refine: r.refine.or(d.refine).unwrap_or(Refine::Adaptive),
+                    theta,
+                    levels,
+                    max_ndof: r.max_ndof.or(d.max_ndof),
+                    estimator,
+                    reference: reference.map(|rf| ReferenceSpec { theta: rf.theta, min_ndof: rf.min_ndof }),
+                    save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
+                },
+                quick_levels,
+            });
+        }
+        Ok(Manifest {
+            study,
+            file,
+            description: raw.description.unwrap_or_default(),
+            runs,
+            drift: raw.drift.unwrap_or_default(),
+            bytes: text.as_bytes().to_vec(),
+        })
+    }
+}

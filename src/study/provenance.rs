@@ -1,0 +1,92 @@
+//! Provenance of a study's results (CONTRACT.md): git commit and dirty flag, Cargo.lock hash,
+//! rustc version, the manifest's hash, machine, threads, date.
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::path::Path;
+use std::process::Command;
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Provenance {
+    pub study: String,
+    pub manifest: String,
+    pub manifest_sha256: String,
+    pub quick: bool,
+    pub git_commit: Option<String>,
+    pub git_dirty: Option<bool>,
+    pub cargo_lock_sha256: Option<String>,
+    pub rustc: Option<String>,
+    pub signorini_version: String,
+    pub machine: Machine,
+    pub threads: usize,
+    /// UTC, ISO 8601.
+    pub date: String,
+    /// Runs present in the study directory (merged by run id across shards and sessions).
+    pub runs: Vec<String>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Machine {
+    pub cpu: String,
+    pub cores: usize,
+    pub memory_kb: Option<u64>,
+    pub os: String,
+}
+
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
+}
+
+fn command(cmd: &str, args: &[&str]) -> Option<String> {
+    let out = Command::new(cmd).args(args).output().ok()?;
+    out.status.success().then(|| String::from_utf8_lossy(&out.stdout).trim().to_string())
+}
+
+pub fn machine() -> Machine {
+    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let cpu = cpuinfo.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split(':').nth(1)).unwrap_or("unknown").trim().to_string();
+    let memory_kb = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| s.lines().next().and_then(|l| l.split_whitespace().nth(1)).and_then(|v| v.parse().ok()));
+    Machine {
+        cpu,
+        cores: std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+        memory_kb,
+        os: format!("{} {}", std::env::consts::OS, std::env::consts::ARCH),
+    }
+}
+
+/// Now as ISO 8601 UTC (days-from-civil inverse, Howard Hinnant's algorithm).
+pub fn utc_now() -> String {
+    let secs = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0) as i64;
+    let (days, rem) = (secs.div_euclid(86400), secs.rem_euclid(86400));
+    let z = days + 719468;
+    let era = z.div_euclid(146097);
+    let doe = z - era * 146097;
+    let yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + (m <= 2) as i64;
+    format!("{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z", rem / 3600, rem / 60 % 60, rem % 60)
+}
+
+pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: bool, runs: Vec<String>) -> Provenance {
+    let root = manifest_path.parent().and_then(|p| p.parent()).filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let git_commit = command("git", &["-C", &root.to_string_lossy(), "rev-parse", "HEAD"]);
+    let git_dirty = command("git", &["-C", &root.to_string_lossy(), "status", "--porcelain", "--untracked-files=no"]).map(|s| !s.is_empty());
+    Provenance {
+        study: study.to_string(),
+        manifest: manifest_path.display().to_string(),
+        manifest_sha256: sha256_hex(manifest_bytes),
+        quick,
+        git_commit,
+        git_dirty,
+        cargo_lock_sha256: std::fs::read(root.join("Cargo.lock")).ok().map(|b| sha256_hex(&b)),
+        rustc: command("rustc", &["--version"]),
+        signorini_version: env!("CARGO_PKG_VERSION").to_string(),
+        machine: machine(),
+        threads: rayon::current_num_threads(),
+        date: utc_now(),
+        runs,
+    }
+}
