@@ -88,7 +88,7 @@ pub struct LevelRecord {
     pub err_nodal: Option<f64>,
     /// estimate / err_quadrature
     pub efficiency: Option<f64>,
-    /// Elements marked for refinement at this level (0 at the last level).
+    /// Elements marked for refinement at this level (also at the last level, not refined).
     pub marked: usize,
     pub t_assembly: f64,
     pub t_factorisation: f64,
@@ -164,7 +164,8 @@ pub fn run(
             Refine::Adaptive => mark_maximum(&est.element, config.theta),
             Refine::Uniform => vec![true; mesh.n_triangles()],
         };
-        let marked = if last { 0 } else { marks.iter().filter(|m| **m).count() };
+        // counted on the last level too, so a shorter run is an exact prefix of a longer one
+        let marked = marks.iter().filter(|m| **m).count();
         let (h_min, h_max) = mesh.h_range();
         let zone = sol.contact_zone();
         let t = &est.terms;

@@ -1,0 +1,139 @@
+//! Studies: malformed manifests are clear errors; results are the same on 1 and 2 threads; an
+//! interrupted study resumes; the quick form is an exact prefix of the full one.
+
+use signorini::records::{RunRecord, StudyDir};
+use signorini::study::manifest::{Manifest, ManifestError};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("signorini-test-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn signorini(args: &[&str]) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!err.contains("panicked"), "{err}");
+    (out.status.success(), err)
+}
+
+fn fixture() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny.toml").display().to_string()
+}
+
+/// Records without timings (fields t_*), as JSON values.
+fn numbers(r: &RunRecord) -> serde_json::Value {
+    let mut v = serde_json::to_value(r).unwrap();
+    for l in v["levels"].as_array_mut().unwrap() {
+        l.as_object_mut().unwrap().retain(|k, _| !k.starts_with("t_"));
+    }
+    v
+}
+
+fn parse_err(text: &str) -> String {
+    match Manifest::parse(Path::new("experiments/bad_case.toml"), text) {
+        Ok(_) => panic!("accepted a bad manifest:\n{text}"),
+        Err(e) => {
+            let s = e.to_string();
+            assert!(s.starts_with("experiments/bad_case.toml"), "error does not name the file: {s}");
+            s
+        }
+    }
+}
+
+#[test]
+fn bad_manifests_name_file_key_and_expectation() {
+    let base = "[defaults]\nproblem = \"ex71\"\nlevels = 3\n";
+    let e = parse_err(&format!("{base}[[run]]\nid = \"a\"\ntheta = 1.5\n"));
+    assert!(e.contains("run[0].theta") && e.contains("(0, 1]") && e.contains("1.5"), "{e}");
+    let e = parse_err(&format!("{base}[[run]]\nid = \"a\"\nproblem = \"ex9\"\n"));
+    assert!(e.contains("run[0].problem") && e.contains("ex71") && e.contains("ex9"), "{e}");
+    let e = parse_err(&format!("{base}[[run]]\nid = \"a\"\nmesh = \"cube:3\"\n"));
+    assert!(e.contains("run[0].mesh") && e.contains("structured:N"), "{e}");
+    let e = parse_err(&format!("{base}[[run]]\ntheta = 0.5\n"));
+    assert!(e.contains("run[0].id"), "{e}");
+    let e = parse_err(&format!("{base}[[run]]\nid = \"a\"\n[[run]]\nid = \"a\"\n"));
+    assert!(e.contains("run[1].id") && e.contains("unique"), "{e}");
+    let e = parse_err(&format!("{base}[[run]]\nid = \"a\"\ntheeta = 0.5\n"));
+    assert!(e.contains("theeta"), "unknown keys are named: {e}");
+    let e = parse_err(&format!("{base}[[run]]\nid = \"a\"\nlevels = \"many\"\n"));
+    assert!(e.contains("levels"), "{e}");
+    let e = parse_err(&format!("{base}[[run]]\nid = \"a\"\nestimator = {{ c0 = -1.0 }}\n"));
+    assert!(e.contains("estimator.c0") && e.contains("positive"), "{e}");
+    let e = parse_err(&format!("{base}[[run]]\nid = \"a\"\nestimator = {{ log_factor = \"cubed\" }}\n"));
+    assert!(e.contains("cubed") && e.contains("squared"), "{e}");
+    let e = parse_err(base);
+    assert!(e.contains("run"), "{e}");
+    assert!(matches!(Manifest::load(Path::new("experiments/does_not_exist.toml")), Err(ManifestError::Read { .. })));
+}
+
+#[test]
+fn bad_manifest_via_cli_is_a_clear_error() {
+    let d = tmp("badcli");
+    let f = d.join("bad_study.toml");
+    std::fs::write(&f, "[[run]]\nid = \"a\"\nproblem = \"ex71\"\nlevels = 0\n").unwrap();
+    let (ok, err) = signorini(&["run", f.to_str().unwrap(), "--results", d.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("bad_study.toml") && err.contains("run[0].levels"), "{err}");
+    let (ok, err) = signorini(&["run", &fixture(), "--shard", "3/2", "--results", d.to_str().unwrap()]);
+    assert!(!ok && err.contains("--shard"), "{err}");
+}
+
+#[test]
+fn same_numbers_on_one_and_two_threads() {
+    let (d1, d2) = (tmp("j1"), tmp("j2"));
+    assert!(signorini(&["run", &fixture(), "--jobs", "1", "--results", d1.to_str().unwrap()]).0);
+    assert!(signorini(&["run", &fixture(), "--jobs", "2", "--results", d2.to_str().unwrap()]).0);
+    let (r1, r2) = (StudyDir::new(&d1, "tiny").read_runs().unwrap(), StudyDir::new(&d2, "tiny").read_runs().unwrap());
+    assert_eq!(r1.len(), 2);
+    for (a, b) in r1.iter().zip(&r2) {
+        assert_eq!(numbers(a), numbers(b), "run {} differs between 1 and 2 threads", a.run.id);
+    }
+    // errors against the reference solution are there for ex72
+    assert!(r1[0].levels.iter().all(|l| l.err_quadrature.is_some()));
+}
+
+#[test]
+fn interrupted_study_resumes_and_shards_merge() {
+    let d = tmp("resume");
+    let res = d.to_str().unwrap();
+    // the first shard stands for a study interrupted after its first run
+    assert!(signorini(&["run", &fixture(), "--shard", "1/2", "--results", res]).0);
+    let dir = StudyDir::new(&d, "tiny");
+    assert_eq!(dir.read_runs().unwrap().len(), 1);
+    let before = std::fs::metadata(dir.run_file("a")).unwrap().modified().unwrap();
+    let (ok, err) = signorini(&["run", &fixture(), "--results", res]);
+    assert!(ok);
+    assert!(err.contains("tiny/a: finished earlier, kept"), "{err}");
+    assert_eq!(std::fs::metadata(dir.run_file("a")).unwrap().modified().unwrap(), before, "finished run rewritten");
+    let runs = dir.read_runs().unwrap();
+    assert_eq!(runs.len(), 2);
+    let csv = std::fs::read_to_string(dir.csv_file()).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 5 + 4);
+    let prov: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.provenance_file()).unwrap()).unwrap();
+    for key in ["git_commit", "git_dirty", "cargo_lock_sha256", "rustc", "manifest_sha256", "machine", "threads", "date"] {
+        assert!(prov.get(key).is_some(), "provenance lacks {key}");
+    }
+    // --fresh starts over
+    let (ok, err) = signorini(&["run", &fixture(), "--fresh", "--results", res]);
+    assert!(ok && !err.contains("finished earlier"), "{err}");
+}
+
+#[test]
+fn quick_form_is_an_exact_prefix() {
+    let (dq, df) = (tmp("quick"), tmp("full"));
+    assert!(signorini(&["run", &fixture(), "--quick", "--results", dq.to_str().unwrap()]).0);
+    assert!(signorini(&["run", &fixture(), "--results", df.to_str().unwrap()]).0);
+    let (q, f) = (StudyDir::new(&dq, "tiny").read_runs().unwrap(), StudyDir::new(&df, "tiny").read_runs().unwrap());
+    for (q, f) in q.iter().zip(&f) {
+        let (qn, fn_) = (numbers(q), numbers(f));
+        let (ql, fl) = (qn["levels"].as_array().unwrap(), fn_["levels"].as_array().unwrap());
+        assert!(ql.len() < fl.len());
+        for (a, b) in ql.iter().zip(fl) {
+            assert_eq!(a, b, "run {}: quick level differs from the full run", q.run.id);
+        }
+    }
+}
