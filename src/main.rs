@@ -45,6 +45,23 @@ enum Command {
         #[arg(long)]
         results: Option<std::path::PathBuf>,
     },
+    /// Rerun every declared study and compare with the stored results, field by field, within
+    /// the manifests' tolerances; exit non-zero on drift.
+    Drift {
+        /// Rerun the quick forms (prefixes of the stored full runs).
+        #[arg(long)]
+        quick: bool,
+        /// Accept a deliberate change: rerun STUDY in full and rewrite its stored results.
+        #[arg(long, value_name = "STUDY")]
+        accept: Vec<String>,
+        /// Check only these studies (default: every experiments/*.toml).
+        #[arg(long, value_name = "STUDY")]
+        study: Vec<String>,
+        #[arg(long, default_value = "experiments")]
+        experiments: std::path::PathBuf,
+        #[arg(long, default_value = "results")]
+        results: std::path::PathBuf,
+    },
     /// Solve and write the mesh and solution for the NGSolve cross-check (mesh.vtu, case.json).
     Export {
         #[command(flatten)]
@@ -233,6 +250,62 @@ fn run_studies(manifests: &[std::path::PathBuf], quick: bool, jobs: Option<usize
     Ok(())
 }
 
+/// The declared studies: experiments/*.toml, sorted; optionally only the named ones.
+fn manifests_in(dir: &std::path::Path, only: &[String]) -> Result<Vec<study::manifest::Manifest>> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .with_context(|| format!("reading {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    let all = files.iter().map(|f| study::manifest::Manifest::load(f)).collect::<Result<Vec<_>, _>>()?;
+    for name in only {
+        if !all.iter().any(|m| &m.study == name) {
+            bail!("unknown study '{name}'; declared studies: {}", all.iter().map(|m| m.study.as_str()).collect::<Vec<_>>().join(", "));
+        }
+    }
+    Ok(all.into_iter().filter(|m| only.is_empty() || only.contains(&m.study)).collect())
+}
+
+fn run_drift(quick: bool, accept: &[String], only: &[String], experiments: &std::path::Path, results: &std::path::Path) -> Result<()> {
+    use signorini::records::StudyDir;
+    if !accept.is_empty() {
+        for m in manifests_in(experiments, accept)? {
+            let options = study::RunOptions { quick: false, shard: None, fresh: true, results: results.to_path_buf(), progress: true };
+            study::run_study(&m, &options)?;
+            eprintln!("accepted: {} rewritten from a full rerun of {}; review and commit the change", results.join(&m.study).display(), m.file.display());
+        }
+        return Ok(());
+    }
+    let scratch = std::path::PathBuf::from("target/drift").join(if quick { "quick" } else { "full" });
+    let mut rows = Vec::new();
+    let mut studies = Vec::new();
+    for m in manifests_in(experiments, only)? {
+        let options = study::RunOptions { quick, shard: None, fresh: true, results: scratch.clone(), progress: true };
+        study::run_study(&m, &options)?;
+        let stored = StudyDir::new(results, &m.study).read_runs()?;
+        let fresh = StudyDir::new(&scratch, &m.study).read_runs()?;
+        let moved = study::drift::compare_study(&m, &stored, &fresh, quick);
+        eprintln!("{}: {}", m.study, if moved.is_empty() { "no drift".to_string() } else { format!("{} field(s) moved", moved.len()) });
+        studies.push(serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": moved.len() }));
+        rows.extend(moved);
+    }
+    let report = serde_json::json!({
+        "date": study::provenance::utc_now(),
+        "quick": quick,
+        "studies": studies,
+        "rows": rows,
+    });
+    signorini::records::write_json(&results.join("drift").join(if quick { "report_quick.json" } else { "report.json" }), &report)?;
+    if rows.is_empty() {
+        println!("drift: none ({} studies checked{})", studies.len(), if quick { ", quick forms" } else { "" });
+        Ok(())
+    } else {
+        print!("{}", study::drift::table(&rows));
+        bail!("drift: {} field(s) moved; if the change is deliberate, run `signorini drift --accept STUDY` and commit results/", rows.len())
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
@@ -244,6 +317,7 @@ fn main() -> ExitCode {
             }
         }),
         Command::Adapt(args) => run_adapt(args),
+        Command::Drift { quick, accept, study, experiments, results } => run_drift(*quick, accept, study, experiments, results),
         Command::Run { manifests, quick, jobs, shard, fresh, results } => run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, results.clone()),
         Command::Export { args, out } => run_solve(args).and_then(|(mesh, sol, r)| report::export_case(out, &mesh, &sol, &r)),
     };

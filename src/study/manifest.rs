@@ -31,6 +31,11 @@
 //! [drift]                    # tolerances of the drift check
 //! default = { rel = 1e-9, abs = 1e-14 }
 //! fields = { err_quadrature = { rel = 1e-6, abs = 0.0 } }
+//! [[drift.rates]]            # one-sided floors on observed rates in NDF
+//! run = "uniform"
+//! field = "err_quadrature"
+//! min = 1.4
+//! last = 4
 //! ```
 //!
 //! Every error names the file, the key and what was expected.
@@ -96,18 +101,31 @@ pub struct Tolerance {
     pub abs: f64,
 }
 
-/// Tolerances of the drift check, per field, with a default.
+/// A one-sided floor on an observed rate: the slope of -log(field) in log(NDF) over the last
+/// `last` levels of run `run` must be at least `min`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RateFloor {
+    pub run: String,
+    pub field: String,
+    pub min: f64,
+    pub last: usize,
+}
+
+/// Tolerances of the drift check, per field, with a default; rate floors.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DriftSpec {
     pub default: Tolerance,
     #[serde(default)]
     pub fields: BTreeMap<String, Tolerance>,
+    #[serde(default)]
+    pub rates: Vec<RateFloor>,
 }
 
 impl Default for DriftSpec {
     fn default() -> Self {
-        DriftSpec { default: Tolerance { rel: 1e-9, abs: 1e-14 }, fields: BTreeMap::new() }
+        DriftSpec { default: Tolerance { rel: 1e-9, abs: 1e-14 }, fields: BTreeMap::new(), rates: Vec::new() }
     }
 }
 
@@ -228,12 +246,21 @@ impl Manifest {
                 quick_levels,
             });
         }
+        let drift = raw.drift.unwrap_or_default();
+        for (i, r) in drift.rates.iter().enumerate() {
+            if !runs.iter().any(|p: &PlannedRun| p.spec.id == r.run) {
+                return Err(invalid(format!("drift.rates[{i}].run"), "the id of a declared run", format!("{:?}", r.run)));
+            }
+            if r.last < 2 {
+                return Err(invalid(format!("drift.rates[{i}].last"), "at least 2 levels", r.last.to_string()));
+            }
+        }
         Ok(Manifest {
             study,
             file,
             description: raw.description.unwrap_or_default(),
             runs,
-            drift: raw.drift.unwrap_or_default(),
+            drift,
             bytes: text.as_bytes().to_vec(),
         })
     }

@@ -7,6 +7,7 @@
 //! are rebuilt from all run records present. `--quick` runs the first `quick_levels` levels of
 //! the same runs: the exact prefix of the full study (same meshes, same numbers).
 
+pub mod drift;
 pub mod manifest;
 pub mod provenance;
 pub mod reference;
@@ -22,6 +23,20 @@ use reference::ReferenceField;
 use std::collections::HashMap;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+
+/// Reference solutions computed in this process, shared by every run and study that declares
+/// the same one (they are deterministic, so sharing changes no number).
+static REFERENCES: Mutex<Option<HashMap<String, Arc<ReferenceField>>>> = Mutex::new(None);
+
+fn reference_for(key: &str, compute: impl FnOnce() -> Result<ReferenceField>) -> Result<Arc<ReferenceField>> {
+    if let Some(r) = REFERENCES.lock().expect("reference cache").get_or_insert_default().get(key) {
+        return Ok(r.clone());
+    }
+    let r = Arc::new(compute()?);
+    REFERENCES.lock().expect("reference cache").get_or_insert_default().insert(key.to_string(), r.clone());
+    Ok(r)
+}
 
 /// How to run a study.
 #[derive(Clone, Debug)]
@@ -68,7 +83,6 @@ pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> 
             }
         }
     }
-    let mut references: HashMap<String, ReferenceField> = HashMap::new();
     let mut executed = Vec::new();
     for (i, planned) in manifest.runs.iter().enumerate() {
         if let Some((k, n)) = opts.shard {
@@ -86,7 +100,7 @@ pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> 
             }
             eprintln!("{}/{}: stored run has another spec, running it again", manifest.study, spec.id);
         }
-        let record = run_one(&manifest.study, &spec, &dir, &mut references, opts.progress)?;
+        let record = run_one(&manifest.study, &spec, &dir, opts.progress)?;
         records::write_json(&dir.run_file(&spec.id), &record).with_context(|| format!("writing {}", dir.run_file(&spec.id).display()))?;
         executed.push(spec.id.clone());
     }
@@ -102,21 +116,21 @@ fn reference_key(spec: &RunSpec) -> Option<String> {
 }
 
 /// One run: the adaptive loop with a progress bar, saving the declared levels.
-fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, references: &mut HashMap<String, ReferenceField>, progress: bool) -> Result<RunRecord> {
+fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Result<RunRecord> {
     let problem = problems::by_name(&spec.problem)?;
     let mesh_spec = MeshSpec::parse(&spec.mesh)?;
-    if let (Some(key), Some(rs)) = (reference_key(spec), &spec.reference) {
-        if !references.contains_key(&key) {
+    let reference = match (reference_key(spec), &spec.reference) {
+        (Some(key), Some(rs)) => Some(reference_for(&key, || {
             let spinner = bar(progress, 0, &format!("{study}/{}: reference solution (min NDF {})", spec.id, rs.min_ndof));
-            let field = reference::compute(problem.as_ref(), &mesh_spec, rs).with_context(|| format!("{study}/{}: computing the reference solution", spec.id))?;
+            let field = reference::compute(problem.as_ref(), &mesh_spec, rs).with_context(|| format!("{study}/{}: computing the reference solution", spec.id));
             spinner.finish_and_clear();
-            references.insert(key.clone(), field);
-        }
-    }
-    let reference = reference_key(spec).and_then(|k| references.get(&k));
+            field
+        })?),
+        _ => None,
+    };
     let exact = problem.exact();
     let exact_fn = exact.map(|e| move |x: [f64; 2]| e.u(x));
-    let reference_fn = reference.map(|r| move |x: [f64; 2]| r.eval(x));
+    let reference_fn = reference.as_ref().map(|r| move |x: [f64; 2]| r.eval(x));
     let error_against: Option<crate::norms::Reference> = match (&exact_fn, &reference_fn) {
         (Some(f), _) => Some(f),
         (None, Some(f)) => Some(f),
@@ -157,7 +171,7 @@ fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, references: &mut HashMap
         let last = levels.last().expect("at least one level");
         eprintln!("{study}/{}: {} levels, final NDF {}, estimate {:.3e}", spec.id, levels.len(), last.ndof, last.estimate);
     }
-    Ok(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof: reference.map(|r| r.ndof) })
+    Ok(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof: reference.as_ref().map(|r| r.ndof) })
 }
 
 fn bar(progress: bool, len: u64, prefix: &str) -> ProgressBar {
