@@ -10,27 +10,34 @@ all: build
 build:
 	$(CARGO) build --release --locked
 
-# Unit and integration tests (release mode: the convergence tests solve real systems).
+# Unit and integration tests (release mode: the convergence tests solve real systems), the
+# quick drift check against results/, and the NGSolve cross-check.
 test: build
 	$(CARGO) test --release --locked
+	$(BIN) drift --quick
 	crosscheck/run.sh
 
+# Redraw figures/ and results/CLAIMS.md from the stored results (no study is rerun).
 figures: build
-	@echo "figures: not generated yet (they come with the studies, issue 4); nothing to do."
+	$(BIN) figures
 
+# Rerun every declared study from scratch, rewrite results/, redraw.
 reproduce: build
-	@echo "reproduce: no studies are declared yet (issue 4); nothing to do."
+	$(BIN) run --fresh experiments/*.toml
+	$(BIN) figures
 
+# Quick forms of every study against results/, field by field; non-zero exit on drift.
 drift: build
-	@echo "drift: no stored results yet (issue 5); nothing to compare."
+	$(BIN) drift --quick
 
 # NGSolve cross-check: creates crosscheck/.venv from the pinned requirements on first use.
 crosscheck: build
 	crosscheck/run.sh
 
+# NGSolve's timings first, then ours with the two side by side (medians over repeats).
 bench: build
+	crosscheck/setup.sh && crosscheck/.venv/bin/python crosscheck/crosscheck.py --out-dir results/bench bench --sizes 32,64,128,256,512
 	$(CARGO) run --release --locked --bin bench
-	crosscheck/setup.sh && crosscheck/.venv/bin/python crosscheck/crosscheck.py --out-dir results/bench bench --sizes 32,64,128,256
 
 clean:
 	$(CARGO) clean

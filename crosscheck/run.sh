@@ -20,6 +20,18 @@ for spec in ex71:8 ex71:16 ex71:32 ex71:64 ex72:8 ex72:16 ex72:32; do
     [ "$p" = ex71 ] && ex71+=("$dir")
 done
 
+# adaptive meshes (level 10 of the studies' loop) and the Example 7.2 reference solution of the
+# studies (experiments/ex72.toml: adaptive, theta 0.5, eta_5 without full-contact nodes, NDF >= 250,000)
+for p in ex71 ex72; do
+    dir="$cases/$p-adaptive-10"
+    "$bin" export --problem "$p" --mesh structured:4 --adapt-levels 10 --out "$dir" || exit 1
+    all+=("$dir")
+done
+dir="$cases/ex72-reference"
+"$bin" export --problem ex72 --mesh structured:4 --adapt-min-ndof 250000 --theta 0.5 \
+    --contact-term without-full-contact --out "$dir" || exit 1
+all+=("$dir")
+
 status=0
 "$py" "$here/crosscheck.py" selftest "$cases/ex71-structured-8" "$cases/ex72-structured-8" || status=1
 "$py" "$here/crosscheck.py" compare "${all[@]}" || status=1

@@ -7,11 +7,13 @@
 
 pub mod adapt;
 pub mod assembly;
+pub mod claims;
 pub mod contact;
 pub mod element;
 pub mod estimate;
 pub mod mesh;
 pub mod norms;
+pub mod plot;
 pub mod problems;
 pub mod records;
 pub mod report;

@@ -62,6 +62,13 @@ enum Command {
         #[arg(long, default_value = "results")]
         results: std::path::PathBuf,
     },
+    /// Redraw every figure under figures/ and results/CLAIMS.md from the stored results alone.
+    Figures {
+        #[arg(long, default_value = "results")]
+        results: std::path::PathBuf,
+        #[arg(long, default_value = "figures")]
+        figures: std::path::PathBuf,
+    },
     /// Solve and write the mesh and solution for the NGSolve cross-check (mesh.vtu, case.json).
     Export {
         #[command(flatten)]
@@ -161,9 +168,16 @@ struct SolveArgs {
     /// Log every active-set iteration on stderr.
     #[arg(long, short)]
     verbose: bool,
-    /// Marking parameter (reported only: one solve marks nothing).
+    /// Marking parameter of the maximum strategy, for --adapt-levels / --adapt-min-ndof.
     #[arg(long)]
     theta: Option<f64>,
+    /// Solve on the mesh of this adaptive level (from --mesh, default estimator) instead.
+    #[arg(long)]
+    adapt_levels: Option<usize>,
+    /// Solve on the first adaptive level with at least this many unknowns (as the studies'
+    /// reference solutions do) instead.
+    #[arg(long)]
+    adapt_min_ndof: Option<usize>,
     #[command(flatten)]
     estimator: EstimatorArgs,
 }
@@ -182,7 +196,24 @@ fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::Discrete
     if args.max_pdas_iterations == 0 {
         bail!("--max-pdas-iterations must be at least 1");
     }
-    let mesh = spec.build(&|x| problem.part_of(x));
+    let mut mesh = spec.build(&|x| problem.part_of(x));
+    let mut mesh_name = spec.to_string();
+    if args.adapt_levels.is_some() || args.adapt_min_ndof.is_some() {
+        let theta = args.theta.unwrap_or(0.5);
+        if !(theta > 0.0 && theta <= 1.0) {
+            bail!("--theta must be in (0, 1], got {theta}");
+        }
+        let config = AdaptConfig { levels: args.adapt_levels.map_or(200, |l| l + 1), theta, estimator: args.estimator.config()?, ..Default::default() };
+        let min_ndof = args.adapt_min_ndof.unwrap_or(0);
+        let mut last = None;
+        adapt::run(problem.as_ref(), mesh.clone(), &config, None, &mut |l| {
+            last = Some((l.mesh.clone(), l.record.level));
+            if l.record.ndof >= min_ndof && args.adapt_min_ndof.is_some() { std::ops::ControlFlow::Break(()) } else { std::ops::ControlFlow::Continue(()) }
+        })?;
+        let (m, level) = last.expect("at least one level");
+        mesh = m;
+        mesh_name = format!("{spec} refined adaptively to level {level} (theta {theta})");
+    }
     let options = PdasOptions { max_iterations: args.max_pdas_iterations, ..Default::default() };
     let verbose = args.verbose;
     let mut log = |it: &signorini::contact::PdasIteration| {
@@ -194,10 +225,10 @@ fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::Discrete
         }
     };
     let sol = solve::solve(&mesh, problem.as_ref(), &options, &mut log)
-        .with_context(|| format!("solving {} on {}", problem.name(), spec))?;
+        .with_context(|| format!("solving {} on {}", problem.name(), mesh_name))?;
     let error = problem.exact().map(|e| norms::linf_error(&mesh, &sol, &|x| e.u(x)));
     let est = estimate::estimate(&mesh, problem.as_ref(), &sol, &args.estimator.config()?);
-    let report = report::SolveReport::new(problem.name(), &spec.to_string(), &mesh, &sol, error, &est, &probes);
+    let report = report::SolveReport::new(problem.name(), &mesh_name, &mesh, &sol, error, &est, &probes);
     Ok((mesh, sol, report))
 }
 
@@ -306,6 +337,16 @@ fn run_drift(quick: bool, accept: &[String], only: &[String], experiments: &std:
     }
 }
 
+fn run_figures(results: &std::path::Path, figures: &std::path::Path) -> Result<()> {
+    let written = signorini::plot::draw_all(results, figures)?;
+    for f in &written {
+        println!("wrote {}", f.display());
+    }
+    signorini::claims::write(results).with_context(|| format!("writing {}", results.join("CLAIMS.md").display()))?;
+    println!("wrote {}", results.join("CLAIMS.md").display());
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
@@ -317,6 +358,7 @@ fn main() -> ExitCode {
             }
         }),
         Command::Adapt(args) => run_adapt(args),
+        Command::Figures { results, figures } => run_figures(results, figures),
         Command::Drift { quick, accept, study, experiments, results } => run_drift(*quick, accept, study, experiments, results),
         Command::Run { manifests, quick, jobs, shard, fresh, results } => run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, results.clone()),
         Command::Export { args, out } => run_solve(args).and_then(|(mesh, sol, r)| report::export_case(out, &mesh, &sol, &r)),

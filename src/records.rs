@@ -49,13 +49,16 @@ pub struct RunSpec {
     pub save_levels: Vec<usize>,
 }
 
-/// How a reference solution is computed: adaptive refinement (default estimator, maximum
-/// strategy with `theta`) from the run's initial mesh until the NDF reaches `min_ndof`. Fixed
-/// by the manifest, not by the run's length, so the quick form measures the same errors.
+/// How a reference solution is computed: adaptive refinement (maximum strategy with `theta`,
+/// the estimator with `contact_term`) from the run's initial mesh until the NDF reaches
+/// `min_ndof`. Fixed by the manifest, not by the run's length, so the quick form measures the
+/// same errors. The default contact term drops full-contact nodes: with eta_5 as written the
+/// refinement piles up along Gamma_C and leaves the body coarse, a biased reference.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ReferenceSpec {
     pub theta: f64,
     pub min_ndof: usize,
+    pub contact_term: crate::estimate::ContactTerm,
 }
 
 /// The record of one finished run: its spec and one `LevelRecord` per level.

@@ -26,6 +26,9 @@ struct Args {
     /// Output file.
     #[arg(long, default_value = "results/bench/solver.json")]
     out: std::path::PathBuf,
+    /// NGSolve's timings of the same systems (crosscheck.py bench), printed side by side.
+    #[arg(long, default_value = "results/bench/ngsolve_bench.json")]
+    ngsolve: std::path::PathBuf,
 }
 
 #[derive(serde::Serialize, Default, Clone)]
@@ -148,5 +151,31 @@ fn main() -> Result<()> {
     });
     records::write_json(&args.out, &doc)?;
     println!("wrote {}", args.out.display());
+    side_by_side(&results, &args.ngsolve);
     Ok(())
+}
+
+/// Our medians next to NGSolve's for the same meshes: assembly, one linear solve (factorisation
+/// and solve), and our whole contact solve against NGSolve's linear solve.
+fn side_by_side(ours: &[SizeResult], ngsolve: &std::path::Path) {
+    let Ok(text) = std::fs::read_to_string(ngsolve) else {
+        println!("(no NGSolve timings at {}: run `make bench` or crosscheck.py bench)", ngsolve.display());
+        return;
+    };
+    let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return };
+    let rows = doc["rows"].as_array().cloned().unwrap_or_default();
+    println!("\n{:<34} {:>5} {:>10} {:>10} {:>7}", "phase", "N", "ours [s]", "NGSolve", "ratio");
+    for r in ours {
+        let Some(ng) = rows.iter().find(|x| x["N"].as_u64() == Some(r.n as u64)) else { continue };
+        let f = |k: &str| ng[k].as_f64().unwrap_or(f64::NAN);
+        let ng_linear = f("factorisation_s") + f("solve_s");
+        let lines = [
+            ("assembly", r.median.assembly, f("assembly_s")),
+            ("linear solve (factor + solve)", r.median.symbolic + r.median.linear_solve, ng_linear),
+            ("contact solve vs their linear", r.median.symbolic + r.median.contact_solve, ng_linear),
+        ];
+        for (name, a, b) in lines {
+            println!("{:<34} {:>5} {:>10.3} {:>10.3} {:>7.2}", name, r.n, a, b, a / b);
+        }
+    }
 }

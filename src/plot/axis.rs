@@ -43,16 +43,16 @@ impl Axis {
     /// Spacing of the labelled ticks of a linear axis: 1, 2 or 5 times a power of ten.
     fn linear_step(&self) -> f64 {
         let raw = (self.hi - self.lo).abs() / LINEAR_TICKS;
-        if !(raw > 0.0) || !raw.is_finite() {
+        if raw.is_nan() || raw <= 0.0 || !raw.is_finite() {
             return 1.0;
         }
         let p = 10f64.powf(raw.log10().floor());
         let m = raw / p;
-        let nice = if m <= 1.0 {
+        let nice = if m < 1.5 {
             1.0
-        } else if m <= 2.0 {
+        } else if m < 3.0 {
             2.0
-        } else if m <= 5.0 {
+        } else if m < 7.0 {
             5.0
         } else {
             10.0
@@ -132,7 +132,7 @@ impl Axis {
 
 /// `10⁻⁴`, `2×10⁻⁴`.
 pub(crate) fn log_label(v: f64) -> String {
-    if !(v > 0.0) {
+    if v.is_nan() || v <= 0.0 {
         return format!("{v}");
     }
     let e = v.log10().floor() as i32;
@@ -178,7 +178,7 @@ impl Ranged for Axis {
 
     fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
         let (a, b) = (self.t(self.lo), self.t(self.hi));
-        let v = if self.log && !(*value > 0.0) { self.lo * 1e-3 } else { *value };
+        let v = if self.log && (value.is_nan() || *value <= 0.0) { self.lo * 1e-3 } else { *value };
         let f = (self.t(v) - a) / (b - a);
         let px = limit.0 as f64 + f * (limit.1 - limit.0) as f64;
         px.clamp(-1e6, 1e6).round() as i32

@@ -20,6 +20,7 @@
 //! [defaults.reference]       # optional: errors against a finer adaptive solution
 //! theta = 0.5
 //! min_ndof = 640000
+//! contact_term = "without_full_contact"   # the default; see records::ReferenceSpec
 //!
 //! [[run]]                    # each run overrides what it names
 //! id = "adaptive"
@@ -73,6 +74,7 @@ struct EstimatorOverrides {
 struct ReferenceToml {
     theta: f64,
     min_ndof: usize,
+    contact_term: Option<ContactTerm>,
 }
 
 #[derive(Clone, Debug, Default, Deserialize)]
@@ -240,7 +242,7 @@ impl Manifest {
                     levels,
                     max_ndof: r.max_ndof.or(d.max_ndof),
                     estimator,
-                    reference: reference.map(|rf| ReferenceSpec { theta: rf.theta, min_ndof: rf.min_ndof }),
+                    reference: reference.map(|rf| ReferenceSpec { theta: rf.theta, min_ndof: rf.min_ndof, contact_term: rf.contact_term.unwrap_or(ContactTerm::WithoutFullContact) }),
                     save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
                 },
                 quick_levels,

@@ -112,7 +112,7 @@ pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> 
 }
 
 fn reference_key(spec: &RunSpec) -> Option<String> {
-    spec.reference.as_ref().map(|r| format!("{}|{}|{}|{}", spec.problem, spec.mesh, r.theta, r.min_ndof))
+    spec.reference.as_ref().map(|r| format!("{}|{}|{}|{}|{:?}", spec.problem, spec.mesh, r.theta, r.min_ndof, r.contact_term))
 }
 
 /// One run: the adaptive loop with a progress bar, saving the declared levels.

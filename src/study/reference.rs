@@ -67,11 +67,13 @@ impl ReferenceField {
     }
 }
 
-/// Compute the reference solution: adaptive refinement with the default estimator from
-/// `mesh_spec` until the NDF reaches `spec.min_ndof`; the last level's solution.
+/// Compute the reference solution: adaptive refinement from `mesh_spec` (estimator with
+/// `spec.contact_term`, otherwise the defaults) until the NDF reaches `spec.min_ndof`; the last
+/// level's solution.
 pub fn compute(problem: &dyn Problem, mesh_spec: &MeshSpec, spec: &ReferenceSpec) -> Result<ReferenceField, SolveError> {
     let mesh = mesh_spec.build(&|x| problem.part_of(x));
-    let config = AdaptConfig { levels: 200, refine: Refine::Adaptive, theta: spec.theta, ..Default::default() };
+    let estimator = crate::estimate::EstimatorConfig { contact_term: spec.contact_term, ..Default::default() };
+    let config = AdaptConfig { levels: 200, refine: Refine::Adaptive, theta: spec.theta, estimator, ..Default::default() };
     let mut result: Option<ReferenceField> = None;
     adapt::run(problem, mesh, &config, None, &mut |level| {
         if level.record.ndof >= spec.min_ndof {

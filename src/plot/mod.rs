@@ -1,0 +1,625 @@
+//! Figures of Section 7, regenerated from the stored records alone (`results/STUDY/runs/*.json`
+//! and `results/STUDY/meshes/*.json`); nothing here calls the solver.
+//!
+//! [`draw_all`] writes every figure as `figures/NAME.svg` and `figures/NAME.png` (900 x 650, or
+//! 800 px per panel for two-panel figures). A figure whose study (or run, or mesh snapshot) has
+//! no results yet is skipped with a note on stderr; [`draw_figures`] returns the notes instead.
+//! Runs are found by their `RunSpec`, not by a fixed list: runs are grouped by `run.problem`,
+//! ordered adaptive (by theta) before uniform, and labelled from their spec or id, so new runs
+//! of a study appear without code changes.
+//!
+//! NDF on every x axis is `LevelRecord::ndof` = 2 x number of P2 nodes, Dirichlet nodes included.
+//! The "estimate" is `LevelRecord::estimate` = C0 * eta_h; the "error" is `err_quadrature`
+//! (||u - u_h||_Linf at the quadrature points, the paper's way; for Example 7.2 against the
+//! reference solution where one was computed).
+//!
+//! | figure | study / runs | shows |
+//! |---|---|---|
+//! | `fig2a` | `ex71`, all runs (`adaptive`, `uniform` dashed) | `err_quadrature` and `estimate` vs NDF, log-log, NDF^-3/2 reference |
+//! | `fig2b` | `ex71`, all runs | efficiency index `efficiency` (= estimate / err_quadrature) vs NDF, line at 1 |
+//! | `fig3a` | `ex72`, all runs | `estimate` vs NDF, plus `err_quadrature` (vs the reference solution) where present, NDF^-3/2 |
+//! | `fig3b` | `ex72`, mesh snapshot of run `adaptive` at level 20 | triangles, active (red) / inactive (blue) contact nodes, the obstacle's kink, NDF in the title |
+//! | `fig4a` | `ex71`, run `adaptive` | `eta1`..`eta5` vs NDF, NDF^-3/2; `eta6`, `eta7` noted in the legend |
+//! | `fig4b` | `ex72`, run `adaptive` | `eta1`..`eta7` vs NDF, NDF^-3/2 |
+//! | `c0_sweep` | `c0_sweep`, panel per problem | efficiency C0' eta_h / err_quadrature for C0' = 0.45 (solid) and the smallest reliable C0' = max_levels err/eta_h (dashed), per run; line at 1 |
+//! | `log_ablation` | `log_ablation`, panel per problem | efficiency per level (vs NDF) for each `estimator.log_factor`; line at 1 |
+//! | `contact_term_ablation` | `contact_term_ablation`, panel per problem | `estimate` (solid) and `eta5` (dashed) vs NDF for each `estimator.contact_term` |
+//! | `theta_ablation` | `theta_ablation`, panel per problem | `err_quadrature` vs NDF for each theta and uniform (the estimate instead where a problem's runs lack errors; the y label says which), NDF^-3/2 |
+//!
+//! On log axes a value that is exactly 0 cannot be drawn: the point is left out, the line
+//! breaks, and the legend says so ("η₆ = 0 at all levels", or "(= 0 at 3 of 20 levels)").
+//! Missing values (`None`, e.g. no error measured at a level) are left out silently.
+//!
+//! Fonts: DejaVu Sans is bundled (`src/plot/DejaVuSans.ttf`, copied from the Debian
+//! fonts-dejavu-core package; the DejaVu fonts licence, a Bitstream Vera derivative, permits
+//! redistributing and embedding the font) and registered with plotters' ab_glyph backend, so no
+//! system font is needed. SVG text asks for "DejaVu Sans, sans-serif".
+
+mod axis;
+mod render;
+mod rich;
+
+use crate::adapt::{LevelRecord, Refine};
+use crate::estimate::{ContactTerm, LogFactor};
+use crate::records::{MeshSnapshot, RunRecord, StudyDir};
+use anyhow::Context;
+use plotters::prelude::*;
+use render::{Figure, HLine, LineFigure, Marker, MeshFigure, Panel, Series, Slope, SlopeAnchor, Style, YScale, PALETTE};
+use std::collections::{BTreeMap, HashSet};
+use std::path::{Path, PathBuf};
+
+/// Every figure, in the order drawn.
+pub const FIGURES: [&str; 10] =
+    ["fig2a", "fig2b", "fig3a", "fig3b", "fig4a", "fig4b", "c0_sweep", "log_ablation", "contact_term_ablation", "theta_ablation"];
+
+/// C0 of Section 7.
+const C0_PAPER: f64 = 0.45;
+/// The level of the mesh in Fig. 3(b).
+const MESH_LEVEL: usize = 20;
+
+const NDF_DESC: &str = "NDF (2 × P2 nodes, Dirichlet nodes included)";
+const ERR: &str = "‖u − u_{h}‖_{∞}";
+const EFF_DESC: &str = "efficiency index C_{0}η_{h} / ‖u − u_{h}‖_{∞}";
+const ESTIMATE: &str = "estimate C_{0}η_{h}";
+
+/// The bundled font (DejaVu Sans, see the module documentation for its licence).
+static FONT_BYTES: &[u8] = include_bytes!("DejaVuSans.ttf");
+
+/// What [`draw_figures`] did.
+#[derive(Clone, Debug, Default)]
+pub struct Outcome {
+    /// Every file written (`NAME.svg` and `NAME.png` per figure drawn).
+    pub written: Vec<PathBuf>,
+    /// Figures not drawn because their results do not exist yet: (figure, reason).
+    pub skipped: Vec<(String, String)>,
+}
+
+/// Draw every figure whose results exist into `figures/`; figures without results are skipped
+/// with a note on stderr. Returns the files written.
+pub fn draw_all(results: &Path, figures: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    let outcome = draw_figures(results, figures)?;
+    for (name, why) in &outcome.skipped {
+        eprintln!("figures: skipped {name}: {why}");
+    }
+    Ok(outcome.written)
+}
+
+/// Draw every figure whose results exist; report the files written and the figures skipped.
+/// A figure that fails (unreadable record, drawing error) does not stop the others; the errors
+/// are reported together at the end.
+pub fn draw_figures(results: &Path, figures: &Path) -> anyhow::Result<Outcome> {
+    register_font()?;
+    std::fs::create_dir_all(figures).with_context(|| format!("creating {}", figures.display()))?;
+    let mut outcome = Outcome::default();
+    let mut errors = Vec::new();
+    for name in FIGURES {
+        match build(name, results).and_then(|b| match b {
+            Ok(fig) => write_figure(&fig, figures, name).map(Ok),
+            Err(why) => Ok(Err(why)),
+        }) {
+            Ok(Ok(files)) => outcome.written.extend(files),
+            Ok(Err(why)) => outcome.skipped.push((name.to_string(), why)),
+            Err(e) => errors.push(format!("{name}: {e:#}")),
+        }
+    }
+    if !errors.is_empty() {
+        anyhow::bail!("{} figure(s) failed:\n  {}", errors.len(), errors.join("\n  "));
+    }
+    Ok(outcome)
+}
+
+fn register_font() -> anyhow::Result<()> {
+    static REGISTERED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| plotters::style::register_font(render::FONT, FontStyle::Normal, FONT_BYTES).is_ok());
+    anyhow::ensure!(ok, "the bundled font DejaVuSans.ttf could not be loaded");
+    Ok(())
+}
+
+/// Render as SVG (into a string, written atomically) and PNG (into a temporary file in the same
+/// directory, then renamed: the `image` encoder behind plotters writes only to paths).
+fn write_figure(fig: &Figure, dir: &Path, name: &str) -> anyhow::Result<Vec<PathBuf>> {
+    let size = fig.size();
+    let svg = dir.join(format!("{name}.svg"));
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        fig.render(&root, rich::SVG)?;
+    }
+    crate::records::write_atomic(&svg, text.as_bytes()).with_context(|| format!("writing {}", svg.display()))?;
+
+    let png = dir.join(format!("{name}.png"));
+    let tmp = dir.join(format!(".{name}.tmp{}.png", std::process::id()));
+    let drawn = {
+        // the backend saves the file when presented (or dropped), before the rename below
+        let root = BitMapBackend::new(&tmp, size).into_drawing_area();
+        fig.render(&root, rich::BITMAP)
+    };
+    if let Err(e) = drawn.and_then(|()| std::fs::rename(&tmp, &png).with_context(|| format!("writing {}", png.display()))) {
+        std::fs::remove_file(&tmp).ok();
+        return Err(e);
+    }
+    Ok(vec![svg, png])
+}
+
+/// A figure, or the reason it cannot be drawn yet.
+type Built = Result<Figure, String>;
+
+fn build(name: &str, results: &Path) -> anyhow::Result<Built> {
+    match name {
+        "fig2a" => fig2a(results),
+        "fig2b" => fig2b(results),
+        "fig3a" => fig3a(results),
+        "fig3b" => fig3b(results),
+        "fig4a" => fig4(results, "ex71", "4a", 5),
+        "fig4b" => fig4(results, "ex72", "4b", 7),
+        "c0_sweep" => c0_sweep(results),
+        "log_ablation" => log_ablation(results),
+        "contact_term_ablation" => contact_term_ablation(results),
+        "theta_ablation" => theta_ablation(results),
+        other => anyhow::bail!("unknown figure {other}"),
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// reading and ordering records
+
+/// The runs of a study, adaptive (by theta) before uniform, then by id; `Err` if there are none.
+fn runs(results: &Path, study: &str) -> anyhow::Result<Result<Vec<RunRecord>, String>> {
+    let dir = StudyDir::new(results, study);
+    let mut runs = dir.read_runs().with_context(|| format!("reading {}", dir.root.display()))?;
+    runs.retain(|r| !r.levels.is_empty());
+    if runs.is_empty() {
+        return Ok(Err(format!("study {study} has no runs yet ({})", dir.root.join("runs").display())));
+    }
+    runs.sort_by(|a, b| order_key(a).partial_cmp(&order_key(b)).unwrap_or(std::cmp::Ordering::Equal).then_with(|| a.run.id.cmp(&b.run.id)));
+    Ok(Ok(runs))
+}
+
+fn order_key(r: &RunRecord) -> (u8, f64) {
+    match r.run.refine {
+        Refine::Adaptive => (0, r.run.theta),
+        Refine::Uniform => (1, 0.0),
+    }
+}
+
+/// Runs grouped by problem (sorted by problem name), each group in `runs` order.
+fn by_problem(runs: &[RunRecord]) -> BTreeMap<String, Vec<&RunRecord>> {
+    let mut m: BTreeMap<String, Vec<&RunRecord>> = BTreeMap::new();
+    for r in runs {
+        m.entry(r.run.problem.clone()).or_default().push(r);
+    }
+    m
+}
+
+/// The adaptive run of a study: id `adaptive`, else the first adaptive run.
+fn adaptive_run(runs: &[RunRecord]) -> Option<&RunRecord> {
+    runs.iter().find(|r| r.run.id == "adaptive").or_else(|| runs.iter().find(|r| r.run.refine == Refine::Adaptive))
+}
+
+fn problem_title(problem: &str) -> String {
+    match problem {
+        "ex71" => "Example 7.1".to_string(),
+        "ex72" => "Example 7.2".to_string(),
+        other => other.to_string(),
+    }
+}
+
+/// The run id without its problem prefix (`ex71_theta0.5` -> `theta0.5`).
+fn short_id(r: &RunRecord) -> &str {
+    r.run.id.strip_prefix(&format!("{}_", r.run.problem)).unwrap_or(&r.run.id)
+}
+
+fn refine_label(r: &RunRecord) -> String {
+    match r.run.refine {
+        Refine::Adaptive => format!("adaptive θ = {}", r.run.theta),
+        Refine::Uniform => "uniform".to_string(),
+    }
+}
+
+/// A suffix telling `r` apart from the other runs of `group` with the same `key`: the
+/// refinement if that tells them apart, else the short id; empty if no other run has the key.
+fn distinguish<K: PartialEq>(group: &[&RunRecord], r: &RunRecord, key: impl Fn(&RunRecord) -> K) -> String {
+    let k = key(r);
+    let same: Vec<&RunRecord> = group.iter().copied().filter(|o| key(o) == k).collect();
+    if same.len() <= 1 {
+        String::new()
+    } else if same.iter().filter(|o| refine_label(o) == refine_label(r)).count() == 1 {
+        format!(" ({})", refine_label(r))
+    } else {
+        format!(" ({})", short_id(r))
+    }
+}
+
+fn series(r: &RunRecord, label: String, style: Style, y: impl Fn(&LevelRecord) -> Option<f64>) -> Series {
+    Series { label, points: r.levels.iter().map(|l| (l.ndof as f64, y(l))).collect(), style }
+}
+
+fn efficiency(l: &LevelRecord) -> Option<f64> {
+    l.efficiency.or_else(|| l.err_quadrature.filter(|&e| e > 0.0).map(|e| l.estimate / e))
+}
+
+fn slope() -> Slope {
+    Slope { rate: -1.5, label: "NDF^{−3/2}".to_string(), anchor: SlopeAnchor::BelowAll }
+}
+
+fn eff_one() -> HLine {
+    HLine { y: 1.0, label: "efficiency = 1".to_string() }
+}
+
+/// `1.23×10^{-4}` (markup for `rich`).
+fn sci(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let e = v.abs().log10().floor() as i32;
+    let m = v / 10f64.powi(e);
+    if (-2..=3).contains(&e) { format!("{v:.*}", (2 - e).max(0) as usize) } else { format!("{m:.2}×10^{{{e}}}") }
+}
+
+fn single(panel: Panel) -> Figure {
+    Figure::Lines(LineFigure { title: None, panels: vec![panel] })
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fig. 2, 3, 4
+
+const COLOR_ERROR: RGBColor = PALETTE[0];
+const COLOR_ESTIMATE: RGBColor = PALETTE[1];
+
+/// Error (blue circles) and estimate (red squares) per run; the first run solid, others dashed.
+fn error_and_estimate(runs: &[RunRecord], panel: &mut Panel, error_label: &str) {
+    for (k, r) in runs.iter().enumerate() {
+        let secondary = k > 0;
+        let id = &r.run.id;
+        if r.levels.iter().any(|l| l.err_quadrature.is_some()) {
+            let st = Style { color: COLOR_ERROR, marker: Marker::Circle, dashed: false, filled: true }.dashed(secondary);
+            panel.series.push(series(r, format!("{error_label}, {id}"), st, |l| l.err_quadrature));
+        }
+        let st = Style { color: COLOR_ESTIMATE, marker: Marker::Square, dashed: false, filled: true }.dashed(secondary);
+        panel.series.push(series(r, format!("{ESTIMATE}, {id}"), st, |l| Some(l.estimate)));
+    }
+}
+
+fn fig2a(results: &Path) -> anyhow::Result<Built> {
+    let runs = match runs(results, "ex71")? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let mut p = Panel::new("Example 7.1: error and estimate vs NDF", NDF_DESC, format!("error {ERR} and {ESTIMATE}"));
+    error_and_estimate(&runs, &mut p, &format!("error {ERR}"));
+    p.slopes.push(Slope { anchor: SlopeAnchor::Below(0), ..slope() });
+    Ok(Ok(single(p)))
+}
+
+fn fig2b(results: &Path) -> anyhow::Result<Built> {
+    let runs = match runs(results, "ex71")? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let mut p = Panel::new("Example 7.1: efficiency index", NDF_DESC, EFF_DESC);
+    p.y_scale = YScale::Auto;
+    for (k, r) in runs.iter().enumerate() {
+        p.series.push(series(r, r.run.id.clone(), Style::nth(k).dashed(r.run.refine == Refine::Uniform), efficiency));
+    }
+    p.hlines.push(eff_one());
+    if !p.has_data() {
+        return Ok(Err("study ex71 has no errors recorded".to_string()));
+    }
+    Ok(Ok(single(p)))
+}
+
+fn fig3a(results: &Path) -> anyhow::Result<Built> {
+    let runs = match runs(results, "ex72")? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let mut p = Panel::new("Example 7.2: estimate vs NDF", NDF_DESC, format!("{ESTIMATE} (and error vs reference solution)"));
+    error_and_estimate(&runs, &mut p, &format!("error {ERR} vs reference"));
+    let mut reference: Vec<usize> = runs.iter().filter_map(|r| r.reference_ndof).collect();
+    reference.dedup();
+    if !reference.is_empty() {
+        let list = reference.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", ");
+        p.notes.push(format!("reference solution: NDF {list}"));
+    }
+    // anchor the slope at the estimate of the first run
+    if let Some(i) = p.series.iter().position(|s| s.label.starts_with("estimate")) {
+        p.slopes.push(Slope { anchor: SlopeAnchor::Below(i), ..slope() });
+    }
+    Ok(Ok(single(p)))
+}
+
+fn fig4(results: &Path, study: &str, fig: &str, terms: usize) -> anyhow::Result<Built> {
+    let runs = match runs(results, study)? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let Some(r) = adaptive_run(&runs) else {
+        return Ok(Err(format!("study {study} has no adaptive run yet")));
+    };
+    let etas = |l: &LevelRecord| [l.eta1, l.eta2, l.eta3, l.eta4, l.eta5, l.eta6, l.eta7];
+    let mut p = Panel::new(
+        format!("{}: individual estimators ({}, Fig. {fig})", problem_title(&r.run.problem), refine_label(r)),
+        NDF_DESC,
+        "estimator contributions η_{i}",
+    );
+    for i in 0..terms {
+        p.series.push(series(r, format!("η_{{{}}}", i + 1), Style::nth(i), |l| Some(etas(l)[i])));
+    }
+    // the terms not plotted (Fig. 4(a) shows eta1..eta5): say what they are
+    for i in terms..7 {
+        let max = r.levels.iter().map(|l| etas(l)[i]).fold(0.0, f64::max);
+        let eta = format!("η_{{{}}}", i + 1);
+        p.notes.push(if max == 0.0 { format!("{eta} = 0 at all levels (not shown)") } else { format!("{eta} not shown (max {})", sci(max)) });
+    }
+    p.slopes.push(Slope { anchor: SlopeAnchor::AboveAll, ..slope() });
+    Ok(Ok(single(p)))
+}
+
+fn fig3b(results: &Path) -> anyhow::Result<Built> {
+    let dir = StudyDir::new(results, "ex72");
+    let mut level = MESH_LEVEL;
+    let mut note = String::new();
+    if !dir.mesh_file("adaptive", level, "json").exists() {
+        // fall back to the finest saved level of the adaptive run, saying so in the title
+        let Some(l) = saved_levels(&dir, "adaptive").into_iter().max() else {
+            return Ok(Err(format!("no mesh snapshot {}", dir.mesh_file("adaptive", level, "json").display())));
+        };
+        note = format!(" (level {MESH_LEVEL} not saved)");
+        level = l;
+    }
+    let snap = dir.read_mesh("adaptive", level).with_context(|| format!("reading the mesh snapshot of level {level}"))?;
+    Ok(Ok(Figure::Mesh(mesh_figure(&snap, &note))))
+}
+
+/// Levels `L` with a `meshes/RUN_levelL.json`.
+fn saved_levels(dir: &StudyDir, run: &str) -> Vec<usize> {
+    let prefix = format!("{run}_level");
+    std::fs::read_dir(dir.root.join("meshes"))
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .filter_map(|e| {
+                    let name = e.file_name().to_string_lossy().into_owned();
+                    name.strip_prefix(&prefix)?.strip_suffix(".json")?.parse().ok()
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+fn mesh_figure(s: &MeshSnapshot, note: &str) -> MeshFigure {
+    let p = |v: [f64; 2]| (v[0], v[1]);
+    let mut bbox = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+    for v in &s.vertices {
+        bbox = [bbox[0].min(v[0]), bbox[1].min(v[1]), bbox[2].max(v[0]), bbox[3].max(v[1])];
+    }
+    if !bbox[0].is_finite() {
+        bbox = [0.0, 0.0, 1.0, 1.0];
+    }
+    MeshFigure {
+        title: format!("{}: {} mesh at level {}{note}, NDF = {}", problem_title(&problem_of(s)), s.run, s.level, s.ndof),
+        edges: edge_chains(&s.vertices, &s.triangles),
+        active: s.contact_nodes.iter().filter(|c| c.1).map(|c| p(c.0)).collect(),
+        inactive: s.contact_nodes.iter().filter(|c| !c.1).map(|c| p(c.0)).collect(),
+        kinks: s.kinks.iter().map(|&k| p(k)).collect(),
+        bbox,
+        n_triangles: s.triangles.len(),
+        n_vertices: s.vertices.len(),
+    }
+}
+
+/// The snapshot does not store its problem; the study name says it for the paper's studies.
+fn problem_of(s: &MeshSnapshot) -> String {
+    if s.study.starts_with("ex71") {
+        "ex71".into()
+    } else if s.study.starts_with("ex72") {
+        "ex72".into()
+    } else {
+        s.study.clone()
+    }
+}
+
+/// The mesh edges (each once) joined greedily into polylines.
+fn edge_chains(vertices: &[[f64; 2]], triangles: &[[usize; 3]]) -> Vec<Vec<(f64, f64)>> {
+    let n = vertices.len();
+    let mut seen = HashSet::new();
+    let mut adj: Vec<Vec<(usize, usize)>> = vec![Vec::new(); n];
+    let mut n_edges = 0;
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if a >= n || b >= n || a == b {
+                continue;
+            }
+            if seen.insert((a.min(b), a.max(b))) {
+                adj[a].push((b, n_edges));
+                adj[b].push((a, n_edges));
+                n_edges += 1;
+            }
+        }
+    }
+    let mut used = vec![false; n_edges];
+    let mut next = vec![0usize; n];
+    let mut chains = Vec::new();
+    // start at odd-degree vertices first: fewer, longer chains
+    let mut starts: Vec<usize> = (0..n).filter(|&v| !adj[v].len().is_multiple_of(2)).collect();
+    starts.extend((0..n).filter(|&v| adj[v].len().is_multiple_of(2)));
+    for s in starts {
+        loop {
+            let mut cur = s;
+            let mut chain = vec![cur];
+            loop {
+                while next[cur] < adj[cur].len() && used[adj[cur][next[cur]].1] {
+                    next[cur] += 1;
+                }
+                let Some(&(to, e)) = adj[cur].get(next[cur]) else { break };
+                used[e] = true;
+                chain.push(to);
+                cur = to;
+            }
+            if chain.len() < 2 {
+                break;
+            }
+            chains.push(chain.into_iter().map(|v| (vertices[v][0], vertices[v][1])).collect());
+        }
+    }
+    chains
+}
+
+// ---------------------------------------------------------------------------------------------
+// ablations: one panel per problem
+
+fn panels(title: &str, panels: Vec<Panel>) -> Figure {
+    if panels.len() == 1 {
+        let mut p = panels.into_iter().next().expect("one panel");
+        p.title = format!("{title}: {}", p.title);
+        single(p)
+    } else {
+        Figure::Lines(LineFigure { title: Some(title.to_string()), panels })
+    }
+}
+
+fn c0_sweep(results: &Path) -> anyhow::Result<Built> {
+    let runs = match runs(results, "c0_sweep")? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let mut out = Vec::new();
+    for (problem, group) in by_problem(&runs) {
+        let mut p = Panel::new(problem_title(&problem), NDF_DESC, EFF_DESC);
+        p.y_scale = YScale::Auto;
+        for (k, r) in group.iter().enumerate() {
+            let ratio = |l: &LevelRecord| l.err_quadrature.filter(|&e| e > 0.0 && l.eta_h > 0.0).map(|e| l.eta_h / e);
+            let c0_min = r.levels.iter().filter_map(|l| ratio(l).map(|q| 1.0 / q)).fold(f64::NEG_INFINITY, f64::max);
+            if !c0_min.is_finite() {
+                p.notes.push(format!("{}: no errors recorded", short_id(r)));
+                continue;
+            }
+            let st = Style::nth(k);
+            p.series.push(series(r, format!("{}, C_{{0}} = {C0_PAPER}", short_id(r)), st, |l| ratio(l).map(|q| C0_PAPER * q)));
+            p.series.push(series(r, format!("{}, C_{{0}} = {} (smallest reliable)", short_id(r), sci(c0_min)), st.dashed(true), |l| {
+                ratio(l).map(|q| c0_min * q)
+            }));
+        }
+        p.hlines.push(eff_one());
+        out.push(p);
+    }
+    if !out.iter().any(Panel::has_data) {
+        return Ok(Err("study c0_sweep has no errors recorded".to_string()));
+    }
+    Ok(Ok(panels("C_{0} sweep: efficiency for C_{0} = 0.45 and the smallest reliable C_{0}", out)))
+}
+
+fn log_label(f: LogFactor) -> &'static str {
+    match f {
+        LogFactor::Squared => "l_{h} = 1 + |log h_{min}|^{2}",
+        LogFactor::Linear => "l_{h} = 1 + |log h_{min}|",
+        LogFactor::One => "l_{h} = 1",
+    }
+}
+
+fn log_ablation(results: &Path) -> anyhow::Result<Built> {
+    let runs = match runs(results, "log_ablation")? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let mut out = Vec::new();
+    for (problem, mut group) in by_problem(&runs) {
+        let mut p = Panel::new(problem_title(&problem), NDF_DESC, EFF_DESC);
+        p.y_scale = YScale::Auto;
+        group.sort_by_key(|r| r.run.estimator.log_factor as u8);
+        for (k, r) in group.iter().enumerate() {
+            let label = format!("{}{}", log_label(r.run.estimator.log_factor), distinguish(&group, r, |o| o.run.estimator.log_factor));
+            p.series.push(series(r, label, Style::nth(k), efficiency));
+        }
+        p.hlines.push(eff_one());
+        out.push(p);
+    }
+    if !out.iter().any(Panel::has_data) {
+        return Ok(Err("study log_ablation has no errors recorded".to_string()));
+    }
+    Ok(Ok(panels("Log factor ablation (efficiency per level)", out)))
+}
+
+fn contact_label(c: ContactTerm) -> &'static str {
+    match c {
+        ContactTerm::AsWritten => "as written",
+        ContactTerm::WithoutFullContact => "without full-contact nodes",
+    }
+}
+
+fn contact_term_ablation(results: &Path) -> anyhow::Result<Built> {
+    let runs = match runs(results, "contact_term_ablation")? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let mut out = Vec::new();
+    for (problem, group) in by_problem(&runs) {
+        let mut p = Panel::new(problem_title(&problem), NDF_DESC, format!("{ESTIMATE} (solid) and η_{{5}} (dashed)"));
+        for (k, r) in group.iter().enumerate() {
+            let variant = format!("{}{}", contact_label(r.run.estimator.contact_term), distinguish(&group, r, |o| o.run.estimator.contact_term));
+            let st = Style::nth(k);
+            p.series.push(series(r, format!("estimate, {variant}"), st, |l| Some(l.estimate)));
+            let st5 = Style { marker: render::MARKERS[(k + 4) % render::MARKERS.len()], ..st }.dashed(true);
+            p.series.push(series(r, format!("η_{{5}}, {variant}"), st5, |l| Some(l.eta5)));
+        }
+        out.push(p);
+    }
+    Ok(Ok(panels("Contact term ablation: η_{5} with and without full-contact nodes", out)))
+}
+
+fn theta_ablation(results: &Path) -> anyhow::Result<Built> {
+    let runs = match runs(results, "theta_ablation")? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let mut out = Vec::new();
+    for (problem, group) in by_problem(&runs) {
+        // the error where every run of the problem has some, else the estimate for all
+        let errors = group.iter().all(|r| r.levels.iter().filter(|l| l.err_quadrature.is_some()).count() >= 2);
+        let y_desc = if errors {
+            if group.iter().any(|r| r.reference_ndof.is_some()) { format!("error {ERR} (vs reference solution)") } else { format!("error {ERR}") }
+        } else {
+            format!("{ESTIMATE} (errors not available)")
+        };
+        let mut p = Panel::new(problem_title(&problem), NDF_DESC, y_desc);
+        for (k, r) in group.iter().enumerate() {
+            let uniform = r.run.refine == Refine::Uniform;
+            let theta = |o: &RunRecord| if o.run.refine == Refine::Uniform { "uniform".to_string() } else { format!("θ = {}", o.run.theta) };
+            let label = format!("{}{}", theta(r), distinguish(&group, r, theta));
+            let y = move |l: &LevelRecord| if errors { l.err_quadrature } else { Some(l.estimate) };
+            p.series.push(series(r, label, Style::nth(k).dashed(uniform), y));
+        }
+        p.slopes.push(slope());
+        out.push(p);
+    }
+    Ok(Ok(panels("Marking parameter θ: error vs NDF", out)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edge_chains_cover_each_edge_once() {
+        let v = vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]];
+        let t = vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]];
+        let chains = edge_chains(&v, &t);
+        let segments: usize = chains.iter().map(|c| c.len() - 1).sum();
+        assert_eq!(segments, 8);
+        let mut seen = HashSet::new();
+        for c in &chains {
+            for w in c.windows(2) {
+                let key = |p: (f64, f64)| ((p.0 * 10.0) as i32, (p.1 * 10.0) as i32);
+                let (a, b) = (key(w[0]), key(w[1]));
+                assert!(seen.insert((a.min(b), a.max(b))), "edge drawn twice");
+            }
+        }
+    }
+
+    #[test]
+    fn scientific() {
+        assert_eq!(sci(1.234e-5), "1.23×10^{-5}");
+        assert_eq!(sci(0.0123), "0.0123");
+        assert_eq!(sci(0.45), "0.450");
+    }
+}

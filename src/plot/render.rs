@@ -1,0 +1,845 @@
+//! Drawing: a figure description (`Figure`, built from records in `mod.rs`) onto any plotters
+//! backend. The same code renders the SVG and the PNG.
+//!
+//! Line panels: log x (NDF), log or linear y, one colour and marker shape per series, dashed
+//! lines and hollow markers for secondary series, reference slopes dashed grey with their label
+//! next to the line, horizontal guide lines (efficiency = 1), and a legend in a white box put in
+//! the first corner of the plot (upper right, upper left, lower right, lower left) where it
+//! covers no data; if every corner is taken, the y range is extended upwards to make room.
+//! On a log axis, points with value 0 (or missing) are not drawn: the line breaks there and the
+//! legend says how many levels were zero ("η₆ = 0 at all levels").
+
+use super::axis::Axis;
+use super::rich::{self, Metrics};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, VPos};
+
+/// The registered font: one name for ab_glyph and a CSS font list for the SVG viewer.
+pub(crate) const FONT: &str = "DejaVu Sans, sans-serif";
+
+const FS_FIGURE_TITLE: f64 = 24.0;
+const FS_TITLE: f64 = 20.0;
+const FS_DESC: f64 = 17.0;
+const FS_TICK: f64 = 15.0;
+const FS_LEGEND: f64 = 15.0;
+const FS_SLOPE: f64 = 16.0;
+const MARKER: i32 = 5;
+const X_LABEL_AREA: i32 = 62;
+const Y_LABEL_AREA: i32 = 96;
+
+pub(crate) fn font(size: f64) -> TextStyle<'static> {
+    TextStyle::from((FONT, size).into_font())
+}
+
+/// Map plotters' drawing errors (which are generic over the backend) to anyhow.
+pub(crate) trait DrawResult<T> {
+    fn drawn(self) -> anyhow::Result<T>;
+}
+
+impl<T, E: std::fmt::Display> DrawResult<T> for Result<T, E> {
+    fn drawn(self) -> anyhow::Result<T> {
+        self.map_err(|e| anyhow::anyhow!("drawing failed: {e}"))
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Marker {
+    Circle,
+    Square,
+    TriangleUp,
+    Diamond,
+    TriangleDown,
+    Cross,
+    Plus,
+    Star,
+}
+
+pub(crate) const MARKERS: [Marker; 8] =
+    [Marker::Circle, Marker::Square, Marker::TriangleUp, Marker::Diamond, Marker::TriangleDown, Marker::Cross, Marker::Plus, Marker::Star];
+
+/// Tableau-10 colours: distinct, and readable on white.
+pub(crate) const PALETTE: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+    RGBColor(188, 189, 34),
+    RGBColor(127, 127, 127),
+];
+
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Style {
+    pub color: RGBColor,
+    pub marker: Marker,
+    pub dashed: bool,
+    pub filled: bool,
+}
+
+impl Style {
+    /// Series number `i` of a panel: colour and marker cycle together.
+    pub fn nth(i: usize) -> Self {
+        Style { color: PALETTE[i % PALETTE.len()], marker: MARKERS[i % MARKERS.len()], dashed: false, filled: true }
+    }
+    pub fn dashed(mut self, dashed: bool) -> Self {
+        self.dashed = dashed;
+        self.filled = !dashed;
+        self
+    }
+}
+
+/// One curve: y per x (NDF); `None` is a missing value (e.g. no error measured at that level).
+#[derive(Clone, Debug)]
+pub(crate) struct Series {
+    pub label: String,
+    pub points: Vec<(f64, Option<f64>)>,
+    pub style: Style,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum YScale {
+    /// Log if all values are positive and span more than a decade, else linear from 0.
+    Auto,
+    Log,
+}
+
+/// A reference line y = c x^rate, drawn over the finer half (in log NDF) of the data.
+#[derive(Clone, Debug)]
+pub(crate) struct Slope {
+    pub rate: f64,
+    pub label: String,
+    pub anchor: SlopeAnchor,
+}
+
+/// Where a reference line goes: a factor 2.5 below (or above) the data it is compared with,
+/// over the x range of the line.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum SlopeAnchor {
+    /// Below series `i`.
+    Below(usize),
+    BelowAll,
+    AboveAll,
+}
+
+/// A reference line placed: the series, its end points in data coordinates, above the data?
+type PlacedSlope<'a> = (&'a Slope, [f64; 4], bool);
+
+#[derive(Clone, Debug)]
+pub(crate) struct HLine {
+    pub y: f64,
+    pub label: String,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) struct Panel {
+    pub title: String,
+    pub x_desc: String,
+    pub y_desc: String,
+    pub y_scale: YScale,
+    pub series: Vec<Series>,
+    pub slopes: Vec<Slope>,
+    pub hlines: Vec<HLine>,
+    /// Legend lines without a curve (e.g. "η₆ = η₇ = 0 at all levels (not shown)").
+    pub notes: Vec<String>,
+}
+
+impl Panel {
+    pub fn new(title: impl Into<String>, x_desc: impl Into<String>, y_desc: impl Into<String>) -> Self {
+        Panel {
+            title: title.into(),
+            x_desc: x_desc.into(),
+            y_desc: y_desc.into(),
+            y_scale: YScale::Log,
+            series: Vec::new(),
+            slopes: Vec::new(),
+            hlines: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
+
+    /// Whether any series has a point that can be drawn (on a linear axis at least).
+    pub fn has_data(&self) -> bool {
+        self.series.iter().any(|s| s.points.iter().any(|&(x, y)| x > 0.0 && y.is_some_and(f64::is_finite)))
+    }
+}
+
+#[derive(Clone, Debug)]
+pub(crate) struct LineFigure {
+    /// Title over all panels (a single panel has its own title only).
+    pub title: Option<String>,
+    pub panels: Vec<Panel>,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) struct MeshFigure {
+    pub title: String,
+    /// Mesh edges joined into polylines (fewer SVG elements than one per edge).
+    pub edges: Vec<Vec<(f64, f64)>>,
+    pub active: Vec<(f64, f64)>,
+    pub inactive: Vec<(f64, f64)>,
+    pub kinks: Vec<(f64, f64)>,
+    /// Bounding box of the vertices.
+    pub bbox: [f64; 4],
+    pub n_triangles: usize,
+    pub n_vertices: usize,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) enum Figure {
+    Lines(LineFigure),
+    Mesh(MeshFigure),
+}
+
+impl Figure {
+    pub fn size(&self) -> (u32, u32) {
+        match self {
+            Figure::Lines(f) if f.panels.len() > 1 => (800 * f.panels.len() as u32, 650),
+            _ => (900, 650),
+        }
+    }
+
+    /// Draw onto `root`; `m` describes how the backend places text (`rich::SVG`, `rich::BITMAP`).
+    pub fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, m: Metrics) -> anyhow::Result<()> {
+        root.fill(&WHITE).drawn()?;
+        match self {
+            Figure::Lines(f) => render_lines(root, f, m)?,
+            Figure::Mesh(mesh) => render_mesh(root, mesh, m)?,
+        }
+        root.present().drawn()
+    }
+}
+
+fn render_lines<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, f: &LineFigure, m: Metrics) -> anyhow::Result<()> {
+    let body = match &f.title {
+        Some(t) => titled(root, root, t, FS_FIGURE_TITLE, m)?,
+        None => root.clone(),
+    };
+    let areas = body.split_evenly((1, f.panels.len().max(1)));
+    for (area, panel) in areas.iter().zip(&f.panels) {
+        render_panel(root, area, panel, m)?;
+    }
+    Ok(())
+}
+
+/// Draw a centred title at the top of `area`; return the rest of the area.
+fn titled<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    size: f64,
+    m: Metrics,
+) -> anyhow::Result<DrawingArea<DB, Shift>> {
+    let (w, _) = area.dim_in_pixel();
+    let (x0, y0) = area.get_base_pixel();
+    rich::draw(root, text, size, &BLACK, (HPos::Center, VPos::Top), (x0 + w as i32 / 2, y0 + 10), false, m)?;
+    Ok(area.split_vertically((size * 1.3) as i32 + 14).1)
+}
+
+/// A message in the middle of an area that has nothing to plot.
+fn message<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, area: &DrawingArea<DB, Shift>, text: &str, m: Metrics) -> anyhow::Result<()> {
+    let (w, h) = area.dim_in_pixel();
+    let (x0, y0) = area.get_base_pixel();
+    rich::draw(root, text, FS_TITLE, &BLACK, (HPos::Center, VPos::Center), (x0 + w as i32 / 2, y0 + h as i32 / 2), false, m)
+}
+
+/// A series reduced to what can be drawn on the chosen axes.
+struct Prepared<'a> {
+    series: &'a Series,
+    segments: Vec<Vec<(f64, f64)>>,
+    zeros: usize,
+    present: usize,
+}
+
+impl Prepared<'_> {
+    fn points(&self) -> impl Iterator<Item = &(f64, f64)> {
+        self.segments.iter().flatten()
+    }
+    fn legend_label(&self) -> String {
+        let l = &self.series.label;
+        if self.segments.is_empty() {
+            if self.zeros > 0 && self.zeros == self.present {
+                format!("{l} = 0 at all levels")
+            } else {
+                format!("{l}: no data")
+            }
+        } else if self.zeros > 0 {
+            format!("{l} (= 0 at {} of {} levels, not drawn)", self.zeros, self.present)
+        } else {
+            l.clone()
+        }
+    }
+}
+
+fn prepare(series: &Series, y_log: bool) -> Prepared<'_> {
+    let mut segments = Vec::new();
+    let mut current: Vec<(f64, f64)> = Vec::new();
+    let (mut zeros, mut present) = (0, 0);
+    for &(x, y) in &series.points {
+        let ok = match y {
+            Some(v) if x > 0.0 && x.is_finite() && v.is_finite() => {
+                present += 1;
+                if y_log && v <= 0.0 {
+                    zeros += 1;
+                    None
+                } else {
+                    Some(v)
+                }
+            }
+            _ => None,
+        };
+        match ok {
+            Some(v) => current.push((x, v)),
+            None => {
+                if !current.is_empty() {
+                    segments.push(std::mem::take(&mut current));
+                }
+            }
+        }
+    }
+    if !current.is_empty() {
+        segments.push(current);
+    }
+    Prepared { series, segments, zeros, present }
+}
+
+enum Entry<'a> {
+    Curve(Style, String),
+    Note(&'a str),
+    Text(String),
+}
+
+impl Entry<'_> {
+    fn text(&self) -> &str {
+        match self {
+            Entry::Curve(_, t) | Entry::Text(t) => t,
+            Entry::Note(t) => t,
+        }
+    }
+}
+
+/// A padded axis range around values, in axis coordinates.
+fn padded(values: &[f64], log: bool, pad: f64, min_decades: f64) -> Axis {
+    let lo = values.iter().cloned().fold(f64::INFINITY, f64::min);
+    let hi = values.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    if log {
+        let (mut a, mut b) = (lo.log10(), hi.log10());
+        let span = (b - a).max(1e-3);
+        a -= pad * span.max(0.5);
+        b += pad * span.max(0.5);
+        if b - a < min_decades {
+            let mid = 0.5 * (a + b);
+            a = mid - 0.5 * min_decades;
+            b = mid + 0.5 * min_decades;
+        }
+        Axis::log(10f64.powf(a), 10f64.powf(b))
+    } else {
+        let lo = lo.min(0.0);
+        let hi = if hi > lo { hi } else { lo + 1.0 };
+        Axis::linear(lo, hi + pad * (hi - lo))
+    }
+}
+
+fn render_panel<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, area: &DrawingArea<DB, Shift>, p: &Panel, m: Metrics) -> anyhow::Result<()> {
+    let area = titled(root, area, &p.title, FS_TITLE, m)?;
+    if !p.has_data() {
+        return message(root, &area, "no results yet", m);
+    }
+
+    // y scale
+    let ys: Vec<f64> = p.series.iter().flat_map(|s| s.points.iter().filter(|(x, _)| *x > 0.0).filter_map(|p| p.1)).filter(|v| v.is_finite()).collect();
+    let y_log = match p.y_scale {
+        YScale::Log => true,
+        YScale::Auto => {
+            let pos: Vec<f64> = ys.iter().cloned().filter(|&v| v > 0.0).collect();
+            let (lo, hi) = pos.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
+            pos.len() == ys.len() && !pos.is_empty() && hi / lo > 10.0
+        }
+    };
+    let prepared: Vec<Prepared> = p.series.iter().map(|s| prepare(s, y_log)).collect();
+    let xs: Vec<f64> = prepared.iter().flat_map(|s| s.points().map(|p| p.0)).collect();
+    let mut yv: Vec<f64> = prepared.iter().flat_map(|s| s.points().map(|p| p.1)).collect();
+    if xs.is_empty() {
+        let msg = prepared.iter().map(|s| s.legend_label()).collect::<Vec<_>>().join("; ");
+        return message(root, &area, &msg, m);
+    }
+    let xa = padded(&xs, true, 0.06, 1.0);
+
+    // reference slopes: (x0, y0, x1, y1)
+    let lx = xs.iter().map(|x| x.log10()).fold(f64::NEG_INFINITY, f64::max);
+    let fx = xs.iter().map(|x| x.log10()).fold(f64::INFINITY, f64::min);
+    let slopes: Vec<PlacedSlope> = p
+        .slopes
+        .iter()
+        .filter(|_| y_log)
+        .filter_map(|s| {
+            let x0 = 10f64.powf(0.5 * (fx + lx));
+            let x1 = 10f64.powf(lx);
+            let ratios = |pr: &Prepared| -> Vec<f64> { pr.points().filter(|q| q.0 >= x0 * (1.0 - 1e-9)).map(|q| q.1 / q.0.powf(s.rate)).collect() };
+            let r: Vec<f64> = match s.anchor {
+                SlopeAnchor::Below(i) => prepared.get(i).map(ratios).unwrap_or_default(),
+                SlopeAnchor::BelowAll | SlopeAnchor::AboveAll => prepared.iter().flat_map(ratios).collect(),
+            };
+            let above = matches!(s.anchor, SlopeAnchor::AboveAll);
+            let c = if above { r.iter().cloned().fold(f64::NEG_INFINITY, f64::max) * 2.5 } else { r.iter().cloned().fold(f64::INFINITY, f64::min) / 2.5 };
+            (x1 > x0 && c.is_finite() && c > 0.0).then(|| (s, [x0, c * x0.powf(s.rate), x1, c * x1.powf(s.rate)], above))
+        })
+        .collect();
+    for (_, l, above) in &slopes {
+        // room for the label on its side of the line
+        let room = if *above { 3.0 } else { 1.0 / 3.0 };
+        yv.extend([l[1], l[3], l[1] * room]);
+    }
+    // guide lines, with room below them for their label
+    let (ymin, ymax) = yv.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
+    for h in &p.hlines {
+        if y_log && h.y > 0.0 {
+            yv.push(h.y);
+            yv.push(h.y * 10f64.powf(-0.08 * (ymax / ymin).log10().max(1.0)));
+        } else if !y_log {
+            yv.push(h.y);
+            yv.push(h.y - 0.08 * (ymax.max(h.y) - ymin.min(h.y)).max(1e-12));
+        }
+    }
+    let mut ya = padded(&yv, y_log, 0.05, 1.0);
+
+    // legend entries
+    let mut entries: Vec<Entry> = Vec::new();
+    for s in &prepared {
+        if s.segments.is_empty() {
+            entries.push(Entry::Text(s.legend_label()));
+        } else {
+            entries.push(Entry::Curve(s.series.style, s.legend_label()));
+        }
+    }
+    for n in &p.notes {
+        entries.push(Entry::Note(n));
+    }
+    let mut text_w = 0;
+    for e in &entries {
+        text_w = text_w.max(rich::width(root, e.text(), FS_LEGEND, m)?);
+    }
+    let row = ((FS_LEGEND * 1.45) as i32).max(20);
+    let (pad, swatch) = (8, 44);
+    let legend_w = pad + swatch + 8 + text_w + pad;
+    let legend_h = pad * 2 + row * entries.len() as i32;
+
+    let build = |ya: Axis| {
+        ChartBuilder::on(&area)
+            .margin(14)
+            .margin_right(24)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
+            .build_cartesian_2d(xa, ya)
+            .drawn()
+    };
+
+    // place the slope labels beside their lines and the legend where it covers nothing (as near
+    // a corner as possible, upper right first); if there is no such place, make room at the top
+    let mut slope_labels = Vec::new();
+    for (s, _, _) in &slopes {
+        slope_labels.push((rich::width(root, &s.label, FS_SLOPE, m)?, 20));
+    }
+    let hline_label_w: Vec<i32> = p.hlines.iter().map(|h| rich::width(root, &h.label, FS_LEGEND, m)).collect::<anyhow::Result<_>>()?;
+    let inset = 10;
+    let mut chart = build(ya)?;
+    let mut legend_at = None;
+    let mut label_at: Vec<(i32, i32)> = Vec::new();
+    for attempt in 0..4 {
+        let (xr, yr) = chart.plotting_area().get_pixel_range();
+        let mut grid = Occupancy::new(xr.clone(), yr.clone());
+        for q in obstacle_samples(&chart, &prepared, &slopes, &p.hlines, xa, ya) {
+            grid.add_point(q);
+        }
+        let data = grid.clone().finish();
+        // slope labels: the first position along the line where the label covers no data
+        label_at.clear();
+        for ((_, l, above), &(w, h)) in slopes.iter().zip(&slope_labels) {
+            let (a, b) = (chart.backend_coord(&(l[0], l[1])), chart.backend_coord(&(l[2], l[3])));
+            let rect = |t: f64| {
+                let (px, py) = ((a.0 as f64 + t * (b.0 - a.0) as f64) as i32, (a.1 as f64 + t * (b.1 - a.1) as f64) as i32);
+                if *above { (px + 6, py - 6 - h, w, h) } else { (px - 6 - w, py + 6, w, h) }
+            };
+            let t = [0.55, 0.4, 0.7, 0.25, 0.85].into_iter().find(|&t| !data.hits(rect(t), 2)).unwrap_or(0.55);
+            let r = rect(t);
+            grid.add_rect(r);
+            label_at.push(if *above { (r.0, r.1 + r.3) } else { (r.0 + r.2, r.1) });
+        }
+        for (hl, w) in p.hlines.iter().zip(&hline_label_w) {
+            if ya.contains(hl.y) {
+                let (px, py) = chart.backend_coord(&(xa.hi, hl.y));
+                grid.add_rect((px - 8 - w, py + 5, *w, 20));
+            }
+        }
+        let taken = grid.finish();
+        let (left, right) = (xr.start + inset, xr.end - inset - legend_w);
+        let (top, bottom) = (yr.start + inset, yr.end - inset - legend_h);
+        if entries.is_empty() {
+            break;
+        }
+        if right >= left && bottom >= top {
+            let xs_: Vec<i32> = (left..=right).step_by(6).chain([right]).collect();
+            let ys_: Vec<i32> = (top..=bottom).step_by(6).chain([bottom]).collect();
+            let best = ys_
+                .iter()
+                .flat_map(|&y| xs_.iter().map(move |&x| (x, y)))
+                .filter(|&(x, y)| !taken.hits((x, y, legend_w, legend_h), 4))
+                .min_by_key(|&(x, y)| {
+                    let (dx, dy) = ((x - left).min(right - x), (y - top).min(bottom - y));
+                    (dx + dy, (y - top > bottom - y) as u8, (x - left < right - x) as u8)
+                });
+            if let Some(c) = best {
+                legend_at = Some(c);
+                break;
+            }
+        }
+        if attempt == 3 {
+            legend_at = Some((right.max(left), top));
+            break;
+        }
+        let plot_h = (yr.end - yr.start).max(1) as f64;
+        let f = ((legend_h + 2 * inset + 6) as f64 / plot_h).min(0.6);
+        let (a, b) = (ya.t(ya.lo), ya.t(ya.hi));
+        let hi = ya.inv(a + (b - a) / (1.0 - f));
+        ya = Axis { hi, ..ya };
+        chart = build(ya)?;
+    }
+
+    chart
+        .configure_mesh()
+        .x_labels(12)
+        .y_labels(12)
+        .max_light_lines(10)
+        .label_style(font(FS_TICK))
+        .axis_desc_style(font(FS_DESC))
+        .bold_line_style(BLACK.mix(0.16))
+        .light_line_style(BLACK.mix(0.06))
+        .set_all_tick_mark_size(6)
+        .draw()
+        .drawn()?;
+    axis_descs(root, &chart, &p.x_desc, &p.y_desc, m)?;
+
+    // guide lines
+    let guide = RGBColor(60, 60, 60);
+    for h in &p.hlines {
+        if !ya.contains(h.y) {
+            continue;
+        }
+        chart.draw_series(LineSeries::new(vec![(xa.lo, h.y), (xa.hi, h.y)], guide.mix(0.8).stroke_width(1))).drawn()?;
+        // the label under the line at the right end: where an efficiency >= 1 leaves room
+        let (px, py) = chart.backend_coord(&(xa.hi, h.y));
+        rich::draw(root, &h.label, FS_LEGEND, &guide, (HPos::Right, VPos::Top), (px - 8, py + 5), false, m)?;
+    }
+    // reference slopes
+    let grey = RGBColor(110, 110, 110);
+    for ((s, [x0, y0, x1, y1], above), at) in slopes.iter().zip(&label_at) {
+        chart.draw_series(DashedLineSeries::new(vec![(*x0, *y0), (*x1, *y1)], 9, 6, grey.stroke_width(2))).drawn()?;
+        let anchor = if *above { (HPos::Left, VPos::Bottom) } else { (HPos::Right, VPos::Top) };
+        rich::draw(root, &s.label, FS_SLOPE, &grey, anchor, *at, false, m)?;
+    }
+    // curves, then markers on top
+    for s in &prepared {
+        let st = s.series.style;
+        let line = st.color.stroke_width(2);
+        for seg in &s.segments {
+            if seg.len() < 2 {
+                continue;
+            }
+            if st.dashed {
+                chart.draw_series(DashedLineSeries::new(seg.clone(), 8, 5, line)).drawn()?;
+            } else {
+                chart.draw_series(LineSeries::new(seg.clone(), line)).drawn()?;
+            }
+        }
+    }
+    for s in &prepared {
+        for pt in s.points() {
+            draw_marker(root, chart.backend_coord(pt), s.series.style, MARKER)?;
+        }
+    }
+
+    // legend
+    if let (Some((x, y)), false) = (legend_at, entries.is_empty()) {
+        root.draw(&Rectangle::new([(x, y), (x + legend_w, y + legend_h)], WHITE.mix(0.92).filled())).drawn()?;
+        root.draw(&Rectangle::new([(x, y), (x + legend_w, y + legend_h)], BLACK.mix(0.45).stroke_width(1))).drawn()?;
+        for (k, e) in entries.iter().enumerate() {
+            let cy = y + pad + row * k as i32 + row / 2;
+            let tx = x + pad + swatch + 8;
+            match e {
+                Entry::Curve(st, label) => {
+                    let (a, b) = (x + pad, x + pad + swatch);
+                    if st.dashed {
+                        for (s0, s1) in [(a, a + 12), (a + 16, a + 28), (a + 32, b)] {
+                            root.draw(&PathElement::new(vec![(s0, cy), (s1, cy)], st.color.stroke_width(2))).drawn()?;
+                        }
+                    } else {
+                        root.draw(&PathElement::new(vec![(a, cy), (b, cy)], st.color.stroke_width(2))).drawn()?;
+                    }
+                    draw_marker(root, ((a + b) / 2, cy), *st, MARKER)?;
+                    rich::draw(root, label, FS_LEGEND, &BLACK, (HPos::Left, VPos::Center), (tx, cy), false, m)?;
+                }
+                Entry::Note(t) => rich::draw(root, t, FS_LEGEND, &grey, (HPos::Left, VPos::Center), (x + pad, cy), false, m)?,
+                Entry::Text(t) => rich::draw(root, t, FS_LEGEND, &grey, (HPos::Left, VPos::Center), (tx, cy), false, m)?,
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The axis descriptions, centred below and left of the plotting area (drawn here rather than by
+/// plotters so that they can have subscripts).
+fn axis_descs<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &ChartContext<DB, Cartesian2d<Axis, Axis>>,
+    x_desc: &str,
+    y_desc: &str,
+    m: Metrics,
+) -> anyhow::Result<()> {
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    let (cx, cy) = ((xr.start + xr.end) / 2, (yr.start + yr.end) / 2);
+    rich::draw(root, x_desc, FS_DESC, &BLACK, (HPos::Center, VPos::Bottom), (cx, yr.end + X_LABEL_AREA - 8), false, m)?;
+    rich::draw(root, y_desc, FS_DESC, &BLACK, (HPos::Center, VPos::Top), (xr.start - Y_LABEL_AREA + 6, cy), true, m)
+}
+
+/// Pixels labels and the legend must not cover: every marker (as a small box), every line
+/// sampled every few pixels, the slope lines, the guide lines.
+fn obstacle_samples<DB: DrawingBackend>(
+    chart: &ChartContext<DB, Cartesian2d<Axis, Axis>>,
+    prepared: &[Prepared],
+    slopes: &[PlacedSlope],
+    hlines: &[HLine],
+    xa: Axis,
+    ya: Axis,
+) -> Vec<(i32, i32)> {
+    let mut out = Vec::new();
+    let line = |a: (i32, i32), b: (i32, i32), out: &mut Vec<(i32, i32)>| {
+        let n = ((b.0 - a.0).abs().max((b.1 - a.1).abs()) / 3).max(1);
+        for k in 0..=n {
+            let t = k as f64 / n as f64;
+            out.push(((a.0 as f64 + t * (b.0 - a.0) as f64) as i32, (a.1 as f64 + t * (b.1 - a.1) as f64) as i32));
+        }
+    };
+    for s in prepared {
+        for seg in &s.segments {
+            let px: Vec<(i32, i32)> = seg.iter().map(|p| chart.backend_coord(p)).collect();
+            for &(x, y) in &px {
+                for (dx, dy) in [(-MARKER, -MARKER), (MARKER, -MARKER), (-MARKER, MARKER), (MARKER, MARKER), (0, 0)] {
+                    out.push((x + dx, y + dy));
+                }
+            }
+            for w in px.windows(2) {
+                line(w[0], w[1], &mut out);
+            }
+        }
+    }
+    for (_, l, _) in slopes {
+        let (a, b) = (chart.backend_coord(&(l[0], l[1])), chart.backend_coord(&(l[2], l[3])));
+        line(a, b, &mut out);
+    }
+    for h in hlines {
+        if ya.contains(h.y) {
+            let (a, b) = (chart.backend_coord(&(xa.lo, h.y)), chart.backend_coord(&(xa.hi, h.y)));
+            line(a, b, &mut out);
+        }
+    }
+    out
+}
+
+/// A marker centred at a backend pixel; hollow markers are white inside.
+pub(crate) fn draw_marker<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, (x, y): (i32, i32), st: Style, r: i32) -> anyhow::Result<()> {
+    let fill = if st.filled { st.color.filled() } else { WHITE.filled() };
+    let edge = st.color.stroke_width(2);
+    let poly = |pts: Vec<(i32, i32)>| -> anyhow::Result<()> {
+        root.draw(&Polygon::new(pts.clone(), fill)).drawn()?;
+        let mut closed = pts;
+        closed.push(closed[0]);
+        root.draw(&PathElement::new(closed, edge)).drawn()
+    };
+    match st.marker {
+        Marker::Circle => {
+            root.draw(&Circle::new((x, y), r, fill)).drawn()?;
+            root.draw(&Circle::new((x, y), r, edge)).drawn()?;
+        }
+        Marker::Square => poly(vec![(x - r + 1, y - r + 1), (x + r - 1, y - r + 1), (x + r - 1, y + r - 1), (x - r + 1, y + r - 1)])?,
+        Marker::TriangleUp => poly(vec![(x, y - r - 1), (x + r + 1, y + r), (x - r - 1, y + r)])?,
+        Marker::TriangleDown => poly(vec![(x, y + r + 1), (x + r + 1, y - r), (x - r - 1, y - r)])?,
+        Marker::Diamond => poly(vec![(x, y - r - 1), (x + r + 1, y), (x, y + r + 1), (x - r - 1, y)])?,
+        Marker::Star => {
+            let pts: Vec<(i32, i32)> = (0..10)
+                .map(|k| {
+                    let rad = if k % 2 == 0 { r as f64 + 2.0 } else { 0.45 * (r as f64 + 2.0) };
+                    let a = std::f64::consts::PI * (k as f64 / 5.0 - 0.5);
+                    ((x as f64 + rad * a.cos()).round() as i32, (y as f64 + rad * a.sin()).round() as i32)
+                })
+                .collect();
+            poly(pts)?
+        }
+        Marker::Cross => {
+            root.draw(&PathElement::new(vec![(x - r, y - r), (x + r, y + r)], edge)).drawn()?;
+            root.draw(&PathElement::new(vec![(x - r, y + r), (x + r, y - r)], edge)).drawn()?;
+        }
+        Marker::Plus => {
+            root.draw(&PathElement::new(vec![(x - r - 1, y), (x + r + 1, y)], edge)).drawn()?;
+            root.draw(&PathElement::new(vec![(x, y - r - 1), (x, y + r + 1)], edge)).drawn()?;
+        }
+    }
+    Ok(())
+}
+
+fn render_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, mesh: &MeshFigure, metrics: Metrics) -> anyhow::Result<()> {
+    let m = mesh;
+    let body = titled(root, root, &m.title, FS_TITLE + 2.0, metrics)?;
+    let (w, h) = body.dim_in_pixel();
+    let (margin, xlab, ylab, legend_w) = (14, 50, 62, 270);
+    let side = (h as i32 - 2 * margin - xlab).min(w as i32 - 2 * margin - ylab - legend_w).max(50);
+    let left_w = side + 2 * margin + ylab;
+    let left_h = side + 2 * margin + xlab;
+    let (left, right) = body.split_horizontally(left_w);
+    let left = left.shrink((0, 0), (left_w, left_h));
+
+    // equal aspect: the same span on both axes around the bounding box
+    let [x0, y0, x1, y1] = m.bbox;
+    let span = (x1 - x0).max(y1 - y0).max(1e-12) * 1.05;
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let xa = Axis::linear(cx - 0.5 * span, cx + 0.5 * span);
+    let ya = Axis::linear(cy - 0.5 * span, cy + 0.5 * span);
+    let mut chart = ChartBuilder::on(&left).margin(margin).x_label_area_size(xlab).y_label_area_size(ylab).build_cartesian_2d(xa, ya).drawn()?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x")
+        .y_desc("y")
+        .label_style(font(FS_TICK))
+        .axis_desc_style(font(FS_DESC))
+        .set_all_tick_mark_size(6)
+        .draw()
+        .drawn()?;
+    let edge = RGBColor(40, 40, 40).mix(0.85).stroke_width(1);
+    chart.draw_series(m.edges.iter().map(|c| PathElement::new(c.clone(), edge))).drawn()?;
+
+    let inactive = Style { color: RGBColor(31, 119, 180), marker: Marker::Circle, dashed: false, filled: true };
+    let active = Style { color: RGBColor(214, 39, 40), marker: Marker::Circle, dashed: false, filled: true };
+    let kink = Style { color: BLACK, marker: Marker::Diamond, dashed: false, filled: false };
+    for p in &m.inactive {
+        draw_marker(root, chart.backend_coord(p), inactive, 3)?;
+    }
+    for p in &m.active {
+        draw_marker(root, chart.backend_coord(p), active, 3)?;
+    }
+    for p in &m.kinks {
+        draw_marker(root, chart.backend_coord(p), kink, 7)?;
+    }
+
+    // legend beside the square
+    let fmt = |v: f64| {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
+    let kinks = m.kinks.iter().map(|&(x, y)| format!("({}, {})", fmt(x), fmt(y))).collect::<Vec<_>>().join(", ");
+    let entries: Vec<(Option<(Style, i32)>, String)> = vec![
+        (Some((active, 3)), format!("active contact node ({})", m.active.len())),
+        (Some((inactive, 3)), format!("inactive contact node ({})", m.inactive.len())),
+        (Some((kink, 7)), if kinks.is_empty() { "obstacle kink (none recorded)".to_string() } else { format!("kink of the obstacle {kinks}") }),
+        (None, format!("{} triangles, {} vertices", m.n_triangles, m.n_vertices)),
+    ];
+    let (rx, ry) = right.get_base_pixel();
+    let (x, y) = (rx + 10, ry + margin + 10);
+    let row = 26;
+    for (k, (marker, text)) in entries.iter().enumerate() {
+        let cy = y + row * k as i32 + row / 2;
+        if let Some((st, r)) = marker {
+            draw_marker(root, (x + 12, cy), *st, *r)?;
+        }
+        rich::draw(root, text, FS_LEGEND, &BLACK, (HPos::Left, VPos::Center), (x + 30, cy), false, metrics)?;
+    }
+    Ok(())
+}
+
+/// Which pixels of the plotting area are taken, in cells of a few pixels, with prefix sums for
+/// "is anything inside this rectangle" queries.
+#[derive(Clone)]
+struct Occupancy {
+    x0: i32,
+    y0: i32,
+    nx: usize,
+    ny: usize,
+    cells: Vec<bool>,
+    sum: Vec<u32>,
+}
+
+const CELL: i32 = 3;
+
+impl Occupancy {
+    fn new(xr: std::ops::Range<i32>, yr: std::ops::Range<i32>) -> Self {
+        let nx = ((xr.end - xr.start).max(1) / CELL + 1) as usize;
+        let ny = ((yr.end - yr.start).max(1) / CELL + 1) as usize;
+        Occupancy { x0: xr.start, y0: yr.start, nx, ny, cells: vec![false; nx * ny], sum: Vec::new() }
+    }
+
+    fn cell(&self, (x, y): (i32, i32)) -> Option<(usize, usize)> {
+        let (i, j) = ((x - self.x0).div_euclid(CELL), (y - self.y0).div_euclid(CELL));
+        (i >= 0 && j >= 0 && (i as usize) < self.nx && (j as usize) < self.ny).then_some((i as usize, j as usize))
+    }
+
+    fn add_point(&mut self, q: (i32, i32)) {
+        if let Some((i, j)) = self.cell(q) {
+            self.cells[j * self.nx + i] = true;
+        }
+    }
+
+    fn add_rect(&mut self, (x, y, w, h): (i32, i32, i32, i32)) {
+        for py in (y..=y + h).step_by(CELL as usize) {
+            for px in (x..=x + w).step_by(CELL as usize) {
+                self.add_point((px, py));
+            }
+        }
+    }
+
+    fn finish(mut self) -> Self {
+        let (nx, ny) = (self.nx, self.ny);
+        let mut sum = vec![0u32; (nx + 1) * (ny + 1)];
+        for j in 0..ny {
+            for i in 0..nx {
+                sum[(j + 1) * (nx + 1) + i + 1] =
+                    self.cells[j * nx + i] as u32 + sum[j * (nx + 1) + i + 1] + sum[(j + 1) * (nx + 1) + i] - sum[j * (nx + 1) + i];
+            }
+        }
+        self.sum = sum;
+        self
+    }
+
+    /// Whether anything is inside the rectangle grown by `margin` pixels.
+    fn hits(&self, (x, y, w, h): (i32, i32, i32, i32), margin: i32) -> bool {
+        let clamp = |v: i32, n: usize| v.clamp(0, n as i32) as usize;
+        let i0 = clamp((x - margin - self.x0).div_euclid(CELL), self.nx);
+        let j0 = clamp((y - margin - self.y0).div_euclid(CELL), self.ny);
+        let i1 = clamp((x + w + margin - self.x0).div_euclid(CELL) + 1, self.nx);
+        let j1 = clamp((y + h + margin - self.y0).div_euclid(CELL) + 1, self.ny);
+        if i1 <= i0 || j1 <= j0 {
+            return false;
+        }
+        let s = |i: usize, j: usize| self.sum[j * (self.nx + 1) + i];
+        s(i1, j1) + s(i0, j0) > s(i0, j1) + s(i1, j0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn occupancy_finds_points_in_rectangles() {
+        let mut g = Occupancy::new(100..400, 50..300);
+        g.add_point((200, 100));
+        g.add_rect((300, 200, 20, 10));
+        let g = g.finish();
+        assert!(g.hits((190, 90, 20, 20), 0));
+        assert!(!g.hits((210, 110, 50, 50), 0));
+        assert!(g.hits((205, 105, 50, 50), 6));
+        assert!(g.hits((310, 205, 2, 2), 0));
+        assert!(!g.hits((100, 250, 150, 40), 0));
+    }
+}

@@ -1,0 +1,320 @@
+//! `plot::draw_all` on a synthetic results directory: every figure is written as SVG and PNG,
+//! the SVGs carry the axis and legend text, and studies without results are skipped, not errors.
+//! The figures are left in `target/tmp/figures-test/figures/` for a look.
+
+use signorini::adapt::{LevelRecord, Refine};
+use signorini::estimate::{ContactTerm, EstimatorConfig, LogFactor};
+use signorini::plot::{self, FIGURES};
+use signorini::records::{MeshSnapshot, RunRecord, RunSpec, StudyDir, write_json};
+use std::path::{Path, PathBuf};
+
+fn level(level: usize, ndof: usize, err: Option<f64>, c0: f64, eta: [f64; 7]) -> LevelRecord {
+    let h_min = 0.25 / 2f64.powf(level as f64 / 2.0);
+    let l_h = 1.0 + h_min.ln().powi(2);
+    let psi: f64 = eta[..5].iter().sum();
+    let eta_h = l_h * psi + eta[5] + eta[6];
+    let estimate = c0 * eta_h;
+    serde_json::from_value(serde_json::json!({
+        "level": level, "ndof": ndof, "ndof_free": ndof * 9 / 10, "n_elements": ndof / 4, "h_min": h_min, "h_max": 0.25,
+        "min_angle": 45.0, "contact_nodes": 9, "active_nodes": 4, "full_contact_nodes": 1, "pdas_iterations": 3,
+        "zone_min": null, "zone_max": null,
+        "eta1": eta[0], "eta2": eta[1], "eta3": eta[2], "eta4": eta[3], "eta5": eta[4], "eta6": eta[5], "eta7": eta[6],
+        "l_h": l_h, "psi": psi, "eta_h": eta_h, "c0": c0, "estimate": estimate,
+        "err_quadrature": err, "err_dense": err, "err_nodal": null,
+        "efficiency": err.map(|e| estimate / e), "marked": 3,
+        "t_assembly": 0.0, "t_factorisation": 0.0, "t_active_set": 0.0, "t_solve": 0.0, "t_estimate": 0.0,
+        "t_refine": 0.0, "t_level": 0.0
+    }))
+    .expect("a LevelRecord")
+}
+
+struct Run<'a> {
+    id: &'a str,
+    problem: &'a str,
+    refine: Refine,
+    theta: f64,
+    estimator: EstimatorConfig,
+    /// Error constant: err = c * NDF^-3/2 (times a pre-asymptotic bump).
+    err: f64,
+    /// No error at these levels (None), or no errors at all.
+    missing: fn(usize) -> bool,
+    /// eta6 and eta7 vanish (Example 7.1).
+    eta67_zero: bool,
+}
+
+impl Run<'_> {
+    fn record(&self, study: &str) -> RunRecord {
+        let growth: f64 = if self.refine == Refine::Uniform { 2.0 } else { 1.45 };
+        let levels = if self.refine == Refine::Uniform { 9 } else { 21 };
+        let log = match self.estimator.log_factor {
+            LogFactor::Squared => 1.0,
+            LogFactor::Linear => 0.35,
+            LogFactor::One => 0.08,
+        };
+        let lv = (0..levels)
+            .map(|k| {
+                let ndof = (60.0 * growth.powi(k as i32)) as usize;
+                let n = ndof as f64;
+                let bump = 1.0 + 2.0 / (1.0 + k as f64);
+                let base = self.err * n.powf(-1.5) * bump;
+                let err = (!(self.missing)(k)).then_some(base);
+                let eta5 = if self.estimator.contact_term == ContactTerm::WithoutFullContact { 0.3 * base } else { 2.0 * base };
+                let mut eta = [3.0 * base, 1.5 * base, 0.8 * base, 0.4 * base, eta5, 0.0, 0.0];
+                if !self.eta67_zero {
+                    eta[5] = 5.0 * base * (1.0 + 0.3 * (k % 3) as f64);
+                    eta[6] = if k % 4 == 0 { 0.0 } else { 2.0 * base };
+                }
+                for e in &mut eta[..5] {
+                    *e *= log;
+                }
+                // the main Example 7.1 study: a flat efficiency (a linear y axis in fig2b)
+                if study == "ex71" {
+                    let l_h = 1.0 + (0.25f64 / 2f64.powf(k as f64 / 2.0)).ln().powi(2);
+                    for e in &mut eta[..5] {
+                        *e *= 3.0 / l_h * (1.0 + 0.2 * (k as f64 * 0.7).sin());
+                    }
+                }
+                level(k, ndof, err, self.estimator.c0, eta)
+            })
+            .collect();
+        RunRecord {
+            study: study.to_string(),
+            run: RunSpec {
+                id: self.id.to_string(),
+                problem: self.problem.to_string(),
+                mesh: "structured:4".to_string(),
+                refine: self.refine,
+                theta: self.theta,
+                levels,
+                max_ndof: None,
+                estimator: self.estimator,
+                reference: None,
+                save_levels: vec![20],
+            },
+            levels: lv,
+            reference_ndof: (self.problem == "ex72").then_some(2_000_000),
+        }
+    }
+}
+
+fn never(_: usize) -> bool {
+    false
+}
+fn always(_: usize) -> bool {
+    true
+}
+fn last_two(k: usize) -> bool {
+    k >= 19
+}
+
+fn run<'a>(id: &'a str, problem: &'a str, refine: Refine) -> Run<'a> {
+    let ex71 = problem == "ex71";
+    Run {
+        id,
+        problem,
+        refine,
+        theta: 0.5,
+        estimator: EstimatorConfig::default(),
+        err: if ex71 { 2.0 } else { 15.0 },
+        missing: if ex71 { never } else { last_two },
+        eta67_zero: ex71,
+    }
+}
+
+fn write_study(results: &Path, study: &str, runs: &[Run]) {
+    let dir = StudyDir::new(results, study);
+    for r in runs {
+        write_json(&dir.run_file(r.id), &r.record(study)).unwrap();
+    }
+}
+
+/// A graded mesh of the unit square, finer towards x = 1 and y = 0.5, with the contact nodes on
+/// x = 1 active near the kink.
+fn mesh_snapshot() -> MeshSnapshot {
+    let nx = 24;
+    let ny = 30;
+    let xs: Vec<f64> = (0..=nx).map(|i| 1.0 - (1.0 - i as f64 / nx as f64).powi(2)).collect();
+    let ys: Vec<f64> = (0..=ny)
+        .map(|j| {
+            let t = 2.0 * j as f64 / ny as f64 - 1.0;
+            0.5 + 0.5 * t.signum() * t.abs().powf(1.6)
+        })
+        .collect();
+    let mut vertices = Vec::new();
+    for &y in &ys {
+        for &x in &xs {
+            vertices.push([x, y]);
+        }
+    }
+    let id = |i: usize, j: usize| j * (nx + 1) + i;
+    let mut triangles = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let contact_nodes = ys.iter().map(|&y| ([1.0, y], (y - 0.5).abs() < 0.22)).collect();
+    MeshSnapshot {
+        study: "ex72".into(),
+        run: "adaptive".into(),
+        level: 20,
+        ndof: 2 * (2 * nx + 1) * (2 * ny + 1),
+        vertices,
+        triangles,
+        contact_nodes,
+        kinks: vec![[1.0, 0.5]],
+    }
+}
+
+fn with_estimator(mut r: Run<'_>, f: impl FnOnce(&mut EstimatorConfig)) -> Run<'_> {
+    f(&mut r.estimator);
+    r
+}
+
+fn with_theta(mut r: Run<'_>, theta: f64) -> Run<'_> {
+    r.theta = theta;
+    r
+}
+
+fn full_results(results: &Path) {
+    use Refine::{Adaptive, Uniform};
+    write_study(results, "ex71", &[run("adaptive", "ex71", Adaptive), run("uniform", "ex71", Uniform)]);
+    write_study(results, "ex72", &[run("adaptive", "ex72", Adaptive), run("uniform", "ex72", Uniform)]);
+    write_json(&StudyDir::new(results, "ex72").mesh_file("adaptive", 20, "json"), &mesh_snapshot()).unwrap();
+    write_study(
+        results,
+        "c0_sweep",
+        &[
+            run("ex71_adaptive", "ex71", Adaptive),
+            run("ex71_uniform", "ex71", Uniform),
+            run("ex72_adaptive", "ex72", Adaptive),
+            Run { missing: always, ..run("ex72_uniform", "ex72", Uniform) },
+        ],
+    );
+    write_study(
+        results,
+        "log_ablation",
+        &[
+            run("ex71_squared", "ex71", Adaptive),
+            with_estimator(run("ex71_linear", "ex71", Adaptive), |e| e.log_factor = LogFactor::Linear),
+            with_estimator(run("ex71_one", "ex71", Adaptive), |e| e.log_factor = LogFactor::One),
+        ],
+    );
+    let without = |r: Run<'static>| with_estimator(r, |e| e.contact_term = ContactTerm::WithoutFullContact);
+    write_study(
+        results,
+        "contact_term_ablation",
+        &[
+            run("ex71_as_written", "ex71", Adaptive),
+            without(run("ex71_without_full_contact", "ex71", Adaptive)),
+            run("ex72_as_written", "ex72", Adaptive),
+            without(run("ex72_without_full_contact", "ex72", Adaptive)),
+        ],
+    );
+    write_study(
+        results,
+        "theta_ablation",
+        &[
+            with_theta(run("ex71_theta0.3", "ex71", Adaptive), 0.3),
+            with_theta(run("ex71_theta0.5", "ex71", Adaptive), 0.5),
+            with_theta(run("ex71_theta0.7", "ex71", Adaptive), 0.7),
+            run("ex71_uniform", "ex71", Uniform),
+            Run { missing: always, ..with_theta(run("ex72_theta0.5", "ex72", Adaptive), 0.5) },
+            Run { missing: always, ..run("ex72_uniform", "ex72", Uniform) },
+        ],
+    );
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    std::fs::remove_dir_all(&dir).ok();
+    dir
+}
+
+fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+#[test]
+fn every_figure_is_written_from_records() {
+    let root = scratch("figures-test");
+    let results = root.join("results");
+    let figures = root.join("figures");
+    full_results(&results);
+
+    let written = plot::draw_all(&results, &figures).expect("draw_all");
+    assert_eq!(written.len(), 2 * FIGURES.len(), "{written:?}");
+    for name in FIGURES {
+        for ext in ["svg", "png"] {
+            let f = figures.join(format!("{name}.{ext}"));
+            assert!(written.contains(&f), "{} not reported", f.display());
+            let size = std::fs::metadata(&f).unwrap_or_else(|e| panic!("{}: {e}", f.display())).len();
+            assert!(size > 5_000, "{} is only {size} bytes", f.display());
+        }
+        let png = std::fs::read(figures.join(format!("{name}.png"))).unwrap();
+        assert_eq!(&png[1..4], b"PNG");
+    }
+    // no temporary files left behind
+    let leftovers: Vec<_> = std::fs::read_dir(&figures).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().starts_with('.')).collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+
+    for name in FIGURES.iter().filter(|n| **n != "fig3b") {
+        let svg = read(&figures.join(format!("{name}.svg")));
+        assert!(svg.contains("NDF (2 × P2 nodes"), "{name}: no NDF axis label");
+        assert!(svg.contains("10³") || svg.contains("10⁴"), "{name}: no decade tick labels");
+    }
+    // labels are drawn in segments (subscripts separately): look for the pieces
+    let fig2a = read(&figures.join("fig2a.svg"));
+    for text in ["Example 7.1", "error ‖u − u", ", adaptive", "estimate C", ", uniform", "\nNDF\n", "−3/2"] {
+        assert!(fig2a.contains(text), "fig2a lacks {text:?}");
+    }
+    assert!(read(&figures.join("fig2b.svg")).contains("efficiency = 1"));
+    let fig3a = read(&figures.join("fig3a.svg"));
+    assert!(fig3a.contains("vs reference, adaptive") && fig3a.contains("reference solution: NDF 2000000") && fig3a.contains("estimate C"));
+    let fig3b = read(&figures.join("fig3b.svg"));
+    for text in ["Example 7.2", "level 20", "NDF = ", "active contact node (17)", "inactive contact node (14)", "kink of the obstacle (1, 0.5)"] {
+        assert!(fig3b.contains(text), "fig3b lacks {text:?}");
+    }
+    let fig4a = read(&figures.join("fig4a.svg"));
+    assert_eq!(fig4a.matches("= 0 at all levels (not shown)").count(), 2, "fig4a: eta6 and eta7 noted as zero");
+    let fig4b = read(&figures.join("fig4b.svg"));
+    assert!(fig4b.contains("(= 0 at 6 of 21 levels, not drawn)"), "fig4b legend");
+    let c0 = read(&figures.join("c0_sweep.svg"));
+    assert!(c0.contains("= 0.45") && c0.contains("(smallest reliable)") && c0.contains("uniform: no errors recorded"));
+    let log = read(&figures.join("log_ablation.svg"));
+    assert!(log.contains("= 1 + |log h") && log.contains("|\n") && !log.contains("squared"));
+    let contact = read(&figures.join("contact_term_ablation.svg"));
+    assert!(contact.contains("Example 7.1") && contact.contains("Example 7.2") && contact.contains("without full-contact nodes"));
+    let theta = read(&figures.join("theta_ablation.svg"));
+    assert!(theta.contains("θ = 0.3") && theta.contains("uniform") && theta.contains("(errors not available)"));
+}
+
+#[test]
+fn missing_studies_are_skipped_not_errors() {
+    let root = scratch("figures-partial");
+    let results = root.join("results");
+    let figures = root.join("figures");
+
+    // nothing at all
+    let written = plot::draw_all(&results, &figures).expect("an empty results directory is not an error");
+    assert!(written.is_empty());
+
+    // only Example 7.1: its figures are drawn, the others skipped with a reason
+    write_study(&results, "ex71", &[run("adaptive", "ex71", Refine::Adaptive)]);
+    let outcome = plot::draw_figures(&results, &figures).expect("draw_figures");
+    let drawn: Vec<String> = outcome.written.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+    for f in ["fig2a.svg", "fig2a.png", "fig2b.svg", "fig4a.png"] {
+        assert!(drawn.contains(&f.to_string()), "{f} not drawn: {drawn:?}");
+    }
+    let skipped: Vec<&str> = outcome.skipped.iter().map(|(n, _)| n.as_str()).collect();
+    for f in ["fig3a", "fig3b", "fig4b", "c0_sweep", "log_ablation", "contact_term_ablation", "theta_ablation"] {
+        assert!(skipped.contains(&f), "{f} not skipped: {skipped:?}");
+    }
+    assert!(!figures.join("fig3b.svg").exists());
+    // a study present without its mesh snapshot: fig3a drawn, fig3b skipped
+    write_study(&results, "ex72", &[run("adaptive", "ex72", Refine::Adaptive)]);
+    let outcome = plot::draw_figures(&results, &figures).expect("draw_figures");
+    assert!(outcome.written.iter().any(|p| p.ends_with("fig3a.svg")));
+    assert!(outcome.skipped.iter().any(|(n, why)| n == "fig3b" && why.contains("mesh snapshot")), "{:?}", outcome.skipped);
+}
