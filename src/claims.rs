@@ -23,8 +23,8 @@ pub enum Verdict {
     NotReproduced,
     OnlyWithVariant,
     NoData,
-    /// An ablation row: measured, no claim to judge.
-    Ablation,
+    /// Measured beyond the paper (an ablation, or a quantity the paper does not report): no claim to judge.
+    NoClaim,
 }
 
 impl Verdict {
@@ -34,7 +34,7 @@ impl Verdict {
             Verdict::NotReproduced => "**not reproduced**",
             Verdict::OnlyWithVariant => "reproduced only with a named variant",
             Verdict::NoData => "no data (study not run)",
-            Verdict::Ablation => "ablation (no verdict)",
+            Verdict::NoClaim => "no claim in the paper (measured)",
         }
     }
 }
@@ -210,7 +210,7 @@ pub fn claims(results: &Path) -> std::io::Result<Vec<Claim>> {
                 format!("error rate {} vs reference NDF {}; efficiency {}", fmt_rate(err72), r.reference_ndof.map(|n| n.to_string()).unwrap_or("-".into()), range(&e))
             })
             .unwrap_or_default(),
-        verdict: if a72.is_none() { Verdict::NoData } else if optimal(err72) { Verdict::Reproduced } else { Verdict::NotReproduced },
+        verdict: if a72.is_none() { Verdict::NoData } else { Verdict::NoClaim },
     });
 
     // Example 7.2: where the adaptive mesh refines
@@ -254,7 +254,7 @@ pub fn claims(results: &Path) -> std::io::Result<Vec<Claim>> {
         id: "log-factor (ablation)",
         claim: "Eq. 6.3's factor l_h = 1 + |log h_min|^2 against 1 + |log h_min| and 1: the efficiency index, first to last level (no claim of the paper; for reading the rows above)".into(),
         measured: la_trend.join("; "),
-        verdict: if la_trend.is_empty() { Verdict::NoData } else { Verdict::Ablation },
+        verdict: if la_trend.is_empty() { Verdict::NoData } else { Verdict::NoClaim },
     });
     Ok(out)
 }

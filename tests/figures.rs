@@ -256,7 +256,8 @@ fn every_figure_is_written_from_records() {
         assert_eq!(&png[1..4], b"PNG");
     }
     // no temporary files left behind
-    let leftovers: Vec<_> = std::fs::read_dir(&figures).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().starts_with('.')).collect();
+    let leftovers: Vec<_> =
+        std::fs::read_dir(&figures).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().starts_with('.')).collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 
     for name in FIGURES.iter().filter(|n| **n != "fig3b") {
@@ -273,7 +274,9 @@ fn every_figure_is_written_from_records() {
     let fig3a = read(&figures.join("fig3a.svg"));
     assert!(fig3a.contains("vs reference, adaptive") && fig3a.contains("reference solution: NDF 2000000") && fig3a.contains("estimate C"));
     let fig3b = read(&figures.join("fig3b.svg"));
-    for text in ["Example 7.2", "level 20", "NDF = ", "active contact node (17)", "inactive contact node (14)", "kink of the obstacle (1, 0.5)"] {
+    for text in
+        ["Example 7.2", "level 20", "NDF = ", "active contact node (17)", "inactive contact node (14)", "kink of the obstacle (1, 0.5)"]
+    {
         assert!(fig3b.contains(text), "fig3b lacks {text:?}");
     }
     let fig4a = read(&figures.join("fig4a.svg"));

@@ -15,25 +15,33 @@
 //!
 //! | figure | study / runs | shows |
 //! |---|---|---|
-//! | `fig2a` | `ex71`, all runs (`adaptive`, `uniform` dashed) | `err_quadrature` and `estimate` vs NDF, log-log, NDF^-3/2 reference |
-//! | `fig2b` | `ex71`, all runs | efficiency index `efficiency` (= estimate / err_quadrature) vs NDF, line at 1 |
-//! | `fig3a` | `ex72`, all runs | `estimate` vs NDF, plus `err_quadrature` (vs the reference solution) where present, NDF^-3/2 |
-//! | `fig3b` | `ex72`, mesh snapshot of run `adaptive` at level 20 | triangles, active (red) / inactive (blue) contact nodes, the obstacle's kink, NDF in the title |
-//! | `fig4a` | `ex71`, run `adaptive` | `eta1`..`eta5` vs NDF, NDF^-3/2; `eta6`, `eta7` noted in the legend |
-//! | `fig4b` | `ex72`, run `adaptive` | `eta1`..`eta7` vs NDF, NDF^-3/2 |
-//! | `c0_sweep` | `c0_sweep`, panel per problem | efficiency C0' eta_h / err_quadrature for C0' = 0.45 (solid) and the smallest reliable C0' = max_levels err/eta_h (dashed), per run; line at 1 |
-//! | `log_ablation` | `log_ablation`, panel per problem | efficiency per level (vs NDF) for each `estimator.log_factor`; line at 1 |
-//! | `contact_term_ablation` | `contact_term_ablation`, panel per problem | `estimate` (solid) and `eta5` (dashed) vs NDF for each `estimator.contact_term` |
-//! | `theta_ablation` | `theta_ablation`, panel per problem | `err_quadrature` vs NDF for each theta and uniform (the estimate instead where a problem's runs lack errors; the y label says which), NDF^-3/2 |
+//! | `fig2a` | `ex71`, all runs (the first, `adaptive`, solid; others dashed, hollow markers) | `err_quadrature` (blue circles) and `estimate` (red squares) vs NDF, log-log; NDF^-3/2 reference 2.5x below the adaptive error |
+//! | `fig2b` | `ex71`, all runs | efficiency index `efficiency` (= estimate / err_quadrature; recomputed if absent) vs NDF, log x; y log if it spans more than a decade, else linear from 0; line at 1 |
+//! | `fig3a` | `ex72`, all runs | `estimate` vs NDF, log-log, plus `err_quadrature` (against the reference solution, its NDF from `reference_ndof` noted in the legend) where present; NDF^-3/2 below the adaptive estimate |
+//! | `fig3b` | `ex72`, `meshes/adaptive_level20.json` (else the finest saved level, said in the title) | the triangles, thin; equal aspect; active contact nodes red, inactive blue; the obstacle's kink (`kinks`) as a black diamond; NDF, triangle and vertex counts |
+//! | `fig4a` | `ex71`, run `adaptive` (else the first adaptive run) | `eta1`..`eta5` vs NDF, log-log, NDF^-3/2 above the data; `eta6`, `eta7` are not plotted (as in the paper) but the legend says whether they are 0 at every level or gives their maximum |
+//! | `fig4b` | `ex72`, run `adaptive` | `eta1`..`eta7` vs NDF, same style |
+//! | `c0_sweep` | `c0_sweep`, a panel per problem | efficiency C0' eta_h / err_quadrature vs NDF for C0' = 0.45 (solid) and the smallest reliable C0' = max over levels of err_quadrature / eta_h (dashed), per run; line at 1; runs without errors are named in the legend |
+//! | `log_ablation` | `log_ablation`, a panel per problem | efficiency per level (vs NDF) for each `estimator.log_factor`; line at 1 |
+//! | `contact_term_ablation` | `contact_term_ablation`, a panel per problem | `estimate` (solid) and `eta5` (dashed) vs NDF for each `estimator.contact_term` |
+//! | `theta_ablation` | `theta_ablation`, a panel per problem | `err_quadrature` vs NDF for each theta and uniform, with NDF^-3/2; where some run of a problem has fewer than two errors, the estimate for all runs of that problem instead (the y label says which) |
+//!
+//! Style: log axes labelled at the decades (`10⁻⁴`; also 2x and 5x when less than two decades
+//! show), light grid lines at 2..9 x each decade; one colour and marker shape per series; the
+//! legend in a white box where it covers no data, as near a corner as possible (upper right
+//! first), the y range growing upwards only if no such place exists; reference slopes dashed grey
+//! with their label beside the line where it covers no data. Labels have real subscripts and
+//! superscripts (see `rich`).
 //!
 //! On log axes a value that is exactly 0 cannot be drawn: the point is left out, the line
-//! breaks, and the legend says so ("η₆ = 0 at all levels", or "(= 0 at 3 of 20 levels)").
-//! Missing values (`None`, e.g. no error measured at a level) are left out silently.
+//! breaks, and the legend says so ("η₆ = 0 at all levels", or "(= 0 at 3 of 20 levels, not
+//! drawn)"). Missing values (`None`, e.g. no error measured at a level) are left out silently.
 //!
 //! Fonts: DejaVu Sans is bundled (`src/plot/DejaVuSans.ttf`, copied from the Debian
-//! fonts-dejavu-core package; the DejaVu fonts licence, a Bitstream Vera derivative, permits
-//! redistributing and embedding the font) and registered with plotters' ab_glyph backend, so no
-//! system font is needed. SVG text asks for "DejaVu Sans, sans-serif".
+//! fonts-dejavu-core package, version 2.37; the DejaVu fonts licence, a Bitstream Vera
+//! derivative, permits redistributing and embedding the font) and registered with plotters'
+//! ab_glyph backend under the name "DejaVu Sans, sans-serif", so no system font is needed to
+//! render the PNGs; the SVGs ask the viewer for that CSS font list.
 
 mod axis;
 mod render;
@@ -44,7 +52,7 @@ use crate::estimate::{ContactTerm, LogFactor};
 use crate::records::{MeshSnapshot, RunRecord, StudyDir};
 use anyhow::Context;
 use plotters::prelude::*;
-use render::{Figure, HLine, LineFigure, Marker, MeshFigure, Panel, Series, Slope, SlopeAnchor, Style, YScale, PALETTE};
+use render::{Figure, HLine, LineFigure, Marker, MeshFigure, PALETTE, Panel, Series, Slope, SlopeAnchor, Style, YScale};
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
@@ -62,7 +70,11 @@ const ERR: &str = "‖u − u_{h}‖_{∞}";
 const EFF_DESC: &str = "efficiency index C_{0}η_{h} / ‖u − u_{h}‖_{∞}";
 const ESTIMATE: &str = "estimate C_{0}η_{h}";
 
-/// The bundled font (DejaVu Sans, see the module documentation for its licence).
+/// The bundled font: DejaVu Sans 2.37, copied unchanged from
+/// /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf (Debian fonts-dejavu-core). Licence: the
+/// Bitstream Vera licence plus public-domain DejaVu changes, which allow copying, embedding and
+/// redistribution provided the copyright and licence notices go with every copy; the font file
+/// carries them in its name table (https://dejavu-fonts.github.io/License.html).
 static FONT_BYTES: &[u8] = include_bytes!("DejaVuSans.ttf");
 
 /// What [`draw_figures`] did.
@@ -349,7 +361,11 @@ fn fig4(results: &Path, study: &str, fig: &str, terms: usize) -> anyhow::Result<
     for i in terms..7 {
         let max = r.levels.iter().map(|l| etas(l)[i]).fold(0.0, f64::max);
         let eta = format!("η_{{{}}}", i + 1);
-        p.notes.push(if max == 0.0 { format!("{eta} = 0 at all levels (not shown)") } else { format!("{eta} not shown (max {})", sci(max)) });
+        p.notes.push(if max == 0.0 {
+            format!("{eta} = 0 at all levels (not shown)")
+        } else {
+            format!("{eta} not shown (max {})", sci(max))
+        });
     }
     p.slopes.push(Slope { anchor: SlopeAnchor::AboveAll, ..slope() });
     Ok(Ok(single(p)))
@@ -556,7 +572,8 @@ fn contact_term_ablation(results: &Path) -> anyhow::Result<Built> {
     for (problem, group) in by_problem(&runs) {
         let mut p = Panel::new(problem_title(&problem), NDF_DESC, format!("{ESTIMATE} (solid) and η_{{5}} (dashed)"));
         for (k, r) in group.iter().enumerate() {
-            let variant = format!("{}{}", contact_label(r.run.estimator.contact_term), distinguish(&group, r, |o| o.run.estimator.contact_term));
+            let variant =
+                format!("{}{}", contact_label(r.run.estimator.contact_term), distinguish(&group, r, |o| o.run.estimator.contact_term));
             let st = Style::nth(k);
             p.series.push(series(r, format!("estimate, {variant}"), st, |l| Some(l.estimate)));
             let st5 = Style { marker: render::MARKERS[(k + 4) % render::MARKERS.len()], ..st }.dashed(true);
@@ -577,14 +594,19 @@ fn theta_ablation(results: &Path) -> anyhow::Result<Built> {
         // the error where every run of the problem has some, else the estimate for all
         let errors = group.iter().all(|r| r.levels.iter().filter(|l| l.err_quadrature.is_some()).count() >= 2);
         let y_desc = if errors {
-            if group.iter().any(|r| r.reference_ndof.is_some()) { format!("error {ERR} (vs reference solution)") } else { format!("error {ERR}") }
+            if group.iter().any(|r| r.reference_ndof.is_some()) {
+                format!("error {ERR} (vs reference solution)")
+            } else {
+                format!("error {ERR}")
+            }
         } else {
             format!("{ESTIMATE} (errors not available)")
         };
         let mut p = Panel::new(problem_title(&problem), NDF_DESC, y_desc);
         for (k, r) in group.iter().enumerate() {
             let uniform = r.run.refine == Refine::Uniform;
-            let theta = |o: &RunRecord| if o.run.refine == Refine::Uniform { "uniform".to_string() } else { format!("θ = {}", o.run.theta) };
+            let theta =
+                |o: &RunRecord| if o.run.refine == Refine::Uniform { "uniform".to_string() } else { format!("θ = {}", o.run.theta) };
             let label = format!("{}{}", theta(r), distinguish(&group, r, theta));
             let y = move |l: &LevelRecord| if errors { l.err_quadrature } else { Some(l.estimate) };
             p.series.push(series(r, label, Style::nth(k).dashed(uniform), y));

@@ -261,11 +261,7 @@ impl Prepared<'_> {
     fn legend_label(&self) -> String {
         let l = &self.series.label;
         if self.segments.is_empty() {
-            if self.zeros > 0 && self.zeros == self.present {
-                format!("{l} = 0 at all levels")
-            } else {
-                format!("{l}: no data")
-            }
+            if self.zeros > 0 && self.zeros == self.present { format!("{l} = 0 at all levels") } else { format!("{l}: no data") }
         } else if self.zeros > 0 {
             format!("{l} (= 0 at {} of {} levels, not drawn)", self.zeros, self.present)
         } else {
@@ -343,14 +339,20 @@ fn padded(values: &[f64], log: bool, pad: f64, min_decades: f64) -> Axis {
     }
 }
 
-fn render_panel<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, area: &DrawingArea<DB, Shift>, p: &Panel, m: Metrics) -> anyhow::Result<()> {
+fn render_panel<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    area: &DrawingArea<DB, Shift>,
+    p: &Panel,
+    m: Metrics,
+) -> anyhow::Result<()> {
     let area = titled(root, area, &p.title, FS_TITLE, m)?;
     if !p.has_data() {
         return message(root, &area, "no results yet", m);
     }
 
     // y scale
-    let ys: Vec<f64> = p.series.iter().flat_map(|s| s.points.iter().filter(|(x, _)| *x > 0.0).filter_map(|p| p.1)).filter(|v| v.is_finite()).collect();
+    let ys: Vec<f64> =
+        p.series.iter().flat_map(|s| s.points.iter().filter(|(x, _)| *x > 0.0).filter_map(|p| p.1)).filter(|v| v.is_finite()).collect();
     let y_log = match p.y_scale {
         YScale::Log => true,
         YScale::Auto => {
@@ -378,13 +380,18 @@ fn render_panel<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, area: &Drawin
         .filter_map(|s| {
             let x0 = 10f64.powf(0.5 * (fx + lx));
             let x1 = 10f64.powf(lx);
-            let ratios = |pr: &Prepared| -> Vec<f64> { pr.points().filter(|q| q.0 >= x0 * (1.0 - 1e-9)).map(|q| q.1 / q.0.powf(s.rate)).collect() };
+            let ratios =
+                |pr: &Prepared| -> Vec<f64> { pr.points().filter(|q| q.0 >= x0 * (1.0 - 1e-9)).map(|q| q.1 / q.0.powf(s.rate)).collect() };
             let r: Vec<f64> = match s.anchor {
                 SlopeAnchor::Below(i) => prepared.get(i).map(ratios).unwrap_or_default(),
                 SlopeAnchor::BelowAll | SlopeAnchor::AboveAll => prepared.iter().flat_map(ratios).collect(),
             };
             let above = matches!(s.anchor, SlopeAnchor::AboveAll);
-            let c = if above { r.iter().cloned().fold(f64::NEG_INFINITY, f64::max) * 2.5 } else { r.iter().cloned().fold(f64::INFINITY, f64::min) / 2.5 };
+            let c = if above {
+                r.iter().cloned().fold(f64::NEG_INFINITY, f64::max) * 2.5
+            } else {
+                r.iter().cloned().fold(f64::INFINITY, f64::min) / 2.5
+            };
             (x1 > x0 && c.is_finite() && c > 0.0).then(|| (s, [x0, c * x0.powf(s.rate), x1, c * x1.powf(s.rate)], above))
         })
         .collect();
@@ -706,7 +713,8 @@ fn render_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, mesh: &MeshFig
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let xa = Axis::linear(cx - 0.5 * span, cx + 0.5 * span);
     let ya = Axis::linear(cy - 0.5 * span, cy + 0.5 * span);
-    let mut chart = ChartBuilder::on(&left).margin(margin).x_label_area_size(xlab).y_label_area_size(ylab).build_cartesian_2d(xa, ya).drawn()?;
+    let mut chart =
+        ChartBuilder::on(&left).margin(margin).x_label_area_size(xlab).y_label_area_size(ylab).build_cartesian_2d(xa, ya).drawn()?;
     chart
         .configure_mesh()
         .disable_mesh()
@@ -742,7 +750,10 @@ fn render_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, mesh: &MeshFig
     let entries: Vec<(Option<(Style, i32)>, String)> = vec![
         (Some((active, 3)), format!("active contact node ({})", m.active.len())),
         (Some((inactive, 3)), format!("inactive contact node ({})", m.inactive.len())),
-        (Some((kink, 7)), if kinks.is_empty() { "obstacle kink (none recorded)".to_string() } else { format!("kink of the obstacle {kinks}") }),
+        (
+            Some((kink, 7)),
+            if kinks.is_empty() { "obstacle kink (none recorded)".to_string() } else { format!("kink of the obstacle {kinks}") },
+        ),
         (None, format!("{} triangles, {} vertices", m.n_triangles, m.n_vertices)),
     ];
     let (rx, ry) = right.get_base_pixel();
