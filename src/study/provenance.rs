@@ -13,6 +13,7 @@ pub struct Provenance {
     pub manifest_sha256: String,
     pub quick: bool,
     pub git_commit: Option<String>,
+    /// Tracked files other than results/ differ from the commit.
     pub git_dirty: Option<bool>,
     pub cargo_lock_sha256: Option<String>,
     pub rustc: Option<String>,
@@ -73,7 +74,8 @@ pub fn utc_now() -> String {
 pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: bool, runs: Vec<String>) -> Provenance {
     let root = manifest_path.parent().and_then(|p| p.parent()).filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let git_commit = command("git", &["-C", &root.to_string_lossy(), "rev-parse", "HEAD"]);
-    let git_dirty = command("git", &["-C", &root.to_string_lossy(), "status", "--porcelain", "--untracked-files=no"]).map(|s| !s.is_empty());
+    // dirty = tracked files changed outside results/ (the study's own outputs are not the code)
+    let git_dirty = command("git", &["-C", &root.to_string_lossy(), "status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)results"]).map(|s| !s.is_empty());
     Provenance {
         study: study.to_string(),
         manifest: manifest_path.display().to_string(),
