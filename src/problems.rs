@@ -89,6 +89,18 @@ pub fn by_name(name: &str) -> Result<Box<dyn Problem>, UnknownProblem> {
 
 const EPS: f64 = 1e-12;
 
+/// The boundary parts of Example 7.2 (and the patch test): contact on x = 1, Dirichlet on x = 0,
+/// Neumann top and bottom.
+fn contact_right_dirichlet_left(x: [f64; 2]) -> Part {
+    if x[0] > 1.0 - EPS {
+        Part::Contact
+    } else if x[0] < EPS {
+        Part::Dirichlet
+    } else {
+        Part::Neumann
+    }
+}
+
 /// Example 7.1: smooth manufactured solution u = (y^2 (y - 1), e^y (1 - y) y (x - 2)),
 /// zeta = mu = 1, Gamma_C the bottom (n = (0, -1), chi = 0), Gamma_D the top, Gamma_N the sides.
 /// The exact solution is in contact along the whole of Gamma_C (sigma_nn = 3x - 6 < 0).
@@ -166,13 +178,7 @@ impl Problem for Ex72 {
         Material::from_young(500.0, 0.3)
     }
     fn part_of(&self, x: [f64; 2]) -> Part {
-        if x[0] > 1.0 - EPS {
-            Part::Contact
-        } else if x[0] < EPS {
-            Part::Dirichlet
-        } else {
-            Part::Neumann
-        }
+        contact_right_dirichlet_left(x)
     }
     fn body_force(&self, _x: [f64; 2]) -> [f64; 2] {
         [0.0, 0.0]
@@ -254,13 +260,7 @@ impl Problem for Patch {
         self.material
     }
     fn part_of(&self, x: [f64; 2]) -> Part {
-        if x[0] > 1.0 - EPS {
-            Part::Contact
-        } else if x[0] < EPS {
-            Part::Dirichlet
-        } else {
-            Part::Neumann
-        }
+        contact_right_dirichlet_left(x)
     }
     /// f = -div sigma(u), constant for quadratic u.
     fn body_force(&self, _x: [f64; 2]) -> [f64; 2] {
