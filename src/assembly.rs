@@ -188,40 +188,66 @@ pub fn element_stiffness(map: &Affine, material: Material, rule: &element::Rule<
     k
 }
 
+/// Runs `fill(item, slice)` for every item of a compressed layout (`offsets`, one slice of
+/// `buf` per item), in parallel over blocks of items: the slices are disjoint, so any thread
+/// count writes the same values.
+fn par_fill<T: Send>(buf: &mut [T], offsets: &[usize], fill: impl Fn(usize, &mut [T]) + Sync) {
+    const BLOCK: usize = 4096;
+    let n = offsets.len() - 1;
+    let mut blocks = Vec::with_capacity(n.div_ceil(BLOCK));
+    let mut rest = buf;
+    for start in (0..n).step_by(BLOCK) {
+        let end = (start + BLOCK).min(n);
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(offsets[end] - offsets[start]);
+        blocks.push((start, end, head));
+        rest = tail;
+    }
+    blocks.into_par_iter().for_each(|(start, end, mut block)| {
+        for item in start..end {
+            let (head, tail) = std::mem::take(&mut block).split_at_mut(offsets[item + 1] - offsets[item]);
+            fill(item, head);
+            block = tail;
+        }
+    });
+}
+
+/// Prefix sums of counts: the offsets of a compressed layout.
+fn offsets(counts: impl Iterator<Item = usize>) -> Vec<usize> {
+    let mut ptr = vec![0];
+    for c in counts {
+        ptr.push(ptr.last().unwrap() + c);
+    }
+    ptr
+}
+
 /// The sparsity pattern of the lower triangle on the unknowns: (row, col) is present when the
 /// two nodes share an element.
 fn pattern(nodes: &P2Nodes, dofs: &DofMap) -> SymCsc {
     let n_nodes = nodes.len();
-    // node adjacency, as sorted unique lists
-    let mut count = vec![0usize; n_nodes + 1];
+    // node adjacency: every node of every element containing the node, then sorted and unique
+    let mut count = vec![0usize; n_nodes];
     for el in &nodes.elements {
         for &p in el {
-            count[p + 1] += N_NODES;
+            count[p] += N_NODES;
         }
     }
-    for i in 0..n_nodes {
-        count[i + 1] += count[i];
-    }
-    let mut adj = vec![0usize; count[n_nodes]];
-    let mut fill = count.clone();
+    let adj_ptr = offsets(count.into_iter());
+    let mut adj = vec![0usize; adj_ptr[n_nodes]];
+    let mut fill = adj_ptr.clone();
     for el in &nodes.elements {
         for &p in el {
-            for &q in el {
-                adj[fill[p]] = q;
-                fill[p] += 1;
-            }
+            adj[fill[p]..fill[p] + N_NODES].copy_from_slice(el);
+            fill[p] += N_NODES;
         }
     }
-    let lists: Vec<Vec<usize>> = (0..n_nodes)
-        .into_par_iter()
-        .map(|p| {
-            let mut l = adj[count[p]..count[p + 1]].to_vec();
-            l.sort_unstable();
-            l.dedup();
-            l
-        })
-        .collect();
-    // each unknown's owner node
+    par_fill(&mut adj, &adj_ptr, |_, list| {
+        list.sort_unstable();
+    });
+    let neighbours = |p: usize| {
+        let list = &adj[adj_ptr[p]..adj_ptr[p + 1]];
+        list.iter().enumerate().filter(move |&(i, q)| i == 0 || list[i - 1] != *q).map(|(_, &q)| q)
+    };
+    // each unknown's owner node; column j holds the unknowns >= j of the owner's neighbours
     let n = dofs.n_free;
     let mut owner = vec![0usize; n];
     for p in 0..n_nodes {
@@ -231,24 +257,16 @@ fn pattern(nodes: &P2Nodes, dofs: &DofMap) -> SymCsc {
             }
         }
     }
-    let columns: Vec<Vec<usize>> = (0..n)
-        .into_par_iter()
-        .map(|j| {
-            let mut rows: Vec<usize> = lists[owner[j]]
-                .iter()
-                .flat_map(|&q| dofs.dof[q])
-                .filter(|&d| d != FIXED && d >= j)
-                .collect();
-            rows.sort_unstable();
-            rows
-        })
-        .collect();
-    let mut col_ptr = Vec::with_capacity(n + 1);
-    col_ptr.push(0);
-    for c in &columns {
-        col_ptr.push(col_ptr.last().unwrap() + c.len());
-    }
-    let row_idx: Vec<usize> = columns.into_iter().flatten().collect();
+    let rows_of = |j: usize| neighbours(owner[j]).flat_map(|q| dofs.dof[q]).filter(move |&d| d != FIXED && d >= j);
+    let counts: Vec<usize> = (0..n).into_par_iter().map(|j| rows_of(j).count()).collect();
+    let col_ptr = offsets(counts.into_iter());
+    let mut row_idx = vec![0usize; col_ptr[n]];
+    par_fill(&mut row_idx, &col_ptr, |j, col| {
+        for (slot, d) in col.iter_mut().zip(rows_of(j)) {
+            *slot = d;
+        }
+        col.sort_unstable();
+    });
     let nnz = row_idx.len();
     SymCsc { n, col_ptr, row_idx, values: vec![0.0; nnz] }
 }
@@ -289,9 +307,7 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
                 (k, f)
             })
             .collect();
-        for (t, (k, f)) in (start..end).zip(local) {
-            scatter(&mut matrix, &mut rhs, &k, &f, &nodes.elements[t], dofs, &dirichlet);
-        }
+        scatter(&mut matrix, &mut rhs, &local, &nodes.elements[start..end], dofs, &dirichlet);
     }
     neumann_load(mesh, nodes, dofs, problem, &mut rhs);
     System { matrix, rhs, dirichlet }
@@ -321,33 +337,71 @@ fn rotate(k: &mut [[f64; 12]; 12], f: &mut [f64; 12], el: &[usize; 6], dofs: &Do
     }
 }
 
+/// Add element matrices and loads, in element order, into the matrix and the right-hand side.
+/// The unknowns are split into ranges of about equal nonzeros, one per thread: a range takes the
+/// matrix entries of its columns and the loads of its rows. Every entry still receives its
+/// contributions in element order, so the sums are the same on any number of threads.
 fn scatter(
     matrix: &mut SymCsc,
     rhs: &mut [f64],
-    k: &[[f64; 12]; 12],
-    f: &[f64; 12],
-    el: &[usize; 6],
+    local: &[([[f64; 12]; 12], [f64; 12])],
+    elements: &[[usize; 6]],
     dofs: &DofMap,
     dirichlet: &[[f64; 2]],
 ) {
-    let global: [usize; 12] = std::array::from_fn(|l| dofs.dof[el[l / 2]][l % 2]);
-    for r in 0..12 {
-        let gr = global[r];
-        if gr == FIXED {
-            continue;
-        }
-        rhs[gr] += f[r];
-        for c in 0..12 {
-            let gc = global[c];
-            if gc == FIXED {
-                // Dirichlet nodes are never rotated: their local components are Cartesian
-                rhs[gr] -= k[r][c] * dirichlet[el[c / 2]][c % 2];
-            } else if gr >= gc {
-                let pos = matrix.position(gr, gc);
-                matrix.values[pos] += k[r][c];
+    let n = matrix.n;
+    let parts = rayon::current_num_threads().max(1);
+    let nnz = matrix.values.len();
+    let mut bounds = vec![0usize];
+    for k in 1..parts {
+        bounds.push(matrix.col_ptr.partition_point(|&c| c < k * nnz / parts).min(n).max(*bounds.last().unwrap()));
+    }
+    bounds.push(n);
+    let (col_ptr, row_idx) = (&matrix.col_ptr, &matrix.row_idx);
+    let mut jobs = Vec::with_capacity(parts);
+    let (mut values, mut rhs_rest) = (&mut matrix.values[..], rhs);
+    for w in bounds.windows(2) {
+        let (v, vt) = std::mem::take(&mut values).split_at_mut(col_ptr[w[1]] - col_ptr[w[0]]);
+        let (r, rt) = std::mem::take(&mut rhs_rest).split_at_mut(w[1] - w[0]);
+        jobs.push((w[0], w[1], v, r));
+        values = vt;
+        rhs_rest = rt;
+    }
+    jobs.into_par_iter().for_each(|(c0, c1, values, rhs)| {
+        let base = col_ptr[c0];
+        let mine = |d: usize| d != FIXED && (c0..c1).contains(&d);
+        for ((k, f), el) in local.iter().zip(elements) {
+            let global: [usize; 12] = std::array::from_fn(|l| dofs.dof[el[l / 2]][l % 2]);
+            for r in (0..12).filter(|&r| mine(global[r])) {
+                let gr = global[r];
+                rhs[gr - c0] += f[r];
+                for c in 0..12 {
+                    if global[c] == FIXED {
+                        // Dirichlet nodes are never rotated: their local components are Cartesian
+                        rhs[gr - c0] -= k[r][c] * dirichlet[el[c / 2]][c % 2];
+                    }
+                }
+            }
+            // local unknowns by increasing global index (FIXED last): the rows of a column are
+            // then found by one forward scan of its sorted row indices
+            let mut order: [usize; 12] = std::array::from_fn(|l| l);
+            order.sort_unstable_by_key(|&l| global[l]);
+            for (i, &c) in order.iter().enumerate() {
+                let gc = global[c];
+                if !mine(gc) {
+                    continue;
+                }
+                let (mut pos, hi) = (col_ptr[gc], col_ptr[gc + 1]);
+                for &r in order[i..].iter().take_while(|&&r| global[r] != FIXED) {
+                    while row_idx[pos] != global[r] {
+                        pos += 1;
+                        assert!(pos < hi, "entry outside the sparsity pattern");
+                    }
+                    values[pos - base] += k[r][c];
+                }
             }
         }
-    }
+    });
 }
 
 /// The P2 basis on an edge, parameter s in [0, 1] from a to b, nodes [a, b, midpoint].

@@ -266,6 +266,48 @@ pub fn key(a: usize, b: usize) -> (usize, usize) {
     if a < b { (a, b) } else { (b, a) }
 }
 
+/// Edges numbered in order of first appearance, found through a linked list per smaller vertex:
+/// a triangle mesh has a handful of edges per vertex, so this beats hashing the vertex pair
+/// (no crate offers this small a structure).
+struct EdgeTable {
+    edges: Vec<[usize; 2]>,
+    /// Per vertex, the last edge inserted whose smaller vertex it is.
+    head: Vec<usize>,
+    /// Per edge, the previous edge with the same smaller vertex.
+    next: Vec<usize>,
+}
+
+impl EdgeTable {
+    const NONE: usize = usize::MAX;
+
+    fn new(n_vertices: usize, capacity: usize) -> Self {
+        EdgeTable { edges: Vec::with_capacity(capacity), head: vec![Self::NONE; n_vertices], next: Vec::with_capacity(capacity) }
+    }
+
+    fn find(&self, a: usize, b: usize) -> Option<usize> {
+        let (lo, hi) = key(a, b);
+        let mut e = self.head[lo];
+        while e != Self::NONE {
+            if self.edges[e][1] == hi {
+                return Some(e);
+            }
+            e = self.next[e];
+        }
+        None
+    }
+
+    fn find_or_insert(&mut self, a: usize, b: usize) -> usize {
+        if let Some(e) = self.find(a, b) {
+            return e;
+        }
+        let (lo, hi) = key(a, b);
+        self.edges.push([lo, hi]);
+        self.next.push(self.head[lo]);
+        self.head[lo] = self.edges.len() - 1;
+        self.edges.len() - 1
+    }
+}
+
 /// The P2 node numbering of a mesh: vertices first, then one node per edge (its midpoint).
 #[derive(Clone, Debug)]
 pub struct P2Nodes {
@@ -292,19 +334,16 @@ pub struct P2Nodes {
 impl P2Nodes {
     pub fn new(mesh: &Mesh) -> Self {
         let nv = mesh.n_vertices();
-        let mut edge_index: HashMap<(usize, usize), usize> = HashMap::with_capacity(3 * mesh.n_triangles());
-        let mut edges = Vec::new();
+        let mut edges = EdgeTable::new(nv, 3 * mesh.n_triangles() / 2 + mesh.boundary.len());
         let mut elements = Vec::with_capacity(mesh.n_triangles());
-        let mut edge_owner: Vec<[Option<(usize, usize)>; 2]> = Vec::new();
+        let mut edge_owner: Vec<[Option<(usize, usize)>; 2]> = Vec::with_capacity(edges.edges.capacity());
         for (t, tri) in mesh.triangles.iter().enumerate() {
             let mut nodes = [tri[0], tri[1], tri[2], 0, 0, 0];
             for (le, [i, j]) in crate::element::EDGE_VERTICES.iter().enumerate() {
-                let k = key(tri[*i], tri[*j]);
-                let e = *edge_index.entry(k).or_insert_with(|| {
-                    edges.push([k.0, k.1]);
+                let e = edges.find_or_insert(tri[*i], tri[*j]);
+                if e == edge_owner.len() {
                     edge_owner.push([None, None]);
-                    edges.len() - 1
-                });
+                }
                 if edge_owner[e][0].is_none() {
                     edge_owner[e][0] = Some((t, le));
                 } else {
@@ -322,7 +361,7 @@ impl P2Nodes {
             }
         }
         let mut coords = mesh.vertices.clone();
-        for [a, b] in &edges {
+        for [a, b] in &edges.edges {
             let (pa, pb) = (mesh.vertices[*a], mesh.vertices[*b]);
             coords.push([0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1])]);
         }
@@ -335,7 +374,7 @@ impl P2Nodes {
         let mut boundary_nodes = Vec::with_capacity(mesh.boundary.len());
         let mut element_boundary = vec![[None; 3]; mesh.n_triangles()];
         for (bi, be) in mesh.boundary.iter().enumerate() {
-            let e = edge_index[&key(be.v[0], be.v[1])];
+            let e = edges.find(be.v[0], be.v[1]).expect("a boundary edge of the mesh is an edge of a triangle");
             let m = nv + e;
             boundary_nodes.push([be.v[0], be.v[1], m]);
             for node in [be.v[0], be.v[1], m] {
@@ -347,6 +386,7 @@ impl P2Nodes {
                 element_boundary[t][le] = Some(bi);
             }
         }
+        let edges = edges.edges;
         P2Nodes { n_vertices: nv, edges, elements, coords, part, boundary_nodes, element_boundary, neighbours }
     }
 
