@@ -84,6 +84,17 @@ impl DofMap {
         })
     }
 
+    /// The position of every unknown (its node's), for the fill-reducing ordering.
+    pub fn unknown_coords(&self, nodes: &P2Nodes) -> Vec<[f64; 2]> {
+        let mut coords = vec![[0.0; 2]; self.n_free];
+        for (p, d) in self.dof.iter().enumerate() {
+            for &k in d.iter().filter(|&&k| k != FIXED) {
+                coords[k] = nodes.coords[p];
+            }
+        }
+        coords
+    }
+
     /// Full Cartesian nodal displacements from the unknowns and the Dirichlet values.
     pub fn displacement(&self, free: &[f64], dirichlet: &[[f64; 2]]) -> Vec<[f64; 2]> {
         (0..self.dof.len())

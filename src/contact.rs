@@ -25,13 +25,14 @@
 //! refactorisation. Both strategies share one active-set driver ([`pdas`]).
 
 use crate::assembly::SymCsc;
+use crate::ordering::OrderingChoice;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, supernodal,
 };
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::{SupernodalThreshold, amd};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::{Conj, Mat, Par, Side, Spec};
 use std::time::Instant;
 
@@ -149,20 +150,23 @@ pub struct ContactSolver {
     /// Refactor strategy: per contact node, the (column, position) of the off-diagonal entries
     /// of its normal unknown's row that lie in earlier columns.
     row_entries: Vec<Vec<(usize, usize)>>,
+    /// The fill-reducing ordering that was kept (of `I` for Schur, of all unknowns for Refactor).
+    pub ordering: OrderingChoice,
     pub timings: Timings,
 }
 
 impl ContactSolver {
     /// Order, factorise and prepare the contact unknowns `n_interior..n`, with the strategy
     /// chosen by the number of contact nodes.
-    pub fn new(matrix: &SymCsc, n_interior: usize) -> Result<Self, ContactError> {
-        Self::with_strategy(matrix, n_interior, Strategy::auto(matrix.n - n_interior))
+    /// `coords` holds the position of every unknown (its node's), for the ordering.
+    pub fn new(matrix: &SymCsc, n_interior: usize, coords: &[[f64; 2]]) -> Result<Self, ContactError> {
+        Self::with_strategy(matrix, n_interior, coords, Strategy::auto(matrix.n - n_interior))
     }
 
-    pub fn with_strategy(matrix: &SymCsc, n_interior: usize, strategy: Strategy) -> Result<Self, ContactError> {
+    pub fn with_strategy(matrix: &SymCsc, n_interior: usize, coords: &[[f64; 2]], strategy: Strategy) -> Result<Self, ContactError> {
         let mut timings = Timings::default();
         let t0 = Instant::now();
-        let symbolic = symbolic_factorisation(matrix, n_interior, strategy)?;
+        let (symbolic, ordering) = symbolic_factorisation(matrix, n_interior, coords, strategy)?;
         let row_entries = match strategy {
             Strategy::Schur => Vec::new(),
             Strategy::Refactor => {
@@ -187,6 +191,7 @@ impl ContactSolver {
             symbolic,
             schur: Mat::zeros(0, 0),
             row_entries,
+            ordering,
             timings,
         };
         solver.refactor(matrix)?;
@@ -398,49 +403,25 @@ impl ContactSolver {
     }
 }
 
-/// Symbolic Cholesky. Schur: a custom ordering, AMD on the leading block `I` then `C` in place,
-/// and the supernodal variant forced so that the trailing block of L can be read. Refactor:
-/// AMD on the whole matrix.
-fn symbolic_factorisation(matrix: &SymCsc, ni: usize, strategy: Strategy) -> Result<SymbolicCholesky<usize>, ContactError> {
-    let factorise = |ord, params| {
-        faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(matrix.as_faer().symbolic(), Side::Lower, ord, params)
-            .map_err(|e| ContactError::Factorisation(format!("{e:?}")))
-    };
-    if strategy == Strategy::Refactor {
-        return factorise(SymmetricOrdering::Amd, CholeskySymbolicParams::default());
-    }
+/// Symbolic Cholesky, supernodal, with the fill-reducing ordering of [`crate::ordering`].
+/// Schur: the leading block `I` is ordered and `C` kept in place at the end, so that the
+/// trailing block of L is L_CC. Refactor: all unknowns are ordered.
+fn symbolic_factorisation(matrix: &SymCsc, ni: usize, coords: &[[f64; 2]], strategy: Strategy) -> Result<(SymbolicCholesky<usize>, OrderingChoice), ContactError> {
     let n = matrix.n;
-    // pattern of K_II (lower triangle): rows are sorted, so rows < ni form a prefix of each column
-    let mut col_ptr = Vec::with_capacity(ni + 1);
-    let mut row_idx = Vec::new();
-    col_ptr.push(0);
-    for j in 0..ni {
-        for &i in &matrix.row_idx[matrix.col_ptr[j]..matrix.col_ptr[j + 1]] {
-            if i < ni {
-                row_idx.push(i);
-            }
-        }
-        col_ptr.push(row_idx.len());
-    }
-    let mut fwd = vec![0usize; n];
+    let n_order = if strategy == Strategy::Schur { ni } else { n };
+    let (fwd, choice) = crate::ordering::fill_reducing(matrix, n_order, coords);
     let mut inv = vec![0usize; n];
-    if ni > 0 {
-        let sym = faer::sparse::SymbolicSparseColMatRef::new_checked(ni, ni, &col_ptr, None, &row_idx);
-        let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(ni, row_idx.len()))
-            .map_err(|e| ContactError::Factorisation(format!("{e:?}")))?;
-        amd::order(&mut fwd[..ni], &mut inv[..ni], sym, amd::Control::default(), MemStack::new(&mut mem))
-            .map_err(|e| ContactError::Factorisation(format!("{e:?}")))?;
-    }
-    for k in ni..n {
-        fwd[k] = k;
-        inv[k] = k;
+    for (new, &old) in fwd.iter().enumerate() {
+        inv[old] = new;
     }
     let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
     let params = CholeskySymbolicParams {
         supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
         ..Default::default()
     };
-    factorise(SymmetricOrdering::Custom(perm), params)
+    let symbolic = faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(matrix.as_faer().symbolic(), Side::Lower, SymmetricOrdering::Custom(perm), params)
+        .map_err(|e| ContactError::Factorisation(format!("{e:?}")))?;
+    Ok((symbolic, choice))
 }
 
 type PdasResult = (Vec<f64>, Vec<f64>, Vec<bool>, Vec<PdasIteration>, f64);

@@ -13,6 +13,7 @@ pub mod element;
 pub mod estimate;
 pub mod mesh;
 pub mod norms;
+pub mod ordering;
 pub mod plot;
 pub mod problems;
 pub mod records;

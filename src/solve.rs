@@ -78,7 +78,7 @@ pub fn solve(
     let System { matrix, rhs, dirichlet } = assembly::assemble(mesh, &nodes, &dofs, problem);
     let assembly_time = t0.elapsed().as_secs_f64();
     let strategy = options.strategy.unwrap_or(Strategy::auto(dofs.contact.len()));
-    let mut solver = ContactSolver::with_strategy(&matrix, dofs.n_interior, strategy)?;
+    let mut solver = ContactSolver::with_strategy(&matrix, dofs.n_interior, &dofs.unknown_coords(&nodes), strategy)?;
     let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
     let out = solver.solve_contact(&matrix, &rhs, &gap, options, observe)?;
     // the residual F - K u: zero at free unknowns, lambda_p at contact normals

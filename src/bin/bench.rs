@@ -102,7 +102,7 @@ fn main() -> Result<()> {
             let dofs = DofMap::new(&nodes, &problem);
             let sys = assembly::assemble(&mesh, &nodes, &dofs, &problem);
             let assembly_time = t0.elapsed().as_secs_f64();
-            let mut solver = ContactSolver::new(&sys.matrix, dofs.n_interior)?;
+            let mut solver = ContactSolver::new(&sys.matrix, dofs.n_interior, &dofs.unknown_coords(&nodes))?;
             let (symbolic, numeric_first) = (solver.timings.symbolic, solver.timings.numeric);
             solver.refactor(&sys.matrix)?;
             let (numeric_warm, schur) = (solver.timings.numeric, solver.timings.schur);
