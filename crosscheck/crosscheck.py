@@ -197,29 +197,53 @@ def bench_once(mesh, prob):
     return (t1 - t0, t2 - t1, t3 - t2), fes, err
 
 
-def cmd_bench(args):
-    sizes = [int(s) for s in args.sizes.split(",")]
-    threads = args.threads or os.cpu_count()
+def bench_size(n, repeats, threads):
+    """All repeats of one size, in this process; returns the row (peak memory of this process)."""
+    import resource
     ng.SetNumThreads(threads)
     prob = problems.problem("ex72")
+    with ng.TaskManager():
+        vertices, tris = make_case.structured_triangles(n)
+        segs, parts = make_case.boundary_segments(vertices, tris, make_case.SIDES["ex72"])
+        mesh = fem.build_ngmesh(vertices, tris, segs, parts)
+        runs = [bench_once(mesh, prob) for _ in range(repeats)]
+        used = ng.GetNumThreads()  # inside the TaskManager: the threads actually used
+    fes, err = runs[-1][1], runs[-1][2]
+    med = [statistics.median(r[0][i] for r in runs) for i in range(3)]
+    return {"N": n, "ndof": fes.ndof, "ndof_free": sum(fes.FreeDofs()),
+            "assembly_s": med[0], "factorisation_s": med[1], "solve_s": med[2],
+            "total_s": sum(med), "first_factorisation_s": runs[0][0][1],
+            "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+            "threads": used, "l1_error_vs_translation": err}
+
+
+def cmd_bench_one(args):
+    print("ROW " + json.dumps(bench_size(args.n, args.repeats, args.threads or os.cpu_count())))
+    return True
+
+
+def cmd_bench(args):
+    # every size in a fresh process: its peak memory is its own, and its first factorisation
+    # pays the first touch of its memory as ours does
+    import subprocess
+    sizes = [int(s) for s in args.sizes.split(",")]
+    threads = args.threads or os.cpu_count()
     rows = []
     load_before = os.getloadavg()[0]  # timings on a busy machine are not worth much: record it
-    with ng.TaskManager():
-        for n in sizes:
-            vertices, tris = make_case.structured_triangles(n)
-            segs, parts = make_case.boundary_segments(vertices, tris, make_case.SIDES["ex72"])
-            mesh = fem.build_ngmesh(vertices, tris, segs, parts)
-            runs = [bench_once(mesh, prob) for _ in range(args.repeats)]
-            fes, err = runs[-1][1], runs[-1][2]
-            med = [statistics.median(r[0][i] for r in runs) for i in range(3)]
-            rows.append({"N": n, "ndof": fes.ndof, "ndof_free": sum(fes.FreeDofs()),
-                         "assembly_s": med[0], "factorisation_s": med[1], "solve_s": med[2],
-                         "total_s": sum(med), "l1_error_vs_translation": err})
-            if err > 1e-8:
-                print(f"bench: N={n}: solution is not the translation (L1 error {err:g})")
-                return False
-        used = ng.GetNumThreads()  # inside the TaskManager: the threads actually used
-    cols = ["N", "ndof", "ndof_free", "assembly_s", "factorisation_s", "solve_s", "total_s"]
+    for n in sizes:
+        out = subprocess.run([sys.executable, os.path.abspath(__file__), "bench-one", "--n", str(n),
+                              "--repeats", str(args.repeats), "--threads", str(threads)],
+                             check=True, capture_output=True, text=True).stdout
+        row = json.loads(next(line[4:] for line in out.splitlines() if line.startswith("ROW ")))
+        rows.append(row)
+        print(f"NGSolve N={n}: assembly {row['assembly_s']:.3f} s, factorisation {row['factorisation_s']:.3f} s, "
+              f"solve {row['solve_s']:.3f} s, peak {row['peak_rss_mb']:.0f} MB", flush=True)
+        err = row["l1_error_vs_translation"]
+        if err > 1e-8:
+            print(f"bench: N={n}: solution is not the translation (L1 error {err:g})")
+            return False
+    used = rows[-1]["threads"] if rows else threads
+    cols = ["N", "ndof", "ndof_free", "assembly_s", "factorisation_s", "solve_s", "total_s", "peak_rss_mb"]
     table = markdown_table(cols, rows)
     print(table)
     doc = {"title": "NGSolve: Example 7.2 linear elasticity (no contact), P2, structured:N",
@@ -229,7 +253,8 @@ def cmd_bench(args):
            "statistic": "median", "mesh": "structured:N, diagonal lower-left to upper-right",
            "timed": {"assembly": "space + stiffness matrix + load vector",
                      "factorisation": "sparse factorisation on the free dofs",
-                     "solve": "Dirichlet values, residual, forward/back substitution"},
+                     "solve": "Dirichlet values, residual, forward/back substitution",
+                     "peak_rss_mb": "peak resident memory of the process that ran the size (one process per size)"},
            "rows": rows}
     if args.out_dir:
         write_atomic(os.path.join(args.out_dir, "ngsolve_bench.json"), json.dumps(doc, indent=1) + "\n")
@@ -294,6 +319,11 @@ def main():
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--threads", type=int, default=0, help="NGSolve threads (default: all cores)")
     p.set_defaults(func=cmd_bench)
+    p = sub.add_parser("bench-one", help="one size of bench, in this process (bench runs it per size)")
+    p.add_argument("--n", type=int, required=True)
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--threads", type=int, default=0)
+    p.set_defaults(func=cmd_bench_one)
     p = sub.add_parser("selftest")
     p.add_argument("dirs", nargs="*", help="exported cases to perturb (default: generated structured:8 cases)")
     p.set_defaults(func=cmd_selftest)

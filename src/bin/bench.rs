@@ -29,9 +29,13 @@ struct Args {
     /// NGSolve's timings of the same systems (crosscheck.py bench), printed side by side.
     #[arg(long, default_value = "results/bench/ngsolve_bench.json")]
     ngsolve: std::path::PathBuf,
+    /// Run the sizes in this process and print one JSON row per size (the parent runs every size
+    /// in a child of its own, so that peak memory and first-touch costs are the size's own).
+    #[arg(long, hide = true)]
+    child: bool,
 }
 
-#[derive(serde::Serialize, Default, Clone)]
+#[derive(serde::Serialize, serde::Deserialize, Default, Clone)]
 struct Phases {
     assembly: f64,
     symbolic: f64,
@@ -47,11 +51,13 @@ struct Phases {
     contact_solve: f64,
 }
 
-#[derive(serde::Serialize)]
+#[derive(serde::Serialize, serde::Deserialize)]
 struct SizeResult {
     n: usize,
     unknowns: usize,
     contact_unknowns: usize,
+    /// the fill-reducing ordering kept, with the flops of both candidates
+    ordering: serde_json::Value,
     pdas_iterations: usize,
     per_iteration_seconds: Vec<f64>,
     median: Phases,
@@ -85,97 +91,154 @@ fn machine() -> serde_json::Value {
     })
 }
 
+const HEADER: &str = "    N  unknowns | assembly symbolic num.first  num.warm   schur  solves act.set  its |   linear  contact  peak MB";
+
 fn main() -> Result<()> {
     let args = Args::parse();
-    let problem = Ex72;
-    let mut results = Vec::new();
-    println!("{:>5} {:>9} | {:>8} {:>8} {:>9} {:>9} {:>7} {:>7} {:>7} {:>4} | {:>8} {:>8}", "N", "unknowns", "assembly", "symbolic", "num.first", "num.warm", "schur", "solves", "act.set", "its", "linear", "contact");
-    for &n in &args.sizes {
-        let spec = MeshSpec::Structured(n);
-        let mut runs = Vec::new();
-        let mut per_iteration = Vec::new();
-        let (mut unknowns, mut m, mut its) = (0, 0, 0);
-        for _ in 0..args.repeats.max(1) {
-            let mesh = spec.build(&|x| problem.part_of(x));
-            let t0 = Instant::now();
-            let nodes = P2Nodes::new(&mesh);
-            let dofs = DofMap::new(&nodes, &problem);
-            let sys = assembly::assemble(&mesh, &nodes, &dofs, &problem);
-            let assembly_time = t0.elapsed().as_secs_f64();
-            let mut solver = ContactSolver::new(&sys.matrix, dofs.n_interior, &dofs.unknown_coords(&nodes))?;
-            let (symbolic, numeric_first) = (solver.timings.symbolic, solver.timings.numeric);
-            solver.refactor(&sys.matrix)?;
-            let (numeric_warm, schur) = (solver.timings.numeric, solver.timings.schur);
-            let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
-            let out = solver.solve_contact(&sys.matrix, &sys.rhs, &gap, &PdasOptions::default(), &mut |_| {})?;
-            let t = &solver.timings;
-            unknowns = sys.matrix.n;
-            m = dofs.contact.len();
-            its = out.iterations.len();
-            per_iteration = out.iterations.iter().map(|i| i.seconds).collect();
-            runs.push(Phases {
-                assembly: assembly_time,
-                symbolic,
-                numeric_first,
-                numeric_warm,
-                schur,
-                solves: t.solves,
-                active_set: t.active_set,
-                linear_solve: numeric_warm + t.solves / 2.0,
-                contact_solve: numeric_warm + schur + t.solves + t.active_set,
-            });
+    if args.child {
+        for &n in &args.sizes {
+            println!("ROW {}", serde_json::to_string(&bench_size(n, args.repeats)?)?);
         }
-        let med = |f: fn(&Phases) -> f64| median(runs.iter().map(f).collect());
-        let median = Phases {
-            assembly: med(|p| p.assembly),
-            symbolic: med(|p| p.symbolic),
-            numeric_first: runs[0].numeric_first,
-            numeric_warm: med(|p| p.numeric_warm),
-            schur: med(|p| p.schur),
-            solves: med(|p| p.solves),
-            active_set: med(|p| p.active_set),
-            linear_solve: med(|p| p.linear_solve),
-            contact_solve: med(|p| p.contact_solve),
-        };
-        println!(
-            "{:>5} {:>9} | {:>8.3} {:>8.3} {:>9.3} {:>9.3} {:>7.3} {:>7.3} {:>7.4} {:>4} | {:>8.3} {:>8.3}",
-            n, unknowns, median.assembly, median.symbolic, median.numeric_first, median.numeric_warm, median.schur, median.solves, median.active_set, its, median.linear_solve, median.contact_solve
-        );
-        results.push(SizeResult { n, unknowns, contact_unknowns: m, pdas_iterations: its, per_iteration_seconds: per_iteration, median, runs, peak_rss_mb: peak_rss_mb() });
+        return Ok(());
     }
+    let exe = std::env::current_exe()?;
+    println!("{HEADER}");
+    let mut results = Vec::new();
+    for &n in &args.sizes {
+        let out = std::process::Command::new(&exe)
+            .args(["--child", "--sizes", &n.to_string(), "--repeats", &args.repeats.to_string()])
+            .stderr(std::process::Stdio::inherit())
+            .output()?;
+        anyhow::ensure!(out.status.success(), "the benchmark of structured:{n} failed ({})", out.status);
+        let text = String::from_utf8_lossy(&out.stdout);
+        let row = text.lines().find_map(|l| l.strip_prefix("ROW ")).ok_or_else(|| anyhow::anyhow!("no result for structured:{n}"))?;
+        let r: SizeResult = serde_json::from_str(row)?;
+        let m = &r.median;
+        println!(
+            "{:>5} {:>9} | {:>8.3} {:>8.3} {:>9.3} {:>9.3} {:>7.3} {:>7.3} {:>7.4} {:>4} | {:>8.3} {:>8.3} {:>8.0}",
+            n, r.unknowns, m.assembly, m.symbolic, m.numeric_first, m.numeric_warm, m.schur, m.solves, m.active_set, r.pdas_iterations, m.linear_solve, m.contact_solve, r.peak_rss_mb
+        );
+        results.push(r);
+    }
+    if let Some(last) = results.last() {
+        breakdown(last);
+    }
+    let comparison = side_by_side(&results, &args.ngsolve);
     let doc = serde_json::json!({
-        "benchmark": "Example 7.2 contact solve on structured:N (seconds; medians over repeats; numeric_first is the first factorisation in the process)",
+        "benchmark": "Example 7.2 contact solve on structured:N (seconds; medians over repeats; numeric_first is the first factorisation in the process; every size in a process of its own, peak_rss_mb its peak resident memory)",
         "repeats": args.repeats,
         "machine": machine(),
+        "ngsolve": args.ngsolve,
+        "comparison": comparison,
         "sizes": results,
     });
     records::write_json(&args.out, &doc)?;
     println!("wrote {}", args.out.display());
-    side_by_side(&results, &args.ngsolve);
     Ok(())
 }
 
-/// Our medians next to NGSolve's for the same meshes: assembly, one linear solve (factorisation
-/// and solve), and our whole contact solve against NGSolve's linear solve.
-fn side_by_side(ours: &[SizeResult], ngsolve: &std::path::Path) {
+/// All repeats of one size, in this process.
+fn bench_size(n: usize, repeats: usize) -> Result<SizeResult> {
+    let problem = Ex72;
+    let spec = MeshSpec::Structured(n);
+    let mut runs = Vec::new();
+    let mut per_iteration = Vec::new();
+    let (mut unknowns, mut m, mut its, mut ordering) = (0, 0, 0, serde_json::Value::Null);
+    for _ in 0..repeats.max(1) {
+        let mesh = spec.build(&|x| problem.part_of(x));
+        let t0 = Instant::now();
+        let nodes = P2Nodes::new(&mesh);
+        let dofs = DofMap::new(&nodes, &problem);
+        let sys = assembly::assemble(&mesh, &nodes, &dofs, &problem);
+        let assembly_time = t0.elapsed().as_secs_f64();
+        let mut solver = ContactSolver::new(&sys.matrix, dofs.n_interior, &dofs.unknown_coords(&nodes))?;
+        let (symbolic, numeric_first) = (solver.timings.symbolic, solver.timings.numeric);
+        solver.refactor(&sys.matrix)?;
+        let (numeric_warm, schur) = (solver.timings.numeric, solver.timings.schur);
+        let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
+        let out = solver.solve_contact(&sys.matrix, &sys.rhs, &gap, &PdasOptions::default(), &mut |_| {})?;
+        let t = &solver.timings;
+        unknowns = sys.matrix.n;
+        m = dofs.contact.len();
+        its = out.iterations.len();
+        ordering = serde_json::to_value(solver.ordering)?;
+        per_iteration = out.iterations.iter().map(|i| i.seconds).collect();
+        runs.push(Phases {
+            assembly: assembly_time,
+            symbolic,
+            numeric_first,
+            numeric_warm,
+            schur,
+            solves: t.solves,
+            active_set: t.active_set,
+            linear_solve: numeric_warm + t.solves / 2.0,
+            contact_solve: numeric_warm + schur + t.solves + t.active_set,
+        });
+    }
+    let med = |f: fn(&Phases) -> f64| median(runs.iter().map(f).collect());
+    let median = Phases {
+        assembly: med(|p| p.assembly),
+        symbolic: med(|p| p.symbolic),
+        numeric_first: runs[0].numeric_first,
+        numeric_warm: med(|p| p.numeric_warm),
+        schur: med(|p| p.schur),
+        solves: med(|p| p.solves),
+        active_set: med(|p| p.active_set),
+        linear_solve: med(|p| p.linear_solve),
+        contact_solve: med(|p| p.contact_solve),
+    };
+    Ok(SizeResult { n, unknowns, contact_unknowns: m, ordering, pdas_iterations: its, per_iteration_seconds: per_iteration, median, runs, peak_rss_mb: peak_rss_mb() })
+}
+
+/// Where the time of the largest size goes: assembly, then the contact solve phase by phase.
+fn breakdown(r: &SizeResult) {
+    let m = &r.median;
+    let phases = [
+        ("assembly (nodes, numbering, pattern, element matrices)", m.assembly),
+        ("symbolic (orderings ND and AMD, elimination tree, supernodes)", m.symbolic),
+        ("numeric factorisation (warm)", m.numeric_warm),
+        ("Schur complement L_CC L_CC^T", m.schur),
+        ("two sparse solves", m.solves),
+        ("active-set iterations (dense, on S)", m.active_set),
+    ];
+    let total: f64 = phases.iter().map(|p| p.1).sum();
+    println!("\nphase breakdown, structured:{} ({} unknowns, {} contact unknowns, ordering {}):", r.n, r.unknowns, r.contact_unknowns, r.ordering["method"].as_str().unwrap_or("?"));
+    for (name, t) in phases {
+        println!("  {:<62} {:>8.3} s {:>5.1}%", name, t, 100.0 * t / total);
+    }
+    println!("  {:<62} {:>8.3} s", "total", total);
+}
+
+/// Our medians next to NGSolve's for the same meshes (targets of issue 7): assembly, one linear
+/// solve (symbolic + numeric factorisation + solve), our contact solve against our own linear
+/// solve and against NGSolve's, and peak memory. Printed and returned for the JSON record.
+fn side_by_side(ours: &[SizeResult], ngsolve: &std::path::Path) -> Vec<serde_json::Value> {
     let Ok(text) = std::fs::read_to_string(ngsolve) else {
         println!("(no NGSolve timings at {}: run `make bench` or crosscheck.py bench)", ngsolve.display());
-        return;
+        return Vec::new();
     };
-    let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return };
+    let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
     let rows = doc["rows"].as_array().cloned().unwrap_or_default();
-    println!("\n{:<34} {:>5} {:>10} {:>10} {:>7}", "phase", "N", "ours [s]", "NGSolve", "ratio");
+    let mut table = Vec::new();
+    println!("\n{:<40} {:>5} {:>10} {:>10} {:>7}  {}", "phase", "N", "ours", "reference", "ratio", "target");
     for r in ours {
         let Some(ng) = rows.iter().find(|x| x["N"].as_u64() == Some(r.n as u64)) else { continue };
         let f = |k: &str| ng[k].as_f64().unwrap_or(f64::NAN);
         let ng_linear = f("factorisation_s") + f("solve_s");
+        let m = &r.median;
+        let our_linear = m.symbolic + m.linear_solve;
+        let our_contact = m.symbolic + m.contact_solve;
         let lines = [
-            ("assembly", r.median.assembly, f("assembly_s")),
-            ("linear solve (factor + solve)", r.median.symbolic + r.median.linear_solve, ng_linear),
-            ("contact solve vs their linear", r.median.symbolic + r.median.contact_solve, ng_linear),
+            ("assembly [s] vs NGSolve", m.assembly, f("assembly_s"), "<= 0.5"),
+            ("linear solve [s] vs NGSolve", our_linear, ng_linear, "-"),
+            ("contact solve [s] vs our linear solve", our_contact, our_linear, "<= 1.3"),
+            ("contact solve [s] vs NGSolve linear solve", our_contact, ng_linear, "<= 0.8"),
+            ("peak memory [MB] vs NGSolve", r.peak_rss_mb, f("peak_rss_mb"), "<= 1.0"),
         ];
-        for (name, a, b) in lines {
-            println!("{:<34} {:>5} {:>10.3} {:>10.3} {:>7.2}", name, r.n, a, b, a / b);
+        for (name, a, b, target) in lines {
+            println!("{:<40} {:>5} {:>10.3} {:>10.3} {:>7.2}  {}", name, r.n, a, b, a / b, target);
+            table.push(serde_json::json!({"phase": name, "N": r.n, "ours": a, "reference": b, "ratio": a / b, "target": target}));
         }
     }
+    table
 }
