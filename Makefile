@@ -1,21 +1,27 @@
-# The harness's front door (CONTRACT.md). Everything a fresh machine needs is installed here:
-# Rust crates through cargo, the Python environment of the NGSolve cross-check by crosscheck/setup.sh.
+# The harness's front door. Everything a fresh machine needs is installed here: Rust crates
+# through cargo, the Python environment of the NGSolve cross-check by crosscheck/setup.sh.
 CARGO ?= cargo
 BIN := target/release/signorini
 
-.PHONY: all build test figures reproduce drift crosscheck bench clean
+.PHONY: all build test figures reproduce drift crosscheck bench roundoff clean
 
 all: build
 
 build:
 	$(CARGO) build --release --locked
 
-# Unit and integration tests (release mode: the convergence tests solve real systems), the
-# quick drift check against results/, and the NGSolve cross-check.
+# What CI runs: unit and integration tests (release mode: the convergence tests solve real
+# systems), the full drift check (every study rerun and compared with results/ at every level,
+# plus levels.csv, provenance and CLAIMS.md against the records), and the NGSolve cross-check.
+# Test-time outputs (drift report, cross-check tables with timings) go under target/; the last
+# step fails if the run changed any file git sees.
 test: build
+	@mkdir -p target && (git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-before-test
 	$(CARGO) test --release --locked
-	$(BIN) drift --quick
-	crosscheck/run.sh
+	$(BIN) drift
+	CROSSCHECK_OUT=target/crosscheck-report crosscheck/run.sh
+	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-after-test
+	@diff target/status-before-test target/status-after-test >/dev/null || { echo "make test changed files git sees (before/after below); test outputs belong under target/"; diff target/status-before-test target/status-after-test; exit 1; }
 
 # Redraw figures/ and results/CLAIMS.md from the stored results (no study is rerun).
 figures: build
@@ -26,11 +32,13 @@ reproduce: build
 	$(BIN) run --fresh experiments/*.toml
 	$(BIN) figures
 
-# Quick forms of every study against results/, field by field; non-zero exit on drift.
+# Every study rerun and compared with results/ at every level, field by field; non-zero exit on
+# drift. Report: target/drift/report.json.
 drift: build
-	$(BIN) drift --quick
+	$(BIN) drift
 
-# NGSolve cross-check: creates crosscheck/.venv from the pinned requirements on first use.
+# NGSolve cross-check: creates crosscheck/.venv from the pinned requirements on first use and
+# stores its tables in results/crosscheck/.
 crosscheck: build
 	crosscheck/run.sh
 
@@ -38,6 +46,22 @@ crosscheck: build
 bench: build
 	crosscheck/setup.sh && crosscheck/.venv/bin/python crosscheck/crosscheck.py --out-dir results/bench bench --sizes 32,64,128,256,512
 	$(CARGO) run --release --locked --bin bench
+
+# How far round-off moves the stored numbers: every study rerun three ways that change only the
+# order of floating-point operations (nested dissection forced, minimum degree forced, one thread
+# instead of all) and compared with results/ (automatic ordering, all threads; it must be
+# current: `make drift` first) by `signorini drift --against`, whose report lists per study and
+# float field the largest relative change and the largest change relative to the field's largest
+# value in its run. Reports: results/roundoff/*.json, the basis of the manifests' [drift] tolerances.
+ROUNDOFF_VARIANTS := nested-dissection:$(shell nproc) minimum-degree:$(shell nproc) auto:1
+roundoff: build
+	@mkdir -p results/roundoff
+	@set -e; for v in $(ROUNDOFF_VARIANTS); do \
+		ordering=$${v%%:*}; jobs=$${v##*:}; name=$$ordering-$$jobs-threads; \
+		echo "== $$name"; \
+		SIGNORINI_ORDERING=$$ordering $(BIN) run --fresh --jobs $$jobs --results target/roundoff/$$name experiments/*.toml; \
+		$(BIN) drift --against target/roundoff/$$name --report results/roundoff/$$name.json || true; \
+	done
 
 clean:
 	$(CARGO) clean

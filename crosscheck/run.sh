@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # `make crosscheck`: export cases with the Rust binary, then run the NGSolve self-test, comparison
 # and rate check on them. Every step runs even if an earlier one failed (all tables get printed);
-# the exit status is non-zero if any failed. Results: results/crosscheck/{selftest,compare,rates}.*
+# the exit status is non-zero if any failed. Results: {selftest,compare,rates}.{json,md} in
+# $CROSSCHECK_OUT (default results/crosscheck, what `make crosscheck` stores; `make test` writes them
+# under target/ so that a test run changes no tracked file: the tables carry timings).
 set -uo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(dirname "$here")"
 bin="${SIGNORINI:-$root/target/release/signorini}"
 cases="$root/target/crosscheck"  # scratch space, under the ignored target/
+out="${CROSSCHECK_OUT:-$root/results/crosscheck}"
 
 "$here/setup.sh" || exit 1
 py="$here/.venv/bin/python"
@@ -33,7 +36,7 @@ dir="$cases/ex72-reference"
 all+=("$dir")
 
 status=0
-"$py" "$here/crosscheck.py" selftest "$cases/ex71-structured-8" "$cases/ex72-structured-8" || status=1
-"$py" "$here/crosscheck.py" compare "${all[@]}" || status=1
-"$py" "$here/crosscheck.py" rates "${ex71[@]}" || status=1
+"$py" "$here/crosscheck.py" --out-dir "$out" selftest "$cases/ex71-structured-8" "$cases/ex72-structured-8" || status=1
+"$py" "$here/crosscheck.py" --out-dir "$out" compare "${all[@]}" || status=1
+"$py" "$here/crosscheck.py" --out-dir "$out" rates "${ex71[@]}" || status=1
 exit $status

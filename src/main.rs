@@ -44,13 +44,24 @@ enum Command {
         /// Results root.
         #[arg(long)]
         results: Option<std::path::PathBuf>,
+        /// If another process is running the same study, wait for it instead of refusing.
+        #[arg(long)]
+        wait: bool,
     },
-    /// Rerun every declared study and compare with the stored results, field by field, within
-    /// the manifests' tolerances; exit non-zero on drift.
+    /// Rerun every declared study and compare with the stored results at every level, field by
+    /// field, within the manifests' tolerances; check levels.csv, provenance.json and CLAIMS.md
+    /// against the records; exit non-zero on drift. The report goes to target/drift/.
     Drift {
-        /// Rerun the quick forms (prefixes of the stored full runs).
+        /// Rerun the quick forms only (prefixes of the stored full runs: the first levels).
         #[arg(long)]
         quick: bool,
+        /// Compare with the records in this results folder instead of rerunning (e.g. the
+        /// studies rerun with another ordering or thread count, to measure round-off).
+        #[arg(long, value_name = "DIR", conflicts_with = "quick")]
+        against: Option<std::path::PathBuf>,
+        /// Where to write the JSON report (default: target/drift/report[_quick][-STUDY...].json).
+        #[arg(long, value_name = "FILE")]
+        report: Option<std::path::PathBuf>,
         /// Accept a deliberate change: rerun STUDY in full and rewrite its stored results.
         #[arg(long, value_name = "STUDY")]
         accept: Vec<String>,
@@ -63,9 +74,14 @@ enum Command {
         results: std::path::PathBuf,
     },
     /// Redraw every figure under figures/ and results/CLAIMS.md from the stored results alone.
+    /// Refuses if a declared study's stored runs do not match its manifest (interrupted, sharded
+    /// or partial), naming what is missing.
     Figures {
         #[arg(long, default_value = "results")]
         results: std::path::PathBuf,
+        /// The declared studies the stored results must match.
+        #[arg(long, default_value = "experiments")]
+        experiments: std::path::PathBuf,
         #[arg(long, default_value = "figures")]
         figures: std::path::PathBuf,
     },
@@ -262,7 +278,7 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
     Ok(())
 }
 
-fn run_studies(manifests: &[std::path::PathBuf], quick: bool, jobs: Option<usize>, shard: Option<&str>, fresh: bool, results: Option<std::path::PathBuf>) -> Result<()> {
+fn run_studies(manifests: &[std::path::PathBuf], quick: bool, jobs: Option<usize>, shard: Option<&str>, fresh: bool, results: Option<std::path::PathBuf>, wait: bool) -> Result<()> {
     if let Some(j) = jobs {
         if j == 0 {
             bail!("--jobs must be at least 1");
@@ -274,70 +290,48 @@ fn run_studies(manifests: &[std::path::PathBuf], quick: bool, jobs: Option<usize
     // parse every manifest first: a typo in the last one should not cost the first one's run
     let parsed = manifests.iter().map(|m| study::manifest::Manifest::load(m)).collect::<Result<Vec<_>, _>>()?;
     for manifest in &parsed {
-        let options = study::RunOptions { quick, shard, fresh, results: results.clone(), progress: true };
+        let options = study::RunOptions { quick, shard, fresh, results: results.clone(), progress: true, wait_for_lock: wait };
         let executed = study::run_study(manifest, &options)?;
         eprintln!("{}: {} run(s) executed, results in {}", manifest.study, executed.len(), results.join(&manifest.study).display());
     }
     Ok(())
 }
 
-/// The declared studies: experiments/*.toml, sorted; optionally only the named ones.
-fn manifests_in(dir: &std::path::Path, only: &[String]) -> Result<Vec<study::manifest::Manifest>> {
-    let mut files: Vec<_> = std::fs::read_dir(dir)
-        .with_context(|| format!("reading {}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
-    let all = files.iter().map(|f| study::manifest::Manifest::load(f)).collect::<Result<Vec<_>, _>>()?;
-    for name in only {
-        if !all.iter().any(|m| &m.study == name) {
-            bail!("unknown study '{name}'; declared studies: {}", all.iter().map(|m| m.study.as_str()).collect::<Vec<_>>().join(", "));
-        }
-    }
-    Ok(all.into_iter().filter(|m| only.is_empty() || only.contains(&m.study)).collect())
-}
-
-fn run_drift(quick: bool, accept: &[String], only: &[String], experiments: &std::path::Path, results: &std::path::Path) -> Result<()> {
-    use signorini::records::StudyDir;
+fn run_drift(quick: bool, against: Option<&std::path::Path>, report_file: Option<&std::path::Path>, accept: &[String], only: &[String], experiments: &std::path::Path, results: &std::path::Path) -> Result<()> {
     if !accept.is_empty() {
-        for m in manifests_in(experiments, accept)? {
-            let options = study::RunOptions { quick: false, shard: None, fresh: true, results: results.to_path_buf(), progress: true };
+        for m in study::manifest::declared(experiments, accept)? {
+            let options = study::RunOptions { quick: false, shard: None, fresh: true, results: results.to_path_buf(), progress: true, wait_for_lock: false };
             study::run_study(&m, &options)?;
-            eprintln!("accepted: {} rewritten from a full rerun of {}; review and commit the change", results.join(&m.study).display(), m.file.display());
+            eprintln!("accepted: {} rewritten from a full rerun of {}; run `signorini figures`, review and commit the change", results.join(&m.study).display(), m.file.display());
         }
         return Ok(());
     }
+    let manifests = study::manifest::declared(experiments, only)?;
     let scratch = std::path::PathBuf::from("target/drift").join(if quick { "quick" } else { "full" });
-    let mut rows = Vec::new();
-    let mut studies = Vec::new();
-    for m in manifests_in(experiments, only)? {
-        let options = study::RunOptions { quick, shard: None, fresh: true, results: scratch.clone(), progress: true };
-        study::run_study(&m, &options)?;
-        let stored = StudyDir::new(results, &m.study).read_runs()?;
-        let fresh = StudyDir::new(&scratch, &m.study).read_runs()?;
-        let moved = study::drift::compare_study(&m, &stored, &fresh, quick);
-        eprintln!("{}: {}", m.study, if moved.is_empty() { "no drift".to_string() } else { format!("{} field(s) moved", moved.len()) });
-        studies.push(serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": moved.len() }));
-        rows.extend(moved);
+    let options = study::drift::DriftOptions { quick, against: against.map(|p| p.to_path_buf()), scratch, results: results.to_path_buf(), progress: true };
+    let report = study::drift::run(&manifests, only.is_empty(), &options, &|r| signorini::claims::claims(r).map(|c| signorini::claims::markdown(&c)))?;
+    // the table first: a report that cannot be written must not cost it
+    if report.rows.is_empty() {
+        println!("drift: none ({} {} checked at every level{})", manifests.len(), if manifests.len() == 1 { "study" } else { "studies" }, if quick { " of the quick forms" } else { "" });
+    } else {
+        print!("{}", study::drift::table(&report.rows));
     }
-    let report = serde_json::json!({
-        "date": study::provenance::utc_now(),
-        "quick": quick,
-        "studies": studies,
-        "rows": rows,
-    });
-    signorini::records::write_json(&results.join("drift").join(if quick { "report_quick.json" } else { "report.json" }), &report)?;
-    if rows.is_empty() {
-        println!("drift: none ({} studies checked{})", studies.len(), if quick { ", quick forms" } else { "" });
+    println!("\nlargest change of each float field (whether within tolerance or not):\n{}", study::drift::changes_table(&report));
+    let default_name = format!("report{}{}.json", if quick { "_quick" } else { "" }, only.iter().map(|s| format!("-{s}")).collect::<String>());
+    let file = report_file.map(|p| p.to_path_buf()).unwrap_or_else(|| std::path::Path::new("target/drift").join(default_name));
+    signorini::records::write_json(&file, &report).with_context(|| format!("writing the drift report {}", file.display()))?;
+    println!("report: {}", file.display());
+    if report.rows.is_empty() {
         Ok(())
     } else {
-        print!("{}", study::drift::table(&rows));
-        bail!("drift: {} field(s) moved; if the change is deliberate, run `signorini drift --accept STUDY` and commit results/", rows.len())
+        bail!("drift: {} field(s) moved; if the change is deliberate, run `signorini drift --accept STUDY`, then `signorini figures`, and commit results/ and figures/", report.rows.len())
     }
 }
 
-fn run_figures(results: &std::path::Path, figures: &std::path::Path) -> Result<()> {
+fn run_figures(results: &std::path::Path, figures: &std::path::Path, experiments: &std::path::Path) -> Result<()> {
+    for m in study::manifest::declared(experiments, &[])? {
+        study::check_complete(&m, results)?;
+    }
     let written = signorini::plot::draw_all(results, figures)?;
     for f in &written {
         println!("wrote {}", f.display());
@@ -347,8 +341,31 @@ fn run_figures(results: &std::path::Path, figures: &std::path::Path) -> Result<(
     Ok(())
 }
 
+/// SIGINT: the first stops a study after its current level (keeping every finished run), a
+/// second one stops at once.
+fn install_interrupt_handler() {
+    let result = ctrlc::set_handler(|| {
+        if study::interrupted() {
+            eprintln!("\ninterrupted again: stopping now (finished runs are on disk)");
+            std::process::exit(130);
+        }
+        eprintln!("\ninterrupt: finishing the current level, then stopping (Ctrl-C again stops at once)");
+        study::interrupt();
+    });
+    if let Err(e) = result {
+        eprintln!("warning: cannot install the interrupt handler: {e}");
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Err(e) = signorini::ordering::forced() {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
+    if matches!(cli.command, Command::Run { .. } | Command::Drift { .. }) {
+        install_interrupt_handler();
+    }
     let result = match &cli.command {
         Command::Solve(args) => run_solve(args).map(|(_, _, r)| {
             if args.json {
@@ -358,13 +375,17 @@ fn main() -> ExitCode {
             }
         }),
         Command::Adapt(args) => run_adapt(args),
-        Command::Figures { results, figures } => run_figures(results, figures),
-        Command::Drift { quick, accept, study, experiments, results } => run_drift(*quick, accept, study, experiments, results),
-        Command::Run { manifests, quick, jobs, shard, fresh, results } => run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, results.clone()),
+        Command::Figures { results, figures, experiments } => run_figures(results, figures, experiments),
+        Command::Drift { quick, against, report, accept, study, experiments, results } => run_drift(*quick, against.as_deref(), report.as_deref(), accept, study, experiments, results),
+        Command::Run { manifests, quick, jobs, shard, fresh, results, wait } => run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, results.clone(), *wait),
         Command::Export { args, out } => run_solve(args).and_then(|(mesh, sol, r)| report::export_case(out, &mesh, &sol, &r)),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.downcast_ref::<study::Interrupted>().is_some() => {
+            eprintln!("{e:#}");
+            ExitCode::from(130)
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE

@@ -90,6 +90,28 @@ pub enum Method {
     MinimumDegree,
 }
 
+/// The environment variable that forces one ordering for every factorisation in the process:
+/// `nested-dissection` or `minimum-degree` (unset or `auto`: the one with fewer flops). A
+/// diagnostic, not a setting: the drift check's tolerances are measured by rerunning every study
+/// with each ordering forced, since the ordering changes the summation order of the
+/// factorisation and so the results at round-off (`results/roundoff/`).
+pub const FORCE_ENV: &str = "SIGNORINI_ORDERING";
+
+/// The ordering forced by [`FORCE_ENV`], read once per process; an unknown value is an error
+/// (the command line checks it at start-up, so a measurement never silently runs with the
+/// automatic choice).
+pub fn forced() -> Result<Option<Method>, String> {
+    static FORCED: std::sync::OnceLock<Result<Option<Method>, String>> = std::sync::OnceLock::new();
+    FORCED
+        .get_or_init(|| match std::env::var(FORCE_ENV).as_deref() {
+            Err(_) | Ok("") | Ok("auto") => Ok(None),
+            Ok("nested-dissection") => Ok(Some(Method::NestedDissection)),
+            Ok("minimum-degree") => Ok(Some(Method::MinimumDegree)),
+            Ok(other) => Err(format!("{FORCE_ENV}={other:?}: expected auto, nested-dissection or minimum-degree")),
+        })
+        .clone()
+}
+
 /// A fill-reducing ordering of the unknowns `0..n_order` of `matrix` (the others keep their
 /// places at the end, after them), from the coordinates of every unknown: nested dissection or
 /// AMD, whichever needs fewer flops. Returns the permutation as `order[new] = old`.
@@ -109,7 +131,11 @@ pub fn fill_reducing(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (V
         },
     );
     let nd_flops = factorisation_flops(&graph, &nd);
-    let method = if nd_flops <= amd_flops { Method::NestedDissection } else { Method::MinimumDegree };
+    let method = match forced().ok().flatten() {
+        Some(m) => m,
+        None if nd_flops <= amd_flops => Method::NestedDissection,
+        None => Method::MinimumDegree,
+    };
     let mut order: Vec<usize> = match method {
         Method::NestedDissection => nd,
         Method::MinimumDegree => amd_order.into_iter().map(|i| i as usize).collect(),

@@ -30,6 +30,18 @@ use crate::estimate::EstimatorConfig;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
+/// The float fields of a level record (the ones the drift check compares within tolerances;
+/// integers are compared exactly, timings `t_*` never), in record order.
+pub fn float_fields() -> Vec<String> {
+    let v = serde_json::to_value(LevelRecord::default()).expect("records serialise");
+    v.as_object()
+        .into_iter()
+        .flatten()
+        .filter(|(k, v)| !k.starts_with("t_") && (v.is_f64() || v.is_null()))
+        .map(|(k, _)| k.clone())
+        .collect()
+}
+
 /// One run of a study: a problem, an initial mesh and every choice that affects the numbers.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunSpec {
@@ -150,6 +162,11 @@ impl StudyDir {
     /// (The csv crate cannot serialise flattened structs, so rows go through serde_json values,
     /// whose maps keep field order.)
     pub fn write_csv(&self, runs: &[RunRecord]) -> std::io::Result<()> {
+        write_atomic(&self.csv_file(), &self.csv_bytes(runs)?)
+    }
+
+    /// The bytes of `levels.csv` for these runs (what [`StudyDir::write_csv`] writes).
+    pub fn csv_bytes(&self, runs: &[RunRecord]) -> std::io::Result<Vec<u8>> {
         let mut w = csv::Writer::from_writer(Vec::new());
         let mut header_written = false;
         let text = |v: &serde_json::Value| match v {
@@ -175,8 +192,7 @@ impl StudyDir {
                 w.write_record(row.values().map(text)).map_err(std::io::Error::other)?;
             }
         }
-        let bytes = w.into_inner().map_err(std::io::Error::other)?;
-        write_atomic(&self.csv_file(), &bytes)
+        w.into_inner().map_err(std::io::Error::other)
     }
 }
 

@@ -19,7 +19,7 @@ fn stored_and_quick() -> &'static (Vec<RunRecord>, Vec<RunRecord>, Vec<RunRecord
         let m = manifest();
         let run = |quick: bool, sub: &str| {
             let results = root.join(sub);
-            study::run_study(&m, &RunOptions { quick, shard: None, fresh: true, results: results.clone(), progress: false }).unwrap();
+            study::run_study(&m, &RunOptions { quick, shard: None, fresh: true, results: results.clone(), progress: false, wait_for_lock: false }).unwrap();
             StudyDir::new(&results, &m.study).read_runs().unwrap()
         };
         (run(false, "full"), run(true, "quick"), run(false, "full2"))
@@ -93,9 +93,122 @@ fn rate_floors_are_one_sided() {
     assert!(rate > 1.2 && rate < 1.7, "ex71 uniform error rate in NDF {rate}");
     let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny.toml")).unwrap();
     for (min, drift) in [(1.2, false), (2.0, true)] {
-        let t = format!("{text}\n[drift]\ndefault = {{ rel = 1e-9, abs = 1e-14 }}\n[[drift.rates]]\nrun = \"b\"\nfield = \"err_quadrature\"\nmin = {min}\nlast = 3\n");
+        let t = format!("{text}\n[drift]\ndefault = {{ rel = 1e-9, floor = 1e-14 }}\n[[drift.rates]]\nrun = \"b\"\nfield = \"err_quadrature\"\nmin = {min}\nlast = 3\n");
         let m = Manifest::parse(Path::new("tiny.toml"), &t).unwrap();
         let rows = compare_study(&m, stored, full2, false);
         assert_eq!(!rows.is_empty(), drift, "floor {min}: {rows:?}");
     }
+}
+
+/// Every declared study with its stored records.
+fn declared() -> Vec<(Manifest, Vec<RunRecord>)> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    signorini::study::manifest::declared(&root.join("experiments"), &[])
+        .unwrap()
+        .into_iter()
+        .map(|m| {
+            let runs = StudyDir::new(&root.join("results"), &m.study).read_runs().unwrap();
+            (m, runs)
+        })
+        .collect()
+}
+
+/// With the tolerances the manifests declare, a change of 1e-5 relative to any float field of
+/// the stored records, at the first, a middle and the last level of every run, is drift (values
+/// within 1e-6 of their run's largest are round-off territory and covered by the floor only).
+#[test]
+fn declared_tolerances_catch_a_relative_change_of_1e_5_anywhere() {
+    let floats = signorini::records::float_fields();
+    let mut checked = 0;
+    for (m, stored) in declared() {
+        assert!(!stored.is_empty(), "{}: no stored results", m.study);
+        for (ri, run) in stored.iter().enumerate() {
+            let n = run.levels.len();
+            for level in [0, n / 2, n - 1] {
+                let values = serde_json::to_value(&run.levels[level]).unwrap();
+                for field in &floats {
+                    let Some(v) = values[field].as_f64() else { continue };
+                    let scale = run.levels.iter().filter_map(|l| serde_json::to_value(l).unwrap()[field].as_f64()).fold(0.0f64, |a, x| a.max(x.abs()));
+                    if v.abs() <= 1e-6 * scale || v == 0.0 {
+                        continue;
+                    }
+                    let mut perturbed = stored.clone();
+                    let mut lv = values.clone();
+                    lv[field] = serde_json::json!(v * (1.0 + 1e-5));
+                    perturbed[ri].levels[level] = serde_json::from_value(lv).unwrap();
+                    let rows = compare_study(&m, &stored, &perturbed, false);
+                    assert!(
+                        rows.iter().any(|r| r.run == run.run.id && r.level == Some(level) && &r.field == field),
+                        "{}/{} level {level}: {field} = {v:e} changed by 1e-5 relative is not drift under {:?}",
+                        m.study,
+                        run.run.id,
+                        m.drift.tolerance(field)
+                    );
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked > 500, "only {checked} values checked");
+}
+
+/// The stored results of every study are consistent with themselves: levels.csv and the
+/// provenance's run list are what the records render, and the runs are the declared ones.
+#[test]
+fn stored_views_match_the_records() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
+    for (m, stored) in declared() {
+        let rows = signorini::study::drift::check_derived(&StudyDir::new(&root, &m.study), &m.study, &stored);
+        assert!(rows.is_empty(), "{}: {rows:?}", m.study);
+        signorini::study::check_complete(&m, &root).unwrap();
+    }
+}
+
+/// Through the command line: a perturbed float at the last level, an edited levels.csv and an
+/// edited CLAIMS.md each fail `signorini drift`; the untouched store passes.
+#[test]
+fn drift_command_fails_on_perturbed_record_csv_or_claims() {
+    let d = std::env::temp_dir().join(format!("signorini-drift-cli-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    let (exp, res) = (d.join("experiments"), d.join("results"));
+    std::fs::create_dir_all(&exp).unwrap();
+    std::fs::copy(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny.toml"), exp.join("tiny.toml")).unwrap();
+    let bin = env!("CARGO_BIN_EXE_signorini");
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(bin).args(args).current_dir(&d).output().unwrap();
+        let text = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+        assert!(!text.contains("panicked"), "{text}");
+        (out.status.success(), text)
+    };
+    assert!(run(&["run", "experiments/tiny.toml", "--quick", "--results", "results"]).0);
+    // CLAIMS.md as rendered from this results folder (drawn by `figures`, which needs no figure data here)
+    let claims = signorini::claims::markdown(&signorini::claims::claims(&res).unwrap());
+    std::fs::write(res.join("CLAIMS.md"), &claims).unwrap();
+    let drift = || run(&["drift", "--quick", "--experiments", "experiments", "--results", "results"]);
+    let (ok, text) = drift();
+    assert!(ok, "{text}");
+    let dir = StudyDir::new(&res, "tiny");
+    // a float at the last level
+    let original = std::fs::read_to_string(dir.run_file("b")).unwrap();
+    let mut rec: RunRecord = serde_json::from_str(&original).unwrap();
+    let last = rec.levels.len() - 1;
+    rec.levels[last].eta2 *= 1.0 + 1e-5;
+    std::fs::write(dir.run_file("b"), serde_json::to_string_pretty(&rec).unwrap()).unwrap();
+    dir.write_csv(&dir.read_runs().unwrap()).unwrap(); // keep the view in step: only the number moved
+    let (ok, text) = drift();
+    assert!(!ok && text.contains("eta2"), "{text}");
+    std::fs::write(dir.run_file("b"), &original).unwrap();
+    dir.write_csv(&dir.read_runs().unwrap()).unwrap();
+    assert!(drift().0);
+    // an edited CSV
+    let csv = std::fs::read_to_string(dir.csv_file()).unwrap();
+    std::fs::write(dir.csv_file(), csv.replacen("ex71", "ex7l", 1)).unwrap();
+    let (ok, text) = drift();
+    assert!(!ok && text.contains("levels.csv"), "{text}");
+    std::fs::write(dir.csv_file(), &csv).unwrap();
+    // an edited CLAIMS.md
+    std::fs::write(res.join("CLAIMS.md"), format!("{claims}a line added by hand\n")).unwrap();
+    let (ok, text) = drift();
+    assert!(!ok && text.contains("CLAIMS.md"), "{text}");
+    std::fs::remove_dir_all(&d).ok();
 }

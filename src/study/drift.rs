@@ -2,16 +2,32 @@
 //! and pytest-regressions' num_regression).
 //!
 //! Integers and structural fields (NDF, levels, active-set sizes, iteration counts, the run's
-//! spec) must match exactly; floats within the manifest's per-field tolerance
-//! |fresh - stored| <= abs + rel |stored|; observed rates (least-squares slope of -log(field) in
-//! log(NDF) over a run's last levels) against one-sided floors; timings (fields `t_*`) never.
-//! A level, field, run or study missing on either side is drift too. In the quick form the fresh
+//! spec) must match exactly. A float passes when
+//!
+//! ```text
+//! |fresh - stored| <= rel * |stored| + floor * scale,   scale = max over the run's stored levels of |field|
+//! ```
+//!
+//! with `rel` and `floor` from the manifest's `[drift]` table (per field, with a default). `rel`
+//! bounds the round-off of a number computed to full relative accuracy; `floor` covers fields
+//! that are differences of nearly equal numbers (an error near round-off, eta_6 at 1e-17 on a
+//! level where the contact zone happens to be resolved): their round-off is relative to the size
+//! the field has elsewhere in the run, not to its own value. Both are measured, not chosen
+//! (`results/roundoff/`). Observed rates (least-squares slope of -log(field) in log(NDF) over a
+//! run's last levels) are checked against one-sided floors; timings (fields `t_*`) never.
+//! A level, field, run or study missing on either side is drift. In the quick form the fresh
 //! runs are prefixes of the stored full runs and are compared level by level.
+//!
+//! Besides the numbers, the files derived from the records are checked: `levels.csv` and
+//! `provenance.json`'s run list must be exactly what the stored records give
+//! ([`check_derived`]), so a hand edit or a bad merge of a view is drift too.
 
 use super::manifest::{DriftSpec, Manifest};
-use crate::records::RunRecord;
+use crate::records::{RunRecord, StudyDir};
 use serde::Serialize;
 use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 /// One thing that moved.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -39,8 +55,45 @@ fn show(v: Option<&Value>) -> String {
     }
 }
 
-/// Compare two level records (as JSON objects), appending what moved.
-fn compare_level(study: &str, run: &str, level: usize, stored: &Value, fresh: &Value, spec: &DriftSpec, out: &mut Vec<DriftRow>) {
+/// The largest change one float field showed across a comparison, whether or not it drifted:
+/// what the round-off measurement records and the tolerances are set from.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct FieldChange {
+    /// max |fresh - stored| / |stored| over the entries with a stored value above the floor's
+    /// reach (|stored| > 1e-6 scale), i.e. the relative change of numbers not near round-off.
+    pub max_rel: f64,
+    /// max |fresh - stored| / scale over all entries (scale: the field's largest |value| in its run).
+    pub max_floor: f64,
+    /// Where `max_rel` was seen: "run level".
+    pub at: String,
+    /// Entries compared.
+    pub entries: usize,
+}
+
+/// What a comparison found: the drift rows, and per float field its largest change.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Comparison {
+    pub rows: Vec<DriftRow>,
+    pub changes: BTreeMap<String, FieldChange>,
+}
+
+/// The largest |value| of every float field over a run's levels (the `scale` of the floor).
+fn field_scales(levels: &[Value]) -> BTreeMap<String, f64> {
+    let mut out = BTreeMap::new();
+    for l in levels {
+        for (k, v) in l.as_object().into_iter().flatten() {
+            if let Some(x) = v.as_f64() {
+                let e = out.entry(k.clone()).or_insert(0.0f64);
+                *e = e.max(x.abs());
+            }
+        }
+    }
+    out
+}
+
+/// Compare two level records (as JSON objects), appending what moved and recording changes.
+#[allow(clippy::too_many_arguments)]
+fn compare_level(study: &str, run: &str, level: usize, stored: &Value, fresh: &Value, scales: &BTreeMap<String, f64>, spec: &DriftSpec, out: &mut Vec<DriftRow>, changes: &mut BTreeMap<String, FieldChange>) {
     let (Some(s), Some(f)) = (stored.as_object(), fresh.as_object()) else { return };
     let mut keys: Vec<&String> = s.keys().chain(f.keys()).collect();
     keys.sort();
@@ -55,10 +108,20 @@ fn compare_level(study: &str, run: &str, level: usize, stored: &Value, fresh: &V
             (Some(Value::Number(a)), Some(Value::Number(b))) if a.is_f64() || b.is_f64() => {
                 let (a, b) = (a.as_f64().unwrap_or(f64::NAN), b.as_f64().unwrap_or(f64::NAN));
                 let tol = spec.tolerance(key);
+                let scale = scales.get(key.as_str()).copied().unwrap_or(0.0);
                 let diff = (a - b).abs();
-                if !(diff <= tol.abs + tol.rel * a.abs()) {
+                let c = changes.entry(key.clone()).or_default();
+                c.entries += 1;
+                if scale > 0.0 {
+                    c.max_floor = c.max_floor.max(diff / scale);
+                }
+                if a.abs() > 1e-6 * scale && diff / a.abs() > c.max_rel {
+                    c.max_rel = diff / a.abs();
+                    c.at = format!("{run} {level}");
+                }
+                if !(diff <= tol.rel * a.abs() + tol.floor * scale) {
                     let rel = if a != 0.0 { Some(diff / a.abs()) } else { None };
-                    out.push(drift(rel, format!("rel {:e}, abs {:e}", tol.rel, tol.abs)));
+                    out.push(drift(rel, format!("rel {:e} + floor {:e} x {scale:.3e}", tol.rel, tol.floor)));
                 }
             }
             (Some(a), Some(b)) if a == b => {}
@@ -92,11 +155,16 @@ pub fn observed_rate(run: &RunRecord, field: &str, last: usize) -> Option<f64> {
 /// Compare a study's fresh runs with its stored runs. `quick`: fresh runs are the quick forms
 /// (prefixes) of the stored full runs.
 pub fn compare_study(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], quick: bool) -> Vec<DriftRow> {
+    compare(manifest, stored, fresh, quick).rows
+}
+
+/// [`compare_study`] with the largest change of every float field.
+pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], quick: bool) -> Comparison {
     let study = &manifest.study;
-    let mut out = Vec::new();
+    let (mut out, mut changes) = (Vec::new(), BTreeMap::new());
     if stored.is_empty() {
         out.push(row(study, "*", None, "study", "(no stored results)".into(), format!("{} runs", fresh.len()), None, "exact".into()));
-        return out;
+        return Comparison { rows: out, changes };
     }
     for planned in &manifest.runs {
         let id = &planned.spec.id;
@@ -121,12 +189,14 @@ pub fn compare_study(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunReco
         if f.levels.len() != expected_levels {
             out.push(row(study, id, None, "levels", expected_levels.to_string(), f.levels.len().to_string(), None, "exact".into()));
         }
+        let stored_levels: Vec<Value> = s.levels.iter().map(|l| serde_json::to_value(l).expect("records serialise")).collect();
+        let scales = field_scales(&stored_levels);
         for l in 0..n_compare {
-            let (sl, fl) = (s.levels.get(l), f.levels.get(l));
+            let (sl, fl) = (stored_levels.get(l), f.levels.get(l));
             match (sl, fl) {
                 (Some(a), Some(b)) => {
-                    let (a, b) = (serde_json::to_value(a).expect("serialises"), serde_json::to_value(b).expect("serialises"));
-                    compare_level(study, id, l, &a, &b, &manifest.drift, &mut out);
+                    let b = serde_json::to_value(b).expect("records serialise");
+                    compare_level(study, id, l, a, &b, &scales, &manifest.drift, &mut out, &mut changes);
                 }
                 (a, b) => out.push(row(study, id, Some(l), "level", if a.is_some() { "present" } else { "(missing)" }.into(), if b.is_some() { "present" } else { "(missing)" }.into(), None, "exact".into())),
             }
@@ -155,7 +225,7 @@ pub fn compare_study(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunReco
             }
         }
     }
-    out
+    Comparison { rows: out, changes }
 }
 
 /// A readable table of what moved.
@@ -173,6 +243,129 @@ pub fn table(rows: &[DriftRow]) -> String {
             r.relative_change.map(|v| format!("{v:.2e}")).unwrap_or("-".into()),
             r.tolerance
         );
+    }
+    s
+}
+
+/// The first line where two texts differ, shortened, as it reads in each.
+fn first_difference(a: &str, b: &str) -> (String, String) {
+    let (al, bl): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
+    let i = (0..al.len().max(bl.len())).find(|&i| al.get(i) != bl.get(i)).unwrap_or(al.len().min(bl.len()));
+    let cut = |s: Option<&&str>| format!("line {}: {}", i + 1, s.map(|s| s.chars().take(60).collect::<String>()).unwrap_or("(none)".into()));
+    (cut(al.get(i)), cut(bl.get(i)))
+}
+
+/// The views of a study's stored records, checked against what the records render:
+/// `levels.csv` byte for byte and `provenance.json`'s list of runs. A hand edit, a bad merge or
+/// a study interrupted before its summaries were rewritten is drift.
+pub fn check_derived(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<DriftRow> {
+    let mut out = Vec::new();
+    let file_row = |field: &str, stored: String, fresh: String| row(study, "*", None, field, stored, fresh, None, "exact (rendered from runs/*.json)".into());
+    match (std::fs::read(dir.csv_file()), dir.csv_bytes(runs)) {
+        (Ok(on_disk), Ok(rendered)) if on_disk == rendered => {}
+        (Ok(on_disk), Ok(rendered)) => {
+            let (a, b) = first_difference(&String::from_utf8_lossy(&on_disk), &String::from_utf8_lossy(&rendered));
+            out.push(file_row("levels.csv", a, b));
+        }
+        (Err(e), _) => out.push(file_row("levels.csv", format!("(cannot read: {e})"), "rendered".into())),
+        (_, Err(e)) => out.push(file_row("levels.csv", "present".into(), format!("(cannot render: {e})"))),
+    }
+    let ids: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
+    let listed = std::fs::read_to_string(dir.provenance_file())
+        .ok()
+        .and_then(|t| serde_json::from_str::<super::provenance::Provenance>(&t).ok())
+        .map(|p| p.runs);
+    if listed.as_ref() != Some(&ids) {
+        out.push(file_row("provenance.json runs", listed.map(|l| l.join(" ")).unwrap_or("(unreadable)".into()), ids.join(" ")));
+    }
+    out
+}
+
+/// What a drift run compares the stored results with.
+#[derive(Clone, Debug)]
+pub struct DriftOptions {
+    /// Rerun the quick forms (prefixes of the stored runs) instead of the full studies.
+    pub quick: bool,
+    /// Compare with the records already in this results folder instead of rerunning (used to
+    /// measure round-off: the studies rerun with another ordering or thread count).
+    pub against: Option<PathBuf>,
+    /// Where fresh runs are written (emptied first, study by study).
+    pub scratch: PathBuf,
+    pub results: PathBuf,
+    pub progress: bool,
+}
+
+/// The outcome of a drift run over some studies.
+#[derive(Clone, Debug, Serialize)]
+pub struct DriftReport {
+    pub date: String,
+    pub quick: bool,
+    pub against: Option<String>,
+    /// Per study: runs compared and rows of drift.
+    pub studies: Vec<Value>,
+    pub rows: Vec<DriftRow>,
+    /// Per study, per float field: the largest change seen (drift or not).
+    pub changes: BTreeMap<String, BTreeMap<String, FieldChange>>,
+}
+
+/// Rerun (or read, with `against`) every manifest's study and compare it with the stored
+/// results: numbers within the manifests' tolerances and the derived files. `claims` renders
+/// `CLAIMS.md` from the results folder; it is compared with the stored file when every
+/// declared study is checked.
+pub fn run(manifests: &[Manifest], all_studies: bool, opts: &DriftOptions, claims: &dyn Fn(&Path) -> std::io::Result<String>) -> anyhow::Result<DriftReport> {
+    use anyhow::Context;
+    let mut report = DriftReport { date: super::provenance::utc_now(), quick: opts.quick, against: opts.against.as_ref().map(|p| p.display().to_string()), studies: Vec::new(), rows: Vec::new(), changes: BTreeMap::new() };
+    for m in manifests {
+        let fresh_root = match &opts.against {
+            Some(dir) => dir.clone(),
+            None => {
+                let options = super::RunOptions { quick: opts.quick, shard: None, fresh: true, results: opts.scratch.clone(), progress: opts.progress, wait_for_lock: true };
+                super::run_study(m, &options)?;
+                opts.scratch.clone()
+            }
+        };
+        let stored_dir = StudyDir::new(&opts.results, &m.study);
+        let stored = stored_dir.read_runs().with_context(|| format!("reading the stored runs of {}", m.study))?;
+        let fresh = StudyDir::new(&fresh_root, &m.study).read_runs().with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?;
+        let mut c = compare(m, &stored, &fresh, opts.quick);
+        if !stored.is_empty() {
+            c.rows.extend(check_derived(&stored_dir, &m.study, &stored));
+        }
+        if opts.progress {
+            eprintln!("{}: {}", m.study, if c.rows.is_empty() { "no drift".to_string() } else { format!("{} field(s) moved", c.rows.len()) });
+        }
+        report.studies.push(serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": c.rows.len() }));
+        report.rows.extend(c.rows);
+        report.changes.insert(m.study.clone(), c.changes);
+    }
+    if all_studies {
+        let file = opts.results.join("CLAIMS.md");
+        let stored = std::fs::read_to_string(&file).unwrap_or_default();
+        let rendered = claims(&opts.results).with_context(|| format!("rendering {}", file.display()))?;
+        if stored != rendered {
+            let (a, b) = first_difference(&stored, &rendered);
+            report.rows.push(row("*", "*", None, "CLAIMS.md", a, b, None, "exact (rendered from results/)".into()));
+        }
+    }
+    Ok(report)
+}
+
+/// The largest change of every float field over the studies of a report, as a table.
+pub fn changes_table(report: &DriftReport) -> String {
+    let mut by_field: BTreeMap<&str, (f64, f64, String)> = BTreeMap::new();
+    for (study, fields) in &report.changes {
+        for (field, c) in fields {
+            let e = by_field.entry(field).or_insert((0.0, 0.0, String::new()));
+            if c.max_rel >= e.0 {
+                e.2 = format!("{study} {}", c.at);
+            }
+            e.0 = e.0.max(c.max_rel);
+            e.1 = e.1.max(c.max_floor);
+        }
+    }
+    let mut s = format!("{:<16} {:>12} {:>12}  {}\n", "field", "max rel", "max/scale", "where (max rel)");
+    for (field, (rel, floor, at)) in by_field {
+        s += &format!("{field:<16} {rel:>12.2e} {floor:>12.2e}  {at}\n");
     }
     s
 }

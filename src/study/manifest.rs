@@ -29,9 +29,10 @@
 //! refine = "uniform"
 //! levels = 9
 //!
-//! [drift]                    # tolerances of the drift check
-//! default = { rel = 1e-9, abs = 1e-14 }
-//! fields = { err_quadrature = { rel = 1e-6, abs = 0.0 } }
+//! [drift]                    # tolerances of the drift check (study::drift): a float passes
+//!                            # when |fresh - stored| <= rel |stored| + floor max_run |stored|
+//! default = { rel = 1e-9, floor = 1e-14 }
+//! fields = { err_nodal = { rel = 1e-6, floor = 1e-12 } }   # float fields of LevelRecord only
 //! [[drift.rates]]            # one-sided floors on observed rates in NDF
 //! run = "uniform"
 //! field = "err_quadrature"
@@ -95,12 +96,14 @@ struct RunToml {
     no_reference: Option<bool>,
 }
 
-/// A tolerance: |fresh - stored| <= abs + rel |stored|.
+/// A tolerance of the drift check: |fresh - stored| <= rel |stored| + floor scale, where scale is
+/// the field's largest |value| over the stored run's levels (see `study::drift`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Tolerance {
     pub rel: f64,
-    pub abs: f64,
+    #[serde(default)]
+    pub floor: f64,
 }
 
 /// A one-sided floor on an observed rate: the slope of -log(field) in log(NDF) over the last
@@ -127,7 +130,7 @@ pub struct DriftSpec {
 
 impl Default for DriftSpec {
     fn default() -> Self {
-        DriftSpec { default: Tolerance { rel: 1e-9, abs: 1e-14 }, fields: BTreeMap::new(), rates: Vec::new() }
+        DriftSpec { default: Tolerance { rel: 1e-9, floor: 0.0 }, fields: BTreeMap::new(), rates: Vec::new() }
     }
 }
 
@@ -249,6 +252,19 @@ impl Manifest {
             });
         }
         let drift = raw.drift.unwrap_or_default();
+        let floats = crate::records::float_fields();
+        for (key, tol) in std::iter::once(("default".to_string(), &drift.default)).chain(drift.fields.iter().map(|(k, t)| (format!("fields.{k}"), t))) {
+            if let Some(name) = key.strip_prefix("fields.") {
+                if !floats.iter().any(|f| f == name) {
+                    return Err(invalid(format!("drift.{key}"), &format!("a float field of the level records ({})", floats.join(", ")), format!("{name:?}")));
+                }
+            }
+            for (part, v) in [("rel", tol.rel), ("floor", tol.floor)] {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(invalid(format!("drift.{key}.{part}"), "a finite number >= 0", v.to_string()));
+                }
+            }
+        }
         for (i, r) in drift.rates.iter().enumerate() {
             if !runs.iter().any(|p: &PlannedRun| p.spec.id == r.run) {
                 return Err(invalid(format!("drift.rates[{i}].run"), "the id of a declared run", format!("{:?}", r.run)));
@@ -266,4 +282,23 @@ impl Manifest {
             bytes: text.as_bytes().to_vec(),
         })
     }
+}
+
+/// The declared studies: every `*.toml` in `dir`, sorted by name; with `only`, just those
+/// (an unknown name is an error listing the declared ones).
+pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
+    use anyhow::Context;
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .with_context(|| format!("reading the study manifests in {}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    let all = files.iter().map(|f| Manifest::load(f)).collect::<Result<Vec<_>, _>>()?;
+    for name in only {
+        if !all.iter().any(|m| &m.study == name) {
+            anyhow::bail!("unknown study '{name}'; declared studies: {}", all.iter().map(|m| m.study.as_str()).collect::<Vec<_>>().join(", "));
+        }
+    }
+    Ok(all.into_iter().filter(|m| only.is_empty() || only.contains(&m.study)).collect())
 }

@@ -6,6 +6,12 @@
 //! `--shard K/N` runs every N-th run; shards merge by run id, since the CSV and the provenance
 //! are rebuilt from all run records present. `--quick` runs the first `quick_levels` levels of
 //! the same runs: the exact prefix of the full study (same meshes, same numbers).
+//!
+//! The store stays consistent whatever happens: `levels.csv` and `provenance.json` are rewritten
+//! after every finished run (they always describe exactly the runs on disk); `--fresh` with
+//! `--shard K/N` removes only shard K's runs; a lock on the study folder ([`StudyLock`]) keeps
+//! a second process from running the same study at the same time; an interrupt stops after the
+//! current level and keeps every finished run ([`Interrupted`]).
 
 pub mod drift;
 pub mod manifest;
@@ -23,6 +29,7 @@ use reference::ReferenceField;
 use std::collections::HashMap;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// Reference solutions computed in this process, shared by every run and study that declares
@@ -38,17 +45,44 @@ fn reference_for(key: &str, compute: impl FnOnce() -> Result<ReferenceField>) ->
     Ok(r)
 }
 
+/// Set when the user interrupts (SIGINT): the runner finishes the level it is on, keeps every
+/// run it finished and stops. The command line installs the handler; a library user may set it.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Ask a running study to stop after the current level (what the SIGINT handler does).
+pub fn interrupt() {
+    INTERRUPTED.store(true, Ordering::SeqCst);
+}
+
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(Ordering::SeqCst)
+}
+
+/// A study stopped by an interrupt: what it kept and how to go on.
+#[derive(Debug, thiserror::Error)]
+#[error("{study}: interrupted; kept {} finished run(s){}{}; levels.csv and provenance.json describe exactly these. Resume with `{resume}` (finished runs are kept)", kept.len(), if kept.is_empty() { String::new() } else { format!(" ({})", kept.join(", ")) }, if missing.is_empty() { String::new() } else { format!(", not yet run: {}", missing.join(", ")) })]
+pub struct Interrupted {
+    pub study: String,
+    /// The command that resumes the study.
+    pub resume: String,
+    pub kept: Vec<String>,
+    pub missing: Vec<String>,
+}
+
 /// How to run a study.
 #[derive(Clone, Debug)]
 pub struct RunOptions {
     pub quick: bool,
     /// (K, N): run the runs with index i such that i % N == K - 1.
     pub shard: Option<(usize, usize)>,
-    /// Delete this study's stored runs first instead of resuming.
+    /// Delete the stored runs this invocation is responsible for first (all of the study's, or
+    /// only shard K's with `shard`) instead of resuming after them.
     pub fresh: bool,
     /// The results root (`results/`).
     pub results: PathBuf,
     pub progress: bool,
+    /// When another process holds the study's lock: wait for it (true) or refuse (false).
+    pub wait_for_lock: bool,
 }
 
 /// Parse "K/N" with 1 <= K <= N.
@@ -72,26 +106,110 @@ pub fn effective_spec(planned: &manifest::PlannedRun, quick: bool) -> RunSpec {
     spec
 }
 
-/// Run a study; returns the ids of the runs executed (not resumed).
+/// An exclusive lock on a study's results folder (`STUDY/.lock`, holding the owner's process id
+/// and command line), held while a study is written, so that two runs of one study neither
+/// compute everything twice nor delete each other's runs. Released when dropped (or when the
+/// process dies: the operating system drops the lock with the file descriptor).
+pub struct StudyLock {
+    _file: std::fs::File,
+}
+
+impl StudyLock {
+    pub fn acquire(dir: &StudyDir, wait: bool) -> Result<StudyLock> {
+        use std::io::{Read, Seek, Write};
+        std::fs::create_dir_all(&dir.root).with_context(|| format!("creating {}", dir.root.display()))?;
+        let path = dir.root.join(".lock");
+        let mut file = std::fs::OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).with_context(|| format!("opening the lock file {}", path.display()))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                let mut holder = String::new();
+                let _ = file.read_to_string(&mut holder);
+                let holder = if holder.trim().is_empty() { "another process".to_string() } else { holder.trim().to_string() };
+                if !wait {
+                    bail!("{} is being written by {holder}; wait for it to finish, or pass --wait to wait for it (the lock is {})", dir.root.display(), path.display());
+                }
+                eprintln!("{} is being written by {holder}; waiting for it to finish", dir.root.display());
+                file.lock().with_context(|| format!("waiting for the lock {}", path.display()))?;
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(e).with_context(|| format!("locking {}", path.display())),
+        }
+        let me = format!("process {} ({}) since {}", std::process::id(), std::env::args().collect::<Vec<_>>().join(" "), provenance::utc_now());
+        file.set_len(0).and_then(|_| file.rewind()).and_then(|_| file.write_all(me.as_bytes())).with_context(|| format!("writing {}", path.display()))?;
+        Ok(StudyLock { _file: file })
+    }
+}
+
+/// Remove a run's record and its saved meshes.
+fn remove_run(dir: &StudyDir, id: &str) -> Result<()> {
+    let file = dir.run_file(id);
+    match std::fs::remove_file(&file) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(e).with_context(|| format!("removing {}", file.display())),
+    }
+    remove_meshes(dir, id)
+}
+
+/// Remove the meshes saved for a run (`meshes/RUN_levelL.*`).
+fn remove_meshes(dir: &StudyDir, id: &str) -> Result<()> {
+    let meshes = dir.root.join("meshes");
+    let Ok(entries) = std::fs::read_dir(&meshes) else { return Ok(()) };
+    let prefix = format!("{id}_level");
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.strip_prefix(&prefix).is_some_and(|rest| rest.starts_with(|c: char| c.is_ascii_digit())) {
+            std::fs::remove_file(e.path()).with_context(|| format!("removing {}", e.path().display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// Rewrite `levels.csv` and `provenance.json` from the run records present, so that they
+/// always describe exactly the runs on disk.
+fn write_summaries(manifest: &Manifest, dir: &StudyDir, quick: bool) -> Result<Vec<RunRecord>> {
+    let runs = dir.read_runs().with_context(|| format!("reading the runs in {}", dir.root.join("runs").display()))?;
+    dir.write_csv(&runs).with_context(|| format!("writing {}", dir.csv_file().display()))?;
+    let prov = provenance::collect(&manifest.study, &manifest.file, &manifest.bytes, quick, runs.iter().map(|r| r.run.id.clone()).collect());
+    records::write_json(&dir.provenance_file(), &prov).with_context(|| format!("writing {}", dir.provenance_file().display()))?;
+    Ok(runs)
+}
+
+/// Run a study; returns the ids of the runs executed (not resumed). Holds the study's lock
+/// throughout. Every finished run is written at once and the summaries rewritten after it; on
+/// an interrupt ([`interrupt`]) the run in progress is dropped and an [`Interrupted`] error says
+/// what was kept.
 pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> {
     let dir = StudyDir::new(&opts.results, &manifest.study);
+    let _lock = StudyLock::acquire(&dir, opts.wait_for_lock)?;
+    let in_shard = |i: usize| opts.shard.is_none_or(|(k, n)| i % n == k - 1);
     if opts.fresh {
-        for sub in ["runs", "meshes"] {
-            let p = dir.root.join(sub);
-            if p.exists() {
-                std::fs::remove_dir_all(&p).with_context(|| format!("removing {}", p.display()))?;
+        match opts.shard {
+            // the whole study: also runs no longer declared
+            None => {
+                for sub in ["runs", "meshes"] {
+                    let p = dir.root.join(sub);
+                    if p.exists() {
+                        std::fs::remove_dir_all(&p).with_context(|| format!("removing {}", p.display()))?;
+                    }
+                }
+            }
+            // only this shard's runs: the other shards' are someone else's
+            Some(_) => {
+                for (_, planned) in manifest.runs.iter().enumerate().filter(|(i, _)| in_shard(*i)) {
+                    remove_run(&dir, &planned.spec.id)?;
+                }
             }
         }
+        write_summaries(manifest, &dir, opts.quick)?;
     }
     let mut executed = Vec::new();
     for (i, planned) in manifest.runs.iter().enumerate() {
-        if let Some((k, n)) = opts.shard {
-            if i % n != k - 1 {
-                continue;
-            }
+        if !in_shard(i) {
+            continue;
         }
         let spec = effective_spec(planned, opts.quick);
-        if let Some(existing) = dir.read_run(&spec.id)? {
+        if let Some(existing) = dir.read_run(&spec.id).with_context(|| format!("reading {}", dir.run_file(&spec.id).display()))? {
             if existing.run == spec {
                 if opts.progress {
                     eprintln!("{}/{}: finished earlier, kept (use --fresh to start over)", manifest.study, spec.id);
@@ -100,32 +218,102 @@ pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> 
             }
             eprintln!("{}/{}: stored run has another spec, running it again", manifest.study, spec.id);
         }
-        let record = run_one(&manifest.study, &spec, &dir, opts.progress)?;
+        let record = match run_one(&manifest.study, &spec, &dir, opts.progress)? {
+            Some(r) => r,
+            None => {
+                // interrupted: drop what the unfinished run saved, keep the finished ones
+                remove_meshes(&dir, &spec.id)?;
+                let runs = write_summaries(manifest, &dir, opts.quick)?;
+                let kept: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
+                let missing = manifest.runs.iter().map(|p| p.spec.id.clone()).filter(|id| !kept.contains(id)).collect();
+                let mut resume = format!("signorini run {}", manifest.file.display());
+                if opts.quick {
+                    resume += " --quick";
+                }
+                if let Some((k, n)) = opts.shard {
+                    resume += &format!(" --shard {k}/{n}");
+                }
+                if opts.results != std::path::Path::new(if opts.quick { "target/quick-results" } else { "results" }) {
+                    resume += &format!(" --results {}", opts.results.display());
+                }
+                return Err(Interrupted { study: manifest.study.clone(), resume, kept, missing }.into());
+            }
+        };
         records::write_json(&dir.run_file(&spec.id), &record).with_context(|| format!("writing {}", dir.run_file(&spec.id).display()))?;
+        write_summaries(manifest, &dir, opts.quick)?;
         executed.push(spec.id.clone());
     }
-    let runs = dir.read_runs()?;
-    dir.write_csv(&runs)?;
-    let prov = provenance::collect(&manifest.study, &manifest.file, &manifest.bytes, opts.quick, runs.iter().map(|r| r.run.id.clone()).collect());
-    records::write_json(&dir.provenance_file(), &prov)?;
+    write_summaries(manifest, &dir, opts.quick)?;
     Ok(executed)
+}
+
+/// Every declared run is stored with exactly its declared (full) spec, and nothing else is:
+/// what figures and claims need before they draw from a study. The error names what is missing
+/// or different and how to complete the study.
+pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<()> {
+    let dir = StudyDir::new(results, &manifest.study);
+    let runs = dir.read_runs().with_context(|| format!("reading the runs in {}", dir.root.join("runs").display()))?;
+    let mut problems = Vec::new();
+    for planned in &manifest.runs {
+        match runs.iter().find(|r| r.run.id == planned.spec.id) {
+            None => problems.push(format!("run {} is missing", planned.spec.id)),
+            Some(r) if r.run != planned.spec => problems.push(format!("run {} was computed with another spec (levels {} vs {} declared, or another setting)", planned.spec.id, r.run.levels, planned.spec.levels)),
+            Some(_) => {}
+        }
+    }
+    for r in &runs {
+        if !manifest.runs.iter().any(|p| p.spec.id == r.run.id) {
+            problems.push(format!("run {} is not declared in {}", r.run.id, manifest.file.display()));
+        }
+    }
+    if !problems.is_empty() {
+        bail!(
+            "{} does not match {}: {}. Complete it with `signorini run {}` (or start over with --fresh) before drawing from it",
+            dir.root.display(),
+            manifest.file.display(),
+            problems.join("; "),
+            manifest.file.display()
+        );
+    }
+    Ok(())
 }
 
 fn reference_key(spec: &RunSpec) -> Option<String> {
     spec.reference.as_ref().map(|r| format!("{}|{}|{}|{}|{:?}", spec.problem, spec.mesh, r.theta, r.min_ndof, r.contact_term))
 }
 
-/// One run: the adaptive loop with a progress bar, saving the declared levels.
-fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Result<RunRecord> {
+/// One run: the adaptive loop with a progress bar, saving the declared levels. `None` when
+/// interrupted.
+fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Result<Option<RunRecord>> {
     let problem = problems::by_name(&spec.problem)?;
     let mesh_spec = MeshSpec::parse(&spec.mesh)?;
+    if spec.reference.is_some() && problem.exact().is_some() {
+        bail!("{study}/{}: problem {} has an exact solution; a reference solution is not needed", spec.id, spec.problem);
+    }
     let reference = match (reference_key(spec), &spec.reference) {
-        (Some(key), Some(rs)) => Some(reference_for(&key, || {
-            let spinner = bar(progress, 0, &format!("{study}/{}: reference solution (min NDF {})", spec.id, rs.min_ndof));
-            let field = reference::compute(problem.as_ref(), &mesh_spec, rs).with_context(|| format!("{study}/{}: computing the reference solution", spec.id));
-            spinner.finish_and_clear();
-            field
-        })?),
+        (Some(key), Some(rs)) => {
+            let computed = reference_for(&key, || {
+                let started = std::time::Instant::now();
+                let label = format!("{study}/{}: reference solution (adaptive to NDF >= {})", spec.id, rs.min_ndof);
+                let spinner = bar(progress, 0, &label);
+                let field = reference::compute(problem.as_ref(), &mesh_spec, rs, &mut |r| {
+                    spinner.set_message(format!("level {} NDF {}", r.level, r.ndof));
+                    if interrupted() { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+                })
+                .with_context(|| format!("{study}/{}: computing the reference solution", spec.id))?;
+                spinner.finish_and_clear();
+                let field = field.ok_or_else(|| anyhow::anyhow!("interrupted"))?;
+                if progress {
+                    eprintln!("{label}: NDF {} in {:.1} s", field.ndof, started.elapsed().as_secs_f64());
+                }
+                Ok(field)
+            });
+            match computed {
+                Ok(r) => Some(r),
+                Err(_) if interrupted() => return Ok(None),
+                Err(e) => return Err(e),
+            }
+        }
         _ => None,
     };
     let exact = problem.exact();
@@ -136,9 +324,6 @@ fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Resul
         (None, Some(f)) => Some(f),
         (None, None) => None,
     };
-    if spec.reference.is_some() && exact.is_some() {
-        bail!("{study}/{}: problem {} has an exact solution; a reference solution is not needed", spec.id, spec.problem);
-    }
     let config = AdaptConfig {
         levels: spec.levels,
         max_ndof: spec.max_ndof,
@@ -149,6 +334,7 @@ fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Resul
     };
     let pb = bar(progress, spec.levels as u64, &format!("{study}/{}", spec.id));
     let mut save_error: Option<anyhow::Error> = None;
+    let mut stopped = false;
     let mesh = mesh_spec.build(&|x| problem.part_of(x));
     let levels = adapt::run(problem.as_ref(), mesh, &config, error_against, &mut |level: Level| {
         let r = level.record;
@@ -160,6 +346,10 @@ fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Resul
                 return ControlFlow::Break(());
             }
         }
+        if interrupted() {
+            stopped = true;
+            return ControlFlow::Break(());
+        }
         ControlFlow::Continue(())
     })
     .with_context(|| format!("{study}/{}", spec.id))?;
@@ -167,11 +357,14 @@ fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Resul
     if let Some(e) = save_error {
         return Err(e);
     }
+    if stopped {
+        return Ok(None);
+    }
     if progress {
         let last = levels.last().expect("at least one level");
         eprintln!("{study}/{}: {} levels, final NDF {}, estimate {:.3e}", spec.id, levels.len(), last.ndof, last.estimate);
     }
-    Ok(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof: reference.as_ref().map(|r| r.ndof) })
+    Ok(Some(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof: reference.as_ref().map(|r| r.ndof) }))
 }
 
 fn bar(progress: bool, len: u64, prefix: &str) -> ProgressBar {

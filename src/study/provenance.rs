@@ -20,6 +20,10 @@ pub struct Provenance {
     pub signorini_version: String,
     pub machine: Machine,
     pub threads: usize,
+    /// The fill-reducing ordering: `auto` unless forced through `SIGNORINI_ORDERING` (a
+    /// round-off measurement; see `ordering::FORCE_ENV`).
+    #[serde(default = "auto")]
+    pub ordering: String,
     /// UTC, ISO 8601.
     pub date: String,
     /// Runs present in the study directory (merged by run id across shards and sessions).
@@ -32,6 +36,10 @@ pub struct Machine {
     pub cores: usize,
     pub memory_kb: Option<u64>,
     pub os: String,
+}
+
+fn auto() -> String {
+    "auto".into()
 }
 
 pub fn sha256_hex(bytes: &[u8]) -> String {
@@ -88,6 +96,10 @@ pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: 
         signorini_version: env!("CARGO_PKG_VERSION").to_string(),
         machine: machine(),
         threads: rayon::current_num_threads(),
+        ordering: match crate::ordering::forced() {
+            Ok(Some(m)) => serde_json::to_value(m).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
+            _ => "auto".into(),
+        },
         date: utc_now(),
         runs,
     }

@@ -1,0 +1,139 @@
+//! The results store survives shards, interrupts and concurrent runs: `--fresh --shard K/N`
+//! removes only shard K's runs; a second process running the same study is refused (or waits)
+//! and deletes nothing; an interrupted study keeps its finished runs with summaries that
+//! describe exactly them, and `figures` refuses it.
+
+use signorini::records::StudyDir;
+use signorini::study::manifest::Manifest;
+use signorini::study::{StudyLock, check_complete, drift};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("signorini-store-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn signorini(args: &[&str]) -> (Option<i32>, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned() + &String::from_utf8_lossy(&out.stdout);
+    assert!(!err.contains("panicked"), "{err}");
+    (out.status.code(), err)
+}
+
+fn fixture() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny.toml").display().to_string()
+}
+
+/// A study of several runs long enough to be interrupted in the middle (about a second each).
+fn long_manifest(dir: &Path) -> PathBuf {
+    let f = dir.join("long.toml");
+    let mut text = String::from("description = \"runs to interrupt\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\nlevels = 18\nsave_levels = [2]\n");
+    for i in 0..6 {
+        text += &format!("[[run]]\nid = \"r{i}\"\ntheta = 0.{}\n", 3 + i);
+    }
+    std::fs::write(&f, text).unwrap();
+    f
+}
+
+#[test]
+fn fresh_shard_removes_only_its_own_runs() {
+    let d = tmp("shard");
+    let res = d.to_str().unwrap();
+    assert_eq!(signorini(&["run", &fixture(), "--quick", "--shard", "2/2", "--results", res]).0, Some(0));
+    let dir = StudyDir::new(&d, "tiny");
+    assert!(dir.run_file("b").exists());
+    let (code, err) = signorini(&["run", &fixture(), "--quick", "--shard", "1/2", "--fresh", "--results", res]);
+    assert_eq!(code, Some(0), "{err}");
+    let ids: Vec<String> = dir.read_runs().unwrap().iter().map(|r| r.run.id.clone()).collect();
+    assert_eq!(ids, ["a", "b"], "shard 1's --fresh removed shard 2's run");
+    // the summaries describe both
+    let runs = dir.read_runs().unwrap();
+    assert!(drift::check_derived(&dir, "tiny", &runs).is_empty());
+}
+
+#[test]
+fn a_second_run_of_the_same_study_is_refused_or_waits_and_loses_nothing() {
+    let d = tmp("lock");
+    let res = d.to_str().unwrap();
+    assert_eq!(signorini(&["run", &fixture(), "--quick", "--shard", "2/2", "--results", res]).0, Some(0));
+    let dir = StudyDir::new(&d, "tiny");
+    let before = std::fs::read(dir.run_file("b")).unwrap();
+    let lock = StudyLock::acquire(&dir, false).unwrap();
+    // refused, naming the holder; with --fresh it must not have deleted anything
+    let (code, err) = signorini(&["run", &fixture(), "--quick", "--fresh", "--results", res]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains("is being written by process") && err.contains(&std::process::id().to_string()) && err.contains("--wait"), "{err}");
+    assert_eq!(std::fs::read(dir.run_file("b")).unwrap(), before, "the refused run touched the other's run");
+    assert!(!dir.run_file("a").exists());
+    // with --wait it waits for the lock, then runs
+    let child = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["run", &fixture(), "--quick", "--wait", "--results", res])
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    assert!(!dir.run_file("a").exists(), "ran while the lock was held");
+    drop(lock);
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("waiting for it to finish"), "{err}");
+    assert!(dir.run_file("a").exists() && dir.run_file("b").exists());
+}
+
+#[test]
+fn an_interrupted_study_keeps_consistent_summaries_and_figures_refuse_it() {
+    let d = tmp("interrupt");
+    let exp = d.join("experiments");
+    std::fs::create_dir_all(&exp).unwrap();
+    let manifest = long_manifest(&exp);
+    let res = d.join("results");
+    let dir = StudyDir::new(&res, "long");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["run", manifest.to_str().unwrap(), "--fresh", "--results", res.to_str().unwrap()])
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    while !dir.run_file("r0").exists() {
+        assert!(t0.elapsed() < Duration::from_secs(120), "the first run did not finish");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    std::thread::sleep(Duration::from_millis(100)); // inside the second run
+    assert!(Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap().success());
+    let status = child.wait().unwrap();
+    let mut err = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut err).unwrap();
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.contains("interrupted; kept") && err.contains("Resume with `signorini run"), "{err}");
+    let runs = dir.read_runs().unwrap();
+    assert!(!runs.is_empty() && runs.len() < 6, "{} runs kept", runs.len());
+    // the summaries describe exactly the runs kept; no mesh of an unfinished run is left
+    assert!(drift::check_derived(&dir, "long", &runs).is_empty(), "{:?}", drift::check_derived(&dir, "long", &runs));
+    let csv = std::fs::read_to_string(dir.csv_file()).unwrap();
+    assert_eq!(csv.lines().count(), 1 + runs.iter().map(|r| r.levels.len()).sum::<usize>());
+    for e in std::fs::read_dir(dir.root.join("meshes")).unwrap().flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        assert!(runs.iter().any(|r| name.starts_with(&format!("{}_level", r.run.id))), "mesh of an unfinished run left: {name}");
+    }
+    // figures refuse the partial study, naming what is missing, and write nothing
+    let m = Manifest::load(&manifest).unwrap();
+    let missing = m.runs.iter().map(|p| p.spec.id.clone()).find(|id| !runs.iter().any(|r| &r.run.id == id)).unwrap();
+    assert!(check_complete(&m, &res).is_err());
+    let figs = d.join("figures");
+    let (code, err) = signorini(&["figures", "--experiments", exp.to_str().unwrap(), "--results", res.to_str().unwrap(), "--figures", figs.to_str().unwrap()]);
+    assert_ne!(code, Some(0));
+    assert!(err.contains(&format!("run {missing} is missing")) && err.contains("signorini run"), "{err}");
+    assert!(!figs.exists(), "figures were drawn from a partial study");
+    // resuming completes it
+    let (code, err) = signorini(&["run", manifest.to_str().unwrap(), "--results", res.to_str().unwrap()]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(check_complete(&m, &res).is_ok());
+}
