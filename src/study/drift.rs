@@ -22,15 +22,16 @@
 //! `provenance.json`'s run list must be exactly what the stored records give
 //! ([`check_derived`]), so a hand edit or a bad merge of a view is drift too.
 
-use super::manifest::{DriftSpec, Manifest};
+use super::manifest::{DriftSpec, Manifest, Tolerance};
+use crate::adapt::LevelRecord;
 use crate::records::{RunRecord, StudyDir};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// One thing that moved.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DriftRow {
     pub study: String,
     pub run: String,
@@ -57,10 +58,11 @@ fn show(v: Option<&Value>) -> String {
 
 /// The largest change one float field showed across a comparison, whether or not it drifted:
 /// what the round-off measurement records and the tolerances are set from.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct FieldChange {
-    /// max |fresh - stored| / |stored| over the entries with a stored value above the floor's
-    /// reach (|stored| > 1e-6 scale), i.e. the relative change of numbers not near round-off.
+    /// max |fresh - stored| / |stored| over the entries with |stored| >= 1e-3 scale: the
+    /// relative change of the numbers the floor does not cover. A tolerance with
+    /// rel = m max_rel and floor = m max_floor covers every entry with a margin m.
     pub max_rel: f64,
     /// max |fresh - stored| / scale over all entries (scale: the field's largest |value| in its run).
     pub max_floor: f64,
@@ -69,6 +71,35 @@ pub struct FieldChange {
     /// Entries compared.
     pub entries: usize,
 }
+
+/// Fields that are functions of other fields of the same record, checked as such (the stored
+/// and the fresh value each equal the function of the record's own fields, to the bit) rather
+/// than within a tolerance of their own: the efficiency index estimate / err_quadrature carries
+/// the error's relative round-off, which near the end of a run is far larger than anything a
+/// tolerance on the index itself could be honest about while still seeing a change of 1e-5.
+pub const DERIVED: [(&str, fn(&LevelRecord) -> Option<f64>); 1] = [("efficiency", |l| l.err_quadrature.map(|e| l.estimate / e))];
+
+fn is_derived(field: &str) -> bool {
+    DERIVED.iter().any(|(f, _)| *f == field)
+}
+
+/// Rows for the derived fields of `levels` that are not what their definition gives.
+fn check_derived_fields(study: &str, run: &str, side: &str, levels: &[LevelRecord], out: &mut Vec<DriftRow>) {
+    for l in levels {
+        let v = serde_json::to_value(l).expect("records serialise");
+        for (field, definition) in DERIVED {
+            let (stored, expected) = (v[field].as_f64(), definition(l));
+            if stored != expected {
+                let text = |x: Option<f64>| x.map(|x| x.to_string()).unwrap_or("null".into());
+                out.push(row(study, run, Some(l.level), field, format!("{side}: {}", text(stored)), format!("by definition: {}", text(expected)), None, "exact (a function of the record's fields)".into()));
+            }
+        }
+    }
+}
+
+/// Entries with |stored| >= REL_RANGE x (the field's largest |value| in its run) count for
+/// [`FieldChange::max_rel`]; below, the floor covers them.
+pub const REL_RANGE: f64 = 1e-3;
 
 /// What a comparison found: the drift rows, and per float field its largest change.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -115,11 +146,11 @@ fn compare_level(study: &str, run: &str, level: usize, stored: &Value, fresh: &V
                 if scale > 0.0 {
                     c.max_floor = c.max_floor.max(diff / scale);
                 }
-                if a.abs() > 1e-6 * scale && diff / a.abs() > c.max_rel {
+                if a.abs() >= REL_RANGE * scale && diff / a.abs() > c.max_rel {
                     c.max_rel = diff / a.abs();
                     c.at = format!("{run} {level}");
                 }
-                if !(diff <= tol.rel * a.abs() + tol.floor * scale) {
+                if !is_derived(key) && !(diff <= tol.rel * a.abs() + tol.floor * scale) {
                     let rel = if a != 0.0 { Some(diff / a.abs()) } else { None };
                     out.push(drift(rel, format!("rel {:e} + floor {:e} x {scale:.3e}", tol.rel, tol.floor)));
                 }
@@ -189,6 +220,8 @@ pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], q
         if f.levels.len() != expected_levels {
             out.push(row(study, id, None, "levels", expected_levels.to_string(), f.levels.len().to_string(), None, "exact".into()));
         }
+        check_derived_fields(study, id, "stored", &s.levels, &mut out);
+        check_derived_fields(study, id, "fresh", &f.levels, &mut out);
         let stored_levels: Vec<Value> = s.levels.iter().map(|l| serde_json::to_value(l).expect("records serialise")).collect();
         let scales = field_scales(&stored_levels);
         for l in 0..n_compare {
@@ -296,7 +329,7 @@ pub struct DriftOptions {
 }
 
 /// The outcome of a drift run over some studies.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct DriftReport {
     pub date: String,
     pub quick: bool,
@@ -365,7 +398,59 @@ pub fn changes_table(report: &DriftReport) -> String {
     }
     let mut s = format!("{:<16} {:>12} {:>12}  {}\n", "field", "max rel", "max/scale", "where (max rel)");
     for (field, (rel, floor, at)) in by_field {
+        let at = if rel > 0.0 { at.as_str() } else { "-" };
         s += &format!("{field:<16} {rel:>12.2e} {floor:>12.2e}  {at}\n");
+    }
+    s
+}
+
+/// The factor between the largest change round-off was measured to make and the tolerance.
+pub const MARGIN: f64 = 10.0;
+/// The least relative tolerance of any float field, also of those that never moved in the
+/// measurement (h_min, l_h, ...): a few units in the last place, for a libm that rounds
+/// `log` or `sqrt` differently on another machine.
+pub const MIN_REL: f64 = 1e-12;
+
+/// Round up to one significant digit (2.3e-7 -> 3e-7), as the decimal the manifest will hold.
+fn round_up(x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    let p = 10f64.powf(x.log10().floor());
+    let digit = (x / p).ceil();
+    // through the decimal text, so the value is the double a manifest saying it parses to
+    format!("{digit}e{}", x.log10().floor()).parse().expect("a decimal number")
+}
+
+/// The tolerances round-off asks for, per study and float field, from the reports of
+/// `make roundoff` (each a comparison of the stored results with one rerun that changes only
+/// the order of operations): rel = MARGIN x the largest `max_rel`, floor = MARGIN x the largest
+/// `max_floor` over the reports, rounded up to one significant digit; rel at least MIN_REL.
+pub fn measured_tolerances(reports: &[DriftReport]) -> BTreeMap<String, BTreeMap<String, Tolerance>> {
+    let mut out: BTreeMap<String, BTreeMap<String, Tolerance>> = BTreeMap::new();
+    for r in reports {
+        for (study, fields) in &r.changes {
+            for (field, c) in fields.iter().filter(|(f, _)| !is_derived(f)) {
+                let t = out.entry(study.clone()).or_default().entry(field.clone()).or_insert(Tolerance { rel: 0.0, floor: 0.0 });
+                t.rel = t.rel.max(c.max_rel);
+                t.floor = t.floor.max(c.max_floor);
+            }
+        }
+    }
+    for fields in out.values_mut() {
+        for t in fields.values_mut() {
+            *t = Tolerance { rel: round_up(MARGIN * t.rel).max(MIN_REL), floor: round_up(MARGIN * t.floor) };
+        }
+    }
+    out
+}
+
+/// A study's measured tolerances as the manifest's `[drift]` table.
+pub fn tolerances_toml(fields: &BTreeMap<String, Tolerance>) -> String {
+    let mut s = String::from("[drift]\ndefault = { rel = 1e-12, floor = 0.0 }   # fields not listed: they did not move\n[drift.fields]\n");
+    for (f, t) in fields.iter().filter(|(_, t)| **t != Tolerance { rel: MIN_REL, floor: 0.0 }) {
+        let num = |v: f64| if v == 0.0 { "0.0".to_string() } else { format!("{v:e}") };
+        s += &format!("{f} = {{ rel = {}, floor = {} }}\n", num(t.rel), num(t.floor));
     }
     s
 }

@@ -255,6 +255,9 @@ impl Manifest {
         let floats = crate::records::float_fields();
         for (key, tol) in std::iter::once(("default".to_string(), &drift.default)).chain(drift.fields.iter().map(|(k, t)| (format!("fields.{k}"), t))) {
             if let Some(name) = key.strip_prefix("fields.") {
+                if crate::study::drift::DERIVED.iter().any(|(f, _)| *f == name) {
+                    return Err(invalid(format!("drift.{key}"), "a field with a tolerance of its own; this one is checked by its definition, exactly", format!("{name:?}")));
+                }
                 if !floats.iter().any(|f| f == name) {
                     return Err(invalid(format!("drift.{key}"), &format!("a float field of the level records ({})", floats.join(", ")), format!("{name:?}")));
                 }
