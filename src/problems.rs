@@ -66,6 +66,13 @@ pub trait Problem: Send + Sync {
     fn required_vertices(&self) -> Vec<[f64; 2]> {
         Vec::new()
     }
+    /// Vertical lines x = c across which the body force is not smooth (a root singularity of a
+    /// derivative, such as ((x - c)_+)^(1/2)): the load of an element crossing one is integrated
+    /// piecewise (`assembly::split_load`), exact to round-off where a Gauss rule on the whole
+    /// element would converge only algebraically.
+    fn load_breaks(&self) -> Vec<f64> {
+        Vec::new()
+    }
     fn exact(&self) -> Option<&dyn Exact> {
         None
     }
@@ -309,6 +316,10 @@ impl Problem for Fb {
     }
     fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
         [0.0, -1.0]
+    }
+    /// f has ((x - a)_+)^(1/2) and ^(3/2) terms.
+    fn load_breaks(&self) -> Vec<f64> {
+        vec![Self::A]
     }
     /// chi(x) = -r(x) + ((a - x)_+)^(3/2).
     fn gap(&self, x: [f64; 2]) -> f64 {
