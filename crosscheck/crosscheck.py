@@ -1,7 +1,7 @@
 """Independent NGSolve cross-check of the Rust Signorini solver (see README.md).
 
     crosscheck.py compare DIR [DIR...]       same mesh, same data, our own PDAS: u and active set must match
-    crosscheck.py rates DIR [DIR...]         ex71 on structured:N: L-infinity errors and rates vs case.json
+    crosscheck.py rates DIR [DIR...]         ex71 and fb on structured:N: L-infinity errors and rates vs case.json
     crosscheck.py bench [--sizes 32,64,...]  NGSolve timings of Example 7.2's linear elasticity system
     crosscheck.py selftest [DIR...]          shows that `compare` fails when one side's data are perturbed
 
@@ -138,17 +138,40 @@ def observed_rates(ns, errs):
 
 
 def cmd_rates(args):
-    cases = []
+    by_problem = {}
     for d in args.dirs:
         case = fem.read_case(d)
         kind, _, n = case.meta.get("mesh", "").partition(":")
-        if case.meta["problem"] != "ex71" or kind != "structured":
-            sys.exit(f"rates: {d} is not an ex71 case on a structured:N mesh")
+        if case.meta["problem"] not in RATE_PROBLEMS or kind != "structured":
+            sys.exit(f"rates: {d} is not a case of {' or '.join(RATE_PROBLEMS)} on a structured:N mesh")
         disc, res, _ = fem.solve_case(case)
-        cases.append((int(n), d, case.meta.get("error", {}), disc.errors(res["U"])))
-    cases.sort()
+        by_problem.setdefault(case.meta["problem"], []).append((int(n), d, case.meta.get("error", {}), disc.errors(res["U"])))
+    all_rows, ok = [], True
+    for problem in sorted(by_problem):
+        rows, good = problem_rates(problem, sorted(by_problem[problem]))
+        all_rows += rows
+        ok = ok and good
+    for row in all_rows:
+        row.setdefault("result", "PASS")
+    cols = ["case", "problem", "N"] + [f"{p}{k}_{s}" for k in ("linf_nodal", "linf_dense")
+                                       for p in ("", "rate_") for s in ("rust", "ngsolve")] + ["result"]
+    report("rates", "Examples with an exact solution (ex71, fb): L-infinity errors and observed rates (in h), Rust vs NGSolve",
+           cols, all_rows,
+           {"tolerance_rate": TOL_RATE,
+            "norm": "max over points and both components of |u - u_h|; "
+                    "dense = barycentric lattice of order 6 per triangle (as src/norms.rs)"},
+           args.out_dir)
+    return ok
+
+
+# Problems with an exact solution, whose rates `rates` compares.
+RATE_PROBLEMS = ("ex71", "fb")
+
+
+def problem_rates(problem, cases):
+    """Rows of one problem's cases (sorted by N) and whether the Rust and NGSolve rates agree."""
     ns = [c[0] for c in cases]
-    rows = [{"case": os.path.basename(os.path.normpath(d)), "N": n} for n, d, _, _ in cases]
+    rows = [{"case": os.path.basename(os.path.normpath(d)), "problem": problem, "N": n} for n, d, _, _ in cases]
     ok = True
     for key in ("linf_nodal", "linf_dense"):
         ours = [c[3][key] for c in cases]
@@ -163,17 +186,8 @@ def cmd_rates(args):
                 ok = False
                 row["result"] = f"FAIL: {key} rate {q_t:.3f} vs {q_o:.3f}"
         if not have:
-            print(f"rates: case.json lacks error.{key} in some case: not compared")
-    for row in rows:
-        row.setdefault("result", "PASS")
-    cols = ["case", "N"] + [f"{p}{k}_{s}" for k in ("linf_nodal", "linf_dense")
-                            for p in ("", "rate_") for s in ("rust", "ngsolve")] + ["result"]
-    report("rates", "Example 7.1: L-infinity errors and observed rates (in h), Rust vs NGSolve", cols, rows,
-           {"tolerance_rate": TOL_RATE,
-            "norm": "max over points and both components of |u - u_h|; "
-                    "dense = barycentric lattice of order 6 per triangle (as src/norms.rs)"},
-           args.out_dir)
-    return ok
+            print(f"rates: case.json lacks error.{key} in some {problem} case: not compared")
+    return rows, ok
 
 
 # -- bench ---------------------------------------------------------------------------------------
@@ -263,16 +277,18 @@ def cmd_bench(args):
 
 # -- selftest ------------------------------------------------------------------------------------
 # The datum we perturb for each problem: one that is nonzero there.
-PERTURB = {"ex71": "f", "ex72": "dirichlet"}
+PERTURB = {"ex71": "f", "ex72": "dirichlet", "fb": "f"}
 
 
 def cmd_selftest(args):
     ok = True
     mesh = fem.build_ngmesh(*_unit_square_for_data_check())
-    ef, eg, ec = problems.check_ex71_data(mesh)
-    print(f"ex71 data vs symbolic derivatives of the exact u: f {ef:.1e}, g {eg:.1e}, contact stress {ec:.1e}")
-    rows = [{"case": "ex71 data", "check": "f, g, sigma on Gamma_C vs exact u", "value": max(ef, eg, ec),
-             "result": "PASS" if max(ef, eg, ec) < 1e-10 else "FAIL"}]
+    rows = []
+    for name in ("ex71", "fb"):
+        ef, eg, ec = problems.check_data(name, mesh)
+        print(f"{name} data vs symbolic derivatives of the exact u: f {ef:.1e}, g {eg:.1e}, contact stress {ec:.1e}")
+        rows.append({"case": f"{name} data", "check": "f, g, sigma on Gamma_C vs exact u", "value": max(ef, eg, ec),
+                     "result": "PASS" if max(ef, eg, ec) < 1e-10 else "FAIL"})
 
     with tempfile.TemporaryDirectory() as tmp:
         dirs = args.dirs

@@ -22,6 +22,7 @@ from problems import problem as make_problem
 
 BOUNDARY_NAMES = {1: "dirichlet", 2: "neumann", 3: "contact"}
 LOAD_BONUS_INTORDER = 10  # ex71's loads are exponentials: integrate them (nearly) exactly
+SPLIT_POINTS = 12  # Gauss points per direction of split_load (fb's f across x = a)
 INVERSE = "sparsecholesky"
 
 
@@ -113,14 +114,76 @@ def stiffness_form(fes, p):
     return BilinearForm(2 * p.mu * InnerProduct(eu, ev) * dx + p.zeta * Trace(eu) * Trace(ev) * dx)
 
 
-def load_form(fes, p):
+def load_form(fes, p, skip=None):
+    """f and g; f not on the elements of the BitArray `skip` (integrated by `split_load`)."""
     v = fes.TestFunction()
     lf = LinearForm(fes)
     if p.f is not None:
-        lf += InnerProduct(p.f, v) * dx(bonus_intorder=LOAD_BONUS_INTORDER)
+        if skip is None:
+            lf += InnerProduct(p.f, v) * dx(bonus_intorder=LOAD_BONUS_INTORDER)
+        else:
+            keep = ~skip  # a new BitArray
+            lf += InnerProduct(p.f, v) * dx(bonus_intorder=LOAD_BONUS_INTORDER, definedonelements=keep)
     if p.g is not None:
         lf += InnerProduct(p.g, v) * ds("neumann", bonus_intorder=LOAD_BONUS_INTORDER)
     return lf
+
+
+def split_load(case, prob, mesh, n=SPLIT_POINTS):
+    """The Lagrange-basis load of the triangles crossed by a line x = c of prob.load_breaks, where f
+    is not smooth (fb: terms in ((x - a)_+)^(1/2), ^(3/2)); NGSolve's rules converge only
+    algebraically there. Returns (element numbers, load vector in the U numbering).
+
+    Iterated integral per triangle: the x-range is cut at the vertices' x and at c, so that the
+    section [y_lo(x), y_hi(x)] is linear on each piece; Gauss in y; Gauss in x after the
+    substitution x = c +- (x_r - x_l) s^2 on the two pieces next to c (the root becomes smooth in s).
+    The P2 Lagrange basis from barycentric coordinates: l_i (2 l_i - 1) at vertices, 4 l_i l_j at
+    the midpoint of edge ij (node order v0 v1 v2 m01 m12 m20)."""
+    gs, gw = np.polynomial.legendre.leggauss(n)
+    gs, gw = 0.5 * (gs + 1), 0.5 * gw
+    npts = len(case.points)
+    elems, pts, wts, owner = [], [], [], []
+    for e, tri in enumerate(case.tris):
+        V = case.points[tri[:3]]
+        cs = [c for c in prob.load_breaks if V[:, 0].min() < c < V[:, 0].max()]
+        if not cs:
+            continue
+        c = cs[0]
+        elems.append(e)
+        xs = np.unique(np.r_[V[:, 0], c])
+        for xl, xr in zip(xs[:-1], xs[1:]):
+            for s, ws in zip(gs, gw):
+                if xl == c:
+                    x, jac = xl + (xr - xl) * s * s, 2 * (xr - xl) * s
+                elif xr == c:
+                    x, jac = xr - (xr - xl) * s * s, 2 * (xr - xl) * s
+                else:
+                    x, jac = xl + (xr - xl) * s, xr - xl
+                ys = [p[1] + (x - p[0]) / (q[0] - p[0]) * (q[1] - p[1])
+                      for p, q in ((V[0], V[1]), (V[1], V[2]), (V[2], V[0])) if (p[0] - x) * (q[0] - x) < 0]
+                lo, hi = min(ys), max(ys)
+                for t, wt in zip(gs, gw):
+                    pts.append((x, lo + (hi - lo) * t))
+                    wts.append(ws * jac * wt * (hi - lo))
+                    owner.append(e)
+    F = np.zeros(2 * npts)
+    if not elems:
+        return elems, F
+    pts, wts, owner = np.array(pts), np.array(wts), np.array(owner)
+    fx = eval_points(mesh, prob.f, pts)  # (m, 2)
+    tris = case.tris[owner]
+    V = case.points[tris[:, :3]]  # (m, 3, 2)
+    # barycentric coordinates of each point in its triangle
+    d = V[:, 1:] - V[:, :1]  # (m, 2, 2): rows b - a, c - a
+    det = d[:, 0, 0] * d[:, 1, 1] - d[:, 0, 1] * d[:, 1, 0]
+    r = pts - V[:, 0]
+    l1 = (r[:, 0] * d[:, 1, 1] - r[:, 1] * d[:, 1, 0]) / det
+    l2 = (d[:, 0, 0] * r[:, 1] - d[:, 0, 1] * r[:, 0]) / det
+    lam = np.stack([1 - l1 - l2, l1, l2], axis=1)
+    phi = np.concatenate([lam * (2 * lam - 1), 4 * lam[:, [0, 1, 2]] * lam[:, [1, 2, 0]]], axis=1)  # (m, 6)
+    for k in range(2):
+        np.add.at(F, k * npts + tris, (wts * fx[:, k])[:, None] * phi)
+    return elems, F
 
 
 def eval_points(mesh, cf, pts):
@@ -150,10 +213,21 @@ class Discretisation:
         self._classify_nodes()
 
         a = stiffness_form(self.fes, prob).Assemble()
-        f = load_form(self.fes, prob).Assemble()
+        # f on triangles crossed by a line where it is not smooth: our own rule (split_load)
+        split, F_split = split_load(case, prob, self.mesh) if prob.f is not None else ([], 0.0)
+        skip = None
+        if split:
+            skip = BitArray(self.mesh.ne)
+            skip.Clear()
+            for e in split:
+                if sorted(v.nr for v in self.mesh[ng.ElementId(ng.VOL, e)].vertices) != sorted(case.tris[e, :3]):
+                    raise RuntimeError("NGSolve element numbers differ from the case's triangles")
+                skip.Set(e)
+        f = load_form(self.fes, prob, skip).Assemble()
         T, Tt = self.T, self.T.CreateTranspose()
         self.K = Tt @ a.mat @ T  # Lagrange-basis stiffness (a SparseMatrixd)
-        self.F = (Tt * f.vec).Evaluate().FV().NumPy().copy()
+        self.F = (Tt * f.vec).Evaluate().FV().NumPy().copy() + F_split
+        self.split_elements = len(split)
 
     # -- change of basis ---------------------------------------------------------------------
     def _build_basis_change(self):
@@ -273,9 +347,14 @@ class Discretisation:
         cdofs = k * npts + self.contact_nodes
         fixed_base = np.zeros(2 * npts, bool)
         values = np.zeros(2 * npts)
+        # Dirichlet values at the Dirichlet nodes: a constant, or a coefficient function evaluated there
+        if isinstance(prob.u_dirichlet, ng.CoefficientFunction):
+            ud = eval_points(self.mesh, prob.u_dirichlet, self.case.points[self.dirichlet])
+        else:
+            ud = np.tile(np.asarray(prob.u_dirichlet, float), (int(self.dirichlet.sum()), 1))
         for comp in range(2):
             fixed_base[comp * npts:(comp + 1) * npts] = self.dirichlet
-            values[comp * npts:(comp + 1) * npts][self.dirichlet] = prob.u_dirichlet[comp]
+            values[comp * npts:(comp + 1) * npts][self.dirichlet] = ud[:, comp]
         values[cdofs] = sign * self.chi
         diag = self._diagonal()
         c = c_scale * float(np.mean(diag[cdofs]))

@@ -17,6 +17,7 @@ import numpy as np
 SIDES = {
     "ex71": {"bottom": 3, "top": 1, "left": 2, "right": 2},
     "ex72": {"left": 1, "right": 3, "bottom": 2, "top": 2},
+    "fb": {"bottom": 3, "top": 1, "left": 2, "right": 2},
 }
 
 

@@ -1,13 +1,15 @@
-"""Problem data of Examples 7.1 and 7.2, transcribed from shared/PAPER-NOTES.md.
+"""Problem data of Examples 7.1 and 7.2, transcribed from shared/PAPER-NOTES.md, and of the
+free-boundary problem `fb` (beyond the paper), transcribed from its definition (issue 12).
 
 Written independently of the Rust code on purpose: the cross-check is only worth something if the
-data enter twice, once on each side. `check_ex71_data` verifies the transcribed f and g against
-NGSolve's symbolic derivative of the exact solution, so a typo here cannot hide.
+data enter twice, once on each side. `check_data` verifies the transcribed f, g and contact stresses
+of ex71 and fb against NGSolve's symbolic derivatives of the exact solution, so a typo here cannot
+hide.
 """
 from dataclasses import dataclass
 
 import numpy as np
-from ngsolve import CF, IfPos, exp, x, y
+from ngsolve import CF, IfPos, cos, exp, sin, sqrt, x, y
 
 # Relative size of the deliberate data perturbation used by `crosscheck.py selftest`.
 PERTURBATION = 1e-6
@@ -20,10 +22,11 @@ class Problem:
     zeta: float  # Lame's lambda; called zeta as in the paper to keep lambda for the contact force
     f: CF | None  # volume load (None: zero)
     g: CF | None  # traction on the "neumann" boundary (None: zero)
-    u_dirichlet: tuple  # constant Dirichlet value on the "dirichlet" boundary
+    u_dirichlet: object  # Dirichlet value on the "dirichlet" boundary: a constant tuple or a CF
     normal: tuple  # outward unit normal of the (straight, axis-parallel) contact boundary
     chi: object  # gap function: numpy (x, y) -> array
     exact: CF | None  # exact displacement, if known
+    load_breaks: tuple = ()  # lines x = c across which f is not smooth (fem.split_load integrates there)
 
     @property
     def normal_component(self):
@@ -47,9 +50,53 @@ def ex71_g():
     return IfPos(x - 0.5, g_right, g_left)
 
 
+# -- fb: free boundary with an exact solution (beyond the paper) ---------------------------------
+# zeta = mu = 1, Gamma_C = bottom (n = (0,-1)), Gamma_D = top, Gamma_N = sides;
+# a = sqrt(2) - 1, r = 0.05 sin(2 pi x), p = -((x - a)_+)^(5/2),
+# u = (-y r', y p / 3 + r), chi = -r + ((a - x)_+)^(3/2); contact exactly on [a, 1].
+FB_A = np.sqrt(2.0) - 1.0
+_K = 2 * np.pi
+
+
+def fb_r():
+    """r and its first three derivatives as coefficient functions."""
+    return (0.05 * sin(_K * x), 0.05 * _K * cos(_K * x), -0.05 * _K**2 * sin(_K * x), -0.05 * _K**3 * cos(_K * x))
+
+
+def fb_p():
+    """p and its first two derivatives; zero left of a (IfPos picks the branch: the square root of
+    a negative number is never used)."""
+    s = x - FB_A
+    return (-IfPos(s, s * s * sqrt(s), 0), -IfPos(s, 2.5 * s * sqrt(s), 0), -IfPos(s, 3.75 * sqrt(s), 0))
+
+
+def fb_exact():
+    r, p = fb_r(), fb_p()
+    return CF((-y * r[1], y * p[0] / 3 + r[0]))
+
+
+def fb_f():
+    """-div sigma(u) for zeta = mu = 1, written out by hand: (3 y r3 - 2 p1 / 3, r2 - y p2 / 3),
+    rk and pk the k-th derivatives."""
+    r, p = fb_r(), fb_p()
+    return CF((3 * y * r[3] - 2 * p[1] / 3, r[2] - y * p[2] / 3))
+
+
+def fb_g():
+    """sigma(u) n on the sides, with sigma_11 = p/3 - 3 y r2 and sigma_12 = y p1 / 3:
+    x = 0 (n = (-1,0)): -(sigma_11, sigma_12); x = 1 (n = (1,0)): (sigma_11, sigma_12)."""
+    r, p = fb_r(), fb_p()
+    s11, s12 = p[0] / 3 - 3 * y * r[2], y * p[1] / 3
+    return IfPos(x - 0.5, CF((s11, s12)), CF((-s11, -s12)))
+
+
+def fb_chi(px, py):
+    return -0.05 * np.sin(_K * px) + np.maximum(FB_A - px, 0.0) ** 1.5
+
+
 def problem(name, perturb=None):
     """The problem's data; perturb = "f" or "dirichlet" scales that datum by 1 + PERTURBATION
-    (only where the datum is nonzero: f for ex71, the Dirichlet value for ex72)."""
+    (only where the datum is nonzero: f for ex71 and fb, the Dirichlet value for ex72)."""
     fscale = 1 + PERTURBATION if perturb == "f" else 1.0
     dscale = 1 + PERTURBATION if perturb == "dirichlet" else 1.0
     if perturb not in (None, "f", "dirichlet"):
@@ -75,7 +122,17 @@ def problem(name, perturb=None):
             chi=lambda px, py: -0.2 + 0.5 * np.abs(py - 0.5),
             exact=None,
         )
-    raise ValueError(f"unknown problem {name!r} (expected ex71 or ex72)")
+    if name == "fb":
+        return Problem(
+            name="fb", mu=1.0, zeta=1.0,
+            f=fscale * fb_f(), g=fb_g(),
+            u_dirichlet=fb_exact(),
+            normal=(0.0, -1.0),
+            chi=fb_chi,
+            exact=fb_exact(),
+            load_breaks=(FB_A,),
+        )
+    raise ValueError(f"unknown problem {name!r} (expected ex71, ex72 or fb)")
 
 
 def stress(p, grad_u):
@@ -85,14 +142,19 @@ def stress(p, grad_u):
     return 2 * p.mu * eps + p.zeta * Trace(eps) * Id(2)
 
 
-def check_ex71_data(mesh):
+# The normal stress sigma_22 on Gamma_C (y = 0) that each problem's definition states.
+SIGMA_NN = {"ex71": lambda px: 3 * px - 6, "fb": lambda px: -max(px - FB_A, 0.0) ** 2.5}
+
+
+def check_data(name, mesh):
     """Max deviation of the transcribed f and g from -div sigma(u) and sigma(u) n of the exact u.
 
     NGSolve differentiates the exact coefficient function symbolically (CF.Diff), which is an
     independent route to the same formulas. Returns (err_f, err_g, err_contact) where err_contact is
-    the deviation of the tangential stress on y = 0 from 0 and of sigma_nn from 3x - 6 (PAPER-NOTES).
+    the deviation of the tangential stress on y = 0 from 0 and of sigma_22 from the stated normal
+    stress (ex71: 3x - 6, PAPER-NOTES; fb: p(x) = -((x - a)_+)^(5/2)).
     """
-    p = problem("ex71")
+    p = problem(name)
     u = p.exact
     grad_u = CF((u[0].Diff(x), u[0].Diff(y), u[1].Diff(x), u[1].Diff(y)), dims=(2, 2))
     s = stress(p, grad_u)
@@ -110,5 +172,5 @@ def check_ex71_data(mesh):
             err_g = max(err_g, np.max(np.abs(np.array(p.g(mp)) - sn)))
     for px in pts:
         sm = np.array(s(mesh(px, 0.0))).reshape(2, 2)
-        err_c = max(err_c, abs(sm[0, 1]), abs(sm[1, 1] - (3 * px - 6)))
+        err_c = max(err_c, abs(sm[0, 1]), abs(sm[1, 1] - SIGMA_NN[name](px)))
     return err_f, err_g, err_c

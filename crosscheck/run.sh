@@ -14,18 +14,18 @@ out="${CROSSCHECK_OUT:-$root/results/crosscheck}"
 "$here/setup.sh" || exit 1
 py="$here/.venv/bin/python"
 rm -rf "$cases" && mkdir -p "$cases"
-all=() ex71=()
-for spec in ex71:8 ex71:16 ex71:32 ex71:64 ex72:8 ex72:16 ex72:32; do
+all=() exact=()
+for spec in ex71:8 ex71:16 ex71:32 ex71:64 ex72:8 ex72:16 ex72:32 fb:8 fb:16 fb:32 fb:64; do
     p="${spec%%:*}" n="${spec##*:}"
     dir="$cases/$p-structured-$n"
     "$bin" export --problem "$p" --mesh "structured:$n" --out "$dir" || exit 1
     all+=("$dir")
-    [ "$p" = ex71 ] && ex71+=("$dir")
+    [ "$p" != ex72 ] && exact+=("$dir")  # problems with an exact solution: rates
 done
 
 # adaptive meshes (level 10 of the studies' loop) and the Example 7.2 reference solution of the
 # studies (experiments/ex72.toml: adaptive, theta 0.5, eta_5 without full-contact nodes, NDF >= 250,000)
-for p in ex71 ex72; do
+for p in ex71 ex72 fb; do
     dir="$cases/$p-adaptive-10"
     "$bin" export --problem "$p" --mesh structured:4 --adapt-levels 10 --out "$dir" || exit 1
     all+=("$dir")
@@ -36,7 +36,7 @@ dir="$cases/ex72-reference"
 all+=("$dir")
 
 status=0
-"$py" "$here/crosscheck.py" --out-dir "$out" selftest "$cases/ex71-structured-8" "$cases/ex72-structured-8" || status=1
+"$py" "$here/crosscheck.py" --out-dir "$out" selftest "$cases/ex71-structured-8" "$cases/ex72-structured-8" "$cases/fb-structured-8" || status=1
 "$py" "$here/crosscheck.py" --out-dir "$out" compare "${all[@]}" || status=1
-"$py" "$here/crosscheck.py" --out-dir "$out" rates "${ex71[@]}" || status=1
+"$py" "$here/crosscheck.py" --out-dir "$out" rates "${exact[@]}" || status=1
 exit $status

@@ -6,7 +6,7 @@
 //! The unknowns are numbered so that every contact normal unknown comes last (the block `C`);
 //! the contact solver relies on that to work on a small Schur complement.
 
-use crate::element::{self, Affine, N_NODES};
+use crate::element::{self, Affine, EDGE_VERTICES, N_NODES};
 use crate::mesh::{Mesh, P2Nodes, Part};
 use crate::problems::{Material, Problem};
 use rayon::prelude::*;
@@ -293,6 +293,7 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
     let stiff_rule = element::triangle_rule(2);
     let load_rule = element::triangle_rule(LOAD_DEGREE);
     let load_basis: Vec<[f64; N_NODES]> = load_rule.points.iter().map(|q| element::p2_values(q[0], q[1])).collect();
+    let breaks = problem.load_breaks();
 
     // Element matrices and loads in parallel (in chunks, to bound memory); scattered in element
     // order so the sums are the same on any number of threads.
@@ -307,11 +308,17 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
                 let mut k = element_stiffness(&map, material, &stiff_rule);
                 let mut f = [0.0; 12];
                 let area = map.det.abs();
-                for ((q, w), phi) in load_rule.points.iter().zip(&load_rule.weights).zip(&load_basis) {
-                    let fx = problem.body_force(map.map(*q));
-                    for a in 0..N_NODES {
-                        f[2 * a] += w * area * fx[0] * phi[a];
-                        f[2 * a + 1] += w * area * fx[1] * phi[a];
+                let corners = mesh.corners(t);
+                let crossing = breaks.iter().find(|&&c| corners.iter().any(|v| v[0] < c) && corners.iter().any(|v| v[0] > c));
+                if let Some(&c) = crossing {
+                    f = split_load(&map, corners, c, &|x| problem.body_force(x));
+                } else {
+                    for ((q, w), phi) in load_rule.points.iter().zip(&load_rule.weights).zip(&load_basis) {
+                        let fx = problem.body_force(map.map(*q));
+                        for a in 0..N_NODES {
+                            f[2 * a] += w * area * fx[0] * phi[a];
+                            f[2 * a + 1] += w * area * fx[1] * phi[a];
+                        }
                     }
                 }
                 rotate(&mut k, &mut f, &nodes.elements[t], dofs);
@@ -322,6 +329,66 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
     }
     neumann_load(mesh, nodes, dofs, problem, &mut rhs);
     System { matrix, rhs, dirichlet }
+}
+
+/// Gauss points per direction of [`split_load`].
+pub const SPLIT_POINTS: usize = 12;
+
+/// The load int_T f phi_a (a = 0..5, both components) of a triangle crossed by the vertical line
+/// x = c across which f is not smooth (a root singularity such as ((x - c)_+)^(1/2), see
+/// `Problem::load_breaks`). An iterated integral: the triangle's x-range is cut at its vertices'
+/// x and at c, so that the section [y_lo(x), y_hi(x)] is linear in x on each interval; Gauss in y;
+/// in x Gauss after the substitution x = c +- (x_r - x_l) s^2 on the two intervals next to c
+/// (which makes ((x - c)_+)^(k/2) smooth in s), plain Gauss elsewhere. Exact to round-off for
+/// such f where a Gauss rule on the whole triangle converges only algebraically.
+pub fn split_load(map: &Affine, corners: [[f64; 2]; 3], c: f64, f: &dyn Fn([f64; 2]) -> [f64; 2]) -> [f64; 12] {
+    let gauss = element::gauss_legendre(SPLIT_POINTS);
+    let mut xs: Vec<f64> = corners.iter().map(|v| v[0]).chain([c]).collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup();
+    // the y-range of the triangle at x strictly between vertex abscissae
+    let section = |x: f64| {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for [i, j] in EDGE_VERTICES {
+            let (p, q) = (corners[i], corners[j]);
+            if (p[0] - x) * (q[0] - x) < 0.0 {
+                let y = p[1] + (x - p[0]) / (q[0] - p[0]) * (q[1] - p[1]);
+                lo = lo.min(y);
+                hi = hi.max(y);
+            }
+        }
+        (lo, hi)
+    };
+    let mut load = [0.0; 12];
+    for w in xs.windows(2) {
+        let (xl, xr) = (w[0], w[1]);
+        for (s, ws) in gauss.points.iter().zip(&gauss.weights) {
+            let s = s[0];
+            let (x, jac) = if xl == c {
+                (xl + (xr - xl) * s * s, 2.0 * (xr - xl) * s)
+            } else if xr == c {
+                (xr - (xr - xl) * s * s, 2.0 * (xr - xl) * s)
+            } else {
+                (xl + (xr - xl) * s, xr - xl)
+            };
+            let (lo, hi) = section(x);
+            if !(hi > lo) {
+                continue;
+            }
+            for (t, wt) in gauss.points.iter().zip(&gauss.weights) {
+                let y = lo + (hi - lo) * t[0];
+                let r = map.inverse([x, y]);
+                let phi = element::p2_values(r[0], r[1]);
+                let fx = f([x, y]);
+                let weight = ws * jac * wt * (hi - lo);
+                for a in 0..N_NODES {
+                    load[2 * a] += weight * fx[0] * phi[a];
+                    load[2 * a + 1] += weight * fx[1] * phi[a];
+                }
+            }
+        }
+    }
+    load
 }
 
 /// Take the element matrix and load to the local frames of its contact nodes:

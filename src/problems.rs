@@ -66,13 +66,20 @@ pub trait Problem: Send + Sync {
     fn required_vertices(&self) -> Vec<[f64; 2]> {
         Vec::new()
     }
+    /// Vertical lines x = c across which the body force is not smooth (a root singularity of a
+    /// derivative, such as ((x - c)_+)^(1/2)): the load of an element crossing one is integrated
+    /// piecewise (`assembly::split_load`), exact to round-off where a Gauss rule on the whole
+    /// element would converge only algebraically.
+    fn load_breaks(&self) -> Vec<f64> {
+        Vec::new()
+    }
     fn exact(&self) -> Option<&dyn Exact> {
         None
     }
 }
 
 /// The names `by_name` knows.
-pub const KNOWN: [&str; 3] = ["ex71", "ex72", "patch"];
+pub const KNOWN: [&str; 4] = ["ex71", "ex72", "fb", "patch"];
 
 #[derive(Debug, thiserror::Error)]
 #[error("unknown problem '{0}'; known problems: {known}", known = KNOWN.join(", "))]
@@ -82,6 +89,7 @@ pub fn by_name(name: &str) -> Result<Box<dyn Problem>, UnknownProblem> {
     match name {
         "ex71" => Ok(Box::new(Ex71)),
         "ex72" => Ok(Box::new(Ex72)),
+        "fb" => Ok(Box::new(Fb)),
         "patch" => Ok(Box::new(Patch::default())),
         _ => Err(UnknownProblem(name.to_string())),
     }
@@ -95,6 +103,18 @@ fn contact_right_dirichlet_left(x: [f64; 2]) -> Part {
     if x[0] > 1.0 - EPS {
         Part::Contact
     } else if x[0] < EPS {
+        Part::Dirichlet
+    } else {
+        Part::Neumann
+    }
+}
+
+/// The boundary parts of Example 7.1 (and `fb`): contact on the bottom y = 0, Dirichlet on the
+/// top y = 1, Neumann on the sides.
+fn contact_bottom_dirichlet_top(x: [f64; 2]) -> Part {
+    if x[1] < EPS {
+        Part::Contact
+    } else if x[1] > 1.0 - EPS {
         Part::Dirichlet
     } else {
         Part::Neumann
@@ -129,13 +149,7 @@ impl Problem for Ex71 {
         Material { mu: 1.0, zeta: 1.0 }
     }
     fn part_of(&self, x: [f64; 2]) -> Part {
-        if x[1] < EPS {
-            Part::Contact
-        } else if x[1] > 1.0 - EPS {
-            Part::Dirichlet
-        } else {
-            Part::Neumann
-        }
+        contact_bottom_dirichlet_top(x)
     }
     /// f = -div sigma(u) = (2 e^y (y^2 + y - 1) - 6 y + 2, 3 y (x - 2)(y + 3) e^y) (PAPER-NOTES.md,
     /// checked against finite differences of the exact stress in tests/problems.rs).
@@ -197,6 +211,122 @@ impl Problem for Ex72 {
     }
     fn required_vertices(&self) -> Vec<[f64; 2]> {
         vec![[1.0, 0.5]]
+    }
+}
+
+/// `fb`: a free boundary with an exact solution (beyond the paper). Example 7.1 is in contact on
+/// all of Gamma_C and Example 7.2 has no exact solution; here the contact zone is [a, 1] with an
+/// irrational free-boundary point a, and the true error is known.
+///
+/// Omega = (0,1)^2, zeta = mu = 1; Gamma_C = (0,1) x {0} with n = (0,-1), Gamma_D the top,
+/// Gamma_N the sides (as in Example 7.1). With a = sqrt(2) - 1, r(x) = 0.05 sin(2 pi x) and
+/// p(x) = -((x - a)_+)^(5/2):
+///
+/// ```text
+/// u(x, y) = ( -y r'(x), y p(x) / (zeta + 2 mu) + r(x) ),
+/// f = -div sigma(u),  g = sigma(u) n on Gamma_N,  u = u on Gamma_D,
+/// chi(x) = -r(x) + ((a - x)_+)^(3/2)                     (constraint u.n <= chi on Gamma_C).
+/// ```
+///
+/// With zeta = mu = 1 (zeta + 2 mu = 3):
+/// sigma_11 = p/3 - 3 y r'',  sigma_12 = y p'/3,  sigma_22 = p - y r'', so on y = 0 the tangential
+/// stress vanishes and sigma_nn = sigma_22 = p <= 0, nonzero exactly on (a, 1]; the gap
+/// chi - u.n = ((a - x)_+)^(3/2) vanishes exactly on [a, 1]. Hence u.n <= chi, sigma_nn <= 0,
+/// sigma_nn (u.n - chi) = 0 and sigma_t = 0: the Signorini conditions (eq. 1.5-1.8) hold and u is
+/// the solution, in contact exactly on [a, 1]. f = (3 y r''' - 2 p'/3, r'' - y p''/3) is bounded
+/// (p'' = -(15/4) ((x - a)_+)^(1/2)) but not smooth across x = a; u has the usual Signorini
+/// regularity there (u_2 ~ (x - a)^(5/2) y), so uniform P2 refinement stays below h^3. Since a is
+/// irrational, no mesh vertex (structured or bisected: dyadic coordinates) ever lands on x = a.
+pub struct Fb;
+
+impl Fb {
+    /// The free-boundary point a = sqrt(2) - 1: contact on [a, 1].
+    pub const A: f64 = std::f64::consts::SQRT_2 - 1.0;
+    const R_AMPLITUDE: f64 = 0.05;
+
+    /// [r, r', r'', r'''] at x, r(x) = 0.05 sin(2 pi x).
+    pub fn r(x: f64) -> [f64; 4] {
+        let k = 2.0 * std::f64::consts::PI;
+        let (s, c) = (k * x).sin_cos();
+        let a = Self::R_AMPLITUDE;
+        [a * s, a * k * c, -a * k * k * s, -a * k * k * k * c]
+    }
+
+    /// [p, p', p''] at x, p(x) = -((x - a)_+)^(5/2): the normal contact stress sigma_nn on Gamma_C.
+    pub fn p(x: f64) -> [f64; 3] {
+        let s = (x - Self::A).max(0.0);
+        let q = s.sqrt();
+        [-s * s * q, -2.5 * s * q, -3.75 * q]
+    }
+
+    fn lame(&self) -> f64 {
+        let m = self.material();
+        m.zeta + 2.0 * m.mu
+    }
+}
+
+impl Exact for Fb {
+    fn u(&self, x: [f64; 2]) -> [f64; 2] {
+        let (r, p, y) = (Self::r(x[0]), Self::p(x[0]), x[1]);
+        [-y * r[1], y * p[0] / self.lame() + r[0]]
+    }
+    fn grad(&self, x: [f64; 2]) -> [[f64; 2]; 2] {
+        let (r, p, y) = (Self::r(x[0]), Self::p(x[0]), x[1]);
+        let l = self.lame();
+        [[-y * r[2], -r[1]], [y * p[1] / l + r[1], p[0] / l]]
+    }
+}
+
+impl Problem for Fb {
+    fn name(&self) -> &'static str {
+        "fb"
+    }
+    fn description(&self) -> &'static str {
+        "Free boundary with an exact solution: contact on [a, 1] of the bottom edge, a = sqrt(2) - 1 (beyond the paper)"
+    }
+    fn material(&self) -> Material {
+        Material { mu: 1.0, zeta: 1.0 }
+    }
+    fn part_of(&self, x: [f64; 2]) -> Part {
+        contact_bottom_dirichlet_top(x)
+    }
+    /// f = -div sigma(u) from the exact second derivatives of u (no finite differences), with
+    /// div sigma = mu Laplace u + (mu + zeta) grad div u; for zeta = mu = 1 this is
+    /// f = (3 y r''' - 2 p'/3, r'' - y p''/3). Checked against finite differences of the exact
+    /// stress in tests/fb.rs.
+    fn body_force(&self, x: [f64; 2]) -> [f64; 2] {
+        let (r, p, y) = (Self::r(x[0]), Self::p(x[0]), x[1]);
+        let Material { mu, zeta } = self.material();
+        let l = zeta + 2.0 * mu;
+        // second derivatives of u: u1_xx = -y r''', u1_xy = -r'', u1_yy = 0,
+        // u2_xx = y p''/L + r'', u2_xy = p'/L, u2_yy = 0
+        let (u1xx, u1xy, u1yy) = (-y * r[3], -r[2], 0.0);
+        let (u2xx, u2xy, u2yy) = (y * p[2] / l + r[2], p[1] / l, 0.0);
+        // div sigma = mu Laplace u + (mu + zeta) grad div u
+        let div1 = mu * (u1xx + u1yy) + (mu + zeta) * (u1xx + u2xy);
+        let div2 = mu * (u2xx + u2yy) + (mu + zeta) * (u1xy + u2yy);
+        [-div1, -div2]
+    }
+    /// g = sigma(u) n from the exact stress.
+    fn traction(&self, x: [f64; 2], n: [f64; 2]) -> [f64; 2] {
+        self.material().traction(self.grad(x), n)
+    }
+    fn dirichlet(&self, x: [f64; 2]) -> [f64; 2] {
+        self.u(x)
+    }
+    fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, -1.0]
+    }
+    /// f has ((x - a)_+)^(1/2) and ^(3/2) terms.
+    fn load_breaks(&self) -> Vec<f64> {
+        vec![Self::A]
+    }
+    /// chi(x) = -r(x) + ((a - x)_+)^(3/2).
+    fn gap(&self, x: [f64; 2]) -> f64 {
+        -Self::r(x[0])[0] + (Self::A - x[0]).max(0.0).powf(1.5)
+    }
+    fn exact(&self) -> Option<&dyn Exact> {
+        Some(self)
     }
 }
 

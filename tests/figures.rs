@@ -224,6 +224,10 @@ fn full_results(results: &Path) {
             Run { missing: always, ..run("ex72_uniform", "ex72", Uniform) },
         ],
     );
+    let fb = |id, refine| Run { missing: never, ..run(id, "fb", refine) };
+    write_study(results, "fb", &[fb("adaptive", Adaptive), without(fb("adaptive_wfc", Adaptive)), fb("uniform", Uniform)]);
+    let snapshot = MeshSnapshot { study: "fb".into(), run: "adaptive_wfc".into(), level: 12, kinks: vec![], ..mesh_snapshot() };
+    write_json(&StudyDir::new(results, "fb").mesh_file("adaptive_wfc", 12, "json"), &snapshot).unwrap();
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -260,7 +264,7 @@ fn every_figure_is_written_from_records() {
         std::fs::read_dir(&figures).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().starts_with('.')).collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 
-    for name in FIGURES.iter().filter(|n| **n != "fig3b") {
+    for name in FIGURES.iter().filter(|n| !["fig3b", "fb_mesh"].contains(*n)) {
         let svg = read(&figures.join(format!("{name}.svg")));
         assert!(svg.contains("NDF (2 × P2 nodes"), "{name}: no NDF axis label");
         assert!(svg.contains("10³") || svg.contains("10⁴"), "{name}: no decade tick labels");
@@ -289,6 +293,12 @@ fn every_figure_is_written_from_records() {
     assert!(log.contains("= 1 + |log h") && log.contains("|\n") && !log.contains("squared"));
     let contact = read(&figures.join("contact_term_ablation.svg"));
     assert!(contact.contains("Example 7.1") && contact.contains("Example 7.2") && contact.contains("without full-contact nodes"));
+    let fb = read(&figures.join("fb_error.svg"));
+    for text in ["Free boundary", "error, adaptive_wfc", "estimate, uniform", "exact contact zone [a, 1]", "−3/2"] {
+        assert!(fb.contains(text), "fb_error lacks {text:?}");
+    }
+    let fb_mesh = read(&figures.join("fb_mesh.svg"));
+    assert!(fb_mesh.contains("adaptive_wfc mesh at level 12") && fb_mesh.contains("free boundary x = a"), "fb_mesh");
     let theta = read(&figures.join("theta_ablation.svg"));
     assert!(theta.contains("θ = 0.3") && theta.contains("uniform") && theta.contains("(errors not available)"));
 }

@@ -25,6 +25,7 @@
 //! | `log_ablation` | `log_ablation`, a panel per problem | efficiency per level (vs NDF) for each `estimator.log_factor`; line at 1 |
 //! | `contact_term_ablation` | `contact_term_ablation`, a panel per problem | `estimate` (solid) and `eta5` (dashed) vs NDF for each `estimator.contact_term` |
 //! | `theta_ablation` | `theta_ablation`, a panel per problem | `err_quadrature` vs NDF for each theta and uniform, with NDF^-3/2; where some run of a problem has fewer than two errors, the estimate for all runs of that problem instead (the y label says which) |
+//! | `fb_error`, `fb_mesh` | `fb` | see [`fb`]: error and estimate vs NDF of the free-boundary problem, and its late adaptive mesh with x = a marked |
 //!
 //! Style: log axes labelled at the decades (`10⁻⁴`; also 2x and 5x when less than two decades
 //! show), light grid lines at 2..9 x each decade; one colour and marker shape per series; the
@@ -44,6 +45,7 @@
 //! render the PNGs; the SVGs ask the viewer for that CSS font list.
 
 mod axis;
+mod fb;
 mod render;
 mod rich;
 
@@ -57,8 +59,9 @@ use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// Every figure, in the order drawn.
-pub const FIGURES: [&str; 10] =
-    ["fig2a", "fig2b", "fig3a", "fig3b", "fig4a", "fig4b", "c0_sweep", "log_ablation", "contact_term_ablation", "theta_ablation"];
+pub const FIGURES: [&str; 12] = [
+    "fig2a", "fig2b", "fig3a", "fig3b", "fig4a", "fig4b", "c0_sweep", "log_ablation", "contact_term_ablation", "theta_ablation", "fb_error", "fb_mesh",
+];
 
 /// C0 of Section 7.
 const C0_PAPER: f64 = 0.45;
@@ -168,6 +171,8 @@ fn build(name: &str, results: &Path) -> anyhow::Result<Built> {
         "log_ablation" => log_ablation(results),
         "contact_term_ablation" => contact_term_ablation(results),
         "theta_ablation" => theta_ablation(results),
+        "fb_error" => fb::fb_error(results),
+        "fb_mesh" => fb::fb_mesh(results),
         other => anyhow::bail!("unknown figure {other}"),
     }
 }
@@ -417,6 +422,7 @@ fn mesh_figure(s: &MeshSnapshot, note: &str) -> MeshFigure {
         active: s.contact_nodes.iter().filter(|c| c.1).map(|c| p(c.0)).collect(),
         inactive: s.contact_nodes.iter().filter(|c| !c.1).map(|c| p(c.0)).collect(),
         kinks: s.kinks.iter().map(|&k| p(k)).collect(),
+        vlines: Vec::new(),
         bbox,
         n_triangles: s.triangles.len(),
         n_vertices: s.vertices.len(),

@@ -182,6 +182,8 @@ pub(crate) struct MeshFigure {
     pub active: Vec<(f64, f64)>,
     pub inactive: Vec<(f64, f64)>,
     pub kinks: Vec<(f64, f64)>,
+    /// Vertical lines x = c across the mesh, dashed, with their legend text (a free boundary).
+    pub vlines: Vec<(f64, String)>,
     /// Bounding box of the vertices.
     pub bbox: [f64; 4],
     pub n_triangles: usize,
@@ -740,6 +742,10 @@ fn render_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, mesh: &MeshFig
     for p in &m.kinks {
         draw_marker(root, chart.backend_coord(p), kink, 7)?;
     }
+    let vline = PALETTE[3].stroke_width(2);
+    for (x, _) in &m.vlines {
+        chart.draw_series(DashedLineSeries::new(vec![(*x, y0), (*x, y1)], 8, 5, vline)).drawn()?;
+    }
 
     // legend beside the square
     let fmt = |v: f64| {
@@ -763,6 +769,13 @@ fn render_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, mesh: &MeshFig
         let cy = y + row * k as i32 + row / 2;
         if let Some((st, r)) = marker {
             draw_marker(root, (x + 12, cy), *st, *r)?;
+        }
+        rich::draw(root, text, FS_LEGEND, &BLACK, (HPos::Left, VPos::Center), (x + 30, cy), false, metrics)?;
+    }
+    for (k, (_, text)) in m.vlines.iter().enumerate() {
+        let cy = y + row * (entries.len() + k) as i32 + row / 2;
+        for (s0, s1) in [(x + 2, x + 9), (x + 14, x + 22)] {
+            root.draw(&PathElement::new(vec![(s0, cy), (s1, cy)], vline)).drawn()?;
         }
         rich::draw(root, text, FS_LEGEND, &BLACK, (HPos::Left, VPos::Center), (x + 30, cy), false, metrics)?;
     }

@@ -18,3 +18,25 @@ pub fn solve_on(problem: &dyn Problem, mesh: &Mesh) -> DiscreteSolution {
 pub fn rate(e1: f64, e2: f64, h1: f64, h2: f64) -> f64 {
     (e1 / e2).ln() / (h1 / h2).ln()
 }
+
+/// The discrete KKT conditions of the solution on `spec`, to round-off: no penetration,
+/// lambda_p >= 0, lambda_p = 0 off the active set, complementarity, the equations at free nodes,
+/// active nodes on the obstacle.
+pub fn assert_kkt(problem: &dyn Problem, spec: &str) {
+    let m = mesh(problem, spec);
+    let sol = solve_on(problem, &m);
+    let k = sol.kkt();
+    let name = format!("{} on {spec}", problem.name());
+    // displacement scale 0.1-1: round-off level
+    assert!(k.max_penetration <= 1e-12, "{name}: penetration {:e}", k.max_penetration);
+    assert!(k.min_lambda >= -1e-10 * k.force_scale, "{name}: min lambda {:e} (scale {:e})", k.min_lambda, k.force_scale);
+    assert!(k.max_inactive_lambda <= 1e-10 * k.force_scale, "{name}: lambda off the active set {:e}", k.max_inactive_lambda);
+    assert!(k.max_complementarity <= 1e-10 * k.force_scale, "{name}: complementarity {:e}", k.max_complementarity);
+    assert!(sol.free_residual < 1e-10, "{name}: equations at free nodes {:e}", sol.free_residual);
+    // active nodes are exactly in contact
+    for (i, c) in sol.dofs.contact.iter().enumerate() {
+        if sol.active[i] {
+            assert!((sol.normal_displacement(i) - c.gap).abs() < 1e-12, "{name}: active node not on the obstacle");
+        }
+    }
+}

@@ -1,0 +1,63 @@
+//! Figures of the `fb` study (the free-boundary problem with an exact solution, beyond the paper),
+//! from its records only.
+//!
+//! | figure | study / runs | shows |
+//! |---|---|---|
+//! | `fb_error` | `fb`, all runs | like Fig. 2(a): `err_quadrature` (solid, filled circles) and `estimate` (dashed, hollow squares) vs NDF, one colour per run, log-log; NDF^-3/2 below the first run's error; the legend gives each run's last contact zone [`zone_min`, `zone_max`] against [a, 1] |
+//! | `fb_mesh` | `fb`, the largest saved level of `adaptive_wfc` (else of `adaptive`) | the mesh as in Fig. 3(b) (same drawing), with the free boundary x = a dashed |
+
+use super::{Built, ERR, ESTIMATE, Figure, Marker, NDF_DESC, PALETTE, Panel, Slope, SlopeAnchor, Style, mesh_figure, runs, saved_levels, series, single, slope};
+use crate::problems::Fb;
+use crate::records::StudyDir;
+use anyhow::Context;
+use std::path::Path;
+
+const STUDY: &str = "fb";
+
+pub(super) fn fb_error(results: &Path) -> anyhow::Result<Built> {
+    let runs = match runs(results, STUDY)? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let mut p = Panel::new(
+        "Free boundary (fb, exact solution): error and estimate vs NDF",
+        NDF_DESC,
+        format!("error {ERR} (solid) and {ESTIMATE} (dashed)"),
+    );
+    for (k, r) in runs.iter().enumerate() {
+        let color = PALETTE[k % PALETTE.len()];
+        let id = &r.run.id;
+        if r.levels.iter().any(|l| l.err_quadrature.is_some()) {
+            p.series.push(series(r, format!("error, {id}"), Style { color, marker: Marker::Circle, dashed: false, filled: true }, |l| l.err_quadrature));
+        }
+        p.series.push(series(r, format!("estimate, {id}"), Style { color, marker: Marker::Square, dashed: true, filled: false }, |l| Some(l.estimate)));
+    }
+    for r in &runs {
+        if let Some(l) = r.levels.last() {
+            let zone = match (l.zone_min, l.zone_max) {
+                (Some(a), Some(b)) => format!("[{a:.5}, {b}]"),
+                _ => "empty".to_string(),
+            };
+            p.notes.push(format!("{}: contact zone {zone} at NDF {}", r.run.id, l.ndof));
+        }
+    }
+    p.notes.push(format!("exact contact zone [a, 1], a = √2 − 1 = {:.5}", Fb::A));
+    p.slopes.push(Slope { anchor: SlopeAnchor::Below(0), ..slope() });
+    if !p.has_data() {
+        return Ok(Err(format!("study {STUDY} has no levels")));
+    }
+    Ok(Ok(single(p)))
+}
+
+pub(super) fn fb_mesh(results: &Path) -> anyhow::Result<Built> {
+    let dir = StudyDir::new(results, STUDY);
+    let found = ["adaptive_wfc", "adaptive"].into_iter().find_map(|run| saved_levels(&dir, run).into_iter().max().map(|l| (run, l)));
+    let Some((run, level)) = found else {
+        return Ok(Err(format!("no mesh snapshot of runs adaptive_wfc or adaptive in {}", dir.root.join("meshes").display())));
+    };
+    let snap = dir.read_mesh(run, level).with_context(|| format!("reading the mesh snapshot of {run} level {level}"))?;
+    let mut fig = mesh_figure(&snap, "");
+    fig.title = format!("Free boundary (fb): {run} mesh at level {level}, NDF = {}", snap.ndof);
+    fig.vlines.push((Fb::A, "free boundary x = a = √2 − 1".to_string()));
+    Ok(Ok(Figure::Mesh(fig)))
+}
