@@ -54,7 +54,7 @@ impl Default for AdaptConfig {
 /// Everything a study stores about one level: the one record type behind JSON, CSV, drift and
 /// plots. Flat, so that it is also one CSV row. Fields starting with `t_` are timings (seconds),
 /// never compared by the drift check.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LevelRecord {
     pub level: usize,
     /// 2 x number of P2 nodes, Dirichlet nodes included (CONTRACT.md).

@@ -353,3 +353,103 @@ mod tests {
         assert!((slow[29] as f64 / slow[w[0]] as f64) >= 10.0 && (slow[29] as f64 / slow[w[1]] as f64) < 10.0, "{w:?}");
     }
 }
+
+/// Refinement locations, tested as what they are: a claimed location is a refinement centre when
+/// the local mesh size h has a local minimum (or a plateau of its own) there.
+pub mod refinement {
+    use crate::records::MeshSnapshot;
+
+    /// One mesh edge on a boundary segment: parameter range [s0, s1] along the segment and length.
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct SegmentEdge {
+        pub s0: f64,
+        pub s1: f64,
+        pub h: f64,
+    }
+
+    /// The edges of the triangulation lying on the segment from `a` to `b` (both end points on
+    /// it), sorted along it; s in [0, 1].
+    pub fn profile(m: &MeshSnapshot, a: [f64; 2], b: [f64; 2]) -> Vec<SegmentEdge> {
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let len2 = d[0] * d[0] + d[1] * d[1];
+        let len = len2.sqrt();
+        let on = |p: [f64; 2]| -> Option<f64> {
+            let q = [p[0] - a[0], p[1] - a[1]];
+            let s = (q[0] * d[0] + q[1] * d[1]) / len2;
+            let off = (q[0] * d[1] - q[1] * d[0]).abs() / len;
+            (off <= 1e-12 * len && (-1e-12..=1.0 + 1e-12).contains(&s)).then_some(s)
+        };
+        let mut seen = std::collections::BTreeSet::new();
+        let mut out = Vec::new();
+        for t in &m.triangles {
+            for i in 0..3 {
+                let (u, v) = (t[i], t[(i + 1) % 3]);
+                if !seen.insert((u.min(v), u.max(v))) {
+                    continue;
+                }
+                if let (Some(s0), Some(s1)) = (on(m.vertices[u]), on(m.vertices[v])) {
+                    let (s0, s1) = (s0.min(s1), s0.max(s1));
+                    out.push(SegmentEdge { s0, s1, h: (s1 - s0) * len });
+                }
+            }
+        }
+        out.sort_by(|x, y| x.s0.total_cmp(&y.s0));
+        out
+    }
+
+    /// The mesh size at a point and on either side of it.
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct LocalMinimum {
+        /// Smallest edge among the edge containing the point and its two neighbours.
+        pub h_at: f64,
+        /// Smallest and largest edge on each side within `reach` (None: no edge there).
+        pub left: Option<(f64, f64)>,
+        pub right: Option<(f64, f64)>,
+        pub holds: bool,
+    }
+
+    impl LocalMinimum {
+        pub fn text(&self) -> String {
+            let side = |s: Option<(f64, f64)>| s.map(|(lo, hi)| format!("{lo:.1e}..{hi:.1e}")).unwrap_or("none".into());
+            format!("h {:.1e} there, {} before, {} after", self.h_at, side(self.left), side(self.right))
+        }
+    }
+
+    /// Is the point at parameter `s` a local minimum (or its own plateau) of h along the profile?
+    /// Near = the edge containing s and one edge either side; each side = the further edges within
+    /// `reach` (in parameter units). It holds when no edge on either side is smaller than near,
+    /// and h grows somewhere on each side that has edges (at least one side must have edges).
+    pub fn local_minimum(profile: &[SegmentEdge], s: f64, reach: f64) -> Option<LocalMinimum> {
+        let k = profile.iter().position(|e| e.s0 <= s && s <= e.s1)?;
+        let near = k.saturating_sub(1)..(k + 2).min(profile.len());
+        let h_at = profile[near.clone()].iter().map(|e| e.h).fold(f64::INFINITY, f64::min);
+        let range = |es: &[SegmentEdge]| -> Option<(f64, f64)> {
+            (!es.is_empty()).then(|| (es.iter().map(|e| e.h).fold(f64::INFINITY, f64::min), es.iter().map(|e| e.h).fold(0.0, f64::max)))
+        };
+        let left: Vec<SegmentEdge> = profile[..near.start].iter().filter(|e| e.s0 >= s - reach).copied().collect();
+        let right: Vec<SegmentEdge> = profile[near.end..].iter().filter(|e| e.s1 <= s + reach).copied().collect();
+        let (left, right) = (range(&left), range(&right));
+        let side_ok = |r: Option<(f64, f64)>| r.is_none_or(|(lo, hi)| lo >= h_at && hi > h_at);
+        let holds = (left.is_some() || right.is_some()) && side_ok(left) && side_ok(right);
+        Some(LocalMinimum { h_at, left, right, holds })
+    }
+
+    /// Smallest element diameter among triangles with centroid within `r` of `p`, and among those
+    /// with centroid between `r` and `reach`: a corner is a refinement centre when the first is
+    /// smaller than the second.
+    pub fn corner(m: &MeshSnapshot, p: [f64; 2], r: f64, reach: f64) -> (f64, f64) {
+        let (mut inner, mut ring) = (f64::INFINITY, f64::INFINITY);
+        for t in &m.triangles {
+            let v = t.map(|i| m.vertices[i]);
+            let c = [(v[0][0] + v[1][0] + v[2][0]) / 3.0, (v[0][1] + v[1][1] + v[2][1]) / 3.0];
+            let d = (0..3).map(|i| crate::mesh::dist(v[i], v[(i + 1) % 3])).fold(0.0, f64::max);
+            let dc = crate::mesh::dist(c, p);
+            if dc <= r {
+                inner = inner.min(d);
+            } else if dc <= reach {
+                ring = ring.min(d);
+            }
+        }
+        (inner, ring)
+    }
+}
