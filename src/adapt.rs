@@ -88,6 +88,19 @@ pub struct LevelRecord {
     pub err_nodal: Option<f64>,
     /// estimate / err_quadrature
     pub efficiency: Option<f64>,
+    /// ||u - u_h||_Linf on Gamma_C (`norms::linf_error_contact`: equally spaced points of every
+    /// contact edge), where u is known.
+    #[serde(default)]
+    pub err_contact: Option<f64>,
+    /// ||u - u_h||_Linf over the lattice points with x >= 1/2 (Example 7.2: away from the
+    /// corners of the clamped side x = 0), where u is known.
+    #[serde(default)]
+    pub err_right_half: Option<f64>,
+    /// Length of the longest contact edge whose three nodes are neither all active nor all
+    /// inactive: the edge straddling a free-boundary point, where eta_6 and eta_7 live. None
+    /// without such an edge.
+    #[serde(default)]
+    pub h_free_boundary: Option<f64>,
     /// Elements marked for refinement at this level (also at the last level, not refined).
     pub marked: usize,
     pub t_assembly: f64,
@@ -111,6 +124,19 @@ pub struct Level<'a> {
 pub fn mark_maximum(indicators: &[f64], theta: f64) -> Vec<bool> {
     let max = indicators.iter().cloned().fold(0.0, f64::max);
     indicators.iter().map(|&e| max > 0.0 && e >= theta * max).collect()
+}
+
+/// The longest contact edge with both active and inactive nodes (`LevelRecord::h_free_boundary`).
+pub fn free_boundary_edge(mesh: &Mesh, sol: &DiscreteSolution) -> Option<f64> {
+    mesh.boundary
+        .iter()
+        .zip(&sol.nodes.boundary_nodes)
+        .filter(|(e, _)| e.part == crate::mesh::Part::Contact)
+        .filter_map(|(e, nodes)| {
+            let active: Vec<bool> = nodes.iter().map(|&n| sol.dofs.contact_index[n].is_some_and(|k| sol.active[k])).collect();
+            (active.contains(&true) && active.contains(&false)).then(|| crate::mesh::dist(mesh.vertices[e.v[0]], mesh.vertices[e.v[1]]))
+        })
+        .reduce(f64::max)
 }
 
 /// Active set for the refined mesh: a new contact node starts active where the previous level's
@@ -201,6 +227,9 @@ pub fn run(
             err_dense: error.map(|e| e.linf_dense),
             err_nodal: error.map(|e| e.linf_nodal),
             efficiency: error.map(|e| t.estimate / e.linf_quadrature),
+            err_contact: reference.and_then(|r| norms::linf_error_contact(&mesh, &sol, r)),
+            err_right_half: reference.and_then(|r| norms::linf_error_where(&mesh, &sol, r, norms::Sampling::Dense, &|x| x[0] >= 0.5)),
+            h_free_boundary: free_boundary_edge(&mesh, &sol),
             marked,
             t_assembly: sol.timings.assembly,
             t_factorisation: ct.symbolic + ct.numeric + ct.schur,

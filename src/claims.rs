@@ -420,6 +420,72 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         },
     });
 
+    // the error away from the corners: on Gamma_C and on x >= 1/2
+    let away: Vec<(&str, Option<RateReport>)> = vec![
+        ("adaptive, on Gamma_C", ctx.rate(a72, Q::Field("err_contact"))),
+        ("adaptive, on x >= 1/2", ctx.rate(a72, Q::Field("err_right_half"))),
+        ("uniform, on Gamma_C", ctx.rate(u72, Q::Field("err_contact"))),
+        ("uniform, on x >= 1/2", ctx.rate(u72, Q::Field("err_right_half"))),
+    ];
+    let have = away.iter().any(|a| a.1.is_some());
+    out.push(Claim {
+        id: "7.2-error-away-from-corners (beyond the paper)",
+        claim: "Ex. 7.2: the error where the contact discretisation acts, away from the corners of x = 0: ||u - u_h||_Linf on Gamma_C (13 equally spaced points per contact edge) and on x >= 1/2 (lattice points), against the reference solution; judged against NDF^(-3/2) on Gamma_C under adaptive refinement".into(),
+        measured: if have {
+            format!(
+                "{}. The reference's own error (row 7.2-error) bounds what can be seen",
+                away.iter().map(|(n, r)| rate_text(n, r.as_ref(), if n.starts_with("adaptive") { Some(OPTIMAL) } else { None })).collect::<Vec<_>>().join("; ")
+            )
+        } else {
+            "no data (records without err_contact / err_right_half: rerun ex72)".into()
+        },
+        verdict: if have { judge(away[0].1.as_ref(), OPTIMAL) } else { Verdict::NoData },
+    });
+
+    // eta_6, eta_7 against the length of the contact edge straddling the free boundary
+    let fb_edge = a72.and_then(|r| {
+        // one point per plateau of h_free_boundary (its last level), where eta_6, eta_7 are above round-off
+        let mut plateaus: Vec<(f64, usize, usize)> = Vec::new();
+        for (i, l) in r.levels.iter().enumerate() {
+            let Some(h) = l.h_free_boundary else { continue };
+            match plateaus.last_mut() {
+                Some(p) if p.0 == h => p.2 = i,
+                _ => plateaus.push((h, i, i)),
+            }
+        }
+        let fit = |f: fn(&crate::adapt::LevelRecord) -> f64| {
+            let pts: Vec<(f64, f64)> = plateaus.iter().map(|p| (p.0, f(&r.levels[p.2]))).filter(|p| p.1 > 1e-14).map(|p| (p.0.ln(), p.1.ln())).collect();
+            verdict::fit_line(&pts)
+        };
+        // largest change of eta_6 + eta_7 within a plateau of at least two levels
+        let within = plateaus
+            .iter()
+            .filter(|p| p.2 > p.1)
+            .map(|p| {
+                let v: Vec<f64> = (p.1..=p.2).map(|i| r.levels[i].eta6 + r.levels[i].eta7).collect();
+                v.iter().cloned().fold(0.0, f64::max) / v.iter().cloned().fold(f64::INFINITY, f64::min)
+            })
+            .fold(1.0, f64::max);
+        Some((fit(|l| l.eta6), fit(|l| l.eta7), plateaus, within))
+    });
+    out.push(Claim {
+        id: "7.2-eta6-eta7 (beyond the paper)",
+        claim: "Ex. 7.2: eta_6 and eta_7 live on the contact edge straddling each free-boundary point (nodes neither all active nor all inactive; its length h_fb): slope of log eta against log h_fb, one point per plateau of h_fb".into(),
+        measured: match &fb_edge {
+            Some((e6, e7, plateaus, within)) if !plateaus.is_empty() => format!(
+                "h_fb over the levels: {}; eta6 ~ h_fb^({}); eta7 ~ h_fb^({}); while h_fb stays constant eta6 + eta7 change by at most a factor {within:.2}: they plateau with it, and stagnate in NDF",
+                plateaus.iter().map(|p| format!("{:.1e} (levels {}–{})", p.0, p.1, p.2)).collect::<Vec<_>>().join(", "),
+                e6.map(|f| format!("{:.2} ± {:.2}", f.slope, f.half_width)).unwrap_or("n/a".into()),
+                e7.map(|f| format!("{:.2} ± {:.2}", f.slope, f.half_width)).unwrap_or("n/a".into()),
+            ),
+            _ => "no data (records without h_free_boundary: rerun ex72)".into(),
+        },
+        verdict: match &fb_edge {
+            Some((_, _, p, _)) if !p.is_empty() => Verdict::NoClaim,
+            _ => Verdict::NoData,
+        },
+    });
+
     // where the adaptive mesh refines: local minima of h along Gamma_C = {1} x (0, 1), corners
     let mut parts = Vec::new();
     let mut ok = true;

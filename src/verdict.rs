@@ -33,6 +33,8 @@ pub const MIN_DECADES: f64 = 1.0;
 pub const MIN_POINTS: usize = 5;
 /// |slope| below this counts as bounded whatever the interval.
 pub const FLAT_SLOPE: f64 = 0.05;
+/// Relative size below which a value is round-off (see [`rate_over`]).
+pub const ROUND_OFF: f64 = 1e-12;
 /// Levels between the ends of the three stability windows.
 pub const WINDOW_SHIFT: usize = 2;
 
@@ -203,8 +205,11 @@ pub fn window(ndof: &[usize], end: usize) -> Vec<usize> {
 
 /// Rate of `values` (one per level; None or non-positive values end the window) against `ndof`
 /// over the window ending at `end`.
+/// Values at or below `ROUND_OFF` x the largest value of the run count as zero (e.g. eta_6 of
+/// 3e-17 where it is otherwise 1e-5) and end the window like missing ones.
 pub fn rate_over(ndof: &[usize], values: &[Option<f64>], end: usize) -> Option<RateFit> {
-    let levels: Vec<usize> = window(ndof, end).into_iter().rev().take_while(|&l| values[l].is_some_and(|v| v > 0.0)).collect();
+    let floor = ROUND_OFF * values.iter().flatten().cloned().fold(0.0, f64::max);
+    let levels: Vec<usize> = window(ndof, end).into_iter().rev().take_while(|&l| values[l].is_some_and(|v| v > floor)).collect();
     let pts: Vec<(f64, f64)> = levels.iter().map(|&l| ((ndof[l] as f64).ln(), -values[l].unwrap().ln())).collect();
     let rate = fit_line(&pts)?;
     let (first, last) = (*levels.last()?, levels[0]);
