@@ -96,6 +96,15 @@ struct Ctx<'r> {
 }
 
 impl Ctx<'_> {
+    /// The run `id` of `runs`; in the dense pass its `ID_dense` twin (estimator maxima on the
+    /// dense lattice too) where the study has one.
+    fn pick<'a>(&self, runs: &'a [RunRecord], id: &str) -> Option<&'a RunRecord> {
+        match self.sampling {
+            ErrorSampling::Dense => run(runs, &format!("{id}_dense")).or_else(|| run(runs, id)),
+            ErrorSampling::Quadrature => run(runs, id),
+        }
+    }
+
     fn err_field(&self) -> &'static str {
         match self.sampling {
             ErrorSampling::Quadrature => "err_quadrature",
@@ -163,7 +172,7 @@ fn growth_text(name: &str, g: Option<&verdict::RateFit>) -> String {
             "{name}: slope of log against log NDF {} ({}) → {}",
             g.text(),
             g.range(),
-            if verdict::judge_bounded(g) { "bounded" } else if g.rate.slope > 0.0 { "growing" } else { "falling" }
+            verdict::judge_trend(g).text()
         ),
     }
 }
@@ -205,10 +214,10 @@ fn latest_mesh(results: &Path, study: &str, run: &str) -> Option<MeshSnapshot> {
 fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let load = |s: &str| StudyDir::new(ctx.results, s).read_runs();
     let (ex71, ct, la) = (load("ex71")?, load("contact_term_ablation")?, load("log_ablation")?);
-    let a71 = run(&ex71, "adaptive");
+    let a71 = ctx.pick(&ex71, "adaptive");
     let u71 = run(&ex71, "uniform");
     let u71c = run(&ex71, "uniform_cartesian");
-    let wfc = run(&ct, "ex71_without_full_contact");
+    let wfc = ctx.pick(&ct, "ex71_without_full_contact");
 
     let (err, err_wfc, err_u) = (ctx.rate(a71, Q::Error), ctx.rate(wfc, Q::Error), ctx.rate(u71, Q::Error));
     out.push(Claim {
@@ -271,7 +280,8 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         id: "7.1-efficiency",
         claim: format!(
-            "Ex. 7.1: the efficiency index estimate/error stays bounded (Fig. 2b), C_0 = 0.45; bounded = the slope of log(efficiency) against log(NDF) has a 95% interval containing 0, or |slope| < {}",
+            "Ex. 7.1: the efficiency index estimate/error stays bounded (Fig. 2b), C_0 = 0.45; bounded = the slope of log(efficiency) against log(NDF) has a 95% interval containing 0 no wider than {}, or |slope| < {}",
+            verdict::MAX_WIDTH,
             verdict::FLAT_SLOPE
         ),
         measured: format!(
@@ -282,9 +292,10 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             growth_text("efficiency / l_h", ctx.growth(wfc, Q::EfficiencyOverLh).as_ref()),
             growth_text("efficiency", ctx.growth(one, Q::Efficiency).as_ref()),
         ),
-        verdict: match g {
+        verdict: match g.map(|g| verdict::judge_trend(&g)) {
             None => Verdict::NoData,
-            Some(g) if verdict::judge_bounded(&g) => Verdict::Reproduced,
+            Some(verdict::Trend::Bounded) => Verdict::Reproduced,
+            Some(verdict::Trend::Inconclusive) => Verdict::Inconclusive,
             Some(_) => Verdict::NotReproduced,
         },
     });
@@ -334,9 +345,9 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let load = |s: &str| StudyDir::new(ctx.results, s).read_runs();
     let (ex72, ct) = (load("ex72")?, load("contact_term_ablation")?);
-    let a72 = run(&ex72, "adaptive");
+    let a72 = ctx.pick(&ex72, "adaptive");
     let u72 = run(&ex72, "uniform");
-    let wfc = run(&ct, "ex72_without_full_contact");
+    let wfc = ctx.pick(&ct, "ex72_without_full_contact");
     let aw = run(&ct, "ex72_as_written");
 
     let names = ["eta_h", "eta1", "eta2", "eta3", "eta4", "eta5", "eta6", "eta7"];
@@ -595,9 +606,10 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 growth_text("efficiency / l_h", ctx.growth(wfc, Q::EfficiencyOverLh).as_ref())
             )
         },
-        verdict: match g {
+        verdict: match g.map(|g| verdict::judge_trend(&g)) {
             None => Verdict::NoData,
-            Some(g) if verdict::judge_bounded(&g) => Verdict::Holds,
+            Some(verdict::Trend::Bounded) => Verdict::Holds,
+            Some(verdict::Trend::Inconclusive) => Verdict::Inconclusive,
             Some(_) => Verdict::Fails,
         },
     });
@@ -675,11 +687,24 @@ pub fn claims_with(results: &Path, sampling: ErrorSampling) -> std::io::Result<V
 pub fn claims(results: &Path) -> std::io::Result<Vec<Claim>> {
     let mut out = claims_with(results, ErrorSampling::Quadrature)?;
     let dense = claims_with(results, ErrorSampling::Dense)?;
-    let flips: Vec<String> = out.iter().zip(&dense).filter(|(q, d)| q.verdict != d.verdict).map(|(q, d)| format!("{}: {} → {}", q.id, q.verdict.text(), d.verdict.text())).collect();
+    let mut dense_runs = Vec::new();
+    for study in ["ex71", "ex72", "contact_term_ablation"] {
+        for r in StudyDir::new(results, study).read_runs()? {
+            if r.run.id.ends_with("_dense") {
+                dense_runs.push(format!("{study}/{}", r.run.id));
+            }
+        }
+    }
+    let flips: Vec<String> = out.iter().zip(&dense).filter(|(q, d)| q.verdict != d.verdict).map(|(q, d)| format!("{}: {} → {} (dense: {})", q.id, q.verdict.text(), d.verdict.text(), d.measured)).collect();
     out.push(Claim {
         id: "sampling",
-        claim: "Gauss-point maxima underestimate the L-infinity norm: every verdict above recomputed with the error maxima over the order-6 barycentric lattice of every element (err_dense) instead of the quadrature points".into(),
-        measured: if flips.is_empty() { format!("no verdict flips ({} verdicts recomputed). The estimator's own maxima are sampled at the quadrature points in both", out.len()) } else { format!("verdicts that flip: {}", flips.join("; ")) },
+        claim: "Gauss-point maxima underestimate the L-infinity norm: every verdict above recomputed with the error maxima over the order-6 barycentric lattice of every element (err_dense) instead of the quadrature points, and with the runs RUN_dense (estimator maxima on the dense lattice and dense edge points too, `estimator.sampling = \"dense\"`) in place of RUN where a study has them".into(),
+        measured: format!(
+            "{} ({} verdicts recomputed; dense-estimator runs used: {})",
+            if flips.is_empty() { "no verdict flips".to_string() } else { format!("verdicts that flip: {}", flips.join("; ")) },
+            out.len(),
+            if dense_runs.is_empty() { "none".to_string() } else { dense_runs.join(", ") }
+        ),
         verdict: if flips.is_empty() { Verdict::Holds } else { Verdict::Fails },
     });
     Ok(out)
@@ -696,7 +721,7 @@ pub fn markdown(claims: &[Claim]) -> String {
          (newest-vertex bisection refines in two-level staircases) over the last levels spanning at least {} decade of NDF and at least {} levels; \
          \"windows\" are the slopes of the same fit ending 0, {} and {} levels earlier. Verdict for a claimed rate c: the interval below c - {b} is **not reproduced**, \
          above c + {b} **different** (faster); otherwise an interval wider than {w} is inconclusive; an interval containing c or inside c ± {b} is reproduced; anything else inconclusive. \
-         A trend is bounded when the slope of log(quantity) against log(NDF) has an interval containing 0 or |slope| < {f}. \
+         A trend is bounded when the slope of log(quantity) against log(NDF) has an interval containing 0 and no wider than {w}, or |slope| < {f} (an interval containing 0 but wider is inconclusive). \
          Errors and estimators are maxima over the quadrature points of each element (the `sampling` row repeats every verdict with a dense lattice); estimate = C_0 eta_h with C_0 = 0.45.\n\n",
         verdict::MIN_DECADES,
         verdict::MIN_POINTS,

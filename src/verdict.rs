@@ -17,8 +17,9 @@
 //! 3. otherwise the interval contains c or lies within c ± 0.1: *reproduced*;
 //! 4. otherwise (it overlaps c ± 0.1 without containing c or lying inside it): *inconclusive*.
 //!
-//! **Bounded** ([`judge_bounded`]): the slope of log(quantity) against log(NDF) has an interval
-//! containing 0, or |slope| < 0.05 (a 10x growth of NDF changes the quantity by less than 12%).
+//! **Bounded** ([`judge_trend`]): the slope of log(quantity) against log(NDF) has an interval
+//! containing 0 and no wider than 0.3, or |slope| < 0.05 (a 10x growth of NDF changes the
+//! quantity by less than 12%); an interval containing 0 but wider than 0.3 is inconclusive.
 
 use crate::records::RunRecord;
 
@@ -299,9 +300,40 @@ pub fn growth(ndof: &[usize], values: &[Option<f64>]) -> Option<RateFit> {
     Some(f)
 }
 
-/// Bounded: the growth interval contains 0 or |growth| < FLAT_SLOPE.
-pub fn judge_bounded(growth: &RateFit) -> bool {
-    (growth.rate.lo() <= 0.0 && 0.0 <= growth.rate.hi()) || growth.rate.slope.abs() < FLAT_SLOPE
+/// What a trend interval says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Trend {
+    Bounded,
+    Growing,
+    Falling,
+    /// The interval contains 0 but is wider than `MAX_WIDTH`: it cannot tell bounded from growing.
+    Inconclusive,
+}
+
+impl Trend {
+    pub fn text(self) -> &'static str {
+        match self {
+            Trend::Bounded => "bounded",
+            Trend::Growing => "growing",
+            Trend::Falling => "falling",
+            Trend::Inconclusive => "inconclusive (interval wider than 0.3)",
+        }
+    }
+}
+
+/// Bounded: |growth| < FLAT_SLOPE, or the growth interval contains 0 and is at most
+/// `MAX_WIDTH` wide (a wider interval containing 0 is inconclusive).
+pub fn judge_trend(growth: &RateFit) -> Trend {
+    let contains_zero = growth.rate.lo() <= 0.0 && 0.0 <= growth.rate.hi();
+    if growth.rate.slope.abs() < FLAT_SLOPE || (contains_zero && growth.rate.width() <= MAX_WIDTH) {
+        Trend::Bounded
+    } else if contains_zero {
+        Trend::Inconclusive
+    } else if growth.rate.slope > 0.0 {
+        Trend::Growing
+    } else {
+        Trend::Falling
+    }
 }
 
 /// Singular exponent lambda in (1/2, 1) of the displacement u ~ r^lambda at a corner of angle

@@ -92,14 +92,19 @@ fn flat_efficiency_is_bounded_and_rising_is_not() {
     let ndof = ndofs(24);
     let mut rng = Lcg(5);
     let flat = verdict::growth(&ndof, &values(&ndof, 0.0, 0.05, &mut rng)).unwrap();
-    assert!(verdict::judge_bounded(&flat), "{}", flat.text());
+    assert_eq!(verdict::judge_trend(&flat), verdict::Trend::Bounded, "{}", flat.text());
+    // flat but so noisy that the interval is wider than 0.3: no evidence either way
+    let noisy = verdict::growth(&ndof, &values(&ndof, 0.0, 0.6, &mut rng)).unwrap();
+    assert!(noisy.rate.width() > verdict::MAX_WIDTH);
+    assert_eq!(verdict::judge_trend(&noisy), verdict::Trend::Inconclusive, "{}", noisy.text());
     // efficiency growing like l_h = 1 + log(NDF)^2 / 4: the log factor
     let rising: Vec<Option<f64>> = ndof.iter().map(|&n| Some(1e3 * (1.0 + (n as f64).ln().powi(2) / 4.0))).collect();
     let g = verdict::growth(&ndof, &rising).unwrap();
-    assert!(!verdict::judge_bounded(&g), "{}", g.text());
-    assert!(g.rate.slope > 0.0);
+    assert_eq!(verdict::judge_trend(&g), verdict::Trend::Growing, "{}", g.text());
     let powered = verdict::growth(&ndof, &values(&ndof, -0.3, 0.05, &mut rng)).unwrap();
-    assert!(!verdict::judge_bounded(&powered));
+    assert_eq!(verdict::judge_trend(&powered), verdict::Trend::Growing);
+    let falling = verdict::growth(&ndof, &values(&ndof, 0.3, 0.05, &mut rng)).unwrap();
+    assert_eq!(verdict::judge_trend(&falling), verdict::Trend::Falling);
 }
 
 /// A strip (0, 1) x (0, 1) triangulated over the vertices `xs` on both y = 0 and y = 1.
