@@ -420,6 +420,16 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 
     // the corner singularity
     let lambda = verdict::clamped_free_corner_exponent(EX72_NU);
+    // where the largest element indicator sits (records from before it was stored have (0, 0) everywhere)
+    let peaks = a72
+        .filter(|r| r.levels.iter().any(|l| l.max_indicator_x != 0.0 || l.max_indicator_y != 0.0))
+        .map(|r| {
+            let near = |l: &crate::adapt::LevelRecord| [[0.0, 0.0], [0.0, 1.0]].iter().any(|c| crate::mesh::dist(*c, [l.max_indicator_x, l.max_indicator_y]) <= 0.05);
+            let n = r.levels.iter().filter(|l| near(l)).count();
+            let at = |k: usize| r.levels.get(k).map(|l| format!("level {k} at ({:.3}, {:.3})", l.max_indicator_x, l.max_indicator_y)).unwrap_or_default();
+            format!("Adaptive run: the largest element indicator lies within 0.05 of a corner (0, 0) or (0, 1) at {n} of {} levels ({}; {})", r.levels.len(), at(20), at(r.levels.len() - 1))
+        })
+        .unwrap_or_default();
     let eu = ctx.rate(u72, Q::Error);
     out.push(Claim {
         id: "7.2-corners (beyond the paper)",
@@ -429,12 +439,13 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         ),
         measured: match &eu {
             Some(r) => format!(
-                "uniform: {}; measured exponent lambda = 2 x rate = {:.3} ± {:.3}; error reduction per halving of h {:.3} (2^-lambda = {:.3})",
+                "uniform: {}; measured exponent lambda = 2 x rate = {:.3} ± {:.3}; error reduction per halving of h {:.3} (2^-lambda = {:.3}). {}",
                 rate_text("error rate", Some(r), Some(lambda / 2.0)),
                 2.0 * r.main.rate.slope,
                 2.0 * r.main.rate.half_width,
                 0.25f64.powf(r.main.rate.slope),
-                0.5f64.powf(lambda)
+                0.5f64.powf(lambda),
+                peaks
             ),
             None => String::new(),
         },
