@@ -88,6 +88,24 @@ pub struct LevelRecord {
     pub err_nodal: Option<f64>,
     /// estimate / err_quadrature
     pub efficiency: Option<f64>,
+    /// ||u - u_h||_Linf on Gamma_C (`norms::linf_error_contact`: equally spaced points of every
+    /// contact edge), where u is known.
+    #[serde(default)]
+    pub err_contact: Option<f64>,
+    /// ||u - u_h||_Linf over the lattice points with x >= 1/2 (Example 7.2: away from the
+    /// corners of the clamped side x = 0), where u is known.
+    #[serde(default)]
+    pub err_right_half: Option<f64>,
+    /// Length of the longest contact edge whose three nodes are neither all active nor all
+    /// inactive: the edge straddling a free-boundary point, where eta_6 and eta_7 live. None
+    /// without such an edge.
+    #[serde(default)]
+    pub h_free_boundary: Option<f64>,
+    /// Centroid of the element with the largest marking indicator eta_T (the first one on ties).
+    #[serde(default)]
+    pub max_indicator_x: f64,
+    #[serde(default)]
+    pub max_indicator_y: f64,
     /// Elements marked for refinement at this level (also at the last level, not refined).
     pub marked: usize,
     pub t_assembly: f64,
@@ -111,6 +129,26 @@ pub struct Level<'a> {
 pub fn mark_maximum(indicators: &[f64], theta: f64) -> Vec<bool> {
     let max = indicators.iter().cloned().fold(0.0, f64::max);
     indicators.iter().map(|&e| max > 0.0 && e >= theta * max).collect()
+}
+
+/// Centroid of the first element with the largest indicator.
+fn largest_indicator_centroid(mesh: &Mesh, indicators: &[f64]) -> [f64; 2] {
+    let t = indicators.iter().enumerate().fold((0, f64::NEG_INFINITY), |best, (t, &e)| if e > best.1 { (t, e) } else { best }).0;
+    let v = mesh.triangles[t].map(|i| mesh.vertices[i]);
+    [(v[0][0] + v[1][0] + v[2][0]) / 3.0, (v[0][1] + v[1][1] + v[2][1]) / 3.0]
+}
+
+/// The longest contact edge with both active and inactive nodes (`LevelRecord::h_free_boundary`).
+pub fn free_boundary_edge(mesh: &Mesh, sol: &DiscreteSolution) -> Option<f64> {
+    mesh.boundary
+        .iter()
+        .zip(&sol.nodes.boundary_nodes)
+        .filter(|(e, _)| e.part == crate::mesh::Part::Contact)
+        .filter_map(|(e, nodes)| {
+            let active: Vec<bool> = nodes.iter().map(|&n| sol.dofs.contact_index[n].is_some_and(|k| sol.active[k])).collect();
+            (active.contains(&true) && active.contains(&false)).then(|| crate::mesh::dist(mesh.vertices[e.v[0]], mesh.vertices[e.v[1]]))
+        })
+        .reduce(f64::max)
 }
 
 /// Active set for the refined mesh: a new contact node starts active where the previous level's
@@ -168,6 +206,7 @@ pub fn run(
         // counted on the last level too, so a shorter run is an exact prefix of a longer one
         let marked = marks.iter().filter(|m| **m).count();
         let (h_min, h_max) = mesh.h_range();
+        let peak = largest_indicator_centroid(&mesh, &est.element);
         let zone = sol.contact_zone();
         let t = &est.terms;
         let ct = &sol.timings.contact;
@@ -201,6 +240,11 @@ pub fn run(
             err_dense: error.map(|e| e.linf_dense),
             err_nodal: error.map(|e| e.linf_nodal),
             efficiency: error.map(|e| t.estimate / e.linf_quadrature),
+            err_contact: reference.and_then(|r| norms::linf_error_contact(&mesh, &sol, r)),
+            err_right_half: reference.and_then(|r| norms::linf_error_where(&mesh, &sol, r, norms::Sampling::Dense, &|x| x[0] >= 0.5)),
+            h_free_boundary: free_boundary_edge(&mesh, &sol),
+            max_indicator_x: peak[0],
+            max_indicator_y: peak[1],
             marked,
             t_assembly: sol.timings.assembly,
             t_factorisation: ct.symbolic + ct.numeric + ct.schur,

@@ -10,6 +10,7 @@
 //! eta_{3,p} = h_p   ||g - sigma(u_h) n||_Linf(Gamma_{p,N})         (Neumann residual), p on Gamma_N
 //! eta_{4,p} = h_p   ||t . sigma(u_h) n||_Linf(Gamma_{p,C})         (tangential contact stress), p on Gamma_C
 //! eta_{5,p} = h_p   ||n . sigma(u_h) n||_Linf(Gamma_{p,C})         (normal contact stress), p on Gamma_C
+//!   (with `StressFrame::Cartesian`: the second and first Cartesian components of sigma(u_h) n)
 //! eta_i = max_p eta_{i,p},
 //! eta_6 = ||(u_h.n - chi)^+||_Linf(Gamma_C),   eta_7 = ||(chi - u_h.n)^+||_Linf(Lambda_h^C),
 //! eta_h = l_h (eta_1 + ... + eta_5) + eta_6 + eta_7,   l_h = 1 + |log h_min|^2,
@@ -71,6 +72,21 @@ impl LogFactor {
     }
 }
 
+/// How the paper's sigma-hat_1, sigma-hat_2 (the components of sigma(u_h) n in eta_5 and eta_4)
+/// are read. The paper defines sigma-hat_1 as the first component of sigma n "in a frame where
+/// e_1 is the normal"; read literally as the first Cartesian component it is -sigma_12 on the
+/// bottom edge of Example 7.1 (n = (0, -1)) and the normal stress sigma_11 on Example 7.2's
+/// right edge (n = (1, 0)).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StressFrame {
+    /// sigma-hat_1 = n . sigma n (normal stress, eta_5), sigma-hat_2 = t . sigma n (eta_4).
+    #[default]
+    Normal,
+    /// sigma-hat_1 = (sigma n)_1 (eta_5), sigma-hat_2 = (sigma n)_2 (eta_4): the Cartesian components.
+    Cartesian,
+}
+
 /// A declared estimator variant.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct EstimatorConfig {
@@ -79,11 +95,14 @@ pub struct EstimatorConfig {
     /// The constant replacing the hidden one of Theorem 6.1 (Section 7: 0.45).
     pub c0: f64,
     pub sampling: Sampling,
+    /// Reading of sigma-hat_1, sigma-hat_2 in eta_4, eta_5 (absent in older records: normal).
+    #[serde(default)]
+    pub stress_frame: StressFrame,
 }
 
 impl Default for EstimatorConfig {
     fn default() -> Self {
-        EstimatorConfig { contact_term: ContactTerm::AsWritten, log_factor: LogFactor::Squared, c0: 0.45, sampling: Sampling::Quadrature }
+        EstimatorConfig { contact_term: ContactTerm::AsWritten, log_factor: LogFactor::Squared, c0: 0.45, sampling: Sampling::Quadrature, stress_frame: StressFrame::Normal }
     }
 }
 
@@ -249,8 +268,13 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
                         Part::Contact => {
                             let n = problem.contact_normal(x);
                             let tng = [-n[1], n[0]];
-                            out.normal[le] = out.normal[le].max((tr[0] * n[0] + tr[1] * n[1]).abs());
-                            out.tangential[le] = out.tangential[le].max((tr[0] * tng[0] + tr[1] * tng[1]).abs());
+                            // (sigma-hat_1, sigma-hat_2): eta_5 takes the first, eta_4 the second
+                            let (s1, s2) = match config.stress_frame {
+                                StressFrame::Normal => (tr[0] * n[0] + tr[1] * n[1], tr[0] * tng[0] + tr[1] * tng[1]),
+                                StressFrame::Cartesian => (tr[0], tr[1]),
+                            };
+                            out.normal[le] = out.normal[le].max(s1.abs());
+                            out.tangential[le] = out.tangential[le].max(s2.abs());
                             let phi = edge_basis(s);
                             let mut un = 0.0;
                             for k in 0..3 {

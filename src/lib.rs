@@ -20,3 +20,4 @@ pub mod records;
 pub mod report;
 pub mod solve;
 pub mod study;
+pub mod verdict;

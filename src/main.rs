@@ -138,6 +138,8 @@ impl EstimatorArgs {
                 SamplingArg::Quadrature => Sampling::Quadrature,
                 SamplingArg::Dense => Sampling::Dense,
             },
+            // the reading of sigma-hat in eta_4, eta_5 is a manifest option (estimator.stress_frame)
+            ..EstimatorConfig::default()
         })
     }
 }

@@ -51,19 +51,62 @@ pub struct LinfError {
 pub type Reference<'a> = &'a (dyn Fn([f64; 2]) -> [f64; 2] + Sync);
 
 pub fn linf_error_on(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference, sampling: Sampling) -> f64 {
+    linf_error_where(mesh, sol, exact, sampling, &|_| true).unwrap_or(0.0)
+}
+
+/// max |u - u_h| over the sampling points x with `keep(x)`; None if no point is kept.
+pub fn linf_error_where(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference, sampling: Sampling, keep: &(dyn Fn([f64; 2]) -> bool + Sync)) -> Option<f64> {
     let refs = sampling.points();
     (0..mesh.n_triangles())
         .into_par_iter()
         .map(|t| {
             sol.eval_element(mesh, t, &refs)
                 .iter()
+                .filter(|(x, _)| keep(*x))
                 .map(|(x, uh)| {
                     let u = exact(*x);
                     (u[0] - uh[0]).abs().max((u[1] - uh[1]).abs())
                 })
-                .fold(0.0, f64::max)
+                .reduce(f64::max)
         })
-        .reduce(|| 0.0, f64::max)
+        .reduce(|| None, |a, b| match (a, b) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
+        })
+}
+
+/// Points per edge of the contact-edge sampling (end points included).
+pub const EDGE_POINTS: usize = 13;
+
+/// ||u - u_h||_Linf on Gamma_C: max over `EDGE_POINTS` equally spaced points of every contact
+/// edge (end points included); None without contact edges.
+pub fn linf_error_contact(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference) -> Option<f64> {
+    let reference = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+    (0..mesh.n_triangles())
+        .into_par_iter()
+        .filter_map(|t| {
+            let tri = mesh.triangles[t];
+            let mut refs = Vec::new();
+            for b in sol.nodes.element_boundary[t].iter().flatten() {
+                let e = &mesh.boundary[*b];
+                if e.part != crate::mesh::Part::Contact {
+                    continue;
+                }
+                let (i, j) = (tri.iter().position(|&v| v == e.v[0])?, tri.iter().position(|&v| v == e.v[1])?);
+                for k in 0..EDGE_POINTS {
+                    let s = k as f64 / (EDGE_POINTS - 1) as f64;
+                    refs.push([(1.0 - s) * reference[i][0] + s * reference[j][0], (1.0 - s) * reference[i][1] + s * reference[j][1]]);
+                }
+            }
+            sol.eval_element(mesh, t, &refs)
+                .iter()
+                .map(|(x, uh)| {
+                    let u = exact(*x);
+                    (u[0] - uh[0]).abs().max((u[1] - uh[1]).abs())
+                })
+                .reduce(f64::max)
+        })
+        .reduce_with(f64::max)
 }
 
 pub fn linf_error(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference) -> LinfError {

@@ -21,7 +21,7 @@ fn configs() -> Vec<EstimatorConfig> {
     let mut out = Vec::new();
     for contact_term in [ContactTerm::AsWritten, ContactTerm::WithoutFullContact] {
         for sampling in [Sampling::Quadrature, Sampling::Dense] {
-            out.push(EstimatorConfig { contact_term, sampling, log_factor: LogFactor::Squared, c0: 0.45 });
+            out.push(EstimatorConfig { contact_term, sampling, log_factor: LogFactor::Squared, c0: 0.45, ..Default::default() });
         }
     }
     out

@@ -17,6 +17,7 @@
 //! contact_term = "as_written"   # or "without_full_contact"
 //! log_factor = "squared"        # or "linear", "one"
 //! sampling = "quadrature"       # or "dense"
+//! stress_frame = "normal"       # or "cartesian": how eta_4, eta_5 read sigma-hat (estimate::StressFrame)
 //! [defaults.reference]       # optional: errors against a finer adaptive solution
 //! theta = 0.5
 //! min_ndof = 640000
@@ -43,7 +44,7 @@
 //! Every error names the file, the key and what was expected.
 
 use crate::adapt::Refine;
-use crate::estimate::{ContactTerm, EstimatorConfig, LogFactor};
+use crate::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
 use crate::mesh::MeshSpec;
 use crate::norms::Sampling;
 use crate::records::{ReferenceSpec, RunSpec};
@@ -68,6 +69,7 @@ struct EstimatorOverrides {
     contact_term: Option<ContactTerm>,
     log_factor: Option<LogFactor>,
     sampling: Option<Sampling>,
+    stress_frame: Option<StressFrame>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -225,6 +227,7 @@ impl Manifest {
                 contact_term: eo.contact_term.or(ed.contact_term).unwrap_or(e.contact_term),
                 log_factor: eo.log_factor.or(ed.log_factor).unwrap_or(e.log_factor),
                 sampling: eo.sampling.or(ed.sampling).unwrap_or(e.sampling),
+                stress_frame: eo.stress_frame.or(ed.stress_frame).unwrap_or(e.stress_frame),
             };
             if !(estimator.c0 > 0.0) {
                 return Err(invalid(key("estimator.c0"), "a positive number", estimator.c0.to_string()));

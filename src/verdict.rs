@@ -1,0 +1,492 @@
+//! Verdicts a referee can check: observed rates with 95% confidence intervals, the rules that
+//! turn an interval into a verdict, trends of the efficiency index, and the singular exponent of a
+//! clamped / traction-free corner (what Example 7.2's error measures).
+//!
+//! **Rates.** A rate is the least-squares slope of -log(quantity) against log(NDF). Newest-vertex
+//! bisection refines in two-level staircases (one bisection halves an element's area, two halve
+//! its diameter), so a fit over consecutive levels depends on where the window starts; the fit
+//! therefore takes every other level (levels of the same parity as the window's last level). The
+//! window ends at a given level and reaches back until it spans at least one decade of NDF
+//! ([`MIN_DECADES`]) and holds at least [`MIN_POINTS`] levels. The 95% interval is slope ± t_{0.975, n-2} x standard error (Student's t,
+//! n points). Stability: the same fit over the decades ending at the last level, two levels
+//! earlier and four levels earlier ([`RateReport::windows`]).
+//!
+//! **Rules** ([`judge_rate`]), for a claimed rate c and interval [lo, hi]:
+//! 1. the interval excludes [c - 0.1, c + 0.1]: *not reproduced* if below, *different (faster)* if above;
+//! 2. otherwise, an interval wider than 0.3, or a window of less than one decade: *inconclusive*;
+//! 3. otherwise the interval contains c or lies within c ± 0.1: *reproduced*;
+//! 4. otherwise (it overlaps c ± 0.1 without containing c or lying inside it): *inconclusive*.
+//!
+//! **Bounded** ([`judge_trend`]): the slope of log(quantity) against log(NDF) has an interval
+//! containing 0 and no wider than 0.3, or |slope| < 0.05 (a 10x growth of NDF changes the
+//! quantity by less than 12%); an interval containing 0 but wider than 0.3 is inconclusive.
+
+use crate::records::RunRecord;
+
+/// A claimed rate counts as met when the interval lies within claim ± RATE_BAND (or contains it).
+pub const RATE_BAND: f64 = 0.1;
+/// An interval wider than this decides nothing.
+pub const MAX_WIDTH: f64 = 0.3;
+/// The fit window spans at least this many decades of NDF.
+pub const MIN_DECADES: f64 = 1.0;
+/// The fit window holds at least this many levels (where the run has them): with fewer, the t
+/// factor of the interval is large (t_{0.975, 3} = 3.18).
+pub const MIN_POINTS: usize = 5;
+/// |slope| below this counts as bounded whatever the interval.
+pub const FLAT_SLOPE: f64 = 0.05;
+/// Relative size below which a value is round-off (see [`rate_over`]).
+pub const ROUND_OFF: f64 = 1e-12;
+/// Levels between the ends of the three stability windows.
+pub const WINDOW_SHIFT: usize = 2;
+
+/// ln Gamma(x), x > 0 (Lanczos, g = 7, 9 terms; relative error below 1e-14).
+fn ln_gamma(x: f64) -> f64 {
+    const G: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    if x < 0.5 {
+        return (std::f64::consts::PI / (std::f64::consts::PI * x).sin()).ln() - ln_gamma(1.0 - x);
+    }
+    let x = x - 1.0;
+    let t = x + 7.5;
+    let a = G[0] + G[1..].iter().enumerate().map(|(i, g)| g / (x + i as f64 + 1.0)).sum::<f64>();
+    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + a.ln()
+}
+
+/// Continued fraction of the incomplete beta function (modified Lentz).
+fn beta_cf(a: f64, b: f64, x: f64) -> f64 {
+    let tiny = 1e-300;
+    let (qab, qap, qam) = (a + b, a + 1.0, a - 1.0);
+    let mut c = 1.0;
+    let mut d = 1.0 - qab * x / qap;
+    if d.abs() < tiny {
+        d = tiny;
+    }
+    d = 1.0 / d;
+    let mut h = d;
+    for m in 1..300 {
+        let m = m as f64;
+        let m2 = 2.0 * m;
+        for aa in [m * (b - m) * x / ((qam + m2) * (a + m2)), -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2))] {
+            d = 1.0 + aa * d;
+            if d.abs() < tiny {
+                d = tiny;
+            }
+            c = 1.0 + aa / c;
+            if c.abs() < tiny {
+                c = tiny;
+            }
+            d = 1.0 / d;
+            h *= d * c;
+        }
+        if (d * c - 1.0).abs() < 1e-15 {
+            break;
+        }
+    }
+    h
+}
+
+/// Regularised incomplete beta function I_x(a, b).
+pub fn incomplete_beta(a: f64, b: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    let front = (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp();
+    if x < (a + 1.0) / (a + b + 2.0) { front * beta_cf(a, b, x) / a } else { 1.0 - front * beta_cf(b, a, 1.0 - x) / b }
+}
+
+/// Two-sided tail probability P(|T| > t) of Student's t with `dof` degrees of freedom.
+pub fn t_two_sided_tail(t: f64, dof: f64) -> f64 {
+    incomplete_beta(dof / 2.0, 0.5, dof / (dof + t * t))
+}
+
+/// The 97.5% quantile of Student's t (the factor of a two-sided 95% interval), by bisection.
+pub fn t_quantile_975(dof: usize) -> f64 {
+    assert!(dof >= 1, "Student's t needs at least one degree of freedom");
+    let (mut lo, mut hi) = (0.0, 1e3);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if t_two_sided_tail(mid, dof as f64) > 0.05 { lo = mid } else { hi = mid }
+    }
+    0.5 * (lo + hi)
+}
+
+/// A least-squares line y = intercept + slope x with the 95% interval of its slope.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LineFit {
+    pub slope: f64,
+    /// t_{0.975, n-2} x standard error of the slope (infinite with two points).
+    pub half_width: f64,
+    pub points: usize,
+}
+
+impl LineFit {
+    pub fn lo(&self) -> f64 {
+        self.slope - self.half_width
+    }
+    pub fn hi(&self) -> f64 {
+        self.slope + self.half_width
+    }
+    pub fn width(&self) -> f64 {
+        2.0 * self.half_width
+    }
+}
+
+/// Least-squares line through (x, y) with a 95% interval on the slope; None with fewer than 2
+/// points or no spread in x.
+pub fn fit_line(pts: &[(f64, f64)]) -> Option<LineFit> {
+    let n = pts.len();
+    if n < 2 {
+        return None;
+    }
+    let nf = n as f64;
+    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / nf, pts.iter().map(|p| p.1).sum::<f64>() / nf);
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    if sxx <= 0.0 {
+        return None;
+    }
+    let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx;
+    let half_width = if n > 2 {
+        let rss: f64 = pts.iter().map(|p| (p.1 - my - slope * (p.0 - mx)).powi(2)).sum();
+        t_quantile_975(n - 2) * (rss / (nf - 2.0) / sxx).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    Some(LineFit { slope, half_width, points: n })
+}
+
+/// A rate fitted over a window of levels: rate = slope of -log(value) against log(NDF).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RateFit {
+    /// The rate (positive: decaying) and its interval.
+    pub rate: LineFit,
+    pub first_level: usize,
+    pub last_level: usize,
+    pub first_ndof: usize,
+    pub last_ndof: usize,
+}
+
+impl RateFit {
+    pub fn decades(&self) -> f64 {
+        (self.last_ndof as f64 / self.first_ndof as f64).log10()
+    }
+    /// "1.52 ± 0.04"
+    pub fn text(&self) -> String {
+        format!("{:.2} ± {}", self.rate.slope, if self.rate.half_width.is_finite() { format!("{:.2}", self.rate.half_width) } else { "inf".into() })
+    }
+    /// "levels 14–24 (every other), NDF 3.1e4–3.1e5"
+    pub fn range(&self) -> String {
+        format!("levels {}–{} every other, NDF {:.1e}–{:.1e}", self.first_level, self.last_level, self.first_ndof as f64, self.last_ndof as f64)
+    }
+}
+
+/// Levels of the window ending at `end`: end, end - 2, ... back until the window spans
+/// `MIN_DECADES` of NDF and holds `MIN_POINTS` levels (or to the start of the run), in increasing order.
+pub fn window(ndof: &[usize], end: usize) -> Vec<usize> {
+    let mut out = vec![end];
+    let mut i = end;
+    while i >= 2 && ((ndof[end] as f64 / ndof[i] as f64).log10() < MIN_DECADES || out.len() < MIN_POINTS) {
+        i -= 2;
+        out.push(i);
+    }
+    out.reverse();
+    out
+}
+
+/// Rate of `values` (one per level; None or non-positive values end the window) against `ndof`
+/// over the window ending at `end`.
+/// Values at or below `ROUND_OFF` x the largest value of the run count as zero (e.g. eta_6 of
+/// 3e-17 where it is otherwise 1e-5) and end the window like missing ones.
+pub fn rate_over(ndof: &[usize], values: &[Option<f64>], end: usize) -> Option<RateFit> {
+    let floor = ROUND_OFF * values.iter().flatten().cloned().fold(0.0, f64::max);
+    let levels: Vec<usize> = window(ndof, end).into_iter().rev().take_while(|&l| values[l].is_some_and(|v| v > floor)).collect();
+    let pts: Vec<(f64, f64)> = levels.iter().map(|&l| ((ndof[l] as f64).ln(), -values[l].unwrap().ln())).collect();
+    let rate = fit_line(&pts)?;
+    let (first, last) = (*levels.last()?, levels[0]);
+    Some(RateFit { rate, first_level: first, last_level: last, first_ndof: ndof[first], last_ndof: ndof[last] })
+}
+
+/// The value of a `LevelRecord` field at every level of a run (None where absent or not a number).
+pub fn field(run: &RunRecord, name: &str) -> Vec<Option<f64>> {
+    run.levels.iter().map(|l| serde_json::to_value(l).ok().and_then(|v| v[name].as_f64())).collect()
+}
+
+/// A rate over the last decade of a run, and the same fit over the windows ending
+/// `WINDOW_SHIFT` and 2 `WINDOW_SHIFT` levels earlier.
+#[derive(Clone, Debug)]
+pub struct RateReport {
+    pub main: RateFit,
+    pub windows: Vec<RateFit>,
+}
+
+impl RateReport {
+    pub fn from_values(ndof: &[usize], values: &[Option<f64>]) -> Option<RateReport> {
+        let end = ndof.len().checked_sub(1)?;
+        let main = rate_over(ndof, values, end)?;
+        let windows = (0..3).filter_map(|k| end.checked_sub(k * WINDOW_SHIFT)).filter_map(|e| rate_over(ndof, values, e)).collect();
+        Some(RateReport { main, windows })
+    }
+
+    pub fn of(run: &RunRecord, name: &str) -> Option<RateReport> {
+        let ndof: Vec<usize> = run.levels.iter().map(|l| l.ndof).collect();
+        Self::from_values(&ndof, &field(run, name))
+    }
+
+    /// "1.52 ± 0.04 (levels .., NDF ..; windows 1.52, 1.50, 1.49)"
+    pub fn text(&self) -> String {
+        format!("{} ({}; windows {})", self.main.text(), self.main.range(), self.windows.iter().map(|w| format!("{:.2}", w.rate.slope)).collect::<Vec<_>>().join(", "))
+    }
+
+    /// Largest minus smallest slope over the three windows.
+    pub fn spread(&self) -> f64 {
+        let s = self.windows.iter().map(|w| w.rate.slope);
+        s.clone().fold(f64::NEG_INFINITY, f64::max) - s.fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// What a rate interval says about a claimed rate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RateVerdict {
+    Reproduced,
+    /// Slower than the claim: the interval lies below claim - RATE_BAND.
+    NotReproduced,
+    /// Faster than the claim: the interval lies above claim + RATE_BAND.
+    Different,
+    Inconclusive,
+}
+
+impl RateVerdict {
+    pub fn text(self) -> &'static str {
+        match self {
+            RateVerdict::Reproduced => "reproduced",
+            RateVerdict::NotReproduced => "not reproduced (slower)",
+            RateVerdict::Different => "different (faster than claimed)",
+            RateVerdict::Inconclusive => "inconclusive",
+        }
+    }
+}
+
+/// The rules of the module docs.
+pub fn judge_rate(fit: &RateFit, claim: f64) -> RateVerdict {
+    let (lo, hi) = (fit.rate.lo(), fit.rate.hi());
+    if hi < claim - RATE_BAND {
+        RateVerdict::NotReproduced
+    } else if lo > claim + RATE_BAND {
+        RateVerdict::Different
+    } else if fit.rate.width() > MAX_WIDTH || fit.decades() < MIN_DECADES {
+        RateVerdict::Inconclusive
+    } else if (lo <= claim && claim <= hi) || (lo >= claim - RATE_BAND && hi <= claim + RATE_BAND) {
+        RateVerdict::Reproduced
+    } else {
+        RateVerdict::Inconclusive
+    }
+}
+
+/// Trend of a quantity: slope of log(value) against log(NDF) over the last decade (positive: growing).
+pub fn growth(ndof: &[usize], values: &[Option<f64>]) -> Option<RateFit> {
+    let mut f = rate_over(ndof, values, ndof.len().checked_sub(1)?)?;
+    f.rate.slope = -f.rate.slope;
+    Some(f)
+}
+
+/// What a trend interval says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Trend {
+    Bounded,
+    Growing,
+    Falling,
+    /// The interval contains 0 but is wider than `MAX_WIDTH`: it cannot tell bounded from growing.
+    Inconclusive,
+}
+
+impl Trend {
+    pub fn text(self) -> &'static str {
+        match self {
+            Trend::Bounded => "bounded",
+            Trend::Growing => "growing",
+            Trend::Falling => "falling",
+            Trend::Inconclusive => "inconclusive (interval wider than 0.3)",
+        }
+    }
+}
+
+/// Bounded: |growth| < FLAT_SLOPE, or the growth interval contains 0 and is at most
+/// `MAX_WIDTH` wide (a wider interval containing 0 is inconclusive).
+pub fn judge_trend(growth: &RateFit) -> Trend {
+    let contains_zero = growth.rate.lo() <= 0.0 && 0.0 <= growth.rate.hi();
+    if growth.rate.slope.abs() < FLAT_SLOPE || (contains_zero && growth.rate.width() <= MAX_WIDTH) {
+        Trend::Bounded
+    } else if contains_zero {
+        Trend::Inconclusive
+    } else if growth.rate.slope > 0.0 {
+        Trend::Growing
+    } else {
+        Trend::Falling
+    }
+}
+
+/// Singular exponent lambda in (1/2, 1) of the displacement u ~ r^lambda at a corner of angle
+/// pi/2 where a clamped side (u = 0) meets a traction-free side, in plane strain with Poisson
+/// ratio `nu`: the smallest root of the eigenvalue equation
+/// 4 lambda^2 = 1 + kappa^2 + 2 kappa cos(lambda pi), kappa = 3 - 4 nu,
+/// which is Williams' characteristic equation of the clamped/free wedge of opening omega,
+/// 4 lambda^2 sin^2(omega) = 1 + kappa^2 + 2 kappa cos(2 lambda omega), at omega = pi/2 (at
+/// omega = pi it gives the known oscillatory exponents 1/2 ± i ln(kappa) / (2 pi)). For
+/// nu = 0.3 (Example 7.2) lambda = 0.7112. Under uniform refinement the L-infinity error near
+/// such a corner decays like h^lambda = NDF^(-lambda/2).
+pub fn clamped_free_corner_exponent(nu: f64) -> f64 {
+    let kappa = 3.0 - 4.0 * nu;
+    let f = |l: f64| 4.0 * l * l - 1.0 - kappa * kappa - 2.0 * kappa * (l * std::f64::consts::PI).cos();
+    let (mut lo, mut hi) = (0.5, 1.0);
+    assert!(f(lo) < 0.0 && f(hi) > 0.0, "no root of the corner eigenvalue equation in (1/2, 1) for nu = {nu}");
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) < 0.0 { lo = mid } else { hi = mid }
+    }
+    0.5 * (lo + hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn t_quantiles_match_tables() {
+        for (dof, t) in [(1, 12.7062), (2, 4.3027), (5, 2.5706), (10, 2.2281), (30, 2.0423), (1000, 1.9623)] {
+            assert!((t_quantile_975(dof) - t).abs() < 1e-3, "dof {dof}: {} vs {t}", t_quantile_975(dof));
+        }
+    }
+
+    #[test]
+    fn corner_exponent_solves_its_equation() {
+        let l = clamped_free_corner_exponent(0.3);
+        let kappa: f64 = 3.0 - 4.0 * 0.3;
+        assert!((4.0 * l * l - 1.0 - kappa * kappa - 2.0 * kappa * (l * std::f64::consts::PI).cos()).abs() < 1e-12);
+        assert!((l - 0.7112).abs() < 5e-4, "{l}");
+        // error reduction per halving of h: 2^-lambda = 0.611 (the issue measured 0.608)
+        assert!((0.5f64.powf(l) - 0.61).abs() < 0.01);
+    }
+
+    #[test]
+    fn window_reaches_back_one_decade_on_every_other_level() {
+        let ndof: Vec<usize> = (0..12).map(|l| 100 * 2usize.pow(l)).collect();
+        // one decade is reached at level 7 (2^4 >= 10), five points at level 3
+        assert_eq!(window(&ndof, 11), vec![3, 5, 7, 9, 11]);
+        assert_eq!(window(&ndof, 2), vec![0, 2]);
+        // slow growth: the decade decides
+        let slow: Vec<usize> = (0..30).map(|l| (100.0 * 1.2f64.powi(l)) as usize).collect();
+        let w = window(&slow, 29);
+        assert!((slow[29] as f64 / slow[w[0]] as f64) >= 10.0 && (slow[29] as f64 / slow[w[1]] as f64) < 10.0, "{w:?}");
+    }
+}
+
+/// Refinement locations, tested as what they are: a claimed location is a refinement centre when
+/// the local mesh size h has a local minimum (or a plateau of its own) there.
+pub mod refinement {
+    use crate::records::MeshSnapshot;
+
+    /// One mesh edge on a boundary segment: parameter range [s0, s1] along the segment and length.
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct SegmentEdge {
+        pub s0: f64,
+        pub s1: f64,
+        pub h: f64,
+    }
+
+    /// The edges of the triangulation lying on the segment from `a` to `b` (both end points on
+    /// it), sorted along it; s in [0, 1].
+    pub fn profile(m: &MeshSnapshot, a: [f64; 2], b: [f64; 2]) -> Vec<SegmentEdge> {
+        let d = [b[0] - a[0], b[1] - a[1]];
+        let len2 = d[0] * d[0] + d[1] * d[1];
+        let len = len2.sqrt();
+        let on = |p: [f64; 2]| -> Option<f64> {
+            let q = [p[0] - a[0], p[1] - a[1]];
+            let s = (q[0] * d[0] + q[1] * d[1]) / len2;
+            let off = (q[0] * d[1] - q[1] * d[0]).abs() / len;
+            (off <= 1e-12 * len && (-1e-12..=1.0 + 1e-12).contains(&s)).then_some(s)
+        };
+        let mut seen = std::collections::BTreeSet::new();
+        let mut out = Vec::new();
+        for t in &m.triangles {
+            for i in 0..3 {
+                let (u, v) = (t[i], t[(i + 1) % 3]);
+                if !seen.insert((u.min(v), u.max(v))) {
+                    continue;
+                }
+                if let (Some(s0), Some(s1)) = (on(m.vertices[u]), on(m.vertices[v])) {
+                    let (s0, s1) = (s0.min(s1), s0.max(s1));
+                    out.push(SegmentEdge { s0, s1, h: (s1 - s0) * len });
+                }
+            }
+        }
+        out.sort_by(|x, y| x.s0.total_cmp(&y.s0));
+        out
+    }
+
+    /// The mesh size at a point and on either side of it.
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub struct LocalMinimum {
+        /// Smallest edge among the edge containing the point and its two neighbours.
+        pub h_at: f64,
+        /// Smallest and largest edge on each side within `reach` (None: no edge there).
+        pub left: Option<(f64, f64)>,
+        pub right: Option<(f64, f64)>,
+        pub holds: bool,
+    }
+
+    impl LocalMinimum {
+        pub fn text(&self) -> String {
+            let side = |s: Option<(f64, f64)>| s.map(|(lo, hi)| format!("{lo:.1e}..{hi:.1e}")).unwrap_or("none".into());
+            format!("h {:.1e} there, {} before, {} after", self.h_at, side(self.left), side(self.right))
+        }
+    }
+
+    /// Is the point at parameter `s` a local minimum (or its own plateau) of h along the profile?
+    /// Near = the edge containing s and one edge either side; each side = the further edges within
+    /// `reach` (in parameter units). It holds when no edge on either side is smaller than near,
+    /// and h grows somewhere on each side that has edges (at least one side must have edges).
+    pub fn local_minimum(profile: &[SegmentEdge], s: f64, reach: f64) -> Option<LocalMinimum> {
+        let k = profile.iter().position(|e| e.s0 <= s && s <= e.s1)?;
+        let near = k.saturating_sub(1)..(k + 2).min(profile.len());
+        let h_at = profile[near.clone()].iter().map(|e| e.h).fold(f64::INFINITY, f64::min);
+        let range = |es: &[SegmentEdge]| -> Option<(f64, f64)> {
+            (!es.is_empty()).then(|| (es.iter().map(|e| e.h).fold(f64::INFINITY, f64::min), es.iter().map(|e| e.h).fold(0.0, f64::max)))
+        };
+        let left: Vec<SegmentEdge> = profile[..near.start].iter().filter(|e| e.s0 >= s - reach).copied().collect();
+        let right: Vec<SegmentEdge> = profile[near.end..].iter().filter(|e| e.s1 <= s + reach).copied().collect();
+        let (left, right) = (range(&left), range(&right));
+        let side_ok = |r: Option<(f64, f64)>| r.is_none_or(|(lo, hi)| lo >= h_at && hi > h_at);
+        let holds = (left.is_some() || right.is_some()) && side_ok(left) && side_ok(right);
+        Some(LocalMinimum { h_at, left, right, holds })
+    }
+
+    /// Smallest element diameter among triangles with centroid within `r` of `p`, and among those
+    /// with centroid between `r` and `reach`: a corner is a refinement centre when the first is
+    /// smaller than the second.
+    pub fn corner(m: &MeshSnapshot, p: [f64; 2], r: f64, reach: f64) -> (f64, f64) {
+        let (mut inner, mut ring) = (f64::INFINITY, f64::INFINITY);
+        for t in &m.triangles {
+            let v = t.map(|i| m.vertices[i]);
+            let c = [(v[0][0] + v[1][0] + v[2][0]) / 3.0, (v[0][1] + v[1][1] + v[2][1]) / 3.0];
+            let d = (0..3).map(|i| crate::mesh::dist(v[i], v[(i + 1) % 3])).fold(0.0, f64::max);
+            let dc = crate::mesh::dist(c, p);
+            if dc <= r {
+                inner = inner.min(d);
+            } else if dc <= reach {
+                ring = ring.min(d);
+            }
+        }
+        (inner, ring)
+    }
+}
