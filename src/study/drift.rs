@@ -176,11 +176,7 @@ pub fn observed_rate(run: &RunRecord, field: &str, last: usize) -> Option<f64> {
         .iter()
         .map(|l| Some(((l["ndof"].as_f64()?).ln(), l[field].as_f64().filter(|v| *v > 0.0)?.ln())))
         .collect::<Option<_>>()?;
-    let n = pts.len() as f64;
-    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
-    let sxy: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    Some(-sxy / sxx)
+    crate::verdict::fit_line(&pts).map(|f| -f.slope)
 }
 
 /// Compare a study's fresh runs with its stored runs. `quick`: fresh runs are the quick forms
