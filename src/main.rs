@@ -48,7 +48,7 @@ enum Command {
         /// Start over instead of resuming after the runs already finished.
         #[arg(long)]
         fresh: bool,
-        /// Results root.
+        /// Results root [default: results, or target/quick-results with --quick].
         #[arg(long)]
         results: Option<std::path::PathBuf>,
     },
@@ -181,7 +181,8 @@ struct SolveArgs {
     /// --adapt-min-ndof) [default: 0.5].
     #[arg(long, allow_negative_numbers = true, requires = "adaptive")]
     theta: Option<f64>,
-    /// Solve on the mesh of this adaptive level (from --mesh, default estimator) instead.
+    /// Solve on the mesh of this adaptive level instead (refined from --mesh, marked with the
+    /// estimator options below); with --adapt-min-ndof, the last level tried.
     #[arg(long, allow_negative_numbers = true)]
     adapt_levels: Option<usize>,
     /// Solve on the first adaptive level with at least this many unknowns (as the studies'

@@ -238,3 +238,31 @@ fn bad_missing_manifest_is_named_once() {
     assert!(err.contains("experiments/no_such_study.toml"), "{err}");
     assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
 }
+
+#[test]
+fn every_flag_of_every_subcommand_has_a_description() {
+    for cmd in [&[][..], &["solve"], &["adapt"], &["run"], &["drift"], &["figures"], &["export"]] {
+        let mut args = cmd.to_vec();
+        args.push("--help");
+        let (code, out, _) = run_out(&args);
+        assert_eq!(code, 0);
+        let lines: Vec<&str> = out.lines().collect();
+        let mut flags = 0;
+        for (i, line) in lines.iter().enumerate() {
+            let t = line.trim_start();
+            if !(t.starts_with("--") || (t.starts_with('-') && t.chars().nth(1).is_some_and(|c| c.is_ascii_alphabetic()))) {
+                continue;
+            }
+            flags += 1;
+            // the description follows on the same line after two spaces, or on the next, indented further
+            let same_line = t.split_once("  ").is_some_and(|(_, d)| !d.trim().is_empty());
+            let indent = line.len() - t.len();
+            let next_line = lines.get(i + 1).is_some_and(|n| {
+                let nt = n.trim_start();
+                n.len() - nt.len() > indent && !nt.is_empty() && !nt.starts_with('-')
+            });
+            assert!(same_line || next_line, "{cmd:?}: flag without a description: {line}");
+        }
+        assert!(flags >= 1, "{cmd:?}: no flags found in\n{out}");
+    }
+}
