@@ -373,8 +373,11 @@ fn convergence_plots_carry_slope_triangles_labelled_with_the_rate() {
     }
 }
 
+/// A polyline in pixels.
+type Curve = Vec<(f64, f64)>;
+
 /// The legend box (x0, y0, x1, y1) and the curves (stroke width 2) of a panel SVG, in pixels.
-fn legend_and_curves(svg: &str) -> (Vec<[f64; 4]>, Vec<Vec<(f64, f64)>>) {
+fn legend_and_curves(svg: &str) -> (Vec<[f64; 4]>, Vec<Curve>) {
     let attr = |l: &str, name: &str| -> Option<String> {
         let i = l.find(&format!(" {name}=\""))? + name.len() + 3;
         Some(l[i..].split('"').next()?.to_string())
