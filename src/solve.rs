@@ -30,24 +30,32 @@ pub fn available_memory() -> Option<f64> {
     Some(kib * 1024.0)
 }
 
+/// Where the machine's available memory is unknown (no `/proc/meminfo`), solves whose estimate
+/// exceeds this (1 TiB) are refused all the same.
+pub const UNKNOWN_MEMORY_LIMIT: f64 = 1024.0 * 1024.0 * MIB;
+
 /// A solve that would not fit in memory.
 #[derive(Debug, thiserror::Error)]
-#[error("{what} has {ndof:.0} unknowns: solving needs about {} (estimate: 64 MiB + 2 KiB per unknown), but this machine has {} available (MemAvailable in /proc/meminfo)", human_bytes(*.needed), human_bytes(*.available))]
+#[error("{what} has {ndof:.0} unknowns: solving needs about {} (estimate: 64 MiB + 2 KiB per unknown), but {}", human_bytes(*.needed), match .available {
+    Some(a) => format!("this machine has {} available (MemAvailable in /proc/meminfo)", human_bytes(*a)),
+    None => format!("this machine's available memory is unknown (no /proc/meminfo) and more than {} is refused", human_bytes(UNKNOWN_MEMORY_LIMIT)),
+})]
 pub struct MemoryError {
     pub what: String,
     pub ndof: f64,
     pub needed: f64,
-    pub available: f64,
+    pub available: Option<f64>,
 }
 
 /// Refuse a solve with `ndof` unknowns before allocating anything, if its memory estimate exceeds
-/// the machine's available memory (not checked where that is unknown).
+/// the machine's available memory (or [`UNKNOWN_MEMORY_LIMIT`] where that is unknown).
 pub fn check_memory(what: &str, ndof: f64) -> Result<(), MemoryError> {
     let needed = memory_estimate(ndof);
-    match available_memory() {
-        Some(available) if needed > available => Err(MemoryError { what: what.to_string(), ndof, needed, available }),
-        _ => Ok(()),
+    let available = available_memory();
+    if needed > available.unwrap_or(UNKNOWN_MEMORY_LIMIT) {
+        return Err(MemoryError { what: what.to_string(), ndof, needed, available });
     }
+    Ok(())
 }
 
 /// Bytes in binary units: "3.4 GiB".

@@ -79,7 +79,10 @@ fn bad_huge_mesh_is_refused_with_the_memory_estimate_before_allocating() {
     for mesh in ["structured:100000", "symmetric:100000"] {
         let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", mesh]);
         assert_eq!(code, 1, "{err}");
-        assert!(err.contains(mesh) && err.contains("TiB") && err.contains("available") && err.contains("MemAvailable"), "{err}");
+        assert!(err.contains(mesh) && err.contains("149.0 TiB") && err.contains("available"), "{err}");
+        if std::path::Path::new("/proc/meminfo").exists() {
+            assert!(err.contains("MemAvailable"), "{err}");
+        }
     }
     let (code, err) = run(&["adapt", "--problem", "ex72", "--mesh", "structured:100000"]);
     assert_eq!(code, 1, "{err}");
