@@ -104,7 +104,7 @@ impl Default for AdaptConfig {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LevelRecord {
     pub level: usize,
-    /// 2 x number of P2 nodes, Dirichlet nodes included (CONTRACT.md).
+    /// 2 x number of P2 nodes, Dirichlet nodes included (the NDF of every figure and table).
     pub ndof: usize,
     pub ndof_free: usize,
     pub n_elements: usize,

@@ -1,5 +1,6 @@
-//! The record of one solve, as `signorini solve --json` prints it (CONTRACT.md), and the export of
-//! a case for the NGSolve cross-check.
+//! The record of one solve, as `signorini solve --json` prints it ([`SolveReport`]: its fields
+//! are the JSON keys; `tests/bad_input.rs` checks the ones scripts rely on), and the export of a
+//! case for the NGSolve cross-check.
 
 use crate::contact::PdasIteration;
 use crate::estimate::{Estimate, EstimatorConfig, Terms};
