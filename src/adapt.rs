@@ -16,7 +16,7 @@ use std::time::Instant;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Refine {
-    /// Maximum strategy: mark T if eta_T >= theta max eta_T (Section 7, [35]).
+    /// Maximum strategy: mark T if eta_T >= theta max eta_T (Section 7, ref. \[35\]).
     Adaptive,
     /// Mark every element (one newest-vertex bisection each, so NDF about doubles per level).
     Uniform,
