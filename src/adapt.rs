@@ -16,13 +16,13 @@ use std::time::Instant;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Refine {
-    /// Maximum strategy: mark T if eta_T >= theta max eta_T (Section 7, [35]).
+    /// Maximum strategy: mark T if eta_T >= theta max eta_T (Section 7, ref. \[35\]).
     Adaptive,
     /// Mark every element (one newest-vertex bisection each, so NDF about doubles per level).
     Uniform,
 }
 
-/// Settings of the loop.
+/// Settings of the loop; [`AdaptConfig::validate`] checks them.
 #[derive(Clone, Debug)]
 pub struct AdaptConfig {
     /// Number of levels solved (level 0 is the initial mesh).
@@ -35,6 +35,53 @@ pub struct AdaptConfig {
     pub pdas: PdasOptions,
     /// Start each level's active-set method from the previous level's active set.
     pub warm_start: bool,
+}
+
+/// A setting of the loop outside its range: `key` is the field (as manifests spell it), `expected`
+/// the admissible values, `got` the value given.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{key}: expected {expected}, got {got}")]
+pub struct ConfigError {
+    pub key: &'static str,
+    pub expected: &'static str,
+    pub got: String,
+}
+
+impl AdaptConfig {
+    /// The loop's settings for a study run.
+    pub fn for_run(spec: &crate::records::RunSpec) -> Self {
+        AdaptConfig {
+            levels: spec.levels,
+            max_ndof: spec.max_ndof,
+            refine: spec.refine,
+            theta: spec.theta,
+            estimator: spec.estimator,
+            ..Default::default()
+        }
+    }
+
+    /// Check every setting: the one validation behind the command line and the manifests.
+    /// With theta > 1 the maximum strategy marks nothing and the loop solves one mesh over and
+    /// over; with `levels = 0` or `max_ndof = 0` it solves nothing.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let bad = |key, expected, got: String| Err(ConfigError { key, expected, got });
+        if self.levels == 0 {
+            return bad("levels", "a number of levels >= 1", "0".into());
+        }
+        if self.max_ndof == Some(0) {
+            return bad("max_ndof", "a number of unknowns >= 1", "0".into());
+        }
+        if !(self.theta > 0.0 && self.theta <= 1.0) {
+            return bad("theta", "a number in (0, 1]", self.theta.to_string());
+        }
+        if !(self.estimator.c0 > 0.0 && self.estimator.c0.is_finite()) {
+            return bad("estimator.c0", "a positive number", self.estimator.c0.to_string());
+        }
+        if self.pdas.max_iterations == 0 {
+            return bad("pdas.max_iterations", "a number of iterations >= 1", "0".into());
+        }
+        Ok(())
+    }
 }
 
 impl Default for AdaptConfig {
@@ -57,7 +104,7 @@ impl Default for AdaptConfig {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LevelRecord {
     pub level: usize,
-    /// 2 x number of P2 nodes, Dirichlet nodes included (CONTRACT.md).
+    /// 2 x number of P2 nodes, Dirichlet nodes included (the NDF of every figure and table).
     pub ndof: usize,
     pub ndof_free: usize,
     pub n_elements: usize,
@@ -176,6 +223,7 @@ pub fn run(
     reference: Option<Reference>,
     observer: &mut dyn FnMut(Level) -> ControlFlow<()>,
 ) -> Result<Vec<LevelRecord>, SolveError> {
+    debug_assert_eq!(config.validate(), Ok(()), "adapt::run needs a validated AdaptConfig");
     let mut records = Vec::new();
     let mut initial_active: Option<Vec<bool>> = None;
     for level in 0..config.levels {

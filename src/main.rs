@@ -19,8 +19,15 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// One solve (no adaptivity) on a structured mesh.
-    Solve(SolveArgs),
+    /// One solve on a structured mesh (or on a mesh of the adaptive loop: --adapt-levels,
+    /// --adapt-min-ndof), with its error, estimator and KKT report.
+    Solve {
+        #[command(flatten)]
+        args: SolveArgs,
+        /// Print one JSON object on stdout instead of the summary.
+        #[arg(long)]
+        json: bool,
+    },
     /// The adaptive loop SOLVE -> ESTIMATE -> MARK -> REFINE, one table row per level.
     Adapt(AdaptArgs),
     /// Run a declared study (experiments/STUDY.toml) into results/STUDY/.
@@ -33,7 +40,7 @@ enum Command {
         #[arg(long)]
         quick: bool,
         /// Threads for assembly, estimator and errors (results do not depend on it).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         jobs: Option<usize>,
         /// Run every N-th run only: K/N, 1 <= K <= N (cluster job arrays); shards merge by run id.
         #[arg(long)]
@@ -41,7 +48,7 @@ enum Command {
         /// Start over instead of resuming after the runs already finished.
         #[arg(long)]
         fresh: bool,
-        /// Results root.
+        /// Results root [default: results, or target/quick-results with --quick].
         #[arg(long)]
         results: Option<std::path::PathBuf>,
         /// If another process is running the same study, wait for it instead of refusing.
@@ -68,8 +75,10 @@ enum Command {
         /// Check only these studies (default: every experiments/*.toml).
         #[arg(long, value_name = "STUDY")]
         study: Vec<String>,
+        /// Folder of the study manifests.
         #[arg(long, default_value = "experiments")]
         experiments: std::path::PathBuf,
+        /// Results root holding the stored results to compare with.
         #[arg(long, default_value = "results")]
         results: std::path::PathBuf,
     },
@@ -77,15 +86,18 @@ enum Command {
     /// Refuses if a declared study's stored runs do not match its manifest (interrupted, sharded
     /// or partial), naming what is missing.
     Figures {
+        /// Results root to read (CLAIMS.md is written there).
         #[arg(long, default_value = "results")]
         results: std::path::PathBuf,
         /// The declared studies the stored results must match.
         #[arg(long, default_value = "experiments")]
         experiments: std::path::PathBuf,
+        /// Folder the figures are written to.
         #[arg(long, default_value = "figures")]
         figures: std::path::PathBuf,
     },
-    /// Solve and write the mesh and solution for the NGSolve cross-check (mesh.vtu, case.json).
+    /// Solve as `solve` does and write the mesh and solution for the NGSolve cross-check
+    /// (OUT/mesh.vtu, OUT/case.json: the report `solve --json` prints).
     Export {
         #[command(flatten)]
         args: SolveArgs,
@@ -98,7 +110,7 @@ enum Command {
 #[derive(clap::Args)]
 struct EstimatorArgs {
     /// Estimator constant C_0 (estimate = C_0 eta_h).
-    #[arg(long, default_value_t = 0.45)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.45)]
     c0: f64,
     /// eta_5 over all contact nodes (as-written) or without full-contact nodes.
     #[arg(long, value_enum, default_value = "as-written")]
@@ -120,9 +132,6 @@ enum SamplingArg { Quadrature, Dense }
 
 impl EstimatorArgs {
     fn config(&self) -> Result<EstimatorConfig> {
-        if !(self.c0 > 0.0) {
-            bail!("--c0 must be a positive number, got {}", self.c0);
-        }
         Ok(EstimatorConfig {
             c0: self.c0,
             contact_term: match self.contact_term {
@@ -146,27 +155,30 @@ impl EstimatorArgs {
 
 #[derive(clap::Args)]
 struct AdaptArgs {
+    /// Problem name (ex71, ex72, patch).
     #[arg(long)]
     problem: String,
-    /// Initial mesh.
+    /// Initial mesh: structured:N (or symmetric:N, mirrored about y = 0.5).
     #[arg(long, default_value = "structured:4")]
     mesh: String,
-    #[arg(long, default_value_t = 20)]
+    /// Number of levels solved (level 0 is the initial mesh).
+    #[arg(long, allow_negative_numbers = true, default_value_t = 20)]
     levels: usize,
-    /// Marking parameter of the maximum strategy.
-    #[arg(long, default_value_t = 0.5)]
+    /// Marking parameter of the maximum strategy: mark T if eta_T >= theta max eta_T, 0 < theta <= 1.
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.5, conflicts_with = "uniform")]
     theta: f64,
     /// Refine every element instead of marking.
     #[arg(long)]
     uniform: bool,
     /// Stop before a level with more unknowns than this.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     max_ndof: Option<usize>,
     #[command(flatten)]
     estimator: EstimatorArgs,
 }
 
 #[derive(clap::Args)]
+#[command(group(clap::ArgGroup::new("adaptive").args(["adapt_levels", "adapt_min_ndof"]).multiple(true)))]
 struct SolveArgs {
     /// Problem name (ex71, ex72, patch).
     #[arg(long)]
@@ -174,65 +186,82 @@ struct SolveArgs {
     /// Mesh: structured:N (or symmetric:N, mirrored about y = 0.5).
     #[arg(long)]
     mesh: String,
-    /// Evaluate u_h at X,Y (repeatable).
-    #[arg(long = "probe", value_name = "X,Y")]
+    /// Evaluate u_h at X,Y in the unit square (repeatable; negative numbers are read as values).
+    #[arg(long = "probe", value_name = "X,Y", allow_hyphen_values = true)]
     probes: Vec<String>,
-    /// Print one JSON object on stdout.
-    #[arg(long)]
-    json: bool,
     /// Maximum number of active-set iterations.
-    #[arg(long, default_value_t = PdasOptions::default().max_iterations)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = PdasOptions::default().max_iterations)]
     max_pdas_iterations: usize,
     /// Log every active-set iteration on stderr.
     #[arg(long, short)]
     verbose: bool,
-    /// Marking parameter of the maximum strategy, for --adapt-levels / --adapt-min-ndof.
-    #[arg(long)]
+    /// Marking parameter of the maximum strategy, 0 < theta <= 1 (only with --adapt-levels /
+    /// --adapt-min-ndof) [default: 0.5].
+    #[arg(long, allow_negative_numbers = true, requires = "adaptive")]
     theta: Option<f64>,
-    /// Solve on the mesh of this adaptive level (from --mesh, default estimator) instead.
-    #[arg(long)]
+    /// Solve on the mesh of this adaptive level instead (refined from --mesh, marked with the
+    /// estimator options below); with --adapt-min-ndof, the last level tried.
+    #[arg(long, allow_negative_numbers = true)]
     adapt_levels: Option<usize>,
     /// Solve on the first adaptive level with at least this many unknowns (as the studies'
     /// reference solutions do) instead.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     adapt_min_ndof: Option<usize>,
     #[command(flatten)]
     estimator: EstimatorArgs,
 }
 
-fn parse_probe(s: &str) -> Result<[f64; 2]> {
-    let (x, y) = s.split_once(',').with_context(|| format!("malformed --probe '{s}': expected X,Y"))?;
-    let x: f64 = x.trim().parse().with_context(|| format!("malformed --probe '{s}': X is not a number"))?;
-    let y: f64 = y.trim().parse().with_context(|| format!("malformed --probe '{s}': Y is not a number"))?;
-    Ok([x, y])
+/// The command-line flag of an `AdaptConfig` field, for its validation errors.
+fn flag_of(key: &str) -> &'static str {
+    match key {
+        "levels" => "--levels",
+        "max_ndof" => "--max-ndof",
+        "theta" => "--theta",
+        "estimator.c0" => "--c0",
+        "pdas.max_iterations" => "--max-pdas-iterations",
+        _ => "an option",
+    }
+}
+
+/// Validate the loop's settings as manifests do, naming the flag.
+fn validate(config: &AdaptConfig) -> Result<()> {
+    config.validate().map_err(|e| anyhow::anyhow!("{}: expected {}, got {}", flag_of(e.key), e.expected, e.got))
 }
 
 fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::DiscreteSolution, report::SolveReport)> {
     let problem = problems::by_name(&args.problem)?;
     let spec = MeshSpec::parse(&args.mesh)?;
-    let probes = args.probes.iter().map(|p| parse_probe(p)).collect::<Result<Vec<_>>>()?;
-    if args.max_pdas_iterations == 0 {
-        bail!("--max-pdas-iterations must be at least 1");
+    let mut probes = Vec::new();
+    for p in &args.probes {
+        let [x, y] = report::parse_probe(p)?;
+        if !spec.contains([x, y]) {
+            bail!(report::ProbeError::Outside { x, y });
+        }
+        probes.push([x, y]);
+    }
+    let pdas = PdasOptions { max_iterations: args.max_pdas_iterations, ..Default::default() };
+    let estimator = args.estimator.config()?;
+    let adaptive = args.adapt_levels.is_some() || args.adapt_min_ndof.is_some();
+    let theta = args.theta.unwrap_or(0.5);
+    let config = AdaptConfig { levels: args.adapt_levels.map_or(200, |l| l + 1), theta, estimator, pdas: pdas.clone(), ..Default::default() };
+    validate(&config)?;
+    solve::check_memory(&spec.to_string(), spec.ndof())?;
+    if let Some(n) = args.adapt_min_ndof {
+        solve::check_memory(&format!("an adaptive level reaching --adapt-min-ndof {n}"), n as f64)?;
     }
     let mut mesh = spec.build(&|x| problem.part_of(x));
     let mut mesh_name = spec.to_string();
-    if args.adapt_levels.is_some() || args.adapt_min_ndof.is_some() {
-        let theta = args.theta.unwrap_or(0.5);
-        if !(theta > 0.0 && theta <= 1.0) {
-            bail!("--theta must be in (0, 1], got {theta}");
-        }
-        let config = AdaptConfig { levels: args.adapt_levels.map_or(200, |l| l + 1), theta, estimator: args.estimator.config()?, ..Default::default() };
+    if adaptive {
         let min_ndof = args.adapt_min_ndof.unwrap_or(0);
         let mut last = None;
         adapt::run(problem.as_ref(), mesh.clone(), &config, None, &mut |l| {
             last = Some((l.mesh.clone(), l.record.level));
             if l.record.ndof >= min_ndof && args.adapt_min_ndof.is_some() { std::ops::ControlFlow::Break(()) } else { std::ops::ControlFlow::Continue(()) }
         })?;
-        let (m, level) = last.expect("at least one level");
+        let (m, level) = last.context("the adaptive loop solved no level")?;
         mesh = m;
         mesh_name = format!("{spec} refined adaptively to level {level} (theta {theta})");
     }
-    let options = PdasOptions { max_iterations: args.max_pdas_iterations, ..Default::default() };
     let verbose = args.verbose;
     let mut log = |it: &signorini::contact::PdasIteration| {
         if verbose {
@@ -242,20 +271,17 @@ fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::Discrete
             );
         }
     };
-    let sol = solve::solve(&mesh, problem.as_ref(), &options, &mut log)
+    let sol = solve::solve(&mesh, problem.as_ref(), &pdas, &mut log)
         .with_context(|| format!("solving {} on {}", problem.name(), mesh_name))?;
     let error = problem.exact().map(|e| norms::linf_error(&mesh, &sol, &|x| e.u(x)));
-    let est = estimate::estimate(&mesh, problem.as_ref(), &sol, &args.estimator.config()?);
-    let report = report::SolveReport::new(problem.name(), &mesh_name, &mesh, &sol, error, &est, &probes);
+    let est = estimate::estimate(&mesh, problem.as_ref(), &sol, &estimator);
+    let report = report::SolveReport::new(problem.name(), &mesh_name, &mesh, &sol, error, &est, &probes)?;
     Ok((mesh, sol, report))
 }
 
 fn run_adapt(args: &AdaptArgs) -> Result<()> {
     let problem = problems::by_name(&args.problem)?;
     let spec = MeshSpec::parse(&args.mesh)?;
-    if !(args.theta > 0.0 && args.theta <= 1.0) {
-        bail!("--theta must be in (0, 1], got {}", args.theta);
-    }
     let config = AdaptConfig {
         levels: args.levels,
         max_ndof: args.max_ndof,
@@ -264,15 +290,21 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
         estimator: args.estimator.config()?,
         ..Default::default()
     };
+    validate(&config)?;
+    solve::check_memory(&spec.to_string(), spec.ndof())?;
     let mesh = spec.build(&|x| problem.part_of(x));
     let exact = problem.exact();
     let reference = exact.map(|e| move |x: [f64; 2]| e.u(x));
+    if exact.is_none() {
+        println!("# {} has no exact solution: the error and eff columns are empty (the studies measure them against a reference solution, see experiments/)", problem.name());
+    }
+    let or_dash = |v: Option<f64>, scientific: bool| v.map_or("-".to_string(), |v| if scientific { format!("{v:.3e}") } else { format!("{v:.3}") });
     println!("{:>3} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>6} {:>4} {:>7}", "lvl", "ndof", "h_min", "error", "estimate", "eff", "eta1", "eta2", "eta3", "eta4", "eta5", "eta6+7", "active", "its", "time");
     adapt::run(problem.as_ref(), mesh, &config, reference.as_ref().map(|r| r as norms::Reference), &mut |l| {
         let r = l.record;
         println!(
-            "{:>3} {:>8} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>6} {:>4} {:>7.3}",
-            r.level, r.ndof, r.h_min, r.err_quadrature.unwrap_or(f64::NAN), r.estimate, r.efficiency.unwrap_or(f64::NAN),
+            "{:>3} {:>8} {:>9.3e} {:>9} {:>9.3e} {:>9} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>6} {:>4} {:>7.3}",
+            r.level, r.ndof, r.h_min, or_dash(r.err_quadrature, true), r.estimate, or_dash(r.efficiency, false),
             r.eta1, r.eta2, r.eta3, r.eta4, r.eta5, r.eta6 + r.eta7, r.active_nodes, r.pdas_iterations, r.t_level
         );
         std::ops::ControlFlow::Continue(())
@@ -369,8 +401,8 @@ fn main() -> ExitCode {
         install_interrupt_handler();
     }
     let result = match &cli.command {
-        Command::Solve(args) => run_solve(args).map(|(_, _, r)| {
-            if args.json {
+        Command::Solve { args, json } => run_solve(args).map(|(_, _, r)| {
+            if *json {
                 println!("{}", serde_json::to_string_pretty(&r).expect("a report serialises"));
             } else {
                 print!("{}", r.summary());

@@ -4,23 +4,38 @@
 use std::io::Write;
 use std::path::Path;
 
-/// Write `bytes` to `path` atomically, creating the parent directory.
+/// Write `bytes` to `path` atomically, creating the parent directory. An error names the path
+/// and the step that failed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir)?;
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    {
+    let step = |what: &str, on: &Path| {
+        let what = what.to_string();
+        let on = on.display().to_string();
+        move |e: std::io::Error| std::io::Error::new(e.kind(), format!("{what} {on}: {e}"))
+    };
+    std::fs::create_dir_all(dir).map_err(step("creating the directory", dir))?;
+    let written = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
-        f.sync_all()?;
-    }
-    std::fs::rename(&tmp, path)
+        f.sync_all()
+    })();
+    written.map_err(step("writing", &tmp))?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        step("renaming the temporary file to", path)(e)
+    })
+}
+
+/// Read a text file; an error names the path.
+pub fn read_text(path: &Path) -> std::io::Result<String> {
+    std::fs::read_to_string(path).map_err(|e| std::io::Error::new(e.kind(), format!("reading {}: {e}", path.display())))
 }
 
 /// Serialise as pretty JSON and write atomically.
 pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Result<()> {
-    let mut s = serde_json::to_string_pretty(value).map_err(std::io::Error::other)?;
+    let mut s = serde_json::to_string_pretty(value).map_err(|e| std::io::Error::other(format!("serialising {}: {e}", path.display())))?;
     s.push('\n');
     write_atomic(path, s.as_bytes())
 }
@@ -130,13 +145,13 @@ impl StudyDir {
         let mut files: Vec<PathBuf> = match std::fs::read_dir(&dir) {
             Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|e| e == "json")).collect(),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-            Err(e) => return Err(e),
+            Err(e) => return Err(std::io::Error::new(e.kind(), format!("reading the directory {}: {e}", dir.display()))),
         };
         files.sort();
         files
             .iter()
             .map(|f| {
-                let text = std::fs::read_to_string(f)?;
+                let text = read_text(f)?;
                 serde_json::from_str(&text).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display())))
             })
             .collect()
@@ -147,13 +162,13 @@ impl StudyDir {
         match std::fs::read_to_string(&f) {
             Ok(text) => serde_json::from_str(&text).map(Some).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display()))),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-            Err(e) => Err(e),
+            Err(e) => Err(std::io::Error::new(e.kind(), format!("reading {}: {e}", f.display()))),
         }
     }
 
     pub fn read_mesh(&self, run: &str, level: usize) -> std::io::Result<MeshSnapshot> {
         let f = self.mesh_file(run, level, "json");
-        let text = std::fs::read_to_string(&f)?;
+        let text = read_text(&f)?;
         serde_json::from_str(&text).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display())))
     }
 

@@ -1,5 +1,6 @@
-//! The record of one solve, as `signorini solve --json` prints it (CONTRACT.md), and the export of
-//! a case for the NGSolve cross-check.
+//! The record of one solve, as `signorini solve --json` prints it ([`SolveReport`]: its fields
+//! are the JSON keys; `tests/bad_input.rs` checks the ones scripts rely on), and the export of a
+//! case for the NGSolve cross-check.
 
 use crate::contact::PdasIteration;
 use crate::estimate::{Estimate, EstimatorConfig, Terms};
@@ -7,17 +8,38 @@ use crate::mesh::{Mesh, io};
 use crate::norms::LinfError;
 use crate::records;
 use crate::solve::{DiscreteSolution, Kkt, SolveTimings};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
 
+/// u_h at a point.
 #[derive(Clone, Debug, Serialize)]
 pub struct Probe {
     pub x: f64,
     pub y: f64,
-    /// None outside the domain.
-    pub u: Option<[f64; 2]>,
+    pub u: [f64; 2],
+}
+
+/// A point to evaluate u_h at that is not one.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ProbeError {
+    #[error("malformed --probe '{0}': expected X,Y with two finite numbers, e.g. 0.5,0.25")]
+    Malformed(String),
+    #[error("--probe {x},{y}: the point is outside the domain, the unit square [0, 1] x [0, 1]")]
+    Outside { x: f64, y: f64 },
+}
+
+/// Read a point `X,Y` (finite numbers; spaces around them are allowed).
+pub fn parse_probe(s: &str) -> Result<[f64; 2], ProbeError> {
+    let bad = || ProbeError::Malformed(s.to_string());
+    let (x, y) = s.split_once(',').ok_or_else(bad)?;
+    let x: f64 = x.trim().parse().map_err(|_| bad())?;
+    let y: f64 = y.trim().parse().map_err(|_| bad())?;
+    if !(x.is_finite() && y.is_finite()) {
+        return Err(bad());
+    }
+    Ok([x, y])
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -55,9 +77,11 @@ pub struct ErrorSampling {
 }
 
 impl SolveReport {
-    pub fn new(problem: &str, mesh_name: &str, mesh: &Mesh, sol: &DiscreteSolution, error: Option<LinfError>, estimate: &Estimate, probes: &[[f64; 2]]) -> Self {
+    /// The report of one solve; an error if a probe is outside the mesh.
+    pub fn new(problem: &str, mesh_name: &str, mesh: &Mesh, sol: &DiscreteSolution, error: Option<LinfError>, estimate: &Estimate, probes: &[[f64; 2]]) -> Result<Self, ProbeError> {
         let (h_min, h_max) = mesh.h_range();
-        SolveReport {
+        let probes = probes.iter().map(|&[x, y]| sol.probe(mesh, [x, y]).map(|u| Probe { x, y, u }).ok_or(ProbeError::Outside { x, y })).collect::<Result<Vec<_>, _>>()?;
+        Ok(SolveReport {
             problem: problem.to_string(),
             mesh: mesh_name.to_string(),
             ndof: 2 * sol.nodes.len(),
@@ -79,25 +103,34 @@ impl SolveReport {
             estimator: estimate.terms,
             estimator_config: estimate.config,
             full_contact_nodes: estimate.full_contact_nodes,
-            probes: probes.iter().map(|p| Probe { x: p[0], y: p[1], u: sol.probe(mesh, *p) }).collect(),
+            probes,
             pdas_log: sol.pdas.clone(),
             timings: sol.timings.clone(),
-        }
+        })
     }
 
     /// A short human-readable summary.
     pub fn summary(&self) -> String {
         let mut s = String::new();
         let _ = writeln!(s, "{} on {}: {} elements, ndof {} ({} free), h in [{:.3e}, {:.3e}]", self.problem, self.mesh, self.n_elements, self.ndof, self.ndof_free, self.h_min, self.h_max);
-        let _ = writeln!(s, "contact: {} of {} nodes active, zone {:?}, {} active-set iterations", self.active_nodes, self.contact_nodes, self.contact_zone, self.pdas_iterations);
+        let zone = match self.contact_zone {
+            Some([a, b]) => format!("contact zone [{a}, {b}] along Gamma_C"),
+            None => "no contact zone".to_string(),
+        };
+        let _ = writeln!(s, "contact: {} of {} nodes active, {zone}, {} active-set iteration{}", self.active_nodes, self.contact_nodes, self.pdas_iterations, if self.pdas_iterations == 1 { "" } else { "s" });
         let _ = writeln!(s, "KKT: penetration {:.2e}, min lambda {:.2e}, complementarity {:.2e}", self.kkt.max_penetration, self.kkt.min_lambda, self.kkt.max_complementarity);
-        if let Some(e) = &self.error {
-            let _ = writeln!(s, "error Linf: quadrature {:.4e}, dense {:.4e}, nodal {:.4e}", e.linf_quadrature, e.linf_dense, e.linf_nodal);
+        match &self.error {
+            Some(e) => {
+                let _ = writeln!(s, "error Linf: quadrature {:.4e}, dense {:.4e}, nodal {:.4e}", e.linf_quadrature, e.linf_dense, e.linf_nodal);
+            }
+            None => {
+                let _ = writeln!(s, "error: not measured ({} has no exact solution)", self.problem);
+            }
         }
         let e = &self.estimator;
         let _ = writeln!(s, "estimator: eta1..7 = {:.3e} {:.3e} {:.3e} {:.3e} {:.3e} {:.3e} {:.3e}, l_h {:.3}, eta_h {:.4e}, estimate (C0 = {}) {:.4e}", e.eta1, e.eta2, e.eta3, e.eta4, e.eta5, e.eta6, e.eta7, e.l_h, e.eta_h, e.c0, e.estimate);
         for p in &self.probes {
-            let _ = writeln!(s, "u({}, {}) = {:?}", p.x, p.y, p.u);
+            let _ = writeln!(s, "u_h({}, {}) = ({:.6e}, {:.6e})", p.x, p.y, p.u[0], p.u[1]);
         }
         let t = &self.timings;
         let _ = writeln!(s, "time: assembly {:.3}s, symbolic {:.3}s, numeric {:.3}s, schur {:.3}s, solves {:.3}s, active set {:.3}s, total {:.3}s", t.assembly, t.contact.symbolic, t.contact.numeric, t.contact.schur, t.contact.solves, t.contact.active_set, t.total);
@@ -122,7 +155,7 @@ pub fn export_case(dir: &Path, mesh: &Mesh, sol: &DiscreteSolution, report: &Sol
         &[("u", io::Field::Vector(&sol.u)), ("lambda", io::Field::Scalar(&lambda)), ("active", io::Field::Int(&active)), ("contact", io::Field::Int(&contact))],
         &[],
     );
-    records::write_atomic(&dir.join("mesh.vtu"), doc.as_bytes()).with_context(|| format!("writing {}", dir.display()))?;
-    records::write_json(&dir.join("case.json"), report).with_context(|| format!("writing {}", dir.display()))?;
+    records::write_atomic(&dir.join("mesh.vtu"), doc.as_bytes())?;
+    records::write_json(&dir.join("case.json"), report)?;
     Ok(())
 }

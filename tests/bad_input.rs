@@ -64,3 +64,208 @@ fn solve_json_has_the_contract_fields() {
     let u = v["probes"][0]["u"].as_array().unwrap();
     assert_eq!(u.len(), 2);
 }
+
+/// Exit code, stdout and stderr of a run that must not panic.
+fn run_out(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!stderr.contains("panicked"), "panic: {stderr}");
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into_owned(), stderr)
+}
+
+#[test]
+fn bad_huge_mesh_is_refused_with_the_memory_estimate_before_allocating() {
+    // this used to abort (SIGABRT) allocating 160 GB of vertices
+    for mesh in ["structured:100000", "symmetric:100000"] {
+        let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", mesh]);
+        assert_eq!(code, 1, "{err}");
+        assert!(err.contains(mesh) && err.contains("149.0 TiB") && err.contains("available"), "{err}");
+        if std::path::Path::new("/proc/meminfo").exists() {
+            assert!(err.contains("MemAvailable"), "{err}");
+        }
+    }
+    let (code, err) = run(&["adapt", "--problem", "ex72", "--mesh", "structured:100000"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("needs about"), "{err}");
+    let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--adapt-min-ndof", "100000000000"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("--adapt-min-ndof") && err.contains("needs about"), "{err}");
+}
+
+#[test]
+fn memory_estimate_covers_the_measured_peaks() {
+    // peak RSS of `signorini solve` measured with /usr/bin/time -v (bytes), and the NDF
+    for (ndof, kib) in [(8450.0, 16964.0), (33282.0, 54412.0), (132098.0, 197736.0), (526338.0, 839248.0), (1182722.0, 1936888.0), (2101250.0, 3501300.0)] {
+        let est = signorini::solve::memory_estimate(ndof);
+        assert!(est >= 1.2 * kib * 1024.0, "NDF {ndof}: estimate {est} below measured peak {kib} KiB + 20 %");
+    }
+    assert_eq!(signorini::mesh::MeshSpec::Structured(512).ndof(), 2101250.0);
+}
+
+#[test]
+fn bad_probe_outside_the_domain_or_not_finite_is_an_error() {
+    for p in ["2,0.5", "0.5,-0.1", "1.0000001,0.5", "-0.1,0.5"] {
+        let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", p]);
+        assert_eq!(code, 1, "{p}: {err}");
+        assert!(err.contains("outside the domain") && err.contains(p), "{p}: {err}");
+    }
+    for p in ["nan,0.5", "0.5,NaN", "inf,0.5", "0.5,-inf", "1e999,0"] {
+        let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", p]);
+        assert_eq!(code, 1, "{p}: {err}");
+        assert!(err.contains("malformed --probe") && err.contains("finite"), "{p}: {err}");
+    }
+}
+
+#[test]
+fn probe_accepts_negative_numbers_and_corners() {
+    // a negative coordinate is a value, not a flag: read as such and then found outside
+    let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", "-0.1,0.5"]);
+    assert_eq!(code, 1);
+    assert!(!err.contains("unexpected argument") && err.contains("outside the domain"), "{err}");
+    let (code, out, err) = run_out(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", "-0,0", "--probe", "1,1", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for p in v["probes"].as_array().unwrap() {
+        assert!(p["x"].is_f64() && p["u"][0].is_f64() && p["u"][1].is_f64(), "{p}");
+    }
+}
+
+#[test]
+fn bad_inert_flags_are_rejected() {
+    let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--theta", "0.3"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--adapt-levels"), "{err}");
+    let (code, err) = run(&["adapt", "--problem", "ex71", "--uniform", "--theta", "0.3"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--uniform") && err.contains("--theta"), "{err}");
+    let d = std::env::temp_dir().join(format!("signorini-inert-{}", std::process::id()));
+    let (code, err) = run(&["export", "--problem", "ex71", "--mesh", "structured:4", "--json", "--out", d.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--json"), "{err}");
+    assert!(!d.exists());
+}
+
+#[test]
+fn bad_loop_settings_are_errors_naming_the_flag() {
+    for (args, flag, expected) in [
+        (&["--levels", "0"][..], "--levels", ">= 1"),
+        (&["--theta", "1.5"][..], "--theta", "(0, 1]"),
+        (&["--theta", "0"][..], "--theta", "(0, 1]"),
+        (&["--theta", "-0.5"][..], "--theta", "(0, 1]"),
+        (&["--max-ndof", "0"][..], "--max-ndof", ">= 1"),
+        (&["--c0", "-1"][..], "--c0", "positive"),
+        (&["--c0", "nan"][..], "--c0", "positive"),
+    ] {
+        let mut a = vec!["adapt", "--problem", "ex71"];
+        if flag != "--levels" {
+            a.extend_from_slice(&["--levels", "2"]);
+        }
+        a.extend_from_slice(args);
+        let (code, out, err) = run_out(&a);
+        assert_eq!(code, 1, "{args:?}: {err}");
+        assert!(out.is_empty(), "{args:?}: printed before failing: {out}");
+        assert!(err.contains(flag) && err.contains(expected), "{args:?}: {err}");
+    }
+    let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--adapt-levels", "1", "--theta", "1.5"]);
+    assert_eq!(code, 1);
+    assert!(err.contains("--theta") && err.contains("1.5"), "{err}");
+    let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--max-pdas-iterations", "0"]);
+    assert_eq!(code, 1);
+    assert!(err.contains("--max-pdas-iterations"), "{err}");
+}
+
+#[test]
+fn adapt_without_exact_solution_says_so_instead_of_nan() {
+    let (code, out, err) = run_out(&["adapt", "--problem", "ex72", "--levels", "2"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("no exact solution"), "{out}");
+    assert!(!out.contains("NaN"), "{out}");
+}
+
+#[test]
+fn human_output_has_no_rust_internals() {
+    let (code, out, err) = run_out(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", "0.5,0.5"]);
+    assert_eq!(code, 0, "{err}");
+    for internal in ["Some(", "None", "1 active-set iterations"] {
+        assert!(!out.contains(internal), "{internal}: {out}");
+    }
+    assert!(out.contains("1 active-set iteration") && out.contains("contact zone [0, 1]") && out.contains("u_h(0.5, 0.5) = ("), "{out}");
+    let (code, out, _) = run_out(&["solve", "--problem", "ex72", "--mesh", "structured:4"]);
+    assert_eq!(code, 0);
+    assert!(out.contains("no exact solution") && !out.contains("None") && !out.contains("Some("), "{out}");
+}
+
+#[test]
+fn bad_unwritable_output_names_the_path_and_the_step() {
+    let d = std::env::temp_dir().join(format!("signorini-unwritable-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    // a file where a folder should be: unwritable even for root
+    let file = d.join("a_file");
+    std::fs::write(&file, "").unwrap();
+    let out = file.join("out");
+    let (code, err) = run(&["export", "--problem", "ex71", "--mesh", "structured:4", "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(err.contains(out.to_str().unwrap()) && err.contains("creating the directory"), "{err}");
+    let fixture = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny.toml");
+    let (code, err) = run(&["run", fixture.to_str().unwrap(), "--quick", "--results", out.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(err.contains(out.to_str().unwrap()), "{err}");
+    let (code, err) = run(&["figures", "--results", "results", "--figures", out.to_str().unwrap()]);
+    assert_eq!(code, 1);
+    assert!(err.contains(out.to_str().unwrap()), "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn write_helpers_name_the_path() {
+    let d = std::env::temp_dir().join(format!("signorini-write-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    std::fs::write(d.join("f"), "").unwrap();
+    let target = d.join("f").join("x.json");
+    let e = signorini::records::write_json(&target, &1).unwrap_err().to_string();
+    assert!(e.contains(d.join("f").to_str().unwrap()) && e.contains("creating the directory"), "{e}");
+    // a directory where the file should be: the rename fails, and no temporary file is left
+    std::fs::create_dir_all(d.join("dir.json").join("sub")).unwrap();
+    let e = signorini::records::write_atomic(&d.join("dir.json"), b"{}").unwrap_err().to_string();
+    assert!(e.contains("dir.json") && e.contains("renaming"), "{e}");
+    assert_eq!(std::fs::read_dir(&d).unwrap().count(), 2, "temporary file left behind");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn bad_missing_manifest_is_named_once() {
+    let (code, err) = run(&["run", "experiments/no_such_study.toml"]);
+    assert_eq!(code, 1);
+    assert!(err.contains("experiments/no_such_study.toml"), "{err}");
+    assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
+}
+
+#[test]
+fn every_flag_of_every_subcommand_has_a_description() {
+    for cmd in [&[][..], &["solve"], &["adapt"], &["run"], &["drift"], &["figures"], &["export"]] {
+        let mut args = cmd.to_vec();
+        args.push("--help");
+        let (code, out, _) = run_out(&args);
+        assert_eq!(code, 0);
+        let lines: Vec<&str> = out.lines().collect();
+        let mut flags = 0;
+        for (i, line) in lines.iter().enumerate() {
+            let t = line.trim_start();
+            if !(t.starts_with("--") || (t.starts_with('-') && t.chars().nth(1).is_some_and(|c| c.is_ascii_alphabetic()))) {
+                continue;
+            }
+            flags += 1;
+            // the description follows on the same line after two spaces, or on the next, indented further
+            let same_line = t.split_once("  ").is_some_and(|(_, d)| !d.trim().is_empty());
+            let indent = line.len() - t.len();
+            let next_line = lines.get(i + 1).is_some_and(|n| {
+                let nt = n.trim_start();
+                n.len() - nt.len() > indent && !nt.is_empty() && !nt.starts_with('-')
+            });
+            assert!(same_line || next_line, "{cmd:?}: flag without a description: {line}");
+        }
+        assert!(flags >= 1, "{cmd:?}: no flags found in\n{out}");
+    }
+}

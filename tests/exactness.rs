@@ -8,7 +8,7 @@ use signorini::assembly::{self, DofMap};
 use signorini::contact::ContactSolver;
 use signorini::element::{self, Affine};
 use signorini::mesh::P2Nodes;
-use signorini::problems::{Exact, Patch, Problem, Material};
+use signorini::problems::{Exact, Patch, Material};
 
 fn max_nodal_error(p: &Patch, sol: &signorini::solve::DiscreteSolution) -> f64 {
     sol.nodes.coords.iter().zip(&sol.u).map(|(x, uh)| {

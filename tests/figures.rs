@@ -331,3 +331,121 @@ fn missing_studies_are_skipped_not_errors() {
     assert!(outcome.written.iter().any(|p| p.ends_with("fig3a.svg")));
     assert!(outcome.skipped.iter().any(|(n, why)| n == "fig3b" && why.contains("mesh snapshot")), "{:?}", outcome.skipped);
 }
+
+/// Tick labels of the y axis as exponents: "10⁻¹⁶" -> -16.
+fn decade_exponents(svg: &str) -> Vec<i32> {
+    let sup = |c: char| "⁰¹²³⁴⁵⁶⁷⁸⁹".chars().position(|d| d == c);
+    svg.lines()
+        .filter_map(|l| l.trim().strip_prefix("10"))
+        .filter_map(|rest| {
+            let (neg, digits) = match rest.strip_prefix('⁻') {
+                Some(d) => (true, d),
+                None => (false, rest),
+            };
+            let v = digits.chars().map(sup).try_fold(0i32, |a, d| d.map(|d| 10 * a + d as i32))?;
+            (!digits.is_empty()).then_some(if neg { -v } else { v })
+        })
+        .collect()
+}
+
+#[test]
+fn roundoff_estimator_terms_are_zeros_and_the_legend_says_so() {
+    let root = scratch("figures-roundoff");
+    let results = root.join("results");
+    let figures = root.join("figures");
+    // Example 7.2's adaptive run with eta6 at round-off (3e-17, next to eta1 of order 1e-2) at three levels
+    let mut rec = run("adaptive", "ex72", Refine::Adaptive).record("ex72");
+    for l in &mut rec.levels[8..11] {
+        l.eta6 = 2.78e-17;
+    }
+    let smallest = rec.levels.iter().flat_map(|l| [l.eta1, l.eta2, l.eta3, l.eta4, l.eta5, l.eta7]).filter(|&v| v > 0.0).fold(f64::INFINITY, f64::min);
+    write_json(&StudyDir::new(&results, "ex72").run_file("adaptive"), &rec).unwrap();
+    plot::draw_all(&results, &figures).expect("draw_all");
+    let fig4b = read(&figures.join("fig4b.svg"));
+    assert!(fig4b.contains("0 or below round-off at 3 of 21 levels, not drawn"), "fig4b legend");
+    // the y axis is not stretched down to the round-off values
+    let lowest = decade_exponents(&fig4b).into_iter().min().unwrap();
+    assert!(lowest as f64 >= smallest.log10().floor() - 2.0, "y axis reaches 10^{lowest}, data go down to {smallest:e}");
+}
+
+#[test]
+fn convergence_plots_carry_slope_triangles_labelled_with_the_rate() {
+    let root = scratch("figures-triangles");
+    let results = root.join("results");
+    let figures = root.join("figures");
+    full_results(&results);
+    plot::draw_all(&results, &figures).expect("draw_all");
+    for name in ["fig2a", "fig3a", "fig4a", "fig4b"] {
+        let svg = read(&figures.join(format!("{name}.svg")));
+        // the legs' labels: run 1, rise 1.5 (the rate in NDF)
+        let lines: Vec<&str> = svg.lines().map(str::trim).collect();
+        assert!(lines.contains(&"1.5") && lines.contains(&"1"), "{name}: no slope triangle labels");
+    }
+}
+
+/// A polyline in pixels.
+type Curve = Vec<(f64, f64)>;
+
+/// The legend box (x0, y0, x1, y1) and the curves (stroke width 2) of a panel SVG, in pixels.
+fn legend_and_curves(svg: &str) -> (Vec<[f64; 4]>, Vec<Curve>) {
+    let attr = |l: &str, name: &str| -> Option<String> {
+        let i = l.find(&format!(" {name}=\""))? + name.len() + 3;
+        Some(l[i..].split('"').next()?.to_string())
+    };
+    let mut boxes = Vec::new();
+    let mut curves = Vec::new();
+    for l in svg.lines() {
+        if l.starts_with("<rect") && attr(l, "opacity").as_deref() == Some("0.45") {
+            let v: Vec<f64> = ["x", "y", "width", "height"].iter().map(|k| attr(l, k).unwrap().parse().unwrap()).collect();
+            boxes.push([v[0], v[1], v[0] + v[2], v[1] + v[3]]);
+        }
+        if l.starts_with("<polyline") && attr(l, "stroke-width").as_deref() == Some("2") {
+            let pts = attr(l, "points").unwrap();
+            curves.push(
+                pts.split_whitespace()
+                    .map(|p| {
+                        let (x, y) = p.split_once(',').unwrap();
+                        (x.parse().unwrap(), y.parse().unwrap())
+                    })
+                    .collect(),
+            );
+        }
+    }
+    (boxes, curves)
+}
+
+#[test]
+fn legends_keep_clear_of_every_curve() {
+    // the stored results where present (fig3a's legend nearly touched a curve), else synthetic ones
+    let root = scratch("figures-clearance");
+    let stored = Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
+    let results = if stored.join("ex72").join("runs").is_dir() {
+        stored
+    } else {
+        full_results(&root.join("results"));
+        root.join("results")
+    };
+    let figures = root.join("figures");
+    plot::draw_figures(&results, &figures).expect("draw_figures");
+    for name in ["fig2a", "fig3a", "fig4a", "fig4b"] {
+        let Ok(svg) = std::fs::read_to_string(figures.join(format!("{name}.svg"))) else { continue };
+        let (boxes, curves) = legend_and_curves(&svg);
+        assert_eq!(boxes.len(), 1, "{name}: one legend");
+        let [x0, y0, x1, y1] = boxes[0];
+        let mut closest = f64::INFINITY;
+        let inside = |&(x, y): &(f64, f64)| x >= x0 && x <= x1 && y >= y0 && y <= y1;
+        // the legend's own swatches are inside it
+        for c in curves.iter().filter(|c| !c.iter().all(inside)) {
+            for w in c.windows(2) {
+                for k in 0..=100 {
+                    let t = k as f64 / 100.0;
+                    let (x, y) = (w[0].0 + t * (w[1].0 - w[0].0), w[0].1 + t * (w[1].1 - w[0].1));
+                    let (dx, dy) = ((x0 - x).max(x - x1).max(0.0), (y0 - y).max(y - y1).max(0.0));
+                    closest = closest.min(dx.hypot(dy));
+                }
+            }
+        }
+        // 9 px in fig3a before: it looked as if the legend touched the curve
+        assert!(closest >= 12.0, "{name}: a curve passes {closest:.1} px from the legend");
+    }
+}

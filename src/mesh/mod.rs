@@ -86,6 +86,18 @@ impl MeshSpec {
         }
     }
 
+    /// Whether `x` lies in the meshed domain: every described mesh covers the unit square.
+    pub fn contains(&self, x: [f64; 2]) -> bool {
+        (0.0..=1.0).contains(&x[0]) && (0.0..=1.0).contains(&x[1])
+    }
+
+    /// Number of P2 unknowns of the mesh, 2 (2N + 1)^2, before building it (as a float: a
+    /// mistyped N overflows any integer type).
+    pub fn ndof(&self) -> f64 {
+        let (MeshSpec::Structured(n) | MeshSpec::Symmetric(n)) = *self;
+        2.0 * (2.0 * n as f64 + 1.0).powi(2)
+    }
+
     /// Build the mesh, tagging each boundary edge by `part_of(edge midpoint)`.
     pub fn build(&self, part_of: &dyn Fn([f64; 2]) -> Part) -> Mesh {
         match *self {

@@ -30,13 +30,18 @@
 //! Style: log axes labelled at the decades (`10⁻⁴`; also 2x and 5x when less than two decades
 //! show), light grid lines at 2..9 x each decade; one colour and marker shape per series; the
 //! legend in a white box where it covers no data, as near a corner as possible (upper right
-//! first), the y range growing upwards only if no such place exists; reference slopes dashed grey
-//! with their label beside the line where it covers no data. Labels have real subscripts and
+//! first) and at least 14 px from every curve, the y range growing upwards only if no such place
+//! exists; reference slopes dashed grey with their label beside the line where it covers no data,
+//! and a slope triangle on the side away from the data, its legs labelled 1 (run) and the rate
+//! (rise), as convergence plots in this field carry them. Labels have real subscripts and
 //! superscripts (see `rich`).
 //!
 //! On log axes a value that is exactly 0 cannot be drawn: the point is left out, the line
 //! breaks, and the legend says so ("η₆ = 0 at all levels", or "(= 0 at 3 of 20 levels, not
-//! drawn)"). Missing values (`None`, e.g. no error measured at a level) are left out silently.
+//! drawn)"). In Fig. 4 an estimator term below round-off (less than [`ROUNDOFF`] times the
+//! largest term of its level, e.g. η₆ = 3×10⁻¹⁷ next to η₁ = 20) is treated as 0 in the same
+//! way, and the legend says "0 or below round-off". Missing values (`None`, e.g. no error
+//! measured at a level) are left out silently.
 //!
 //! Fonts: DejaVu Sans is bundled (`src/plot/DejaVuSans.ttf`, copied from the Debian
 //! fonts-dejavu-core package, version 2.37; the DejaVu fonts licence, a Bitstream Vera
@@ -65,6 +70,11 @@ pub const FIGURES: [&str; 12] = [
 
 /// C0 of Section 7.
 const C0_PAPER: f64 = 0.45;
+/// An estimator term below `ROUNDOFF` times the largest term of its level is round-off: drawn
+/// as 0 (not at all, on a log axis). Legitimate small terms are 1e-6 of the largest or more in
+/// every stored run; round-off is 1e-18 of it.
+pub const ROUNDOFF: f64 = 1e-12;
+
 /// The level of the mesh in Fig. 3(b).
 const MESH_LEVEL: usize = 20;
 
@@ -248,7 +258,7 @@ fn distinguish<K: PartialEq>(group: &[&RunRecord], r: &RunRecord, key: impl Fn(&
 }
 
 fn series(r: &RunRecord, label: String, style: Style, y: impl Fn(&LevelRecord) -> Option<f64>) -> Series {
-    Series { label, points: r.levels.iter().map(|l| (l.ndof as f64, y(l))).collect(), style }
+    Series { label, points: r.levels.iter().map(|l| (l.ndof as f64, y(l))).collect(), style, roundoff: false }
 }
 
 fn efficiency(l: &LevelRecord) -> Option<f64> {
@@ -359,8 +369,11 @@ fn fig4(results: &Path, study: &str, fig: &str, terms: usize) -> anyhow::Result<
         NDF_DESC,
         "estimator contributions η_{i}",
     );
+    let is_roundoff = |l: &LevelRecord, v: f64| v != 0.0 && v.abs() < ROUNDOFF * etas(l).iter().fold(0.0f64, |a, e| a.max(e.abs()));
     for i in 0..terms {
-        p.series.push(series(r, format!("η_{{{}}}", i + 1), Style::nth(i), |l| Some(etas(l)[i])));
+        let mut s = series(r, format!("η_{{{}}}", i + 1), Style::nth(i), |l| Some(if is_roundoff(l, etas(l)[i]) { 0.0 } else { etas(l)[i] }));
+        s.roundoff = r.levels.iter().any(|l| is_roundoff(l, etas(l)[i]));
+        p.series.push(s);
     }
     // the terms not plotted (Fig. 4(a) shows eta1..eta5): say what they are
     for i in terms..7 {

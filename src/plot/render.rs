@@ -25,6 +25,8 @@ const FS_TICK: f64 = 15.0;
 const FS_LEGEND: f64 = 15.0;
 const FS_SLOPE: f64 = 16.0;
 const MARKER: i32 = 5;
+/// Pixels between the legend box and any curve, marker or label.
+const LEGEND_CLEARANCE: i32 = 14;
 const X_LABEL_AREA: i32 = 62;
 const Y_LABEL_AREA: i32 = 96;
 
@@ -98,6 +100,8 @@ pub(crate) struct Series {
     pub label: String,
     pub points: Vec<(f64, Option<f64>)>,
     pub style: Style,
+    /// Some zeros stand for values below round-off (the legend says so).
+    pub roundoff: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -127,6 +131,29 @@ pub(crate) enum SlopeAnchor {
 
 /// A reference line placed: the series, its end points in data coordinates, above the data?
 type PlacedSlope<'a> = (&'a Slope, [f64; 4], bool);
+
+/// The slope triangle of a reference line `l` = [x0, y0, x1, y1] (log-log): its hypotenuse is the
+/// part of the line between 68 % and 95 % of its length, its legs are horizontal (one unit of
+/// run) and vertical (the rate), on the side of the line away from the data. Returns the corners
+/// A (start of the hypotenuse), B (its end) and the right-angle corner C.
+fn slope_triangle(l: [f64; 4], above: bool) -> [(f64, f64); 3] {
+    let at = |t: f64| {
+        let x = l[0] * (l[2] / l[0]).powf(t);
+        let y = l[1] * (l[3] / l[1]).powf(t);
+        (x, y)
+    };
+    let (a, b) = (at(0.68), at(0.95));
+    // a falling line: below it the corner is under A, above it over B (and the other way round)
+    let falling = l[3] < l[1];
+    let c = if above == falling { (b.0, a.1) } else { (a.0, b.1) };
+    [a, b, c]
+}
+
+/// The rate as the legs' label: "1.5", "2", "0.5".
+fn rate_text(rate: f64) -> String {
+    let r = rate.abs();
+    if (r - r.round()).abs() < 1e-9 { format!("{}", r.round()) } else { format!("{r}") }
+}
 
 #[derive(Clone, Debug)]
 pub(crate) struct HLine {
@@ -262,10 +289,11 @@ impl Prepared<'_> {
     }
     fn legend_label(&self) -> String {
         let l = &self.series.label;
+        let zero = if self.series.roundoff { "0 or below round-off" } else { "0" };
         if self.segments.is_empty() {
-            if self.zeros > 0 && self.zeros == self.present { format!("{l} = 0 at all levels") } else { format!("{l}: no data") }
+            if self.zeros > 0 && self.zeros == self.present { format!("{l} = {zero} at all levels") } else { format!("{l}: no data") }
         } else if self.zeros > 0 {
-            format!("{l} (= 0 at {} of {} levels, not drawn)", self.zeros, self.present)
+            format!("{l} (= {zero} at {} of {} levels, not drawn)", self.zeros, self.present)
         } else {
             l.clone()
         }
@@ -398,9 +426,10 @@ fn render_panel<DB: DrawingBackend>(
         })
         .collect();
     for (_, l, above) in &slopes {
-        // room for the label on its side of the line
+        // room for the label on its side of the line, and for the triangle's labels
         let room = if *above { 3.0 } else { 1.0 / 3.0 };
         yv.extend([l[1], l[3], l[1] * room]);
+        yv.extend(slope_triangle(*l, *above).iter().map(|c| c.1 * if *above { 1.5 } else { 1.0 / 1.5 }));
     }
     // guide lines, with room below them for their label
     let (ymin, ymax) = yv.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
@@ -495,7 +524,7 @@ fn render_panel<DB: DrawingBackend>(
             let best = ys_
                 .iter()
                 .flat_map(|&y| xs_.iter().map(move |&x| (x, y)))
-                .filter(|&(x, y)| !taken.hits((x, y, legend_w, legend_h), 4))
+                .filter(|&(x, y)| !taken.hits((x, y, legend_w, legend_h), LEGEND_CLEARANCE))
                 .min_by_key(|&(x, y)| {
                     let (dx, dy) = ((x - left).min(right - x), (y - top).min(bottom - y));
                     (dx + dy, (y - top > bottom - y) as u8, (x - left < right - x) as u8)
@@ -548,6 +577,18 @@ fn render_panel<DB: DrawingBackend>(
         chart.draw_series(DashedLineSeries::new(vec![(*x0, *y0), (*x1, *y1)], 9, 6, grey.stroke_width(2))).drawn()?;
         let anchor = if *above { (HPos::Left, VPos::Bottom) } else { (HPos::Right, VPos::Top) };
         rich::draw(root, &s.label, FS_SLOPE, &grey, anchor, *at, false, m)?;
+        // the slope triangle: legs 1 (horizontal) and the rate (vertical), labelled outside
+        let [a, b, c] = slope_triangle([*x0, *y0, *x1, *y1], *above);
+        let [pa, pb, pc] = [a, b, c].map(|q| chart.backend_coord(&q));
+        root.draw(&PathElement::new(vec![pa, pc, pb], grey.stroke_width(2))).drawn()?;
+        // the horizontal leg joins C and whichever of A, B shares its y
+        let (h_end, v_end) = if pc.1 == pa.1 { (pa, pb) } else { (pb, pa) };
+        let h_mid = ((pc.0 + h_end.0) / 2, pc.1);
+        let v_mid = (pc.0, (pc.1 + v_end.1) / 2);
+        let h_below = pc.1 > v_end.1;
+        let v_left = pc.0 < h_end.0;
+        rich::draw(root, "1", FS_SLOPE, &grey, (HPos::Center, if h_below { VPos::Top } else { VPos::Bottom }), (h_mid.0, h_mid.1 + if h_below { 5 } else { -5 }), false, m)?;
+        rich::draw(root, &rate_text(s.rate), FS_SLOPE, &grey, (if v_left { HPos::Right } else { HPos::Left }, VPos::Center), (v_mid.0 + if v_left { -6 } else { 6 }, v_mid.1), false, m)?;
     }
     // curves, then markers on top
     for s in &prepared {
@@ -644,9 +685,21 @@ fn obstacle_samples<DB: DrawingBackend>(
             }
         }
     }
-    for (_, l, _) in slopes {
+    for (_, l, above) in slopes {
         let (a, b) = (chart.backend_coord(&(l[0], l[1])), chart.backend_coord(&(l[2], l[3])));
         line(a, b, &mut out);
+        // the slope triangle's legs and a box for each of their labels
+        let [pa, pb, pc] = slope_triangle(*l, *above).map(|q| chart.backend_coord(&q));
+        line(pa, pc, &mut out);
+        line(pc, pb, &mut out);
+        let (h_end, v_end) = if pc.1 == pa.1 { (pa, pb) } else { (pb, pa) };
+        for mid in [((pc.0 + h_end.0) / 2, pc.1), (pc.0, (pc.1 + v_end.1) / 2)] {
+            for dx in [-30, -15, 0, 15, 30] {
+                for dy in [-20, -10, 0, 10, 20] {
+                    out.push((mid.0 + dx, mid.1 + dy));
+                }
+            }
+        }
     }
     for h in hlines {
         if ya.contains(h.y) {

@@ -29,6 +29,7 @@
 //! id = "uniform"
 //! refine = "uniform"
 //! levels = 9
+//! no_reference = true        # drop the defaults' reference in this run
 //!
 //! [drift]                    # tolerances of the drift check (study::drift): a float passes
 //!                            # when |fresh - stored| <= rel |stored| + floor max_run |stored|
@@ -41,9 +42,11 @@
 //! last = 4
 //! ```
 //!
-//! Every error names the file, the key and what was expected.
+//! Every error names the file, the key and what was expected; unknown keys are errors. The run's
+//! loop settings are checked by [`AdaptConfig::validate`](crate::adapt::AdaptConfig::validate),
+//! as on the command line.
 
-use crate::adapt::Refine;
+use crate::adapt::{AdaptConfig, Refine};
 use crate::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
 use crate::mesh::MeshSpec;
 use crate::norms::Sampling;
@@ -54,8 +57,8 @@ use std::path::{Path, PathBuf};
 
 #[derive(Debug, thiserror::Error)]
 pub enum ManifestError {
-    #[error("{file}: cannot read: {source}")]
-    Read { file: PathBuf, source: std::io::Error },
+    #[error("{file}: cannot read the manifest: {error}")]
+    Read { file: PathBuf, error: std::io::Error },
     #[error("{file}: {message}")]
     Syntax { file: PathBuf, message: String },
     #[error("{file}: key `{key}`: expected {expected}, got {got}")]
@@ -63,7 +66,7 @@ pub enum ManifestError {
 }
 
 #[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table of estimator settings (c0, contact_term, log_factor, sampling)")]
 struct EstimatorOverrides {
     c0: Option<f64>,
     contact_term: Option<ContactTerm>,
@@ -73,7 +76,7 @@ struct EstimatorOverrides {
 }
 
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table { theta, min_ndof, contact_term }")]
 struct ReferenceToml {
     theta: f64,
     min_ndof: usize,
@@ -81,7 +84,7 @@ struct ReferenceToml {
 }
 
 #[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a table of run settings")]
 struct RunToml {
     id: Option<String>,
     problem: Option<String>,
@@ -94,7 +97,7 @@ struct RunToml {
     save_levels: Option<Vec<usize>>,
     estimator: Option<EstimatorOverrides>,
     reference: Option<ReferenceToml>,
-    /// `reference = false` in a run drops the defaults' reference.
+    /// `no_reference = true` in a run drops the defaults' reference.
     no_reference: Option<bool>,
 }
 
@@ -143,7 +146,7 @@ impl DriftSpec {
 }
 
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a manifest (description, [defaults], [[run]], [drift])")]
 struct ManifestToml {
     description: Option<String>,
     defaults: Option<RunToml>,
@@ -174,7 +177,7 @@ pub struct Manifest {
 
 impl Manifest {
     pub fn load(path: &Path) -> Result<Self, ManifestError> {
-        let bytes = std::fs::read(path).map_err(|source| ManifestError::Read { file: path.to_path_buf(), source })?;
+        let bytes = std::fs::read(path).map_err(|error| ManifestError::Read { file: path.to_path_buf(), error })?;
         let text = String::from_utf8_lossy(&bytes);
         Self::parse(path, &text).map(|mut m| {
             m.bytes = bytes.clone();
@@ -184,13 +187,19 @@ impl Manifest {
 
     pub fn parse(path: &Path, text: &str) -> Result<Self, ManifestError> {
         let file = path.to_path_buf();
-        let raw: ManifestToml = toml::from_str(text).map_err(|e| ManifestError::Syntax { file: file.clone(), message: e.to_string().trim_end().to_string() })?;
+        let raw: ManifestToml = toml::from_str(text).map_err(|e| ManifestError::Syntax { file: file.clone(), message: plain_words(e.to_string().trim_end()) })?;
         let study = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let invalid = |key: String, expected: &str, got: String| ManifestError::Invalid { file: file.clone(), key, expected: expected.to_string(), got };
         if raw.run.is_empty() {
             return Err(invalid("run".into(), "at least one [[run]] table", "none".into()));
         }
         let d = raw.defaults.clone().unwrap_or_default();
+        if d.id.is_some() {
+            return Err(invalid("defaults.id".into(), "no id in [defaults] (every [[run]] names its own)", format!("{:?}", d.id.unwrap_or_default())));
+        }
+        if d.no_reference.is_some() {
+            return Err(invalid("defaults.no_reference".into(), "no_reference only in a [[run]] (leave [defaults.reference] out instead)", "a value".into()));
+        }
         let mut runs = Vec::new();
         let mut ids = std::collections::BTreeSet::new();
         for (i, r) in raw.run.iter().enumerate() {
@@ -209,17 +218,7 @@ impl Manifest {
             let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| "structured:4".into());
             MeshSpec::parse(&mesh).map_err(|_| invalid(key("mesh"), "'structured:N' or 'symmetric:N'", format!("{mesh:?}")))?;
             let levels = r.levels.or(d.levels).ok_or_else(|| invalid(key("levels"), "a number of levels >= 1", "nothing".into()))?;
-            if levels == 0 {
-                return Err(invalid(key("levels"), "a number of levels >= 1", "0".into()));
-            }
-            let quick_levels = r.quick_levels.or(d.quick_levels).unwrap_or(levels.min(6));
-            if quick_levels == 0 || quick_levels > levels {
-                return Err(invalid(key("quick_levels"), &format!("a number in 1..={levels} (levels)"), quick_levels.to_string()));
-            }
             let theta = r.theta.or(d.theta).unwrap_or(0.5);
-            if !(theta > 0.0 && theta <= 1.0) {
-                return Err(invalid(key("theta"), "a number in (0, 1]", theta.to_string()));
-            }
             let e = EstimatorConfig::default();
             let (eo, ed) = (r.estimator.clone().unwrap_or_default(), d.estimator.clone().unwrap_or_default());
             let estimator = EstimatorConfig {
@@ -229,17 +228,13 @@ impl Manifest {
                 sampling: eo.sampling.or(ed.sampling).unwrap_or(e.sampling),
                 stress_frame: eo.stress_frame.or(ed.stress_frame).unwrap_or(e.stress_frame),
             };
-            if !(estimator.c0 > 0.0) {
-                return Err(invalid(key("estimator.c0"), "a positive number", estimator.c0.to_string()));
-            }
             let reference = if r.no_reference == Some(true) { None } else { r.reference.clone().or(d.reference.clone()) };
-            if let Some(rf) = &reference {
-                if !(rf.theta > 0.0 && rf.theta <= 1.0) {
-                    return Err(invalid(key("reference.theta"), "a number in (0, 1]", rf.theta.to_string()));
-                }
+            if let Some(rf) = &reference
+                && !(rf.theta > 0.0 && rf.theta <= 1.0)
+            {
+                return Err(invalid(key("reference.theta"), "a number in (0, 1]", rf.theta.to_string()));
             }
-            runs.push(PlannedRun {
-                spec: RunSpec {
+            let spec = RunSpec {
                     id,
                     problem,
                     mesh,
@@ -250,9 +245,19 @@ impl Manifest {
                     estimator,
                     reference: reference.map(|rf| ReferenceSpec { theta: rf.theta, min_ndof: rf.min_ndof, contact_term: rf.contact_term.unwrap_or(ContactTerm::WithoutFullContact) }),
                     save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
-                },
-                quick_levels,
-            });
+            };
+            AdaptConfig::for_run(&spec).validate().map_err(|e| invalid(key(e.key), e.expected, e.got))?;
+            let quick_levels = r.quick_levels.or(d.quick_levels).unwrap_or(levels.min(6));
+            if quick_levels == 0 || quick_levels > levels {
+                return Err(invalid(key("quick_levels"), &format!("a number in 1..={levels} (levels)"), quick_levels.to_string()));
+            }
+            if let Some(&l) = spec.save_levels.iter().find(|&&l| l >= levels) {
+                return Err(invalid(key("save_levels"), &format!("levels in 0..={} (the run has {levels} levels, numbered from 0)", levels - 1), l.to_string()));
+            }
+            if spec.reference.as_ref().is_some_and(|rf| rf.min_ndof == 0) {
+                return Err(invalid(key("reference.min_ndof"), "a number of unknowns >= 1", "0".into()));
+            }
+            runs.push(PlannedRun { spec, quick_levels });
         }
         let drift = raw.drift.unwrap_or_default();
         let floats = crate::records::float_fields();
@@ -307,4 +312,11 @@ pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
         }
     }
     Ok(all.into_iter().filter(|m| only.is_empty() || only.contains(&m.study)).collect())
+}
+
+/// Serde's messages name Rust types (`expected usize`); a manifest's reader knows TOML values.
+fn plain_words(message: &str) -> String {
+    [("expected usize", "expected a non-negative integer"), ("expected u64", "expected a non-negative integer"), ("expected f64", "expected a number"), ("expected i64", "expected an integer"), ("expected a sequence", "expected an array"), ("expected a map", "expected a table")]
+        .iter()
+        .fold(message.to_string(), |m, (rust, toml)| m.replace(rust, toml))
 }

@@ -1,0 +1,133 @@
+//! Manifests: every setting the loop cannot use is an error naming the file and the key, checked by
+//! the same `AdaptConfig::validate` as the command line; unknown keys are errors everywhere;
+//! serde's Rust type names never reach the reader.
+
+use signorini::adapt::AdaptConfig;
+use signorini::study::manifest::Manifest;
+use std::path::Path;
+
+const BASE: &str = "[defaults]\nproblem = \"ex71\"\nlevels = 24\n";
+
+fn parse_err(text: &str) -> String {
+    match Manifest::parse(Path::new("experiments/bad_case.toml"), text) {
+        Ok(_) => panic!("accepted a bad manifest:\n{text}"),
+        Err(e) => {
+            let s = e.to_string();
+            assert!(s.starts_with("experiments/bad_case.toml"), "error does not name the file: {s}");
+            s
+        }
+    }
+}
+
+fn run_with(extra: &str) -> String {
+    parse_err(&format!("{BASE}[[run]]\nid = \"a\"\n{extra}\n"))
+}
+
+#[test]
+fn bad_save_levels_beyond_the_run_are_errors() {
+    let e = run_with("save_levels = [99]");
+    assert!(e.contains("run[0].save_levels") && e.contains("99") && e.contains("0..=23"), "{e}");
+    let e = run_with("levels = 3\nsave_levels = [0, 3]");
+    assert!(e.contains("run[0].save_levels") && e.contains("got 3"), "{e}");
+    // the defaults' save_levels are checked against each run's levels
+    let e = parse_err("[defaults]\nproblem = \"ex71\"\nlevels = 5\nsave_levels = [4]\n[[run]]\nid = \"a\"\n[[run]]\nid = \"b\"\nlevels = 2\n");
+    assert!(e.contains("run[1].save_levels"), "{e}");
+}
+
+#[test]
+fn bad_loop_settings_are_errors_from_the_one_validation() {
+    let e = run_with("max_ndof = 0");
+    assert!(e.contains("run[0].max_ndof") && e.contains(">= 1"), "{e}");
+    let e = run_with("levels = 0");
+    assert!(e.contains("run[0].levels") && e.contains(">= 1"), "{e}");
+    let e = run_with("theta = 1.01");
+    assert!(e.contains("run[0].theta") && e.contains("(0, 1]"), "{e}");
+    let e = run_with("estimator = { c0 = 0.0 }");
+    assert!(e.contains("run[0].estimator.c0") && e.contains("positive"), "{e}");
+    let e = run_with("reference = { theta = 0.5, min_ndof = 0 }");
+    assert!(e.contains("run[0].reference.min_ndof"), "{e}");
+}
+
+#[test]
+fn adapt_config_validate_rejects_what_the_loop_cannot_run() {
+    assert_eq!(AdaptConfig::default().validate(), Ok(()));
+    let bad = [
+        AdaptConfig { theta: 1.5, ..Default::default() },
+        AdaptConfig { theta: 0.0, ..Default::default() },
+        AdaptConfig { theta: f64::NAN, ..Default::default() },
+        AdaptConfig { levels: 0, ..Default::default() },
+        AdaptConfig { max_ndof: Some(0), ..Default::default() },
+    ];
+    let keys = ["theta", "theta", "theta", "levels", "max_ndof"];
+    for (c, key) in bad.iter().zip(keys) {
+        let e = c.validate().unwrap_err();
+        assert_eq!(e.key, key);
+        assert!(e.to_string().contains("expected"), "{e}");
+    }
+    let mut c = AdaptConfig::default();
+    c.estimator.c0 = -1.0;
+    assert_eq!(c.validate().unwrap_err().key, "estimator.c0");
+    c = AdaptConfig::default();
+    c.pdas.max_iterations = 0;
+    assert_eq!(c.validate().unwrap_err().key, "pdas.max_iterations");
+}
+
+#[test]
+fn bad_keys_are_errors_everywhere() {
+    for (text, key) in [
+        (format!("{BASE}[[run]]\nid = \"a\"\nsave_level = [1]\n"), "save_level"),
+        (format!("{BASE}lvels = 3\n[[run]]\nid = \"a\"\n"), "lvels"),
+        (format!("descripton = \"x\"\n{BASE}[[run]]\nid = \"a\"\n"), "descripton"),
+        (format!("{BASE}[[run]]\nid = \"a\"\nestimator = {{ c_0 = 1.0 }}\n"), "c_0"),
+        (format!("{BASE}[[run]]\nid = \"a\"\nreference = {{ theta = 0.5, min_ndof = 10, thta = 1 }}\n"), "thta"),
+        (format!("{BASE}[defaults.estimator]\nsamplng = \"dense\"\n[[run]]\nid = \"a\"\n"), "samplng"),
+    ] {
+        let e = parse_err(&text);
+        assert!(e.contains(key), "{key}: {e}");
+    }
+    // keys that only make sense per run are not silently ignored in [defaults]
+    let e = parse_err(&format!("{BASE}id = \"x\"\n[[run]]\nid = \"a\"\n"));
+    assert!(e.contains("defaults.id"), "{e}");
+    let e = parse_err(&format!("{BASE}no_reference = true\n[[run]]\nid = \"a\"\n"));
+    assert!(e.contains("defaults.no_reference"), "{e}");
+}
+
+#[test]
+fn no_reference_drops_the_defaults_reference() {
+    let text = "[defaults]\nproblem = \"ex72\"\nlevels = 3\nreference = { theta = 0.5, min_ndof = 4000 }\n[[run]]\nid = \"a\"\n[[run]]\nid = \"b\"\nno_reference = true\n";
+    let m = Manifest::parse(Path::new("x.toml"), text).unwrap();
+    assert!(m.runs[0].spec.reference.is_some());
+    assert!(m.runs[1].spec.reference.is_none());
+    // and the format documentation says so
+    let doc = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("src/study/manifest.rs")).unwrap();
+    assert!(doc.contains("no_reference = true") && !doc.contains("`reference = false`"));
+}
+
+#[test]
+fn type_errors_speak_toml_not_rust() {
+    for (extra, expected) in [
+        ("levels = -1", "a non-negative integer"),
+        ("levels = \"many\"", "a non-negative integer"),
+        ("theta = \"half\"", "a number"),
+        ("save_levels = 3", "an array"),
+        ("reference = 3", "a table"),
+        ("estimator = 2", "a table"),
+    ] {
+        let e = run_with(extra);
+        assert!(e.contains(expected), "{extra}: {e}");
+        for rust in ["usize", "f64", "struct", "ReferenceToml", "EstimatorOverrides", "RunToml", "Option"] {
+            assert!(!e.contains(rust), "{extra}: Rust type name {rust} in: {e}");
+        }
+    }
+}
+
+#[test]
+fn every_declared_study_still_parses() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
+    for f in std::fs::read_dir(&dir).unwrap() {
+        let f = f.unwrap().path();
+        if f.extension().is_some_and(|e| e == "toml") {
+            Manifest::load(&f).unwrap_or_else(|e| panic!("{e}"));
+        }
+    }
+}
