@@ -22,7 +22,7 @@ SIDES = {
 
 
 def structured_triangles(n):
-    """CONTRACT.md's structured:N mesh: unit square, N x N squares, each cut by the diagonal
+    """The harness's structured:N mesh (README, 'The command line'): unit square, N x N squares, each cut by the diagonal
     from its lower-left to its upper-right corner. Returns vertices (n+1)^2 x 2, CCW triangles."""
     t = np.linspace(0.0, 1.0, n + 1)
     X, Y = np.meshgrid(t, t)  # vertex (i, j) -> index j * (n + 1) + i

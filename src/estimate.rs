@@ -106,7 +106,7 @@ impl Default for EstimatorConfig {
     }
 }
 
-/// The estimator's terms (the `estimator` object of CONTRACT.md).
+/// The estimator's terms (the `estimator` object of `signorini solve --json`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Terms {
     pub eta1: f64,

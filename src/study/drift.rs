@@ -209,7 +209,8 @@ pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], q
             out.push(row(study, id, None, "run spec", serde_json::to_string(&expected_spec).unwrap_or_default(), serde_json::to_string(&f.run).unwrap_or_default(), None, "exact".into()));
         }
         if s.reference_ndof != f.reference_ndof {
-            out.push(row(study, id, None, "reference_ndof", format!("{:?}", s.reference_ndof), format!("{:?}", f.reference_ndof), None, "exact".into()));
+            let text = |n: Option<usize>| n.map(|n| n.to_string()).unwrap_or("none".into());
+            out.push(row(study, id, None, "reference_ndof", text(s.reference_ndof), text(f.reference_ndof), None, "exact".into()));
         }
         let n_compare = if quick { f.levels.len() } else { s.levels.len().max(f.levels.len()) };
         let expected_levels = if quick { s.levels.len().min(expected_spec.levels) } else { s.levels.len() };

@@ -316,7 +316,7 @@ pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
 
 /// Serde's messages name Rust types (`expected usize`); a manifest's reader knows TOML values.
 fn plain_words(message: &str) -> String {
-    [("expected usize", "expected a non-negative integer"), ("expected u64", "expected a non-negative integer"), ("expected f64", "expected a number"), ("expected i64", "expected an integer"), ("expected a sequence", "expected an array"), ("expected a map", "expected a table")]
+    [("expected usize", "expected a non-negative integer"), ("expected u64", "expected a non-negative integer"), ("expected f64", "expected a number"), ("expected i64", "expected an integer"), ("expected a sequence", "expected an array"), ("expected a map", "expected a table"), ("expected struct Tolerance", "expected a table { rel = .., floor = .. }")]
         .iter()
         .fold(message.to_string(), |m, (rust, toml)| m.replace(rust, toml))
 }

@@ -287,6 +287,7 @@ fn reference_key(spec: &RunSpec) -> Option<String> {
 fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Result<Option<RunRecord>> {
     let problem = problems::by_name(&spec.problem)?;
     let mesh_spec = MeshSpec::parse(&spec.mesh)?;
+    crate::solve::check_memory(&format!("{study}/{}: the initial mesh {}", spec.id, spec.mesh), mesh_spec.ndof())?;
     if spec.reference.is_some() && problem.exact().is_some() {
         bail!("{study}/{}: problem {} has an exact solution; a reference solution is not needed", spec.id, spec.problem);
     }
@@ -324,14 +325,7 @@ fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Resul
         (None, Some(f)) => Some(f),
         (None, None) => None,
     };
-    let config = AdaptConfig {
-        levels: spec.levels,
-        max_ndof: spec.max_ndof,
-        refine: spec.refine,
-        theta: spec.theta,
-        estimator: spec.estimator,
-        ..Default::default()
-    };
+    let config = AdaptConfig::for_run(spec);
     let pb = bar(progress, spec.levels as u64, &format!("{study}/{}", spec.id));
     let mut save_error: Option<anyhow::Error> = None;
     let mut stopped = false;

@@ -1,4 +1,4 @@
-//! Provenance of a study's results (CONTRACT.md): git commit and dirty flag, Cargo.lock hash,
+//! Provenance of a study's results (`results/STUDY/provenance.json`): git commit and dirty flag, Cargo.lock hash,
 //! rustc version, the manifest's hash, machine, threads, date.
 
 use serde::{Deserialize, Serialize};
