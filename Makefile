@@ -10,13 +10,15 @@ all: build
 build:
 	$(CARGO) build --release --locked
 
-# What CI runs: unit and integration tests (release mode: the convergence tests solve real
+# What CI runs: formatting and lints (rustfmt.toml, clippy -D warnings), unit and integration tests (release mode: the convergence tests solve real
 # systems), the full drift check (every study rerun and compared with results/ at every level,
 # plus levels.csv, provenance and CLAIMS.md against the records), and the NGSolve cross-check.
 # Test-time outputs (drift report, cross-check tables with timings) go under target/; the last
 # step fails if the run changed any file git sees.
 test: build
 	@mkdir -p target && (git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-before-test
+	$(CARGO) fmt --check
+	$(CARGO) clippy --release --locked --all-targets -- -D warnings
 	$(CARGO) test --release --locked
 	$(BIN) drift
 	CROSSCHECK_OUT=target/crosscheck-report crosscheck/run.sh

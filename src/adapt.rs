@@ -3,8 +3,8 @@
 
 use crate::contact::PdasOptions;
 use crate::estimate::{self, Estimate, EstimatorConfig};
-use crate::mesh::refine::{self, Refinement};
 use crate::mesh::Mesh;
+use crate::mesh::refine::{self, Refinement};
 use crate::norms::{self, Reference};
 use crate::problems::Problem;
 use crate::solve::{self, DiscreteSolution, SolveError};

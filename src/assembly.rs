@@ -393,6 +393,7 @@ pub fn split_load(map: &Affine, corners: [[f64; 2]; 3], c: f64, f: &dyn Fn([f64;
 
 /// Take the element matrix and load to the local frames of its contact nodes:
 /// K' = T K T^T, f' = T f with T block diagonal (rotation at contact nodes, identity elsewhere).
+#[allow(clippy::needless_range_loop)] // two rows (columns) of k change together
 fn rotate(k: &mut [[f64; 12]; 12], f: &mut [f64; 12], el: &[usize; 6], dofs: &DofMap) {
     for (a, &p) in el.iter().enumerate() {
         let Some(r) = dofs.frame(p) else { continue };
@@ -520,10 +521,9 @@ fn neumann_load(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
                 Some(r) => [r[0][0] * load[i][0] + r[0][1] * load[i][1], r[1][0] * load[i][0] + r[1][1] * load[i][1]],
                 None => load[i],
             };
-            for c in 0..2 {
-                let d = dofs.dof[p][c];
+            for (&d, &lc) in dofs.dof[p].iter().zip(&l) {
                 if d != FIXED {
-                    rhs[d] += l[c];
+                    rhs[d] += lc;
                 }
             }
         }

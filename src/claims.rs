@@ -168,12 +168,7 @@ fn estimator_text(ctx: &Ctx, r: Option<&RunRecord>) -> String {
 fn growth_text(name: &str, g: Option<&verdict::RateFit>) -> String {
     match g {
         None => format!("{name}: n/a"),
-        Some(g) => format!(
-            "{name}: slope of log against log NDF {} ({}) → {}",
-            g.text(),
-            g.range(),
-            verdict::judge_trend(g).text()
-        ),
+        Some(g) => format!("{name}: slope of log against log NDF {} ({}) → {}", g.text(), g.range(), verdict::judge_trend(g).text()),
     }
 }
 
@@ -181,11 +176,16 @@ fn growth_text(name: &str, g: Option<&verdict::RateFit>) -> String {
 /// (max over the levels of error / eta_h).
 pub fn overestimation(r: &RunRecord, err_field: &str) -> Option<(f64, f64, f64)> {
     let err = verdict::field(r, err_field);
-    let pairs: Vec<(f64, f64)> = r.levels.iter().zip(&err).map(|(l, e)| e.filter(|e| *e > 0.0).map(|e| (l.estimate / e, e / l.eta_h))).collect::<Option<_>>()?;
+    let pairs: Vec<(f64, f64)> =
+        r.levels.iter().zip(&err).map(|(l, e)| e.filter(|e| *e > 0.0).map(|e| (l.estimate / e, e / l.eta_h))).collect::<Option<_>>()?;
     if pairs.is_empty() {
         return None;
     }
-    Some((pairs.iter().map(|p| p.0).fold(f64::INFINITY, f64::min), pairs.iter().map(|p| p.0).fold(0.0, f64::max), pairs.iter().map(|p| p.1).fold(0.0, f64::max)))
+    Some((
+        pairs.iter().map(|p| p.0).fold(f64::INFINITY, f64::min),
+        pairs.iter().map(|p| p.0).fold(0.0, f64::max),
+        pairs.iter().map(|p| p.1).fold(0.0, f64::max),
+    ))
 }
 
 /// Smallest C_0 with C_0 eta_h >= error at every level (quadrature sampling).
@@ -240,7 +240,8 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         verdict: judge(est.as_ref(), OPTIMAL),
     });
 
-    let terms: Vec<String> = ["eta1", "eta2", "eta3", "eta4", "eta5"].iter().map(|n| rate_text(n, ctx.rate(a71, Q::Field(n)).as_ref(), Some(OPTIMAL))).collect();
+    let terms: Vec<String> =
+        ["eta1", "eta2", "eta3", "eta4", "eta5"].iter().map(|n| rate_text(n, ctx.rate(a71, Q::Field(n)).as_ref(), Some(OPTIMAL))).collect();
     let slower = |r: Option<&RunRecord>| -> String {
         let rates: Option<Vec<f64>> = ["eta4", "eta5"].iter().map(|n| ctx.rate(r, Q::Field(n)).map(|x| x.main.rate.slope)).collect();
         rates.map(|v| format!("NDF^(-{:.2})", v[0].min(v[1]))).unwrap_or("n/a".into())
@@ -355,7 +356,8 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let verdicts: Vec<Verdict> = reps.iter().map(|r| judge(r.as_ref(), OPTIMAL)).collect();
     out.push(Claim {
         id: "7.2-rates",
-        claim: "Ex. 7.2: the full estimator eta_h and the individual estimators eta_1..eta_7 converge optimally, NDF^(-3/2) (Fig. 3a, 4b)".into(),
+        claim: "Ex. 7.2: the full estimator eta_h and the individual estimators eta_1..eta_7 converge optimally, NDF^(-3/2) (Fig. 3a, 4b)"
+            .into(),
         measured: if a72.is_none() {
             String::new()
         } else {
@@ -424,10 +426,19 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let peaks = a72
         .filter(|r| r.levels.iter().any(|l| l.max_indicator_x != 0.0 || l.max_indicator_y != 0.0))
         .map(|r| {
-            let near = |l: &crate::adapt::LevelRecord| [[0.0, 0.0], [0.0, 1.0]].iter().any(|c| crate::mesh::dist(*c, [l.max_indicator_x, l.max_indicator_y]) <= 0.05);
+            let near = |l: &crate::adapt::LevelRecord| {
+                [[0.0, 0.0], [0.0, 1.0]].iter().any(|c| crate::mesh::dist(*c, [l.max_indicator_x, l.max_indicator_y]) <= 0.05)
+            };
             let n = r.levels.iter().filter(|l| near(l)).count();
-            let at = |k: usize| r.levels.get(k).map(|l| format!("level {k} at ({:.3}, {:.3})", l.max_indicator_x, l.max_indicator_y)).unwrap_or_default();
-            format!("Adaptive run: the largest element indicator lies within 0.05 of a corner (0, 0) or (0, 1) at {n} of {} levels ({}; {})", r.levels.len(), at(20), at(r.levels.len() - 1))
+            let at = |k: usize| {
+                r.levels.get(k).map(|l| format!("level {k} at ({:.3}, {:.3})", l.max_indicator_x, l.max_indicator_y)).unwrap_or_default()
+            };
+            format!(
+                "Adaptive run: the largest element indicator lies within 0.05 of a corner (0, 0) or (0, 1) at {n} of {} levels ({}; {})",
+                r.levels.len(),
+                at(20),
+                at(r.levels.len() - 1)
+            )
         })
         .unwrap_or_default();
     let eu = ctx.rate(u72, Q::Error);
@@ -482,7 +493,7 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     });
 
     // eta_6, eta_7 against the length of the contact edge straddling the free boundary
-    let fb_edge = a72.and_then(|r| {
+    let fb_edge = a72.map(|r| {
         // one point per plateau of h_free_boundary (its last level), where eta_6, eta_7 are above round-off
         let mut plateaus: Vec<(f64, usize, usize)> = Vec::new();
         for (i, l) in r.levels.iter().enumerate() {
@@ -493,7 +504,8 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             }
         }
         let fit = |f: fn(&crate::adapt::LevelRecord) -> f64| {
-            let pts: Vec<(f64, f64)> = plateaus.iter().map(|p| (p.0, f(&r.levels[p.2]))).filter(|p| p.1 > 1e-14).map(|p| (p.0.ln(), p.1.ln())).collect();
+            let pts: Vec<(f64, f64)> =
+                plateaus.iter().map(|p| (p.0, f(&r.levels[p.2]))).filter(|p| p.1 > 1e-14).map(|p| (p.0.ln(), p.1.ln())).collect();
             verdict::fit_line(&pts)
         };
         // largest change of eta_6 + eta_7 within a plateau of at least two levels
@@ -505,7 +517,7 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 v.iter().cloned().fold(0.0, f64::max) / v.iter().cloned().fold(f64::INFINITY, f64::min)
             })
             .fold(1.0, f64::max);
-        Some((fit(|l| l.eta6), fit(|l| l.eta7), plateaus, within))
+        (fit(|l| l.eta6), fit(|l| l.eta7), plateaus, within)
     });
     out.push(Claim {
         id: "7.2-eta6-eta7 (beyond the paper)",
@@ -535,7 +547,9 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         any = true;
         let prof = refinement::profile(&m, [1.0, 0.0], [1.0, 1.0]);
         let mut pts: Vec<String> = Vec::new();
-        for (name, s, claimed) in [("free boundary y = zone start", z0, true), ("free boundary y = zone end", z1, true), ("wedge tip y = 0.5", 0.5, false)] {
+        for (name, s, claimed) in
+            [("free boundary y = zone start", z0, true), ("free boundary y = zone end", z1, true), ("wedge tip y = 0.5", 0.5, false)]
+        {
             if let Some(lm) = refinement::local_minimum(&prof, s, 0.15) {
                 if claimed && study == "ex72" {
                     ok &= lm.holds;
@@ -548,7 +562,10 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             if study == "ex72" {
                 ok &= inner < ring;
             }
-            pts.push(format!("{name}: h_min {inner:.1e} within 0.02, {ring:.1e} at 0.02–0.1 → {}", if inner < ring { "refinement centre" } else { "no refinement centre" }));
+            pts.push(format!(
+                "{name}: h_min {inner:.1e} within 0.02, {ring:.1e} at 0.02–0.1 → {}",
+                if inner < ring { "refinement centre" } else { "no refinement centre" }
+            ));
         }
         parts.push(format!("{study}/{id} level {} (NDF {}): {}", m.level, m.ndof, pts.join("; ")));
     }
@@ -564,7 +581,8 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 /// The log-factor ablation: the efficiency trend per l_h.
 fn log_factor_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let la = StudyDir::new(ctx.results, "log_ablation").read_runs()?;
-    let rows: Vec<String> = la.iter().map(|r| growth_text(&format!("{} efficiency", r.run.id), ctx.growth(Some(r), Q::Efficiency).as_ref())).collect();
+    let rows: Vec<String> =
+        la.iter().map(|r| growth_text(&format!("{} efficiency", r.run.id), ctx.growth(Some(r), Q::Efficiency).as_ref())).collect();
     out.push(Claim {
         id: "log-factor (ablation)",
         claim: "Eq. 6.3's factor l_h = 1 + |log h_min|^2 against 1 + |log h_min| and 1: the trend of the efficiency index (no claim of the paper; for reading the rows above)".into(),
@@ -599,12 +617,19 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         verdict: if none { Verdict::NoData } else { judge(e_ad.as_ref(), OPTIMAL) },
     });
 
-    let rows: Vec<(String, f64)> = [("adaptive", ad), ("adaptive_wfc", wfc), ("uniform", un)].iter().filter_map(|(n, r)| c0_text(n, (*r)?, ctx.err_field())).collect();
+    let rows: Vec<(String, f64)> =
+        [("adaptive", ad), ("adaptive_wfc", wfc), ("uniform", un)].iter().filter_map(|(n, r)| c0_text(n, (*r)?, ctx.err_field())).collect();
     out.push(Claim {
         id: "fb-reliability",
         claim: "fb: C_0 = 0.45 is reliable, C_0 eta_h >= ||u - u_h||_Linf at every level; the smallest reliable C_0".into(),
         measured: if rows.is_empty() { "no data".into() } else { rows.iter().map(|r| r.0.clone()).collect::<Vec<_>>().join("; ") },
-        verdict: if rows.is_empty() { Verdict::NoData } else if rows.iter().all(|r| r.1 <= 0.45) { Verdict::Holds } else { Verdict::Fails },
+        verdict: if rows.is_empty() {
+            Verdict::NoData
+        } else if rows.iter().all(|r| r.1 <= 0.45) {
+            Verdict::Holds
+        } else {
+            Verdict::Fails
+        },
     });
 
     // judged for the paper's estimator as written, like 7.1-efficiency
@@ -642,7 +667,13 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 if verdict == Verdict::NoData {
                     verdict = if lm.holds { Verdict::Holds } else { Verdict::Fails };
                 }
-                parts.push(format!("{id} level {} (NDF {}): at x = a {} → {}", m.level, m.ndof, lm.text(), if lm.holds { "local minimum" } else { "no local minimum" }));
+                parts.push(format!(
+                    "{id} level {} (NDF {}): at x = a {} → {}",
+                    m.level,
+                    m.ndof,
+                    lm.text(),
+                    if lm.holds { "local minimum" } else { "no local minimum" }
+                ));
             }
             None => parts.push(format!("{id} level {}: no mesh edge on Gamma_C contains x = a", m.level)),
         }
@@ -680,9 +711,16 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let zs: Vec<(String, bool)> = [ad, wfc, un].into_iter().filter_map(zone).collect();
     out.push(Claim {
         id: "fb-contact-zone",
-        claim: "fb: the discrete contact zone tends to [a, 1]: |zone start - a| decays (rate interval above 0) and the zone ends at x = 1".into(),
+        claim: "fb: the discrete contact zone tends to [a, 1]: |zone start - a| decays (rate interval above 0) and the zone ends at x = 1"
+            .into(),
         measured: if zs.is_empty() { "no data".into() } else { zs.iter().map(|z| z.0.clone()).collect::<Vec<_>>().join("; ") },
-        verdict: if zs.is_empty() { Verdict::NoData } else if zs.iter().all(|z| z.1) { Verdict::Holds } else { Verdict::Fails },
+        verdict: if zs.is_empty() {
+            Verdict::NoData
+        } else if zs.iter().all(|z| z.1) {
+            Verdict::Holds
+        } else {
+            Verdict::Fails
+        },
     });
     Ok(())
 }
@@ -712,7 +750,12 @@ pub fn claims(results: &Path) -> std::io::Result<Vec<Claim>> {
             }
         }
     }
-    let flips: Vec<String> = out.iter().zip(&dense).filter(|(q, d)| q.verdict != d.verdict).map(|(q, d)| format!("{}: {} → {} (dense: {})", q.id, q.verdict.text(), d.verdict.text(), d.measured)).collect();
+    let flips: Vec<String> = out
+        .iter()
+        .zip(&dense)
+        .filter(|(q, d)| q.verdict != d.verdict)
+        .map(|(q, d)| format!("{}: {} → {} (dense: {})", q.id, q.verdict.text(), d.verdict.text(), d.measured))
+        .collect();
     out.push(Claim {
         id: "sampling",
         claim: "Gauss-point maxima underestimate the L-infinity norm: every verdict above recomputed with the error maxima over the order-6 barycentric lattice of every element (err_dense) instead of the quadrature points, and with the runs RUN_dense (estimator maxima on the dense lattice and dense edge points too, `estimator.sampling = \"dense\"`) in place of RUN where a study has them".into(),

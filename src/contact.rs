@@ -27,21 +27,25 @@
 use crate::assembly::SymCsc;
 use crate::ordering::OrderingChoice;
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, supernodal,
 };
-use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::SupernodalThreshold;
 use faer::{Conj, Mat, Par, Side, Spec};
 use std::time::Instant;
 
 /// Why the contact solve failed.
 #[derive(Debug, thiserror::Error)]
 pub enum ContactError {
-    #[error("the primal-dual active set method did not converge in {iterations} iterations (NCP residual {residual:.3e}, tolerance {tolerance:.1e}, {active} active nodes)")]
+    #[error(
+        "the primal-dual active set method did not converge in {iterations} iterations (NCP residual {residual:.3e}, tolerance {tolerance:.1e}, {active} active nodes)"
+    )]
     NotConverged { iterations: usize, residual: f64, tolerance: f64, active: usize },
-    #[error("the primal-dual active set method is cycling: the active set of iteration {iterations} was already seen at iteration {first_seen} (NCP residual {residual:.3e})")]
+    #[error(
+        "the primal-dual active set method is cycling: the active set of iteration {iterations} was already seen at iteration {first_seen} (NCP residual {residual:.3e})"
+    )]
     Cycling { iterations: usize, first_seen: usize, residual: f64 },
     #[error("the stiffness matrix is not positive definite: {0}")]
     NotPositiveDefinite(String),
@@ -323,7 +327,13 @@ impl ContactSolver {
         Ok(PdasOutput { u, lambda, active, iterations, termination: Termination::Converged, c })
     }
 
-    fn solve_schur(&mut self, rhs: &[f64], gap: &[f64], options: &PdasOptions, observe: &mut dyn FnMut(&PdasIteration)) -> Result<PdasResult, ContactError> {
+    fn solve_schur(
+        &mut self,
+        rhs: &[f64],
+        gap: &[f64],
+        options: &PdasOptions,
+        observe: &mut dyn FnMut(&PdasIteration),
+    ) -> Result<PdasResult, ContactError> {
         let (ni, m) = (self.n_interior, self.n_contact());
         let y = self.solve(rhs);
         let yc = &y[ni..];
@@ -358,7 +368,14 @@ impl ContactSolver {
         Ok((u, lambda, active, iterations, c))
     }
 
-    fn solve_refactor(&mut self, matrix: &SymCsc, rhs: &[f64], gap: &[f64], options: &PdasOptions, observe: &mut dyn FnMut(&PdasIteration)) -> Result<PdasResult, ContactError> {
+    fn solve_refactor(
+        &mut self,
+        matrix: &SymCsc,
+        rhs: &[f64],
+        gap: &[f64],
+        options: &PdasOptions,
+        observe: &mut dyn FnMut(&PdasIteration),
+    ) -> Result<PdasResult, ContactError> {
         let (ni, m) = (self.n_interior, self.n_contact());
         let diag = |k: usize| matrix.values[matrix.col_ptr[ni + k]];
         let c = options.c_scale * (0..m).map(diag).sum::<f64>() / m as f64;
@@ -406,7 +423,12 @@ impl ContactSolver {
 /// Symbolic Cholesky, supernodal, with the fill-reducing ordering of [`crate::ordering`].
 /// Schur: the leading block `I` is ordered and `C` kept in place at the end, so that the
 /// trailing block of L is L_CC. Refactor: all unknowns are ordered.
-fn symbolic_factorisation(matrix: &SymCsc, ni: usize, coords: &[[f64; 2]], strategy: Strategy) -> Result<(SymbolicCholesky<usize>, OrderingChoice), ContactError> {
+fn symbolic_factorisation(
+    matrix: &SymCsc,
+    ni: usize,
+    coords: &[[f64; 2]],
+    strategy: Strategy,
+) -> Result<(SymbolicCholesky<usize>, OrderingChoice), ContactError> {
     let n = matrix.n;
     let n_order = if strategy == Strategy::Schur { ni } else { n };
     let (fwd, choice) = crate::ordering::fill_reducing(matrix, n_order, coords);
@@ -415,16 +437,23 @@ fn symbolic_factorisation(matrix: &SymCsc, ni: usize, coords: &[[f64; 2]], strat
         inv[old] = new;
     }
     let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
-    let params = CholeskySymbolicParams {
-        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-        ..Default::default()
-    };
-    let symbolic = faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(matrix.as_faer().symbolic(), Side::Lower, SymmetricOrdering::Custom(perm), params)
-        .map_err(|e| ContactError::Factorisation(format!("{e:?}")))?;
+    let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
+    let symbolic = faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
+        matrix.as_faer().symbolic(),
+        Side::Lower,
+        SymmetricOrdering::Custom(perm),
+        params,
+    )
+    .map_err(|e| ContactError::Factorisation(format!("{e:?}")))?;
     Ok((symbolic, choice))
 }
 
 type PdasResult = (Vec<f64>, Vec<f64>, Vec<bool>, Vec<PdasIteration>, f64);
+
+/// The values of u and lambda at the contact normals (one active-set step's result).
+pub type Pair = (Vec<f64>, Vec<f64>);
+/// What [`pdas`] returns: u and lambda at the contact normals, the active set, the iterations.
+pub type PdasOutcome = (Vec<f64>, Vec<f64>, Vec<bool>, Vec<PdasIteration>);
 
 /// The primal–dual active set iteration, whatever solves its linear systems.
 /// Active set A = {p : lambda_p + c (u_p - g_p) > 0}; `step(A)` returns (u_C, lambda) with
@@ -437,8 +466,8 @@ pub fn pdas(
     initial: Vec<bool>,
     options: &PdasOptions,
     observe: &mut dyn FnMut(&PdasIteration),
-    step: &mut dyn FnMut(&[bool]) -> Result<(Vec<f64>, Vec<f64>), ContactError>,
-) -> Result<(Vec<f64>, Vec<f64>, Vec<bool>, Vec<PdasIteration>), ContactError> {
+    step: &mut dyn FnMut(&[bool]) -> Result<Pair, ContactError>,
+) -> Result<PdasOutcome, ContactError> {
     let m = g.len();
     let mut active = initial;
     let mut seen: Vec<(Vec<bool>, usize)> = Vec::new();
@@ -462,10 +491,10 @@ pub fn pdas(
         if next == active && residual <= options.tolerance {
             return Ok((u, lambda, active, iterations));
         }
-        if next != active {
-            if let Some((_, first_seen)) = seen.iter().find(|(a, _)| *a == next) {
-                return Err(ContactError::Cycling { iterations: it, first_seen: *first_seen, residual });
-            }
+        if next != active
+            && let Some((_, first_seen)) = seen.iter().find(|(a, _)| *a == next)
+        {
+            return Err(ContactError::Cycling { iterations: it, first_seen: *first_seen, residual });
         }
         seen.push((active.clone(), it));
         active = next;

@@ -151,19 +151,13 @@ impl Affine {
     /// Physical point of reference point (x, y).
     #[inline]
     pub fn map(&self, p: [f64; 2]) -> [f64; 2] {
-        [
-            self.origin[0] + self.jac[0][0] * p[0] + self.jac[0][1] * p[1],
-            self.origin[1] + self.jac[1][0] * p[0] + self.jac[1][1] * p[1],
-        ]
+        [self.origin[0] + self.jac[0][0] * p[0] + self.jac[0][1] * p[1], self.origin[1] + self.jac[1][0] * p[0] + self.jac[1][1] * p[1]]
     }
 
     /// Physical gradient from a reference gradient.
     #[inline]
     pub fn grad(&self, g: [f64; 2]) -> [f64; 2] {
-        [
-            self.inv_t[0][0] * g[0] + self.inv_t[0][1] * g[1],
-            self.inv_t[1][0] * g[0] + self.inv_t[1][1] * g[1],
-        ]
+        [self.inv_t[0][0] * g[0] + self.inv_t[0][1] * g[1], self.inv_t[1][0] * g[0] + self.inv_t[1][1] * g[1]]
     }
 
     /// Reference coordinates of a physical point (inverse map).
@@ -171,10 +165,7 @@ impl Affine {
     pub fn inverse(&self, x: [f64; 2]) -> [f64; 2] {
         let d = [x[0] - self.origin[0], x[1] - self.origin[1]];
         // J^{-1} = inv_t^T
-        [
-            self.inv_t[0][0] * d[0] + self.inv_t[1][0] * d[1],
-            self.inv_t[0][1] * d[0] + self.inv_t[1][1] * d[1],
-        ]
+        [self.inv_t[0][0] * d[0] + self.inv_t[1][0] * d[1], self.inv_t[0][1] * d[0] + self.inv_t[1][1] * d[1]]
     }
 }
 
@@ -184,9 +175,7 @@ pub fn p2_hessians(map: &Affine) -> [[f64; 3]; N_NODES] {
     // barycentric gradients in physical coordinates
     let dl = [map.grad([-1.0, -1.0]), map.grad([1.0, 0.0]), map.grad([0.0, 1.0])];
     let mut h = [[0.0; 3]; N_NODES];
-    let outer = |a: [f64; 2], b: [f64; 2]| {
-        [a[0] * b[0], 0.5 * (a[0] * b[1] + a[1] * b[0]), a[1] * b[1]]
-    };
+    let outer = |a: [f64; 2], b: [f64; 2]| [a[0] * b[0], 0.5 * (a[0] * b[1] + a[1] * b[0]), a[1] * b[1]];
     for i in 0..3 {
         // L_i (2 L_i - 1): hessian 4 dL_i dL_i^T
         let o = outer(dl[i], dl[i]);

@@ -102,7 +102,13 @@ pub struct EstimatorConfig {
 
 impl Default for EstimatorConfig {
     fn default() -> Self {
-        EstimatorConfig { contact_term: ContactTerm::AsWritten, log_factor: LogFactor::Squared, c0: 0.45, sampling: Sampling::Quadrature, stress_frame: StressFrame::Normal }
+        EstimatorConfig {
+            contact_term: ContactTerm::AsWritten,
+            log_factor: LogFactor::Squared,
+            c0: 0.45,
+            sampling: Sampling::Quadrature,
+            stress_frame: StressFrame::Normal,
+        }
     }
 }
 

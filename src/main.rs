@@ -2,10 +2,10 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use signorini::contact::PdasOptions;
-use signorini::mesh::MeshSpec;
 use signorini::adapt::{self, AdaptConfig, Refine};
+use signorini::contact::PdasOptions;
 use signorini::estimate::{self, ContactTerm, EstimatorConfig, LogFactor};
+use signorini::mesh::MeshSpec;
 use signorini::norms::Sampling;
 use signorini::{norms, problems, report, solve, study};
 use std::process::ExitCode;
@@ -124,11 +124,21 @@ struct EstimatorArgs {
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
-enum ContactTermArg { AsWritten, WithoutFullContact }
+enum ContactTermArg {
+    AsWritten,
+    WithoutFullContact,
+}
 #[derive(Clone, Copy, clap::ValueEnum)]
-enum LogFactorArg { Squared, Linear, One }
+enum LogFactorArg {
+    Squared,
+    Linear,
+    One,
+}
 #[derive(Clone, Copy, clap::ValueEnum)]
-enum SamplingArg { Quadrature, Dense }
+enum SamplingArg {
+    Quadrature,
+    Dense,
+}
 
 impl EstimatorArgs {
     fn config(&self) -> Result<EstimatorConfig> {
@@ -243,7 +253,8 @@ fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::Discrete
     let estimator = args.estimator.config()?;
     let adaptive = args.adapt_levels.is_some() || args.adapt_min_ndof.is_some();
     let theta = args.theta.unwrap_or(0.5);
-    let config = AdaptConfig { levels: args.adapt_levels.map_or(200, |l| l + 1), theta, estimator, pdas: pdas.clone(), ..Default::default() };
+    let config =
+        AdaptConfig { levels: args.adapt_levels.map_or(200, |l| l + 1), theta, estimator, pdas: pdas.clone(), ..Default::default() };
     validate(&config)?;
     solve::check_memory(&spec.to_string(), spec.ndof())?;
     if let Some(n) = args.adapt_min_ndof {
@@ -256,7 +267,11 @@ fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::Discrete
         let mut last = None;
         adapt::run(problem.as_ref(), mesh.clone(), &config, None, &mut |l| {
             last = Some((l.mesh.clone(), l.record.level));
-            if l.record.ndof >= min_ndof && args.adapt_min_ndof.is_some() { std::ops::ControlFlow::Break(()) } else { std::ops::ControlFlow::Continue(()) }
+            if l.record.ndof >= min_ndof && args.adapt_min_ndof.is_some() {
+                std::ops::ControlFlow::Break(())
+            } else {
+                std::ops::ControlFlow::Continue(())
+            }
         })?;
         let (m, level) = last.context("the adaptive loop solved no level")?;
         mesh = m;
@@ -265,14 +280,11 @@ fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::Discrete
     let verbose = args.verbose;
     let mut log = |it: &signorini::contact::PdasIteration| {
         if verbose {
-            eprintln!(
-                "pdas {:>3}: active {:>6} (+{} -{}), residual {:.3e}",
-                it.iteration, it.active, it.added, it.removed, it.residual
-            );
+            eprintln!("pdas {:>3}: active {:>6} (+{} -{}), residual {:.3e}", it.iteration, it.active, it.added, it.removed, it.residual);
         }
     };
-    let sol = solve::solve(&mesh, problem.as_ref(), &pdas, &mut log)
-        .with_context(|| format!("solving {} on {}", problem.name(), mesh_name))?;
+    let sol =
+        solve::solve(&mesh, problem.as_ref(), &pdas, &mut log).with_context(|| format!("solving {} on {}", problem.name(), mesh_name))?;
     let error = problem.exact().map(|e| norms::linf_error(&mesh, &sol, &|x| e.u(x)));
     let est = estimate::estimate(&mesh, problem.as_ref(), &sol, &estimator);
     let report = report::SolveReport::new(problem.name(), &mesh_name, &mesh, &sol, error, &est, &probes)?;
@@ -296,23 +308,51 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
     let exact = problem.exact();
     let reference = exact.map(|e| move |x: [f64; 2]| e.u(x));
     if exact.is_none() {
-        println!("# {} has no exact solution: the error and eff columns are empty (the studies measure them against a reference solution, see experiments/)", problem.name());
+        println!(
+            "# {} has no exact solution: the error and eff columns are empty (the studies measure them against a reference solution, see experiments/)",
+            problem.name()
+        );
     }
-    let or_dash = |v: Option<f64>, scientific: bool| v.map_or("-".to_string(), |v| if scientific { format!("{v:.3e}") } else { format!("{v:.3}") });
-    println!("{:>3} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>6} {:>4} {:>7}", "lvl", "ndof", "h_min", "error", "estimate", "eff", "eta1", "eta2", "eta3", "eta4", "eta5", "eta6+7", "active", "its", "time");
+    let or_dash =
+        |v: Option<f64>, scientific: bool| v.map_or("-".to_string(), |v| if scientific { format!("{v:.3e}") } else { format!("{v:.3}") });
+    println!(
+        "{:>3} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>6} {:>4} {:>7}",
+        "lvl", "ndof", "h_min", "error", "estimate", "eff", "eta1", "eta2", "eta3", "eta4", "eta5", "eta6+7", "active", "its", "time"
+    );
     adapt::run(problem.as_ref(), mesh, &config, reference.as_ref().map(|r| r as norms::Reference), &mut |l| {
         let r = l.record;
         println!(
             "{:>3} {:>8} {:>9.3e} {:>9} {:>9.3e} {:>9} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>6} {:>4} {:>7.3}",
-            r.level, r.ndof, r.h_min, or_dash(r.err_quadrature, true), r.estimate, or_dash(r.efficiency, false),
-            r.eta1, r.eta2, r.eta3, r.eta4, r.eta5, r.eta6 + r.eta7, r.active_nodes, r.pdas_iterations, r.t_level
+            r.level,
+            r.ndof,
+            r.h_min,
+            or_dash(r.err_quadrature, true),
+            r.estimate,
+            or_dash(r.efficiency, false),
+            r.eta1,
+            r.eta2,
+            r.eta3,
+            r.eta4,
+            r.eta5,
+            r.eta6 + r.eta7,
+            r.active_nodes,
+            r.pdas_iterations,
+            r.t_level
         );
         std::ops::ControlFlow::Continue(())
     })?;
     Ok(())
 }
 
-fn run_studies(manifests: &[std::path::PathBuf], quick: bool, jobs: Option<usize>, shard: Option<&str>, fresh: bool, results: Option<std::path::PathBuf>, wait: bool) -> Result<()> {
+fn run_studies(
+    manifests: &[std::path::PathBuf],
+    quick: bool,
+    jobs: Option<usize>,
+    shard: Option<&str>,
+    fresh: bool,
+    results: Option<std::path::PathBuf>,
+    wait: bool,
+) -> Result<()> {
     if let Some(j) = jobs {
         if j == 0 {
             bail!("--jobs must be at least 1");
@@ -331,34 +371,70 @@ fn run_studies(manifests: &[std::path::PathBuf], quick: bool, jobs: Option<usize
     Ok(())
 }
 
-fn run_drift(quick: bool, against: Option<&std::path::Path>, report_file: Option<&std::path::Path>, accept: &[String], only: &[String], experiments: &std::path::Path, results: &std::path::Path) -> Result<()> {
+fn run_drift(
+    quick: bool,
+    against: Option<&std::path::Path>,
+    report_file: Option<&std::path::Path>,
+    accept: &[String],
+    only: &[String],
+    experiments: &std::path::Path,
+    results: &std::path::Path,
+) -> Result<()> {
     if !accept.is_empty() {
         for m in study::manifest::declared(experiments, accept)? {
-            let options = study::RunOptions { quick: false, shard: None, fresh: true, results: results.to_path_buf(), progress: true, wait_for_lock: false };
+            let options = study::RunOptions {
+                quick: false,
+                shard: None,
+                fresh: true,
+                results: results.to_path_buf(),
+                progress: true,
+                wait_for_lock: false,
+            };
             study::run_study(&m, &options)?;
-            eprintln!("accepted: {} rewritten from a full rerun of {}; run `signorini figures`, review and commit the change", results.join(&m.study).display(), m.file.display());
+            eprintln!(
+                "accepted: {} rewritten from a full rerun of {}; run `signorini figures`, review and commit the change",
+                results.join(&m.study).display(),
+                m.file.display()
+            );
         }
         return Ok(());
     }
     let manifests = study::manifest::declared(experiments, only)?;
     let scratch = std::path::PathBuf::from("target/drift").join(if quick { "quick" } else { "full" });
-    let options = study::drift::DriftOptions { quick, against: against.map(|p| p.to_path_buf()), scratch, results: results.to_path_buf(), progress: true };
-    let report = study::drift::run(&manifests, only.is_empty(), &options, &|r| signorini::claims::claims(r).map(|c| signorini::claims::markdown(&c)))?;
+    let options = study::drift::DriftOptions {
+        quick,
+        against: against.map(|p| p.to_path_buf()),
+        scratch,
+        results: results.to_path_buf(),
+        progress: true,
+    };
+    let report = study::drift::run(&manifests, only.is_empty(), &options, &|r| {
+        signorini::claims::claims(r).map(|c| signorini::claims::markdown(&c))
+    })?;
     // the table first: a report that cannot be written must not cost it
     if report.rows.is_empty() {
-        println!("drift: none ({} {} checked at every level{})", manifests.len(), if manifests.len() == 1 { "study" } else { "studies" }, if quick { " of the quick forms" } else { "" });
+        println!(
+            "drift: none ({} {} checked at every level{})",
+            manifests.len(),
+            if manifests.len() == 1 { "study" } else { "studies" },
+            if quick { " of the quick forms" } else { "" }
+        );
     } else {
         print!("{}", study::drift::table(&report.rows));
     }
     println!("\nlargest change of each float field (whether within tolerance or not):\n{}", study::drift::changes_table(&report));
-    let default_name = format!("report{}{}.json", if quick { "_quick" } else { "" }, only.iter().map(|s| format!("-{s}")).collect::<String>());
+    let default_name =
+        format!("report{}{}.json", if quick { "_quick" } else { "" }, only.iter().map(|s| format!("-{s}")).collect::<String>());
     let file = report_file.map(|p| p.to_path_buf()).unwrap_or_else(|| std::path::Path::new("target/drift").join(default_name));
     signorini::records::write_json(&file, &report).with_context(|| format!("writing the drift report {}", file.display()))?;
     println!("report: {}", file.display());
     if report.rows.is_empty() {
         Ok(())
     } else {
-        bail!("drift: {} field(s) moved; if the change is deliberate, run `signorini drift --accept STUDY`, then `signorini figures`, and commit results/ and figures/", report.rows.len())
+        bail!(
+            "drift: {} field(s) moved; if the change is deliberate, run `signorini drift --accept STUDY`, then `signorini figures`, and commit results/ and figures/",
+            report.rows.len()
+        )
     }
 }
 
@@ -410,8 +486,12 @@ fn main() -> ExitCode {
         }),
         Command::Adapt(args) => run_adapt(args),
         Command::Figures { results, figures, experiments } => run_figures(results, figures, experiments),
-        Command::Drift { quick, against, report, accept, study, experiments, results } => run_drift(*quick, against.as_deref(), report.as_deref(), accept, study, experiments, results),
-        Command::Run { manifests, quick, jobs, shard, fresh, results, wait } => run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, results.clone(), *wait),
+        Command::Drift { quick, against, report, accept, study, experiments, results } => {
+            run_drift(*quick, against.as_deref(), report.as_deref(), accept, study, experiments, results)
+        }
+        Command::Run { manifests, quick, jobs, shard, fresh, results, wait } => {
+            run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, results.clone(), *wait)
+        }
         Command::Export { args, out } => run_solve(args).and_then(|(mesh, sol, r)| report::export_case(out, &mesh, &sol, &r)),
     };
     match result {

@@ -55,7 +55,13 @@ pub fn linf_error_on(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference, samp
 }
 
 /// max |u - u_h| over the sampling points x with `keep(x)`; None if no point is kept.
-pub fn linf_error_where(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference, sampling: Sampling, keep: &(dyn Fn([f64; 2]) -> bool + Sync)) -> Option<f64> {
+pub fn linf_error_where(
+    mesh: &Mesh,
+    sol: &DiscreteSolution,
+    exact: Reference,
+    sampling: Sampling,
+    keep: &(dyn Fn([f64; 2]) -> bool + Sync),
+) -> Option<f64> {
     let refs = sampling.points();
     (0..mesh.n_triangles())
         .into_par_iter()
@@ -69,10 +75,13 @@ pub fn linf_error_where(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference, s
                 })
                 .reduce(f64::max)
         })
-        .reduce(|| None, |a, b| match (a, b) {
-            (Some(a), Some(b)) => Some(a.max(b)),
-            (a, b) => a.or(b),
-        })
+        .reduce(
+            || None,
+            |a, b| match (a, b) {
+                (Some(a), Some(b)) => Some(a.max(b)),
+                (a, b) => a.or(b),
+            },
+        )
 }
 
 /// Points per edge of the contact-edge sampling (end points included).

@@ -124,9 +124,9 @@ pub fn fill_reducing(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (V
         || {
             let pattern = faer::sparse::SymbolicSparseColMatRef::new_checked(n_order, n_order, &graph.ptr, None, &graph.adj);
             let (mut fwd, mut inv) = (vec![0u32; n_order], vec![0u32; n_order]);
-            let flops = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(n_order, graph.adj.len()))
-                .ok()
-                .and_then(|mut mem| amd::order_maybe_unsorted(&mut fwd, &mut inv, pattern, amd::Control::default(), MemStack::new(&mut mem)).ok());
+            let flops = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(n_order, graph.adj.len())).ok().and_then(|mut mem| {
+                amd::order_maybe_unsorted(&mut fwd, &mut inv, pattern, amd::Control::default(), MemStack::new(&mut mem)).ok()
+            });
             (fwd, flops.map(|f| f.n_div + f.n_mult_subs_ldl).unwrap_or(f64::INFINITY))
         },
     );
@@ -219,7 +219,13 @@ fn dissect(graph: &Graph, coords: &[[f64; 2]], side: &[AtomicU8], set: &mut [usi
 /// separator the unknowns of one half coupled to the other, of the half where they are fewer.
 /// Returns (first half, second half, separator) without the separator in the halves, or None
 /// if all unknowns have the same coordinate.
-fn split_along(graph: &Graph, coords: &[[f64; 2]], side: &[AtomicU8], set: &mut [usize], axis: usize) -> Option<(Vec<usize>, Vec<usize>, Vec<usize>)> {
+fn split_along(
+    graph: &Graph,
+    coords: &[[f64; 2]],
+    side: &[AtomicU8],
+    set: &mut [usize],
+    axis: usize,
+) -> Option<(Vec<usize>, Vec<usize>, Vec<usize>)> {
     let cmp = |a: &usize, b: &usize| coords[*a][axis].total_cmp(&coords[*b][axis]).then(a.cmp(b));
     let mid = set.len() / 2;
     set.select_nth_unstable_by(mid, cmp);
@@ -237,10 +243,14 @@ fn split_along(graph: &Graph, coords: &[[f64; 2]], side: &[AtomicU8], set: &mut 
     for &i in right {
         side[i].store(2, Relaxed);
     }
-    let coupled = |half: &[usize], other: u8| -> Vec<bool> { half.iter().map(|&i| graph.neighbours(i).any(|j| side[j].load(Relaxed) == other)).collect() };
+    let coupled = |half: &[usize], other: u8| -> Vec<bool> {
+        half.iter().map(|&i| graph.neighbours(i).any(|j| side[j].load(Relaxed) == other)).collect()
+    };
     let (in_left, in_right) = (coupled(left, 2), coupled(right, 1));
     let count = |flags: &[bool]| flags.iter().filter(|&&b| b).count();
-    let pick = |half: &[usize], flags: &[bool], keep: bool| -> Vec<usize> { half.iter().zip(flags).filter(|p| *p.1 == keep).map(|p| *p.0).collect() };
+    let pick = |half: &[usize], flags: &[bool], keep: bool| -> Vec<usize> {
+        half.iter().zip(flags).filter(|p| *p.1 == keep).map(|p| *p.0).collect()
+    };
     let out = if count(&in_right) <= count(&in_left) {
         (left.to_vec(), pick(right, &in_right, false), pick(right, &in_right, true))
     } else {
@@ -288,7 +298,14 @@ mod tests {
         let pattern = faer::sparse::SymbolicSparseColMatRef::new_checked(n, n, &graph.ptr, None, &graph.adj);
         let (mut fwd, mut inv) = (vec![0u32; n], vec![0u32; n]);
         let mut mem = faer::dyn_stack::MemBuffer::new(faer::sparse::linalg::amd::order_maybe_unsorted_scratch::<u32>(n, graph.adj.len()));
-        let f = faer::sparse::linalg::amd::order_maybe_unsorted(&mut fwd, &mut inv, pattern, Default::default(), faer::dyn_stack::MemStack::new(&mut mem)).unwrap();
+        let f = faer::sparse::linalg::amd::order_maybe_unsorted(
+            &mut fwd,
+            &mut inv,
+            pattern,
+            Default::default(),
+            faer::dyn_stack::MemStack::new(&mut mem),
+        )
+        .unwrap();
         let order: Vec<usize> = fwd.iter().map(|&i| i as usize).collect();
         let ours = factorisation_flops(&graph, &order);
         let amd = f.n_div + f.n_mult_subs_ldl;
@@ -298,7 +315,9 @@ mod tests {
     #[test]
     fn the_same_ordering_on_one_and_two_threads() {
         let (matrix, coords) = system(160); // large enough for the parallel recursion
-        let run = |threads| rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| fill_reducing(&matrix, matrix.n - 7, &coords));
+        let run = |threads| {
+            rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| fill_reducing(&matrix, matrix.n - 7, &coords))
+        };
         let (one, two) = (run(1), run(2));
         assert_eq!(one.0, two.0);
         assert_eq!(one.1, two.1);

@@ -78,9 +78,20 @@ pub struct ErrorSampling {
 
 impl SolveReport {
     /// The report of one solve; an error if a probe is outside the mesh.
-    pub fn new(problem: &str, mesh_name: &str, mesh: &Mesh, sol: &DiscreteSolution, error: Option<LinfError>, estimate: &Estimate, probes: &[[f64; 2]]) -> Result<Self, ProbeError> {
+    pub fn new(
+        problem: &str,
+        mesh_name: &str,
+        mesh: &Mesh,
+        sol: &DiscreteSolution,
+        error: Option<LinfError>,
+        estimate: &Estimate,
+        probes: &[[f64; 2]],
+    ) -> Result<Self, ProbeError> {
         let (h_min, h_max) = mesh.h_range();
-        let probes = probes.iter().map(|&[x, y]| sol.probe(mesh, [x, y]).map(|u| Probe { x, y, u }).ok_or(ProbeError::Outside { x, y })).collect::<Result<Vec<_>, _>>()?;
+        let probes = probes
+            .iter()
+            .map(|&[x, y]| sol.probe(mesh, [x, y]).map(|u| Probe { x, y, u }).ok_or(ProbeError::Outside { x, y }))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(SolveReport {
             problem: problem.to_string(),
             mesh: mesh_name.to_string(),
@@ -112,28 +123,52 @@ impl SolveReport {
     /// A short human-readable summary.
     pub fn summary(&self) -> String {
         let mut s = String::new();
-        let _ = writeln!(s, "{} on {}: {} elements, ndof {} ({} free), h in [{:.3e}, {:.3e}]", self.problem, self.mesh, self.n_elements, self.ndof, self.ndof_free, self.h_min, self.h_max);
+        let _ = writeln!(
+            s,
+            "{} on {}: {} elements, ndof {} ({} free), h in [{:.3e}, {:.3e}]",
+            self.problem, self.mesh, self.n_elements, self.ndof, self.ndof_free, self.h_min, self.h_max
+        );
         let zone = match self.contact_zone {
             Some([a, b]) => format!("contact zone [{a}, {b}] along Gamma_C"),
             None => "no contact zone".to_string(),
         };
-        let _ = writeln!(s, "contact: {} of {} nodes active, {zone}, {} active-set iteration{}", self.active_nodes, self.contact_nodes, self.pdas_iterations, if self.pdas_iterations == 1 { "" } else { "s" });
-        let _ = writeln!(s, "KKT: penetration {:.2e}, min lambda {:.2e}, complementarity {:.2e}", self.kkt.max_penetration, self.kkt.min_lambda, self.kkt.max_complementarity);
+        let _ = writeln!(
+            s,
+            "contact: {} of {} nodes active, {zone}, {} active-set iteration{}",
+            self.active_nodes,
+            self.contact_nodes,
+            self.pdas_iterations,
+            if self.pdas_iterations == 1 { "" } else { "s" }
+        );
+        let _ = writeln!(
+            s,
+            "KKT: penetration {:.2e}, min lambda {:.2e}, complementarity {:.2e}",
+            self.kkt.max_penetration, self.kkt.min_lambda, self.kkt.max_complementarity
+        );
         match &self.error {
             Some(e) => {
-                let _ = writeln!(s, "error Linf: quadrature {:.4e}, dense {:.4e}, nodal {:.4e}", e.linf_quadrature, e.linf_dense, e.linf_nodal);
+                let _ =
+                    writeln!(s, "error Linf: quadrature {:.4e}, dense {:.4e}, nodal {:.4e}", e.linf_quadrature, e.linf_dense, e.linf_nodal);
             }
             None => {
                 let _ = writeln!(s, "error: not measured ({} has no exact solution)", self.problem);
             }
         }
         let e = &self.estimator;
-        let _ = writeln!(s, "estimator: eta1..7 = {:.3e} {:.3e} {:.3e} {:.3e} {:.3e} {:.3e} {:.3e}, l_h {:.3}, eta_h {:.4e}, estimate (C0 = {}) {:.4e}", e.eta1, e.eta2, e.eta3, e.eta4, e.eta5, e.eta6, e.eta7, e.l_h, e.eta_h, e.c0, e.estimate);
+        let _ = writeln!(
+            s,
+            "estimator: eta1..7 = {:.3e} {:.3e} {:.3e} {:.3e} {:.3e} {:.3e} {:.3e}, l_h {:.3}, eta_h {:.4e}, estimate (C0 = {}) {:.4e}",
+            e.eta1, e.eta2, e.eta3, e.eta4, e.eta5, e.eta6, e.eta7, e.l_h, e.eta_h, e.c0, e.estimate
+        );
         for p in &self.probes {
             let _ = writeln!(s, "u_h({}, {}) = ({:.6e}, {:.6e})", p.x, p.y, p.u[0], p.u[1]);
         }
         let t = &self.timings;
-        let _ = writeln!(s, "time: assembly {:.3}s, symbolic {:.3}s, numeric {:.3}s, schur {:.3}s, solves {:.3}s, active set {:.3}s, total {:.3}s", t.assembly, t.contact.symbolic, t.contact.numeric, t.contact.schur, t.contact.solves, t.contact.active_set, t.total);
+        let _ = writeln!(
+            s,
+            "time: assembly {:.3}s, symbolic {:.3}s, numeric {:.3}s, schur {:.3}s, solves {:.3}s, active set {:.3}s, total {:.3}s",
+            t.assembly, t.contact.symbolic, t.contact.numeric, t.contact.schur, t.contact.solves, t.contact.active_set, t.total
+        );
         s
     }
 }
@@ -152,7 +187,12 @@ pub fn export_case(dir: &Path, mesh: &Mesh, sol: &DiscreteSolution, report: &Sol
     let doc = io::vtu(
         mesh,
         &sol.nodes,
-        &[("u", io::Field::Vector(&sol.u)), ("lambda", io::Field::Scalar(&lambda)), ("active", io::Field::Int(&active)), ("contact", io::Field::Int(&contact))],
+        &[
+            ("u", io::Field::Vector(&sol.u)),
+            ("lambda", io::Field::Scalar(&lambda)),
+            ("active", io::Field::Int(&active)),
+            ("contact", io::Field::Int(&contact)),
+        ],
         &[],
     );
     records::write_atomic(&dir.join("mesh.vtu"), doc.as_bytes())?;

@@ -183,11 +183,18 @@ impl RateFit {
     }
     /// "1.52 ± 0.04"
     pub fn text(&self) -> String {
-        format!("{:.2} ± {}", self.rate.slope, if self.rate.half_width.is_finite() { format!("{:.2}", self.rate.half_width) } else { "inf".into() })
+        format!(
+            "{:.2} ± {}",
+            self.rate.slope,
+            if self.rate.half_width.is_finite() { format!("{:.2}", self.rate.half_width) } else { "inf".into() }
+        )
     }
     /// "levels 14–24 (every other), NDF 3.1e4–3.1e5"
     pub fn range(&self) -> String {
-        format!("levels {}–{} every other, NDF {:.1e}–{:.1e}", self.first_level, self.last_level, self.first_ndof as f64, self.last_ndof as f64)
+        format!(
+            "levels {}–{} every other, NDF {:.1e}–{:.1e}",
+            self.first_level, self.last_level, self.first_ndof as f64, self.last_ndof as f64
+        )
     }
 }
 
@@ -245,7 +252,12 @@ impl RateReport {
 
     /// "1.52 ± 0.04 (levels .., NDF ..; windows 1.52, 1.50, 1.49)"
     pub fn text(&self) -> String {
-        format!("{} ({}; windows {})", self.main.text(), self.main.range(), self.windows.iter().map(|w| format!("{:.2}", w.rate.slope)).collect::<Vec<_>>().join(", "))
+        format!(
+            "{} ({}; windows {})",
+            self.main.text(),
+            self.main.range(),
+            self.windows.iter().map(|w| format!("{:.2}", w.rate.slope)).collect::<Vec<_>>().join(", ")
+        )
     }
 
     /// Largest minus smallest slope over the three windows.

@@ -35,7 +35,14 @@ fn side(a: [f64; 2], b: [f64; 2]) -> Option<&'static str> {
 }
 
 /// What every adaptive mesh must satisfy; `expected(side)` is the part of each side.
-fn check_mesh(problem: &dyn Problem, mesh: &Mesh, previous: Option<&Mesh>, expected: &dyn Fn(&str) -> Part, must_have: &[[f64; 2]], level: usize) {
+fn check_mesh(
+    problem: &dyn Problem,
+    mesh: &Mesh,
+    previous: Option<&Mesh>,
+    expected: &dyn Fn(&str) -> Part,
+    must_have: &[[f64; 2]],
+    level: usize,
+) {
     let name = problem.name();
     mesh.check().unwrap_or_else(|e| panic!("{name} level {level}: {e}"));
     let area: f64 = (0..mesh.n_triangles()).map(|t| mesh.area(t)).sum();
@@ -54,7 +61,8 @@ fn check_mesh(problem: &dyn Problem, mesh: &Mesh, previous: Option<&Mesh>, expec
         assert!((length[s] - 1.0).abs() < 1e-12, "{name} level {level}: the {s} side has length {}", length[s]);
     }
     // boundary edges run counter-clockwise (the estimator takes the outward normal from it)
-    let directed: std::collections::HashSet<(usize, usize)> = mesh.triangles.iter().flat_map(|&[a, b, c]| [(a, b), (b, c), (c, a)]).collect();
+    let directed: std::collections::HashSet<(usize, usize)> =
+        mesh.triangles.iter().flat_map(|&[a, b, c]| [(a, b), (b, c), (c, a)]).collect();
     for e in &mesh.boundary {
         assert!(directed.contains(&(e.v[0], e.v[1])), "{name} level {level}: boundary edge {:?} is not counter-clockwise", e.v);
     }
@@ -67,7 +75,12 @@ fn check_mesh(problem: &dyn Problem, mesh: &Mesh, previous: Option<&Mesh>, expec
     }
 }
 
-fn adaptive_run_keeps_meshes_valid(problem: &dyn Problem, expected: &dyn Fn(&str) -> Part, must_have: &[[f64; 2]], levels: usize) -> Vec<LevelRecord> {
+fn adaptive_run_keeps_meshes_valid(
+    problem: &dyn Problem,
+    expected: &dyn Fn(&str) -> Part,
+    must_have: &[[f64; 2]],
+    levels: usize,
+) -> Vec<LevelRecord> {
     let config = AdaptConfig { levels, max_ndof: Some(200_000), refine: Refine::Adaptive, theta: 0.5, ..Default::default() };
     let mut previous: Option<Mesh> = None;
     let mut seen = 0;
@@ -379,7 +392,7 @@ fn ex71_observed_rates() {
     // refinement. Measured: adaptive NDF 46070, error 8.16e-6; uniform NDF 33282, error 3.01e-6.
     let (uniform, adaptive) = (&histories[0], &histories[2]);
     let (n_a, e_a) = (adaptive.last().unwrap().0, adaptive.last().unwrap().1[6]);
-    let (n_u, e_u) = uniform.iter().filter(|h| h.0 <= n_a).map(|h| (h.0, h.1[6])).last().unwrap();
+    let (n_u, e_u) = uniform.iter().filter(|h| h.0 <= n_a).map(|h| (h.0, h.1[6])).next_back().unwrap();
     eprintln!("error at the last adaptive level (eta_5 as written): NDF {n_a}, {e_a:.3e}; uniform with fewer NDF {n_u}: {e_u:.3e}");
     assert!(e_a > 2.0 * e_u, "adaptive (eta_5 as written) NDF {n_a} error {e_a:e} vs uniform NDF {n_u} error {e_u:e}");
     // while without full-contact nodes the adaptive error is the smaller one at its last level

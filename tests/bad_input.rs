@@ -54,7 +54,20 @@ fn solve_json_has_the_contract_fields() {
         .unwrap();
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    for key in ["problem", "ndof", "ndof_free", "n_elements", "h_min", "h_max", "pdas_iterations", "active_nodes", "contact_zone", "kkt", "error", "probes"] {
+    for key in [
+        "problem",
+        "ndof",
+        "ndof_free",
+        "n_elements",
+        "h_min",
+        "h_max",
+        "pdas_iterations",
+        "active_nodes",
+        "contact_zone",
+        "kkt",
+        "error",
+        "probes",
+    ] {
         assert!(v.get(key).is_some(), "missing {key}");
     }
     assert_eq!(v["ndof"], 2 * 81);
@@ -95,7 +108,9 @@ fn bad_huge_mesh_is_refused_with_the_memory_estimate_before_allocating() {
 #[test]
 fn memory_estimate_covers_the_measured_peaks() {
     // peak RSS of `signorini solve` measured with /usr/bin/time -v (bytes), and the NDF
-    for (ndof, kib) in [(8450.0, 16964.0), (33282.0, 54412.0), (132098.0, 197736.0), (526338.0, 839248.0), (1182722.0, 1936888.0), (2101250.0, 3501300.0)] {
+    for (ndof, kib) in
+        [(8450.0, 16964.0), (33282.0, 54412.0), (132098.0, 197736.0), (526338.0, 839248.0), (1182722.0, 1936888.0), (2101250.0, 3501300.0)]
+    {
         let est = signorini::solve::memory_estimate(ndof);
         assert!(est >= 1.2 * kib * 1024.0, "NDF {ndof}: estimate {est} below measured peak {kib} KiB + 20 %");
     }
@@ -122,7 +137,8 @@ fn probe_accepts_negative_numbers_and_corners() {
     let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", "-0.1,0.5"]);
     assert_eq!(code, 1);
     assert!(!err.contains("unexpected argument") && err.contains("outside the domain"), "{err}");
-    let (code, out, err) = run_out(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", "-0,0", "--probe", "1,1", "--json"]);
+    let (code, out, err) =
+        run_out(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", "-0,0", "--probe", "1,1", "--json"]);
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     for p in v["probes"].as_array().unwrap() {

@@ -19,7 +19,11 @@ fn stored_and_quick() -> &'static (Vec<RunRecord>, Vec<RunRecord>, Vec<RunRecord
         let m = manifest();
         let run = |quick: bool, sub: &str| {
             let results = root.join(sub);
-            study::run_study(&m, &RunOptions { quick, shard: None, fresh: true, results: results.clone(), progress: false, wait_for_lock: false }).unwrap();
+            study::run_study(
+                &m,
+                &RunOptions { quick, shard: None, fresh: true, results: results.clone(), progress: false, wait_for_lock: false },
+            )
+            .unwrap();
             StudyDir::new(&results, &m.study).read_runs().unwrap()
         };
         (run(false, "full"), run(true, "quick"), run(false, "full2"))
@@ -57,7 +61,10 @@ fn changed_integer_is_reported_exactly() {
     s[1].levels[1].active_nodes += 1;
     let rows = compare_study(&manifest(), &s, quick, true);
     assert_eq!(rows.len(), 1, "{rows:?}");
-    assert_eq!((rows[0].run.as_str(), rows[0].level, rows[0].field.as_str(), rows[0].tolerance.as_str()), ("b", Some(1), "active_nodes", "exact"));
+    assert_eq!(
+        (rows[0].run.as_str(), rows[0].level, rows[0].field.as_str(), rows[0].tolerance.as_str()),
+        ("b", Some(1), "active_nodes", "exact")
+    );
 }
 
 #[test]
@@ -93,7 +100,9 @@ fn rate_floors_are_one_sided() {
     assert!(rate > 1.2 && rate < 1.7, "ex71 uniform error rate in NDF {rate}");
     let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny.toml")).unwrap();
     for (min, drift) in [(1.2, false), (2.0, true)] {
-        let t = format!("{text}\n[drift]\ndefault = {{ rel = 1e-9, floor = 1e-14 }}\n[[drift.rates]]\nrun = \"b\"\nfield = \"err_quadrature\"\nmin = {min}\nlast = 3\n");
+        let t = format!(
+            "{text}\n[drift]\ndefault = {{ rel = 1e-9, floor = 1e-14 }}\n[[drift.rates]]\nrun = \"b\"\nfield = \"err_quadrature\"\nmin = {min}\nlast = 3\n"
+        );
         let m = Manifest::parse(Path::new("tiny.toml"), &t).unwrap();
         let rows = compare_study(&m, stored, full2, false);
         assert_eq!(!rows.is_empty(), drift, "floor {min}: {rows:?}");
@@ -142,8 +151,18 @@ fn declared_tolerances_catch_a_relative_change_of_1e_5_wherever_round_off_allows
                     let scale = levels.iter().filter_map(|l| l[field].as_f64()).fold(0.0f64, |a, x| a.max(x.abs()));
                     let tol = m.drift.tolerance(field);
                     if tol.rel * v.abs() + tol.floor * scale >= 1e-5 * v.abs() {
-                        assert!(v.abs() < REL_RANGE * scale, "{}/{} level {level}: {field} = {v:e} cannot be checked to 1e-5 although it is not near round-off", m.study, run.run.id);
-                        limited.push(format!("{}/{} L{level} {field} {:.1e}", m.study, run.run.id, (tol.rel * v.abs() + tol.floor * scale) / v.abs()));
+                        assert!(
+                            v.abs() < REL_RANGE * scale,
+                            "{}/{} level {level}: {field} = {v:e} cannot be checked to 1e-5 although it is not near round-off",
+                            m.study,
+                            run.run.id
+                        );
+                        limited.push(format!(
+                            "{}/{} L{level} {field} {:.1e}",
+                            m.study,
+                            run.run.id,
+                            (tol.rel * v.abs() + tol.floor * scale) / v.abs()
+                        ));
                         continue;
                     }
                     let mut perturbed = stored.clone();
@@ -236,7 +255,8 @@ fn drift_command_fails_on_perturbed_record_csv_or_claims() {
 fn manifest_tolerances_are_the_measured_round_off_times_the_margin() {
     use signorini::study::drift::{DriftReport, measured_tolerances, tolerances_toml};
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/roundoff");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "json")).collect();
+    let mut files: Vec<PathBuf> =
+        std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).filter(|p| p.extension().is_some_and(|e| e == "json")).collect();
     files.sort();
     assert!(files.len() >= 3, "expected a report per variant (orderings forced, one thread) in {}", dir.display());
     let reports: Vec<DriftReport> = files.iter().map(|f| serde_json::from_str(&std::fs::read_to_string(f).unwrap()).unwrap()).collect();

@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use signorini::adapt;
 use signorini::norms::{self, Sampling};
-use signorini::problems::{Exact, Ex71, Ex72, Patch, Problem};
+use signorini::problems::{Ex71, Ex72, Exact, Patch, Problem};
 
 #[test]
 fn p2_field_has_no_error_on_gamma_c() {
@@ -37,7 +37,12 @@ fn parts_never_exceed_the_whole_and_gamma_c_is_sampled_on_its_edge() {
     // the contact error is the maximum over points with y = 0: recompute it by brute force
     let mut brute = 0.0f64;
     for t in 0..m.n_triangles() {
-        let refs: Vec<[f64; 2]> = (0..=12).flat_map(|k| { let s = k as f64 / 12.0; [[s, 0.0], [0.0, s], [s, 1.0 - s]] }).collect();
+        let refs: Vec<[f64; 2]> = (0..=12)
+            .flat_map(|k| {
+                let s = k as f64 / 12.0;
+                [[s, 0.0], [0.0, s], [s, 1.0 - s]]
+            })
+            .collect();
         for (x, uh) in sol.eval_element(&m, t, &refs) {
             if x[1].abs() < 1e-14 {
                 let ue = exact.u(x);

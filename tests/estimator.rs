@@ -54,7 +54,8 @@ fn check_patch_exactness(p: &Patch, spec: &str) {
         Some(base) => {
             let mut m = mesh(p, base);
             for _ in 0..3 {
-                let marked: Vec<bool> = (0..m.n_triangles()).map(|t| m.corners(t).iter().any(|x| signorini::mesh::dist(*x, [1.0, 0.5]) < 0.3)).collect();
+                let marked: Vec<bool> =
+                    (0..m.n_triangles()).map(|t| m.corners(t).iter().any(|x| signorini::mesh::dist(*x, [1.0, 0.5]) < 0.3)).collect();
                 m = signorini::mesh::refine::refine(&m, &marked).mesh;
             }
             m
@@ -76,7 +77,13 @@ fn check_patch_exactness(p: &Patch, spec: &str) {
     assert!(scale >= sigma);
     let mat = p.material();
     let umax = sol.nodes.coords.iter().map(|x| p.u(*x)).fold(0.0f64, |a, u| a.max(u[0].abs()).max(u[1].abs()));
-    let tols = [1e-12 * (2.0 * mat.mu + mat.zeta) * umax, 1e-12 * scale * h_max, 1e-12 * scale * h_max, 1e-12 * scale * h_max, 1e-12 * scale * h_max];
+    let tols = [
+        1e-12 * (2.0 * mat.mu + mat.zeta) * umax,
+        1e-12 * scale * h_max,
+        1e-12 * scale * h_max,
+        1e-12 * scale * h_max,
+        1e-12 * scale * h_max,
+    ];
     let tol_sum: f64 = tols.iter().sum();
     for (what, u) in [("discrete solution", None), ("nodal interpolant of u", Some(()))] {
         if u.is_some() {
@@ -86,7 +93,10 @@ fn check_patch_exactness(p: &Patch, spec: &str) {
         for config in configs() {
             let e = estimate::estimate(&m, p, &sol, &config);
             let t = e.terms;
-            eprintln!("patch {spec} {what} {config:?}: eta / tol = {:?}", std::array::from_fn::<f64, 5, _>(|i| residual_terms(&t)[i] / tols[i]));
+            eprintln!(
+                "patch {spec} {what} {config:?}: eta / tol = {:?}",
+                std::array::from_fn::<f64, 5, _>(|i| residual_terms(&t)[i] / tols[i])
+            );
             for (i, (v, tol)) in residual_terms(&t).iter().zip(tols).enumerate() {
                 assert!(v.abs() <= tol, "{spec}, {what}, {config:?}: eta_{} = {v:e} > {tol:e} (max|sigma| {sigma}, h {h_max})", i + 1);
             }
@@ -177,7 +187,12 @@ fn check_rigid(problem: &dyn Problem, spec: &str) {
             let t1 = e1.terms;
             for (i, (v0, v1)) in residual_terms(&t0).iter().zip(residual_terms(&t1)).enumerate() {
                 let d = rel_diff(*v0, v1);
-                assert!(d <= 1e-10, "{} {spec} {config:?}, r = ({a}, {b}, {c}): eta_{} {v0:e} -> {v1:e} (rel {d:e})", problem.name(), i + 1);
+                assert!(
+                    d <= 1e-10,
+                    "{} {spec} {config:?}, r = ({a}, {b}, {c}): eta_{} {v0:e} -> {v1:e} (rel {d:e})",
+                    problem.name(),
+                    i + 1
+                );
             }
             // the indicators' residual parts are unchanged too; for these problems (Ex71 in full
             // contact with chi = 0, Ex72 with no penetration) only eta_6/eta_7 may change
@@ -295,7 +310,12 @@ fn ex71_has_no_penetration_and_no_separation_terms() {
         assert_eq!(sol.active_count(), sol.dofs.contact.len(), "{spec}: full contact");
         for config in configs() {
             let e = estimate::estimate(&m, &p, &sol, &config);
-            assert!(e.terms.eta6 <= 1e-14 && e.terms.eta7 <= 1e-14, "{spec} {config:?}: eta_6 = {:e}, eta_7 = {:e}", e.terms.eta6, e.terms.eta7);
+            assert!(
+                e.terms.eta6 <= 1e-14 && e.terms.eta7 <= 1e-14,
+                "{spec} {config:?}: eta_6 = {:e}, eta_7 = {:e}",
+                e.terms.eta6,
+                e.terms.eta7
+            );
             // every contact node's patch is in full contact
             assert!(e.full_contact_nodes > 0);
             if config.contact_term == ContactTerm::WithoutFullContact {

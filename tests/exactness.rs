@@ -8,13 +8,18 @@ use signorini::assembly::{self, DofMap};
 use signorini::contact::ContactSolver;
 use signorini::element::{self, Affine};
 use signorini::mesh::P2Nodes;
-use signorini::problems::{Exact, Patch, Material};
+use signorini::problems::{Exact, Material, Patch};
 
 fn max_nodal_error(p: &Patch, sol: &signorini::solve::DiscreteSolution) -> f64 {
-    sol.nodes.coords.iter().zip(&sol.u).map(|(x, uh)| {
-        let u = p.u(*x);
-        (u[0] - uh[0]).abs().max((u[1] - uh[1]).abs())
-    }).fold(0.0, f64::max)
+    sol.nodes
+        .coords
+        .iter()
+        .zip(&sol.u)
+        .map(|(x, uh)| {
+            let u = p.u(*x);
+            (u[0] - uh[0]).abs().max((u[1] - uh[1]).abs())
+        })
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -45,13 +50,15 @@ fn oblique_contact_normal_changes_nothing_when_inactive() {
 #[test]
 fn oblique_contact_normal_active_satisfies_kkt() {
     // an obstacle close enough to touch, along an oblique normal
-    let mut p = Patch::default();
-    p.normal = [0.8, -0.6];
-    p.gap = 0.0;
+    let p = Patch { normal: [0.8, -0.6], gap: 0.0, ..Patch::default() };
     let m = mesh(&p, "structured:8");
     let sol = solve_on(&p, &m);
     let k = sol.kkt();
-    assert!(sol.active_count() > 0 && sol.active_count() < sol.dofs.contact.len(), "a genuine free boundary: {} active", sol.active_count());
+    assert!(
+        sol.active_count() > 0 && sol.active_count() < sol.dofs.contact.len(),
+        "a genuine free boundary: {} active",
+        sol.active_count()
+    );
     assert!(k.max_penetration < 1e-12, "{k:?}");
     assert!(k.min_lambda > -1e-10 * k.force_scale, "{k:?}");
     assert!(k.max_inactive_lambda < 1e-10 * k.force_scale, "{k:?}");
@@ -64,14 +71,14 @@ fn element_stiffness_is_symmetric_with_rigid_kernel() {
     let rule = element::triangle_rule(2);
     let k = assembly::element_stiffness(&map, Material::from_young(500.0, 0.3), &rule);
     let scale = k.iter().flatten().fold(0.0f64, |a, v| a.max(v.abs()));
-    for i in 0..12 {
-        for j in 0..12 {
-            assert!((k[i][j] - k[j][i]).abs() < 1e-13 * scale);
+    for (i, row) in k.iter().enumerate() {
+        for (j, kij) in row.iter().enumerate() {
+            assert!((kij - k[j][i]).abs() < 1e-13 * scale);
         }
     }
     // rigid motions (two translations, one rotation) are in the kernel
     let nodes = [[0.1, 0.2], [0.9, 0.3], [0.4, 0.8], [0.5, 0.25], [0.65, 0.55], [0.25, 0.5]];
-    let modes: [Box<dyn Fn([f64; 2]) -> [f64; 2]>; 3] = [Box::new(|_| [1.0, 0.0]), Box::new(|_| [0.0, 1.0]), Box::new(|x| [-x[1], x[0]])];
+    let modes: [fn([f64; 2]) -> [f64; 2]; 3] = [|_| [1.0, 0.0], |_| [0.0, 1.0], |x| [-x[1], x[0]]];
     for mode in &modes {
         let v: Vec<f64> = nodes.iter().flat_map(|x| mode(*x)).collect();
         for row in &k {

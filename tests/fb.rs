@@ -1,6 +1,7 @@
 //! The free-boundary problem `fb` (beyond the paper): its data satisfy the Signorini conditions
 //! with the contact zone exactly [a, 1], a = sqrt(2) - 1; uniform P2 errors converge; the discrete
 //! contact zone tends to [a, 1]; the discrete KKT conditions hold; the CLI solves it.
+#![allow(clippy::needless_range_loop)] // component loops read as the formulas they check
 
 mod common;
 use common::*;
@@ -52,7 +53,10 @@ fn fb_gradient_and_body_force_match_finite_differences() {
     // (p'' = -(15/4) ((x - a)_+)^(1/2) has an infinite slope at a+)
     let (l, r) = (p.body_force([A - 1e-9, 0.5]), p.body_force([A + 1e-9, 0.5]));
     assert!((l[1] - r[1]).abs() < 1e-3, "f2 continuous at x = a");
-    let bound = (0..=200).flat_map(|i| (0..=20).map(move |j| [i as f64 / 200.0, j as f64 / 20.0])).map(|q| p.body_force(q)).fold(0.0f64, |m, f| m.max(f[0].abs()).max(f[1].abs()));
+    let bound = (0..=200)
+        .flat_map(|i| (0..=20).map(move |j| [i as f64 / 200.0, j as f64 / 20.0]))
+        .map(|q| p.body_force(q))
+        .fold(0.0f64, |m, f| m.max(f[0].abs()).max(f[1].abs()));
     assert!(bound < 50.0, "f bounded: max |f| = {bound}");
 }
 
@@ -181,7 +185,10 @@ fn fb_discrete_contact_zone_tends_to_a_1() {
         last_inactive.push(last - A);
     }
     for d in [&first_active, &last_inactive] {
-        assert!(d.windows(2).all(|w| w[1] < w[0]), "distances to a: first active node {first_active:?}, last inactive node {last_inactive:?}");
+        assert!(
+            d.windows(2).all(|w| w[1] < w[0]),
+            "distances to a: first active node {first_active:?}, last inactive node {last_inactive:?}"
+        );
     }
     assert!(first_active[2] < 0.01, "N = 128: zone starts {:.4} right of a", first_active[2]);
     assert!(last_inactive[2] < 0.03, "N = 128: an inactive node {:.4} right of a", last_inactive[2]);
@@ -250,7 +257,11 @@ fn split_load_integrates_root_singularities_exactly() {
     let (split, full) = (split_load(&map, corners, c, &root), gauss(&root, LOAD_DEGREE));
     for k in 0..2 {
         assert!((sum(split, k) - exact[k]).abs() < 1e-14, "split: int f_{k} = {} vs {}", sum(split, k), exact[k]);
-        eprintln!("int f_{k}: split {:.3e}, degree-{LOAD_DEGREE} rule {:.3e} off", (sum(split, k) - exact[k]).abs(), (sum(full, k) - exact[k]).abs());
+        eprintln!(
+            "int f_{k}: split {:.3e}, degree-{LOAD_DEGREE} rule {:.3e} off",
+            (sum(split, k) - exact[k]).abs(),
+            (sum(full, k) - exact[k]).abs()
+        );
     }
     // the whole-triangle rule is not exact there: why fb needs the split
     assert!((sum(full, 0) - exact[0]).abs() > 1e-7);

@@ -358,7 +358,8 @@ fn roundoff_estimator_terms_are_zeros_and_the_legend_says_so() {
     for l in &mut rec.levels[8..11] {
         l.eta6 = 2.78e-17;
     }
-    let smallest = rec.levels.iter().flat_map(|l| [l.eta1, l.eta2, l.eta3, l.eta4, l.eta5, l.eta7]).filter(|&v| v > 0.0).fold(f64::INFINITY, f64::min);
+    let smallest =
+        rec.levels.iter().flat_map(|l| [l.eta1, l.eta2, l.eta3, l.eta4, l.eta5, l.eta7]).filter(|&v| v > 0.0).fold(f64::INFINITY, f64::min);
     write_json(&StudyDir::new(&results, "ex72").run_file("adaptive"), &rec).unwrap();
     plot::draw_all(&results, &figures).expect("draw_all");
     let fig4b = read(&figures.join("fig4b.svg"));

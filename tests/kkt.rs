@@ -28,9 +28,13 @@ fn warm_start_from_the_solution_converges_in_one_iteration() {
 #[test]
 fn schur_and_refactor_strategies_agree() {
     use signorini::contact::{PdasOptions, Strategy};
-    for (problem, spec) in [(&problems::Ex72 as &dyn Problem, "structured:24"), (&problems::Ex71, "structured:12"), (&problems::Ex72, "symmetric:16")] {
+    for (problem, spec) in
+        [(&problems::Ex72 as &dyn Problem, "structured:24"), (&problems::Ex71, "structured:12"), (&problems::Ex72, "symmetric:16")]
+    {
         let m = mesh(problem, spec);
-        let run = |s: Strategy| signorini::solve::solve(&m, problem, &PdasOptions { strategy: Some(s), ..Default::default() }, &mut |_| {}).unwrap();
+        let run = |s: Strategy| {
+            signorini::solve::solve(&m, problem, &PdasOptions { strategy: Some(s), ..Default::default() }, &mut |_| {}).unwrap()
+        };
         let (a, b) = (run(Strategy::Schur), run(Strategy::Refactor));
         assert_eq!((a.strategy, b.strategy), (Strategy::Schur, Strategy::Refactor));
         assert_eq!(a.active, b.active, "{} on {spec}: active sets differ", problem.name());
@@ -40,6 +44,9 @@ fn schur_and_refactor_strategies_agree() {
         let ldiff = a.lambda.iter().zip(&b.lambda).fold(0.0f64, |s, (x, y)| s.max((x - y).abs()));
         assert!(ldiff < 1e-9 * a.force_scale, "{} on {spec}: lambda differs by {ldiff:e}", problem.name());
         let k = b.kkt();
-        assert!(k.max_penetration <= 1e-12 && k.min_lambda >= -1e-10 * k.force_scale && k.max_inactive_lambda <= 1e-10 * k.force_scale, "refactor KKT {k:?}");
+        assert!(
+            k.max_penetration <= 1e-12 && k.min_lambda >= -1e-10 * k.force_scale && k.max_inactive_lambda <= 1e-10 * k.force_scale,
+            "refactor KKT {k:?}"
+        );
     }
 }

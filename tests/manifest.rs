@@ -30,7 +30,8 @@ fn bad_save_levels_beyond_the_run_are_errors() {
     let e = run_with("levels = 3\nsave_levels = [0, 3]");
     assert!(e.contains("run[0].save_levels") && e.contains("got 3"), "{e}");
     // the defaults' save_levels are checked against each run's levels
-    let e = parse_err("[defaults]\nproblem = \"ex71\"\nlevels = 5\nsave_levels = [4]\n[[run]]\nid = \"a\"\n[[run]]\nid = \"b\"\nlevels = 2\n");
+    let e =
+        parse_err("[defaults]\nproblem = \"ex71\"\nlevels = 5\nsave_levels = [4]\n[[run]]\nid = \"a\"\n[[run]]\nid = \"b\"\nlevels = 2\n");
     assert!(e.contains("run[1].save_levels"), "{e}");
 }
 

@@ -33,7 +33,16 @@ fn toml_value() -> impl Strategy<Value = String> {
         Just("-inf".to_string()),
         any::<bool>().prop_map(|v| v.to_string()),
         "[a-z_:0-9]{0,12}".prop_map(|s| format!("{s:?}")),
-        prop_oneof![Just("ex71"), Just("ex72"), Just("patch"), Just("structured:4"), Just("symmetric:2"), Just("uniform"), Just("adaptive")].prop_map(|s| format!("{s:?}")),
+        prop_oneof![
+            Just("ex71"),
+            Just("ex72"),
+            Just("patch"),
+            Just("structured:4"),
+            Just("symmetric:2"),
+            Just("uniform"),
+            Just("adaptive")
+        ]
+        .prop_map(|s| format!("{s:?}")),
         proptest::collection::vec(0u64..30, 0..4).prop_map(|v| format!("{v:?}")),
         Just("{ theta = 0.5, min_ndof = 1000 }".to_string()),
         Just("{ c0 = 0.45 }".to_string()),
@@ -41,7 +50,20 @@ fn toml_value() -> impl Strategy<Value = String> {
     ]
 }
 
-const RUN_KEYS: &[&str] = &["id", "problem", "mesh", "levels", "quick_levels", "theta", "refine", "max_ndof", "save_levels", "estimator", "reference", "no_reference"];
+const RUN_KEYS: &[&str] = &[
+    "id",
+    "problem",
+    "mesh",
+    "levels",
+    "quick_levels",
+    "theta",
+    "refine",
+    "max_ndof",
+    "save_levels",
+    "estimator",
+    "reference",
+    "no_reference",
+];
 const MISSPELLED: &[&str] = &["lvels", "theeta", "save_level", "max_dof", "refinement", "estimater", "referense", "Levels"];
 
 fn key() -> impl Strategy<Value = &'static str> {
@@ -52,7 +74,9 @@ fn key() -> impl Strategy<Value = &'static str> {
 fn plausible_for(key: &'static str) -> BoxedStrategy<String> {
     match key {
         "problem" => proptest::sample::select(&["ex71", "ex72", "patch", "ex73"][..]).prop_map(|s| format!("{s:?}")).boxed(),
-        "mesh" => proptest::sample::select(&["structured:4", "structured:3", "symmetric:4", "symmetric:3", "structured:0"][..]).prop_map(|s| format!("{s:?}")).boxed(),
+        "mesh" => proptest::sample::select(&["structured:4", "structured:3", "symmetric:4", "symmetric:3", "structured:0"][..])
+            .prop_map(|s| format!("{s:?}"))
+            .boxed(),
         "levels" | "quick_levels" | "max_ndof" => (0u64..12).prop_map(|v| v.to_string()).boxed(),
         "theta" => (-0.2..1.2f64).prop_map(|v| format!("{v:?}")).boxed(),
         "refine" => proptest::sample::select(&["adaptive", "uniform", "bisect"][..]).prop_map(|s| format!("{s:?}")).boxed(),

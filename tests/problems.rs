@@ -28,10 +28,10 @@ fn ex71_gradient_matches_finite_differences() {
     let h = 1e-6;
     let x = [0.37, 0.61];
     let g = p.grad(x);
-    for i in 0..2 {
+    for (i, gi) in g.iter().enumerate() {
         let dx = (p.u([x[0] + h, x[1]])[i] - p.u([x[0] - h, x[1]])[i]) / (2.0 * h);
         let dy = (p.u([x[0], x[1] + h])[i] - p.u([x[0], x[1] - h])[i]) / (2.0 * h);
-        assert!((g[i][0] - dx).abs() < 1e-8 && (g[i][1] - dy).abs() < 1e-8);
+        assert!((gi[0] - dx).abs() < 1e-8 && (gi[1] - dy).abs() < 1e-8);
     }
 }
 

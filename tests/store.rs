@@ -31,7 +31,9 @@ fn fixture() -> String {
 /// A study of several runs long enough to be interrupted in the middle (about a second each).
 fn long_manifest(dir: &Path) -> PathBuf {
     let f = dir.join("long.toml");
-    let mut text = String::from("description = \"runs to interrupt\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\nlevels = 18\nsave_levels = [2]\n");
+    let mut text = String::from(
+        "description = \"runs to interrupt\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\nlevels = 18\nsave_levels = [2]\n",
+    );
     for i in 0..6 {
         text += &format!("[[run]]\nid = \"r{i}\"\ntheta = 0.{}\n", 3 + i);
     }
@@ -66,7 +68,10 @@ fn a_second_run_of_the_same_study_is_refused_or_waits_and_loses_nothing() {
     // refused, naming the holder; with --fresh it must not have deleted anything
     let (code, err) = signorini(&["run", &fixture(), "--quick", "--fresh", "--results", res]);
     assert_ne!(code, Some(0));
-    assert!(err.contains("is being written by process") && err.contains(&std::process::id().to_string()) && err.contains("--wait"), "{err}");
+    assert!(
+        err.contains("is being written by process") && err.contains(&std::process::id().to_string()) && err.contains("--wait"),
+        "{err}"
+    );
     assert_eq!(std::fs::read(dir.run_file("b")).unwrap(), before, "the refused run touched the other's run");
     assert!(!dir.run_file("a").exists());
     // with --wait it waits for the lock, then runs
@@ -128,7 +133,15 @@ fn an_interrupted_study_keeps_consistent_summaries_and_figures_refuse_it() {
     let missing = m.runs.iter().map(|p| p.spec.id.clone()).find(|id| !runs.iter().any(|r| &r.run.id == id)).unwrap();
     assert!(check_complete(&m, &res).is_err());
     let figs = d.join("figures");
-    let (code, err) = signorini(&["figures", "--experiments", exp.to_str().unwrap(), "--results", res.to_str().unwrap(), "--figures", figs.to_str().unwrap()]);
+    let (code, err) = signorini(&[
+        "figures",
+        "--experiments",
+        exp.to_str().unwrap(),
+        "--results",
+        res.to_str().unwrap(),
+        "--figures",
+        figs.to_str().unwrap(),
+    ]);
     assert_ne!(code, Some(0));
     assert!(err.contains(&format!("run {missing} is missing")) && err.contains("signorini run"), "{err}");
     assert!(!figs.exists(), "figures were drawn from a partial study");

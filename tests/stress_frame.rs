@@ -11,7 +11,8 @@ fn both(problem: &dyn Problem) -> (estimate::Terms, estimate::Terms) {
     let mesh = common::mesh(problem, "structured:8");
     let sol = common::solve_on(problem, &mesh);
     let normal = estimate::estimate(&mesh, problem, &sol, &EstimatorConfig::default()).terms;
-    let cartesian = estimate::estimate(&mesh, problem, &sol, &EstimatorConfig { stress_frame: StressFrame::Cartesian, ..Default::default() }).terms;
+    let cartesian =
+        estimate::estimate(&mesh, problem, &sol, &EstimatorConfig { stress_frame: StressFrame::Cartesian, ..Default::default() }).terms;
     (normal, cartesian)
 }
 

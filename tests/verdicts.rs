@@ -117,7 +117,16 @@ fn strip(xs: &[f64], level: usize) -> MeshSnapshot {
         triangles.push([i, i + 1, n + i]);
         triangles.push([i + 1, n + i + 1, n + i]);
     }
-    MeshSnapshot { study: "fb".into(), run: "adaptive_wfc".into(), level, ndof: 2 * (2 * n), vertices, triangles, contact_nodes: vec![], kinks: vec![] }
+    MeshSnapshot {
+        study: "fb".into(),
+        run: "adaptive_wfc".into(),
+        level,
+        ndof: 2 * (2 * n),
+        vertices,
+        triangles,
+        contact_nodes: vec![],
+        kinks: vec![],
+    }
 }
 
 /// Vertices graded geometrically towards `a` from both sides.
@@ -226,7 +235,9 @@ fn fb_rows_on_synthetic_records() {
     let dir = StudyDir::new(&d, "fb");
     std::fs::create_dir_all(dir.root.join("runs")).unwrap();
     std::fs::create_dir_all(dir.root.join("meshes")).unwrap();
-    for (id, refine, rate, growth) in [("adaptive", Refine::Adaptive, 1.0, 0.2), ("adaptive_wfc", Refine::Adaptive, 1.5, 0.0), ("uniform", Refine::Uniform, 1.25, 0.0)] {
+    for (id, refine, rate, growth) in
+        [("adaptive", Refine::Adaptive, 1.0, 0.2), ("adaptive_wfc", Refine::Adaptive, 1.5, 0.0), ("uniform", Refine::Uniform, 1.25, 0.0)]
+    {
         write_json(&dir.run_file(id), &record(id, refine, synthetic_levels(rate, growth, 26))).unwrap();
     }
     let a = claims::fb_free_boundary();
@@ -237,7 +248,11 @@ fn fb_rows_on_synthetic_records() {
 
     let e = row(&c, "fb-error-rate");
     assert_eq!(e.verdict, Verdict::NotReproduced, "judged on eta_5 as written (rate 1.0): {}", e.measured);
-    assert!(e.measured.contains("adaptive (eta_5 as written) 1.00 ± 0.00") && e.measured.contains("without full-contact nodes 1.50 ± 0.00"), "{}", e.measured);
+    assert!(
+        e.measured.contains("adaptive (eta_5 as written) 1.00 ± 0.00") && e.measured.contains("without full-contact nodes 1.50 ± 0.00"),
+        "{}",
+        e.measured
+    );
     assert!(e.measured.contains("uniform 1.25"), "{}", e.measured);
     let r = row(&c, "fb-reliability");
     assert_eq!(r.verdict, Verdict::Holds, "{}", r.measured);

@@ -73,7 +73,11 @@ fn median(mut v: Vec<f64>) -> f64 {
 fn peak_rss_mb() -> f64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
-        .and_then(|s| s.lines().find(|l| l.starts_with("VmHWM:")).map(|l| l.split_whitespace().nth(1).unwrap_or("0").parse::<f64>().unwrap_or(0.0) / 1024.0))
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .map(|l| l.split_whitespace().nth(1).unwrap_or("0").parse::<f64>().unwrap_or(0.0) / 1024.0)
+        })
         .unwrap_or(f64::NAN)
 }
 
@@ -116,7 +120,19 @@ fn main() -> Result<()> {
         let m = &r.median;
         println!(
             "{:>5} {:>9} | {:>8.3} {:>8.3} {:>9.3} {:>9.3} {:>7.3} {:>7.3} {:>7.4} {:>4} | {:>8.3} {:>8.3} {:>8.0}",
-            n, r.unknowns, m.assembly, m.symbolic, m.numeric_first, m.numeric_warm, m.schur, m.solves, m.active_set, r.pdas_iterations, m.linear_solve, m.contact_solve, r.peak_rss_mb
+            n,
+            r.unknowns,
+            m.assembly,
+            m.symbolic,
+            m.numeric_first,
+            m.numeric_warm,
+            m.schur,
+            m.solves,
+            m.active_set,
+            r.pdas_iterations,
+            m.linear_solve,
+            m.contact_solve,
+            r.peak_rss_mb
         );
         results.push(r);
     }
@@ -187,7 +203,17 @@ fn bench_size(n: usize, repeats: usize) -> Result<SizeResult> {
         linear_solve: med(|p| p.linear_solve),
         contact_solve: med(|p| p.contact_solve),
     };
-    Ok(SizeResult { n, unknowns, contact_unknowns: m, ordering, pdas_iterations: its, per_iteration_seconds: per_iteration, median, runs, peak_rss_mb: peak_rss_mb() })
+    Ok(SizeResult {
+        n,
+        unknowns,
+        contact_unknowns: m,
+        ordering,
+        pdas_iterations: its,
+        per_iteration_seconds: per_iteration,
+        median,
+        runs,
+        peak_rss_mb: peak_rss_mb(),
+    })
 }
 
 /// Where the time of the largest size goes: assembly, then the contact solve phase by phase.
@@ -202,7 +228,13 @@ fn breakdown(r: &SizeResult) {
         ("active-set iterations (dense, on S)", m.active_set),
     ];
     let total: f64 = phases.iter().map(|p| p.1).sum();
-    println!("\nphase breakdown, structured:{} ({} unknowns, {} contact unknowns, ordering {}):", r.n, r.unknowns, r.contact_unknowns, r.ordering["method"].as_str().unwrap_or("?"));
+    println!(
+        "\nphase breakdown, structured:{} ({} unknowns, {} contact unknowns, ordering {}):",
+        r.n,
+        r.unknowns,
+        r.contact_unknowns,
+        r.ordering["method"].as_str().unwrap_or("?")
+    );
     for (name, t) in phases {
         println!("  {:<62} {:>8.3} s {:>5.1}%", name, t, 100.0 * t / total);
     }
@@ -220,7 +252,7 @@ fn side_by_side(ours: &[SizeResult], ngsolve: &std::path::Path) -> Vec<serde_jso
     let Ok(doc) = serde_json::from_str::<serde_json::Value>(&text) else { return Vec::new() };
     let rows = doc["rows"].as_array().cloned().unwrap_or_default();
     let mut table = Vec::new();
-    println!("\n{:<40} {:>5} {:>10} {:>10} {:>7}  {}", "phase", "N", "ours", "reference", "ratio", "target");
+    println!("\n{:<40} {:>5} {:>10} {:>10} {:>7}  target", "phase", "N", "ours", "reference", "ratio");
     for r in ours {
         let Some(ng) = rows.iter().find(|x| x["N"].as_u64() == Some(r.n as u64)) else { continue };
         let f = |k: &str| ng[k].as_f64().unwrap_or(f64::NAN);

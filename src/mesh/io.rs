@@ -58,7 +58,9 @@ pub fn vtu(mesh: &Mesh, nodes: &P2Nodes, point_data: &[(&str, Field)], cell_data
     let n_tri = mesh.n_triangles();
     let n_line = mesh.boundary.len();
     let mut s = String::new();
-    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n");
+    s.push_str(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n",
+    );
     let _ = writeln!(s, r#"<Piece NumberOfPoints="{}" NumberOfCells="{}">"#, nodes.len(), n_tri + n_line);
     s.push_str("<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
     for p in &nodes.coords {

@@ -48,7 +48,9 @@ pub struct Mesh {
 /// What is wrong with a mesh.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
-    #[error("malformed mesh description '{0}': expected 'structured:N' or 'symmetric:N' with N a positive integer (N even keeps y = 0.5 a vertex)")]
+    #[error(
+        "malformed mesh description '{0}': expected 'structured:N' or 'symmetric:N' with N a positive integer (N even keeps y = 0.5 a vertex)"
+    )]
     BadSpec(String),
     #[error("triangle {t} has non-positive area {area:e} (vertices must be counter-clockwise and distinct)")]
     NonPositiveArea { t: usize, area: f64 },
@@ -81,7 +83,7 @@ impl MeshSpec {
         let n: usize = n.trim().parse().map_err(|_| bad())?;
         match kind.trim() {
             "structured" if n >= 1 => Ok(MeshSpec::Structured(n)),
-            "symmetric" if n >= 2 && n % 2 == 0 => Ok(MeshSpec::Symmetric(n)),
+            "symmetric" if n >= 2 && n.is_multiple_of(2) => Ok(MeshSpec::Symmetric(n)),
             _ => Err(bad()),
         }
     }
@@ -416,7 +418,13 @@ mod tests {
     use super::*;
 
     fn tag(x: [f64; 2]) -> Part {
-        if x[1] < 1e-12 { Part::Contact } else if x[1] > 1.0 - 1e-12 { Part::Dirichlet } else { Part::Neumann }
+        if x[1] < 1e-12 {
+            Part::Contact
+        } else if x[1] > 1.0 - 1e-12 {
+            Part::Dirichlet
+        } else {
+            Part::Neumann
+        }
     }
 
     #[test]

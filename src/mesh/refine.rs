@@ -49,7 +49,7 @@
 //! written here against [`Mesh`] directly.
 
 use super::{BoundaryEdge, Mesh, P2Nodes};
-use crate::element::{p2_values, Affine};
+use crate::element::{Affine, p2_values};
 
 /// Marker for "no triangle" in the edge owner table.
 const NONE: usize = usize::MAX;
@@ -292,7 +292,7 @@ pub fn transfer_p2<const D: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::super::{dist, Part};
+    use super::super::{Part, dist};
     use super::*;
     use std::collections::{HashMap, HashSet};
 
@@ -385,8 +385,7 @@ mod tests {
         for (k, l) in &lo {
             assert!((l - ln[k]).abs() < 1e-12, "length of part {k} changed: {l} -> {}", ln[k]);
         }
-        let directed: HashSet<(usize, usize)> =
-            new.triangles.iter().flat_map(|&[a, b, c]| [(a, b), (b, c), (c, a)]).collect();
+        let directed: HashSet<(usize, usize)> = new.triangles.iter().flat_map(|&[a, b, c]| [(a, b), (b, c), (c, a)]).collect();
         for e in &new.boundary {
             let (p, q) = (new.vertices[e.v[0]], new.vertices[e.v[1]]);
             assert!(directed.contains(&(e.v[0], e.v[1])), "boundary edge {:?} is not counter-clockwise", e.v);

@@ -6,7 +6,10 @@
 //! | `fb_error` | `fb`, all runs | like Fig. 2(a): `err_quadrature` (solid, filled circles) and `estimate` (dashed, hollow squares) vs NDF, one colour per run, log-log; NDF^-3/2 below the first run's error; the legend gives each run's last contact zone [`zone_min`, `zone_max`] against [a, 1] |
 //! | `fb_mesh` | `fb`, the largest saved level of `adaptive_wfc` (else of `adaptive`) | the mesh as in Fig. 3(b) (same drawing), with the free boundary x = a dashed |
 
-use super::{Built, ERR, ESTIMATE, Figure, Marker, NDF_DESC, PALETTE, Panel, Slope, SlopeAnchor, Style, mesh_figure, runs, saved_levels, series, single, slope};
+use super::{
+    Built, ERR, ESTIMATE, Figure, Marker, NDF_DESC, PALETTE, Panel, Slope, SlopeAnchor, Style, mesh_figure, runs, saved_levels, series,
+    single, slope,
+};
 use crate::problems::Fb;
 use crate::records::StudyDir;
 use anyhow::Context;
@@ -28,9 +31,13 @@ pub(super) fn fb_error(results: &Path) -> anyhow::Result<Built> {
         let color = PALETTE[k % PALETTE.len()];
         let id = &r.run.id;
         if r.levels.iter().any(|l| l.err_quadrature.is_some()) {
-            p.series.push(series(r, format!("error, {id}"), Style { color, marker: Marker::Circle, dashed: false, filled: true }, |l| l.err_quadrature));
+            p.series.push(series(r, format!("error, {id}"), Style { color, marker: Marker::Circle, dashed: false, filled: true }, |l| {
+                l.err_quadrature
+            }));
         }
-        p.series.push(series(r, format!("estimate, {id}"), Style { color, marker: Marker::Square, dashed: true, filled: false }, |l| Some(l.estimate)));
+        p.series.push(series(r, format!("estimate, {id}"), Style { color, marker: Marker::Square, dashed: true, filled: false }, |l| {
+            Some(l.estimate)
+        }));
     }
     for r in &runs {
         if let Some(l) = r.levels.last() {

@@ -65,7 +65,18 @@ use std::path::{Path, PathBuf};
 
 /// Every figure, in the order drawn.
 pub const FIGURES: [&str; 12] = [
-    "fig2a", "fig2b", "fig3a", "fig3b", "fig4a", "fig4b", "c0_sweep", "log_ablation", "contact_term_ablation", "theta_ablation", "fb_error", "fb_mesh",
+    "fig2a",
+    "fig2b",
+    "fig3a",
+    "fig3b",
+    "fig4a",
+    "fig4b",
+    "c0_sweep",
+    "log_ablation",
+    "contact_term_ablation",
+    "theta_ablation",
+    "fb_error",
+    "fb_mesh",
 ];
 
 /// C0 of Section 7.
@@ -371,7 +382,8 @@ fn fig4(results: &Path, study: &str, fig: &str, terms: usize) -> anyhow::Result<
     );
     let is_roundoff = |l: &LevelRecord, v: f64| v != 0.0 && v.abs() < ROUNDOFF * etas(l).iter().fold(0.0f64, |a, e| a.max(e.abs()));
     for i in 0..terms {
-        let mut s = series(r, format!("η_{{{}}}", i + 1), Style::nth(i), |l| Some(if is_roundoff(l, etas(l)[i]) { 0.0 } else { etas(l)[i] }));
+        let mut s =
+            series(r, format!("η_{{{}}}", i + 1), Style::nth(i), |l| Some(if is_roundoff(l, etas(l)[i]) { 0.0 } else { etas(l)[i] }));
         s.roundoff = r.levels.iter().any(|l| is_roundoff(l, etas(l)[i]));
         p.series.push(s);
     }

@@ -587,8 +587,26 @@ fn render_panel<DB: DrawingBackend>(
         let v_mid = (pc.0, (pc.1 + v_end.1) / 2);
         let h_below = pc.1 > v_end.1;
         let v_left = pc.0 < h_end.0;
-        rich::draw(root, "1", FS_SLOPE, &grey, (HPos::Center, if h_below { VPos::Top } else { VPos::Bottom }), (h_mid.0, h_mid.1 + if h_below { 5 } else { -5 }), false, m)?;
-        rich::draw(root, &rate_text(s.rate), FS_SLOPE, &grey, (if v_left { HPos::Right } else { HPos::Left }, VPos::Center), (v_mid.0 + if v_left { -6 } else { 6 }, v_mid.1), false, m)?;
+        rich::draw(
+            root,
+            "1",
+            FS_SLOPE,
+            &grey,
+            (HPos::Center, if h_below { VPos::Top } else { VPos::Bottom }),
+            (h_mid.0, h_mid.1 + if h_below { 5 } else { -5 }),
+            false,
+            m,
+        )?;
+        rich::draw(
+            root,
+            &rate_text(s.rate),
+            FS_SLOPE,
+            &grey,
+            (if v_left { HPos::Right } else { HPos::Left }, VPos::Center),
+            (v_mid.0 + if v_left { -6 } else { 6 }, v_mid.1),
+            false,
+            m,
+        )?;
     }
     // curves, then markers on top
     for s in &prepared {

@@ -44,7 +44,17 @@ pub struct DriftRow {
     pub tolerance: String,
 }
 
-fn row(study: &str, run: &str, level: Option<usize>, field: &str, stored: String, fresh: String, rel: Option<f64>, tol: String) -> DriftRow {
+#[allow(clippy::too_many_arguments)] // one argument per column of the table
+fn row(
+    study: &str,
+    run: &str,
+    level: Option<usize>,
+    field: &str,
+    stored: String,
+    fresh: String,
+    rel: Option<f64>,
+    tol: String,
+) -> DriftRow {
     DriftRow { study: study.into(), run: run.into(), level, field: field.into(), stored, fresh, relative_change: rel, tolerance: tol }
 }
 
@@ -72,12 +82,15 @@ pub struct FieldChange {
     pub entries: usize,
 }
 
+/// A derived field's value as a function of its record.
+pub type Definition = fn(&LevelRecord) -> Option<f64>;
+
 /// Fields that are functions of other fields of the same record, checked as such (the stored
 /// and the fresh value each equal the function of the record's own fields, to the bit) rather
 /// than within a tolerance of their own: the efficiency index estimate / err_quadrature carries
 /// the error's relative round-off, which near the end of a run is far larger than anything a
 /// tolerance on the index itself could be honest about while still seeing a change of 1e-5.
-pub const DERIVED: [(&str, fn(&LevelRecord) -> Option<f64>); 1] = [("efficiency", |l| l.err_quadrature.map(|e| l.estimate / e))];
+pub const DERIVED: [(&str, Definition); 1] = [("efficiency", |l| l.err_quadrature.map(|e| l.estimate / e))];
 
 fn is_derived(field: &str) -> bool {
     DERIVED.iter().any(|(f, _)| *f == field)
@@ -91,7 +104,16 @@ fn check_derived_fields(study: &str, run: &str, side: &str, levels: &[LevelRecor
             let (stored, expected) = (v[field].as_f64(), definition(l));
             if stored != expected {
                 let text = |x: Option<f64>| x.map(|x| x.to_string()).unwrap_or("null".into());
-                out.push(row(study, run, Some(l.level), field, format!("{side}: {}", text(stored)), format!("by definition: {}", text(expected)), None, "exact (a function of the record's fields)".into()));
+                out.push(row(
+                    study,
+                    run,
+                    Some(l.level),
+                    field,
+                    format!("{side}: {}", text(stored)),
+                    format!("by definition: {}", text(expected)),
+                    None,
+                    "exact (a function of the record's fields)".into(),
+                ));
             }
         }
     }
@@ -124,7 +146,17 @@ fn field_scales(levels: &[Value]) -> BTreeMap<String, f64> {
 
 /// Compare two level records (as JSON objects), appending what moved and recording changes.
 #[allow(clippy::too_many_arguments)]
-fn compare_level(study: &str, run: &str, level: usize, stored: &Value, fresh: &Value, scales: &BTreeMap<String, f64>, spec: &DriftSpec, out: &mut Vec<DriftRow>, changes: &mut BTreeMap<String, FieldChange>) {
+fn compare_level(
+    study: &str,
+    run: &str,
+    level: usize,
+    stored: &Value,
+    fresh: &Value,
+    scales: &BTreeMap<String, f64>,
+    spec: &DriftSpec,
+    out: &mut Vec<DriftRow>,
+    changes: &mut BTreeMap<String, FieldChange>,
+) {
     let (Some(s), Some(f)) = (stored.as_object(), fresh.as_object()) else { return };
     let mut keys: Vec<&String> = s.keys().chain(f.keys()).collect();
     keys.sort();
@@ -199,14 +231,33 @@ pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], q
         let (s, f) = match (s, f) {
             (Some(s), Some(f)) => (s, f),
             (s, f) => {
-                out.push(row(study, id, None, "run", if s.is_some() { "present" } else { "(missing)" }.into(), if f.is_some() { "present" } else { "(missing)" }.into(), None, "exact".into()));
+                out.push(row(
+                    study,
+                    id,
+                    None,
+                    "run",
+                    if s.is_some() { "present" } else { "(missing)" }.into(),
+                    if f.is_some() { "present" } else { "(missing)" }.into(),
+                    None,
+                    "exact".into(),
+                ));
                 continue;
             }
         };
         // the spec: the stored full spec, shortened to the quick form where quick
-        let expected_spec = super::effective_spec(&super::manifest::PlannedRun { spec: s.run.clone(), quick_levels: planned.quick_levels }, quick);
+        let expected_spec =
+            super::effective_spec(&super::manifest::PlannedRun { spec: s.run.clone(), quick_levels: planned.quick_levels }, quick);
         if expected_spec != f.run {
-            out.push(row(study, id, None, "run spec", serde_json::to_string(&expected_spec).unwrap_or_default(), serde_json::to_string(&f.run).unwrap_or_default(), None, "exact".into()));
+            out.push(row(
+                study,
+                id,
+                None,
+                "run spec",
+                serde_json::to_string(&expected_spec).unwrap_or_default(),
+                serde_json::to_string(&f.run).unwrap_or_default(),
+                None,
+                "exact".into(),
+            ));
         }
         if s.reference_ndof != f.reference_ndof {
             let text = |n: Option<usize>| n.map(|n| n.to_string()).unwrap_or("none".into());
@@ -228,7 +279,16 @@ pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], q
                     let b = serde_json::to_value(b).expect("records serialise");
                     compare_level(study, id, l, a, &b, &scales, &manifest.drift, &mut out, &mut changes);
                 }
-                (a, b) => out.push(row(study, id, Some(l), "level", if a.is_some() { "present" } else { "(missing)" }.into(), if b.is_some() { "present" } else { "(missing)" }.into(), None, "exact".into())),
+                (a, b) => out.push(row(
+                    study,
+                    id,
+                    Some(l),
+                    "level",
+                    if a.is_some() { "present" } else { "(missing)" }.into(),
+                    if b.is_some() { "present" } else { "(missing)" }.into(),
+                    None,
+                    "exact".into(),
+                )),
             }
         }
     }
@@ -260,7 +320,10 @@ pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], q
 
 /// A readable table of what moved.
 pub fn table(rows: &[DriftRow]) -> String {
-    let mut s = format!("{:<22} {:<34} {:>5} {:<20} {:>24} {:>24} {:>10} {}\n", "study", "run", "level", "field", "stored", "fresh", "rel.change", "tolerance");
+    let mut s = format!(
+        "{:<22} {:<34} {:>5} {:<20} {:>24} {:>24} {:>10} {}\n",
+        "study", "run", "level", "field", "stored", "fresh", "rel.change", "tolerance"
+    );
     for r in rows {
         s += &format!(
             "{:<22} {:<34} {:>5} {:<20} {:>24} {:>24} {:>10} {}\n",
@@ -281,7 +344,8 @@ pub fn table(rows: &[DriftRow]) -> String {
 fn first_difference(a: &str, b: &str) -> (String, String) {
     let (al, bl): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
     let i = (0..al.len().max(bl.len())).find(|&i| al.get(i) != bl.get(i)).unwrap_or(al.len().min(bl.len()));
-    let cut = |s: Option<&&str>| format!("line {}: {}", i + 1, s.map(|s| s.chars().take(60).collect::<String>()).unwrap_or("(none)".into()));
+    let cut =
+        |s: Option<&&str>| format!("line {}: {}", i + 1, s.map(|s| s.chars().take(60).collect::<String>()).unwrap_or("(none)".into()));
     (cut(al.get(i)), cut(bl.get(i)))
 }
 
@@ -290,7 +354,9 @@ fn first_difference(a: &str, b: &str) -> (String, String) {
 /// a study interrupted before its summaries were rewritten is drift.
 pub fn check_derived(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<DriftRow> {
     let mut out = Vec::new();
-    let file_row = |field: &str, stored: String, fresh: String| row(study, "*", None, field, stored, fresh, None, "exact (rendered from runs/*.json)".into());
+    let file_row = |field: &str, stored: String, fresh: String| {
+        row(study, "*", None, field, stored, fresh, None, "exact (rendered from runs/*.json)".into())
+    };
     match (std::fs::read(dir.csv_file()), dir.csv_bytes(runs)) {
         (Ok(on_disk), Ok(rendered)) if on_disk == rendered => {}
         (Ok(on_disk), Ok(rendered)) => {
@@ -342,27 +408,52 @@ pub struct DriftReport {
 /// results: numbers within the manifests' tolerances and the derived files. `claims` renders
 /// `CLAIMS.md` from the results folder; it is compared with the stored file when every
 /// declared study is checked.
-pub fn run(manifests: &[Manifest], all_studies: bool, opts: &DriftOptions, claims: &dyn Fn(&Path) -> std::io::Result<String>) -> anyhow::Result<DriftReport> {
+pub fn run(
+    manifests: &[Manifest],
+    all_studies: bool,
+    opts: &DriftOptions,
+    claims: &dyn Fn(&Path) -> std::io::Result<String>,
+) -> anyhow::Result<DriftReport> {
     use anyhow::Context;
-    let mut report = DriftReport { date: super::provenance::utc_now(), quick: opts.quick, against: opts.against.as_ref().map(|p| p.display().to_string()), studies: Vec::new(), rows: Vec::new(), changes: BTreeMap::new() };
+    let mut report = DriftReport {
+        date: super::provenance::utc_now(),
+        quick: opts.quick,
+        against: opts.against.as_ref().map(|p| p.display().to_string()),
+        studies: Vec::new(),
+        rows: Vec::new(),
+        changes: BTreeMap::new(),
+    };
     for m in manifests {
         let fresh_root = match &opts.against {
             Some(dir) => dir.clone(),
             None => {
-                let options = super::RunOptions { quick: opts.quick, shard: None, fresh: true, results: opts.scratch.clone(), progress: opts.progress, wait_for_lock: true };
+                let options = super::RunOptions {
+                    quick: opts.quick,
+                    shard: None,
+                    fresh: true,
+                    results: opts.scratch.clone(),
+                    progress: opts.progress,
+                    wait_for_lock: true,
+                };
                 super::run_study(m, &options)?;
                 opts.scratch.clone()
             }
         };
         let stored_dir = StudyDir::new(&opts.results, &m.study);
         let stored = stored_dir.read_runs().with_context(|| format!("reading the stored runs of {}", m.study))?;
-        let fresh = StudyDir::new(&fresh_root, &m.study).read_runs().with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?;
+        let fresh = StudyDir::new(&fresh_root, &m.study)
+            .read_runs()
+            .with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?;
         let mut c = compare(m, &stored, &fresh, opts.quick);
         if !stored.is_empty() {
             c.rows.extend(check_derived(&stored_dir, &m.study, &stored));
         }
         if opts.progress {
-            eprintln!("{}: {}", m.study, if c.rows.is_empty() { "no drift".to_string() } else { format!("{} field(s) moved", c.rows.len()) });
+            eprintln!(
+                "{}: {}",
+                m.study,
+                if c.rows.is_empty() { "no drift".to_string() } else { format!("{} field(s) moved", c.rows.len()) }
+            );
         }
         report.studies.push(serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": c.rows.len() }));
         report.rows.extend(c.rows);

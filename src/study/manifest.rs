@@ -187,18 +187,32 @@ impl Manifest {
 
     pub fn parse(path: &Path, text: &str) -> Result<Self, ManifestError> {
         let file = path.to_path_buf();
-        let raw: ManifestToml = toml::from_str(text).map_err(|e| ManifestError::Syntax { file: file.clone(), message: plain_words(e.to_string().trim_end()) })?;
+        let raw: ManifestToml = toml::from_str(text)
+            .map_err(|e| ManifestError::Syntax { file: file.clone(), message: plain_words(e.to_string().trim_end()) })?;
         let study = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        let invalid = |key: String, expected: &str, got: String| ManifestError::Invalid { file: file.clone(), key, expected: expected.to_string(), got };
+        let invalid = |key: String, expected: &str, got: String| ManifestError::Invalid {
+            file: file.clone(),
+            key,
+            expected: expected.to_string(),
+            got,
+        };
         if raw.run.is_empty() {
             return Err(invalid("run".into(), "at least one [[run]] table", "none".into()));
         }
         let d = raw.defaults.clone().unwrap_or_default();
         if d.id.is_some() {
-            return Err(invalid("defaults.id".into(), "no id in [defaults] (every [[run]] names its own)", format!("{:?}", d.id.unwrap_or_default())));
+            return Err(invalid(
+                "defaults.id".into(),
+                "no id in [defaults] (every [[run]] names its own)",
+                format!("{:?}", d.id.unwrap_or_default()),
+            ));
         }
         if d.no_reference.is_some() {
-            return Err(invalid("defaults.no_reference".into(), "no_reference only in a [[run]] (leave [defaults.reference] out instead)", "a value".into()));
+            return Err(invalid(
+                "defaults.no_reference".into(),
+                "no_reference only in a [[run]] (leave [defaults.reference] out instead)",
+                "a value".into(),
+            ));
         }
         let mut runs = Vec::new();
         let mut ids = std::collections::BTreeSet::new();
@@ -211,7 +225,8 @@ impl Manifest {
             if !ids.insert(id.clone()) {
                 return Err(invalid(key("id"), "a name unique within the study", format!("{id:?} twice")));
             }
-            let problem = r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid(key("problem"), "a problem name", "nothing".into()))?;
+            let problem =
+                r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid(key("problem"), "a problem name", "nothing".into()))?;
             if crate::problems::by_name(&problem).is_err() {
                 return Err(invalid(key("problem"), &format!("one of {}", crate::problems::KNOWN.join(", ")), format!("{problem:?}")));
             }
@@ -235,16 +250,20 @@ impl Manifest {
                 return Err(invalid(key("reference.theta"), "a number in (0, 1]", rf.theta.to_string()));
             }
             let spec = RunSpec {
-                    id,
-                    problem,
-                    mesh,
-                    refine: r.refine.or(d.refine).unwrap_or(Refine::Adaptive),
-                    theta,
-                    levels,
-                    max_ndof: r.max_ndof.or(d.max_ndof),
-                    estimator,
-                    reference: reference.map(|rf| ReferenceSpec { theta: rf.theta, min_ndof: rf.min_ndof, contact_term: rf.contact_term.unwrap_or(ContactTerm::WithoutFullContact) }),
-                    save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
+                id,
+                problem,
+                mesh,
+                refine: r.refine.or(d.refine).unwrap_or(Refine::Adaptive),
+                theta,
+                levels,
+                max_ndof: r.max_ndof.or(d.max_ndof),
+                estimator,
+                reference: reference.map(|rf| ReferenceSpec {
+                    theta: rf.theta,
+                    min_ndof: rf.min_ndof,
+                    contact_term: rf.contact_term.unwrap_or(ContactTerm::WithoutFullContact),
+                }),
+                save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
             };
             AdaptConfig::for_run(&spec).validate().map_err(|e| invalid(key(e.key), e.expected, e.got))?;
             let quick_levels = r.quick_levels.or(d.quick_levels).unwrap_or(levels.min(6));
@@ -252,7 +271,11 @@ impl Manifest {
                 return Err(invalid(key("quick_levels"), &format!("a number in 1..={levels} (levels)"), quick_levels.to_string()));
             }
             if let Some(&l) = spec.save_levels.iter().find(|&&l| l >= levels) {
-                return Err(invalid(key("save_levels"), &format!("levels in 0..={} (the run has {levels} levels, numbered from 0)", levels - 1), l.to_string()));
+                return Err(invalid(
+                    key("save_levels"),
+                    &format!("levels in 0..={} (the run has {levels} levels, numbered from 0)", levels - 1),
+                    l.to_string(),
+                ));
             }
             if spec.reference.as_ref().is_some_and(|rf| rf.min_ndof == 0) {
                 return Err(invalid(key("reference.min_ndof"), "a number of unknowns >= 1", "0".into()));
@@ -261,13 +284,23 @@ impl Manifest {
         }
         let drift = raw.drift.unwrap_or_default();
         let floats = crate::records::float_fields();
-        for (key, tol) in std::iter::once(("default".to_string(), &drift.default)).chain(drift.fields.iter().map(|(k, t)| (format!("fields.{k}"), t))) {
+        for (key, tol) in
+            std::iter::once(("default".to_string(), &drift.default)).chain(drift.fields.iter().map(|(k, t)| (format!("fields.{k}"), t)))
+        {
             if let Some(name) = key.strip_prefix("fields.") {
                 if crate::study::drift::DERIVED.iter().any(|(f, _)| *f == name) {
-                    return Err(invalid(format!("drift.{key}"), "a field with a tolerance of its own; this one is checked by its definition, exactly", format!("{name:?}")));
+                    return Err(invalid(
+                        format!("drift.{key}"),
+                        "a field with a tolerance of its own; this one is checked by its definition, exactly",
+                        format!("{name:?}"),
+                    ));
                 }
                 if !floats.iter().any(|f| f == name) {
-                    return Err(invalid(format!("drift.{key}"), &format!("a float field of the level records ({})", floats.join(", ")), format!("{name:?}")));
+                    return Err(invalid(
+                        format!("drift.{key}"),
+                        &format!("a float field of the level records ({})", floats.join(", ")),
+                        format!("{name:?}"),
+                    ));
                 }
             }
             for (part, v) in [("rel", tol.rel), ("floor", tol.floor)] {
@@ -284,14 +317,7 @@ impl Manifest {
                 return Err(invalid(format!("drift.rates[{i}].last"), "at least 2 levels", r.last.to_string()));
             }
         }
-        Ok(Manifest {
-            study,
-            file,
-            description: raw.description.unwrap_or_default(),
-            runs,
-            drift,
-            bytes: text.as_bytes().to_vec(),
-        })
+        Ok(Manifest { study, file, description: raw.description.unwrap_or_default(), runs, drift, bytes: text.as_bytes().to_vec() })
     }
 }
 
@@ -308,7 +334,10 @@ pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
     let all = files.iter().map(|f| Manifest::load(f)).collect::<Result<Vec<_>, _>>()?;
     for name in only {
         if !all.iter().any(|m| &m.study == name) {
-            anyhow::bail!("unknown study '{name}'; declared studies: {}", all.iter().map(|m| m.study.as_str()).collect::<Vec<_>>().join(", "));
+            anyhow::bail!(
+                "unknown study '{name}'; declared studies: {}",
+                all.iter().map(|m| m.study.as_str()).collect::<Vec<_>>().join(", ")
+            );
         }
     }
     Ok(all.into_iter().filter(|m| only.is_empty() || only.contains(&m.study)).collect())
@@ -316,7 +345,15 @@ pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
 
 /// Serde's messages name Rust types (`expected usize`); a manifest's reader knows TOML values.
 fn plain_words(message: &str) -> String {
-    [("expected usize", "expected a non-negative integer"), ("expected u64", "expected a non-negative integer"), ("expected f64", "expected a number"), ("expected i64", "expected an integer"), ("expected a sequence", "expected an array"), ("expected a map", "expected a table"), ("expected struct Tolerance", "expected a table { rel = .., floor = .. }")]
-        .iter()
-        .fold(message.to_string(), |m, (rust, toml)| m.replace(rust, toml))
+    [
+        ("expected usize", "expected a non-negative integer"),
+        ("expected u64", "expected a non-negative integer"),
+        ("expected f64", "expected a number"),
+        ("expected i64", "expected an integer"),
+        ("expected a sequence", "expected an array"),
+        ("expected a map", "expected a table"),
+        ("expected struct Tolerance", "expected a table { rel = .., floor = .. }"),
+    ]
+    .iter()
+    .fold(message.to_string(), |m, (rust, toml)| m.replace(rust, toml))
 }

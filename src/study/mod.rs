@@ -119,7 +119,13 @@ impl StudyLock {
         use std::io::{Read, Seek, Write};
         std::fs::create_dir_all(&dir.root).with_context(|| format!("creating {}", dir.root.display()))?;
         let path = dir.root.join(".lock");
-        let mut file = std::fs::OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).with_context(|| format!("opening the lock file {}", path.display()))?;
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .with_context(|| format!("opening the lock file {}", path.display()))?;
         match file.try_lock() {
             Ok(()) => {}
             Err(std::fs::TryLockError::WouldBlock) => {
@@ -127,15 +133,23 @@ impl StudyLock {
                 let _ = file.read_to_string(&mut holder);
                 let holder = if holder.trim().is_empty() { "another process".to_string() } else { holder.trim().to_string() };
                 if !wait {
-                    bail!("{} is being written by {holder}; wait for it to finish, or pass --wait to wait for it (the lock is {})", dir.root.display(), path.display());
+                    bail!(
+                        "{} is being written by {holder}; wait for it to finish, or pass --wait to wait for it (the lock is {})",
+                        dir.root.display(),
+                        path.display()
+                    );
                 }
                 eprintln!("{} is being written by {holder}; waiting for it to finish", dir.root.display());
                 file.lock().with_context(|| format!("waiting for the lock {}", path.display()))?;
             }
             Err(std::fs::TryLockError::Error(e)) => return Err(e).with_context(|| format!("locking {}", path.display())),
         }
-        let me = format!("process {} ({}) since {}", std::process::id(), std::env::args().collect::<Vec<_>>().join(" "), provenance::utc_now());
-        file.set_len(0).and_then(|_| file.rewind()).and_then(|_| file.write_all(me.as_bytes())).with_context(|| format!("writing {}", path.display()))?;
+        let me =
+            format!("process {} ({}) since {}", std::process::id(), std::env::args().collect::<Vec<_>>().join(" "), provenance::utc_now());
+        file.set_len(0)
+            .and_then(|_| file.rewind())
+            .and_then(|_| file.write_all(me.as_bytes()))
+            .with_context(|| format!("writing {}", path.display()))?;
         Ok(StudyLock { _file: file })
     }
 }
@@ -170,7 +184,8 @@ fn remove_meshes(dir: &StudyDir, id: &str) -> Result<()> {
 fn write_summaries(manifest: &Manifest, dir: &StudyDir, quick: bool) -> Result<Vec<RunRecord>> {
     let runs = dir.read_runs().with_context(|| format!("reading the runs in {}", dir.root.join("runs").display()))?;
     dir.write_csv(&runs).with_context(|| format!("writing {}", dir.csv_file().display()))?;
-    let prov = provenance::collect(&manifest.study, &manifest.file, &manifest.bytes, quick, runs.iter().map(|r| r.run.id.clone()).collect());
+    let prov =
+        provenance::collect(&manifest.study, &manifest.file, &manifest.bytes, quick, runs.iter().map(|r| r.run.id.clone()).collect());
     records::write_json(&dir.provenance_file(), &prov).with_context(|| format!("writing {}", dir.provenance_file().display()))?;
     Ok(runs)
 }
@@ -257,7 +272,10 @@ pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<
     for planned in &manifest.runs {
         match runs.iter().find(|r| r.run.id == planned.spec.id) {
             None => problems.push(format!("run {} is missing", planned.spec.id)),
-            Some(r) if r.run != planned.spec => problems.push(format!("run {} was computed with another spec (levels {} vs {} declared, or another setting)", planned.spec.id, r.run.levels, planned.spec.levels)),
+            Some(r) if r.run != planned.spec => problems.push(format!(
+                "run {} was computed with another spec (levels {} vs {} declared, or another setting)",
+                planned.spec.id, r.run.levels, planned.spec.levels
+            )),
             Some(_) => {}
         }
     }
@@ -332,13 +350,19 @@ fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Resul
     let mesh = mesh_spec.build(&|x| problem.part_of(x));
     let levels = adapt::run(problem.as_ref(), mesh, &config, error_against, &mut |level: Level| {
         let r = level.record;
-        pb.set_message(format!("level {} NDF {} estimate {:.3e}{}", r.level, r.ndof, r.estimate, r.err_quadrature.map(|e| format!(" error {e:.3e}")).unwrap_or_default()));
+        pb.set_message(format!(
+            "level {} NDF {} estimate {:.3e}{}",
+            r.level,
+            r.ndof,
+            r.estimate,
+            r.err_quadrature.map(|e| format!(" error {e:.3e}")).unwrap_or_default()
+        ));
         pb.inc(1);
-        if spec.save_levels.contains(&r.level) {
-            if let Err(e) = save_level(study, spec, dir, &level, problem.as_ref()) {
-                save_error = Some(e);
-                return ControlFlow::Break(());
-            }
+        if spec.save_levels.contains(&r.level)
+            && let Err(e) = save_level(study, spec, dir, &level, problem.as_ref())
+        {
+            save_error = Some(e);
+            return ControlFlow::Break(());
         }
         if interrupted() {
             stopped = true;
@@ -393,7 +417,12 @@ fn save_level(study: &str, spec: &RunSpec, dir: &StudyDir, level: &Level, proble
     let doc = io::vtu(
         mesh,
         &sol.nodes,
-        &[("u", io::Field::Vector(&sol.u)), ("lambda", io::Field::Scalar(&lambda)), ("active", io::Field::Int(&active)), ("contact", io::Field::Int(&contact))],
+        &[
+            ("u", io::Field::Vector(&sol.u)),
+            ("lambda", io::Field::Scalar(&lambda)),
+            ("active", io::Field::Int(&active)),
+            ("contact", io::Field::Int(&contact)),
+        ],
         &[("indicator", io::Field::Scalar(&level.estimate.element))],
     );
     let l = level.record.level;

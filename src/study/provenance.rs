@@ -53,8 +53,11 @@ fn command(cmd: &str, args: &[&str]) -> Option<String> {
 
 pub fn machine() -> Machine {
     let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
-    let cpu = cpuinfo.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split(':').nth(1)).unwrap_or("unknown").trim().to_string();
-    let memory_kb = std::fs::read_to_string("/proc/meminfo").ok().and_then(|s| s.lines().next().and_then(|l| l.split_whitespace().nth(1)).and_then(|v| v.parse().ok()));
+    let cpu =
+        cpuinfo.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split(':').nth(1)).unwrap_or("unknown").trim().to_string();
+    let memory_kb = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|s| s.lines().next().and_then(|l| l.split_whitespace().nth(1)).and_then(|v| v.parse().ok()));
     Machine {
         cpu,
         cores: std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
@@ -83,7 +86,9 @@ pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: 
     let root = manifest_path.parent().and_then(|p| p.parent()).filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let git_commit = command("git", &["-C", &root.to_string_lossy(), "rev-parse", "HEAD"]);
     // dirty = tracked files changed outside results/ (the study's own outputs are not the code)
-    let git_dirty = command("git", &["-C", &root.to_string_lossy(), "status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)results"]).map(|s| !s.is_empty());
+    let git_dirty =
+        command("git", &["-C", &root.to_string_lossy(), "status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)results"])
+            .map(|s| !s.is_empty());
     Provenance {
         study: study.to_string(),
         manifest: manifest_path.display().to_string(),

@@ -71,7 +71,12 @@ impl ReferenceField {
 /// `spec.contact_term`, otherwise the defaults) until the NDF reaches `spec.min_ndof`; the last
 /// level's solution. `on_level` sees every level (progress) and may stop the loop (an
 /// interrupt): then the result is `None`.
-pub fn compute(problem: &dyn Problem, mesh_spec: &MeshSpec, spec: &ReferenceSpec, on_level: &mut dyn FnMut(&crate::adapt::LevelRecord) -> std::ops::ControlFlow<()>) -> Result<Option<ReferenceField>, SolveError> {
+pub fn compute(
+    problem: &dyn Problem,
+    mesh_spec: &MeshSpec,
+    spec: &ReferenceSpec,
+    on_level: &mut dyn FnMut(&crate::adapt::LevelRecord) -> std::ops::ControlFlow<()>,
+) -> Result<Option<ReferenceField>, SolveError> {
     let mesh = mesh_spec.build(&|x| problem.part_of(x));
     let estimator = crate::estimate::EstimatorConfig { contact_term: spec.contact_term, ..Default::default() };
     let config = AdaptConfig { levels: 200, refine: Refine::Adaptive, theta: spec.theta, estimator, ..Default::default() };
