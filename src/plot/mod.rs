@@ -18,6 +18,7 @@
 //! | `fig2a` | `ex71`, all runs (the first, `adaptive`, solid; others dashed, hollow markers) | `err_quadrature` (blue circles) and `estimate` (red squares) vs NDF, log-log; NDF^-3/2 reference 2.5x below the adaptive error |
 //! | `fig2b` | `ex71`, all runs | efficiency index `efficiency` (= estimate / err_quadrature; recomputed if absent) vs NDF, log x; y log if it spans more than a decade, else linear from 0; line at 1 |
 //! | `fig3a` | `ex72`, all runs | `estimate` vs NDF, log-log, plus `err_quadrature` (against the reference solution, its NDF from `reference_ndof` noted in the legend) where present; NDF^-3/2 below the adaptive estimate |
+//! | `fig3b_variant` | `contact_term_ablation`, `meshes/ex72_without_full_contact_level20.json` | as `fig3b`, for the run marking with eta_5 without full-contact nodes: the mesh beside the paper's |
 //! | `fig3b` | `ex72`, `meshes/adaptive_level20.json` (else the finest saved level, said in the title) | the triangles, thin; equal aspect; active contact nodes red, inactive blue; the obstacle's kink (`kinks`) as a black diamond; NDF, triangle and vertex counts |
 //! | `fig4a` | `ex71`, run `adaptive` (else the first adaptive run) | `eta1`..`eta5` vs NDF, log-log, NDF^-3/2 above the data; `eta6`, `eta7` are not plotted (as in the paper) but the legend says whether they are 0 at every level or gives their maximum |
 //! | `fig4b` | `ex72`, run `adaptive` | `eta1`..`eta7` vs NDF, same style |
@@ -64,11 +65,12 @@ use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// Every figure, in the order drawn.
-pub const FIGURES: [&str; 12] = [
+pub const FIGURES: [&str; 13] = [
     "fig2a",
     "fig2b",
     "fig3a",
     "fig3b",
+    "fig3b_variant",
     "fig4a",
     "fig4b",
     "c0_sweep",
@@ -185,7 +187,8 @@ fn build(name: &str, results: &Path) -> anyhow::Result<Built> {
         "fig2a" => fig2a(results),
         "fig2b" => fig2b(results),
         "fig3a" => fig3a(results),
-        "fig3b" => fig3b(results),
+        "fig3b" => mesh_at_level_20(results, "ex72", "adaptive"),
+        "fig3b_variant" => mesh_at_level_20(results, "contact_term_ablation", "ex72_without_full_contact"),
         "fig4a" => fig4(results, "ex71", "4a", 5),
         "fig4b" => fig4(results, "ex72", "4b", 7),
         "c0_sweep" => c0_sweep(results),
@@ -401,19 +404,21 @@ fn fig4(results: &Path, study: &str, fig: &str, terms: usize) -> anyhow::Result<
     Ok(Ok(single(p)))
 }
 
-fn fig3b(results: &Path) -> anyhow::Result<Built> {
-    let dir = StudyDir::new(results, "ex72");
+/// Fig. 3(b): a run's mesh at level 20 (`fig3b`: the paper's run, eta_5 as written; `fig3b_variant`:
+/// eta_5 without full-contact nodes, where the free-boundary points are refinement centres).
+fn mesh_at_level_20(results: &Path, study: &str, run: &str) -> anyhow::Result<Built> {
+    let dir = StudyDir::new(results, study);
     let mut level = MESH_LEVEL;
     let mut note = String::new();
-    if !dir.mesh_file("adaptive", level, "json").exists() {
-        // fall back to the finest saved level of the adaptive run, saying so in the title
-        let Some(l) = saved_levels(&dir, "adaptive").into_iter().max() else {
-            return Ok(Err(format!("no mesh snapshot {}", dir.mesh_file("adaptive", level, "json").display())));
+    if !dir.mesh_file(run, level, "json").exists() {
+        // fall back to the finest saved level of the run, saying so in the title
+        let Some(l) = saved_levels(&dir, run).into_iter().max() else {
+            return Ok(Err(format!("no mesh snapshot {}", dir.mesh_file(run, level, "json").display())));
         };
         note = format!(" (level {MESH_LEVEL} not saved)");
         level = l;
     }
-    let snap = dir.read_mesh("adaptive", level).with_context(|| format!("reading the mesh snapshot of level {level}"))?;
+    let snap = dir.read_mesh(run, level).with_context(|| format!("reading the mesh snapshot of level {level}"))?;
     Ok(Ok(Figure::Mesh(mesh_figure(&snap, &note))))
 }
 
@@ -456,9 +461,9 @@ fn mesh_figure(s: &MeshSnapshot, note: &str) -> MeshFigure {
 
 /// The snapshot does not store its problem; the study name says it for the paper's studies.
 fn problem_of(s: &MeshSnapshot) -> String {
-    if s.study.starts_with("ex71") {
+    if s.study.starts_with("ex71") || s.run.starts_with("ex71") {
         "ex71".into()
-    } else if s.study.starts_with("ex72") {
+    } else if s.study.starts_with("ex72") || s.run.starts_with("ex72") {
         "ex72".into()
     } else {
         s.study.clone()

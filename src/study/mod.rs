@@ -272,10 +272,17 @@ pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<
     for planned in &manifest.runs {
         match runs.iter().find(|r| r.run.id == planned.spec.id) {
             None => problems.push(format!("run {} is missing", planned.spec.id)),
-            Some(r) if r.run != planned.spec => problems.push(format!(
-                "run {} was computed with another spec (levels {} vs {} declared, or another setting)",
-                planned.spec.id, r.run.levels, planned.spec.levels
-            )),
+            Some(r) if r.run != planned.spec => {
+                let (a, b) = (serde_json::to_value(&r.run).unwrap_or_default(), serde_json::to_value(&planned.spec).unwrap_or_default());
+                let differ: Vec<String> = a
+                    .as_object()
+                    .into_iter()
+                    .flatten()
+                    .filter(|(k, v)| b.get(k.as_str()) != Some(v))
+                    .map(|(k, v)| format!("{k} {v} stored, {} declared", b.get(k.as_str()).unwrap_or(&serde_json::Value::Null)))
+                    .collect();
+                problems.push(format!("run {} was computed with another spec ({})", planned.spec.id, differ.join(", ")))
+            }
             Some(_) => {}
         }
     }
