@@ -148,7 +148,8 @@ pub struct LevelRecord {
     /// without such an edge.
     #[serde(default)]
     pub h_free_boundary: Option<f64>,
-    /// Centroid of the element with the largest marking indicator eta_T (the first one on ties).
+    /// Centroid of the element with the largest marking indicator eta_T (on ties within 1e-8, the
+    /// smallest centroid by x, then y).
     #[serde(default)]
     pub max_indicator_x: f64,
     #[serde(default)]
@@ -180,9 +181,20 @@ pub fn mark_maximum(indicators: &[f64], theta: f64) -> Vec<bool> {
 
 /// Centroid of the first element with the largest indicator.
 fn largest_indicator_centroid(mesh: &Mesh, indicators: &[f64]) -> [f64; 2] {
-    let t = indicators.iter().enumerate().fold((0, f64::NEG_INFINITY), |best, (t, &e)| if e > best.1 { (t, e) } else { best }).0;
-    let v = mesh.triangles[t].map(|i| mesh.vertices[i]);
-    [(v[0][0] + v[1][0] + v[2][0]) / 3.0, (v[0][1] + v[1][1] + v[2][1]) / 3.0]
+    let centroid = |t: usize| {
+        let v = mesh.triangles[t].map(|i| mesh.vertices[i]);
+        [(v[0][0] + v[1][0] + v[2][0]) / 3.0, (v[0][1] + v[1][1] + v[2][1]) / 3.0]
+    };
+    let max = indicators.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    // elements within TIE of the largest count as tied (round-off moves indicators by about
+    // 1e-10 relative, results/roundoff/), and the tie goes to the smallest centroid (x, then y):
+    // otherwise which of two near-equal corners wins would depend on the summation order
+    const TIE: f64 = 1e-8;
+    (0..indicators.len())
+        .filter(|&t| indicators[t] >= max - TIE * max.abs())
+        .map(centroid)
+        .min_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])))
+        .unwrap_or([f64::NAN; 2])
 }
 
 /// The longest contact edge with both active and inactive nodes (`LevelRecord::h_free_boundary`).
