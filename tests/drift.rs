@@ -124,20 +124,20 @@ fn declared() -> Vec<(Manifest, Vec<RunRecord>)> {
 
 /// With the tolerances the manifests declare, a change of 1e-5 relative to any float field of
 /// the stored records, at the first, a middle and the last level of every run, is drift --
-/// wherever measured round-off allows it. Round-off moves a number by at most (rel |v| + floor
-/// scale) / margin; where that bound times the margin exceeds 1e-5 |v| (a field far below its
-/// largest value in the run: an error of 1e-8 in a run that starts at 1e-3), no tolerance
-/// honest about round-off can see a change of 1e-5. Those entries must all lie below
-/// REL_RANGE of their run's largest value, and every declared `rel` must be below 1e-5.
+/// wherever measured round-off allows it. The tolerances are 10x the measured round-off
+/// (`manifest_tolerances_are_the_measured_round_off_times_the_margin`); where that exceeds 1e-5
+/// of a value (a field far below its largest value in the run: an error of 1e-8 in a run that
+/// starts at 1e-3, eta_4 decaying at NDF^-3.3), no tolerance honest about round-off can see a
+/// change of 1e-5. Those entries are listed and must be a small minority; every declared `rel`
+/// is below 1e-6.
 #[test]
 fn declared_tolerances_catch_a_relative_change_of_1e_5_wherever_round_off_allows() {
-    use signorini::study::drift::REL_RANGE;
     let floats = signorini::records::float_fields();
     let (mut checked, mut limited) = (0, Vec::new());
     for (m, stored) in declared() {
         assert!(!stored.is_empty(), "{}: no stored results", m.study);
         for field in &floats {
-            assert!(m.drift.tolerance(field).rel < 1e-5, "{}: rel tolerance of {field} is {:e}", m.study, m.drift.tolerance(field).rel);
+            assert!(m.drift.tolerance(field).rel < 1e-6, "{}: rel tolerance of {field} is {:e}", m.study, m.drift.tolerance(field).rel);
         }
         for (ri, run) in stored.iter().enumerate() {
             let n = run.levels.len();
@@ -151,12 +151,6 @@ fn declared_tolerances_catch_a_relative_change_of_1e_5_wherever_round_off_allows
                     let scale = levels.iter().filter_map(|l| l[field].as_f64()).fold(0.0f64, |a, x| a.max(x.abs()));
                     let tol = m.drift.tolerance(field);
                     if tol.rel * v.abs() + tol.floor * scale >= 1e-5 * v.abs() {
-                        assert!(
-                            v.abs() < REL_RANGE * scale,
-                            "{}/{} level {level}: {field} = {v:e} cannot be checked to 1e-5 although it is not near round-off",
-                            m.study,
-                            run.run.id
-                        );
                         limited.push(format!(
                             "{}/{} L{level} {field} {:.1e}",
                             m.study,
