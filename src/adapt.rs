@@ -149,23 +149,75 @@ fn transfer_active_set(old_mesh: &Mesh, old: &DiscreteSolution, refinement: &Ref
         .collect()
 }
 
+/// Why [`run`] stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Termination {
+    /// All `AdaptConfig::levels` levels were solved.
+    LevelsReached,
+    /// The next level would have had more unknowns than `AdaptConfig::max_ndof` (it was not solved).
+    MaxNdofReached,
+    /// The observer returned `ControlFlow::Break` (checked before the other two: an observer that
+    /// stops at the last level is reported here).
+    StoppedByObserver,
+}
+
+/// What [`run`] returns: the state of the last level solved and why the loop stopped (in the
+/// shape of argmin's `OptimizationResult`).
+pub struct AdaptResult {
+    /// The mesh of the last level solved (not refined further).
+    pub mesh: Mesh,
+    /// The discrete solution on `mesh`.
+    pub solution: DiscreteSolution,
+    /// The estimate of that solution.
+    pub estimate: Estimate,
+    /// One record per level solved, in order; the last one describes `mesh`.
+    pub records: Vec<LevelRecord>,
+    pub termination: Termination,
+}
+
 /// Run the loop from `mesh`. `reference` gives the displacement errors are measured against
-/// (an exact solution or a reference solution), if any. The observer may stop the loop.
+/// (an exact solution or a reference solution), if any. The observer sees every level and may
+/// stop the loop.
+///
+/// `config` must be valid ([`AdaptConfig::validate`]); at least level 0 is always solved.
+///
+/// ```rust
+/// use signorini::adapt::{self, AdaptConfig, Termination};
+/// use signorini::mesh::MeshSpec;
+/// use signorini::problems::{self, Problem};
+/// use std::ops::ControlFlow;
+///
+/// let problem = problems::by_name("ex71").unwrap();
+/// let mesh = MeshSpec::parse("structured:2").unwrap().build(&|x| problem.part_of(x));
+/// let config = AdaptConfig { levels: 3, ..Default::default() };
+/// config.validate().unwrap();
+/// let exact = problem.exact().unwrap();
+/// let u = |x: [f64; 2]| exact.u(x);
+/// let result = adapt::run(problem.as_ref(), mesh, &config, Some(&u), &mut |_| ControlFlow::Continue(())).unwrap();
+/// assert_eq!(result.termination, Termination::LevelsReached);
+/// assert_eq!(result.records.len(), 3);
+/// assert_eq!(result.records[2].ndof, 2 * result.solution.nodes.len());
+/// assert!(result.records[2].err_quadrature.unwrap() < result.records[0].err_quadrature.unwrap());
+/// ```
 pub fn run(
     problem: &dyn Problem,
     mut mesh: Mesh,
     config: &AdaptConfig,
     reference: Option<Reference>,
     observer: &mut dyn FnMut(Level) -> ControlFlow<()>,
-) -> Result<Vec<LevelRecord>, SolveError> {
+) -> Result<AdaptResult, SolveError> {
     debug_assert_eq!(config.validate(), Ok(()), "adapt::run needs a validated AdaptConfig");
+    assert!(config.levels > 0, "adapt::run needs levels >= 1 (AdaptConfig::validate)");
     let mut records = Vec::new();
+    let mut state: Option<(Mesh, DiscreteSolution, Estimate)> = None;
+    let mut termination = Termination::LevelsReached;
     let mut initial_active: Option<Vec<bool>> = None;
     for level in 0..config.levels {
         if let Some(max) = config.max_ndof {
             // edges of a triangulation: (3 triangles + boundary edges) / 2; no need to number them
             let ndof = 2 * (mesh.n_vertices() + (3 * mesh.n_triangles() + mesh.boundary.len()) / 2);
             if level > 0 && ndof > max {
+                termination = Termination::MaxNdofReached;
                 break;
             }
         }
@@ -249,7 +301,9 @@ pub fn run(
         record.t_level = t_level.elapsed().as_secs_f64();
         let flow = observer(Level { record: &record, mesh: &mesh, solution: &sol, estimate: &est });
         records.push(record);
+        state = Some((mesh, sol, est));
         if flow.is_break() {
+            termination = Termination::StoppedByObserver;
             break;
         }
         match next {
@@ -260,5 +314,6 @@ pub fn run(
             None => break,
         }
     }
-    Ok(records)
+    let (mesh, solution, estimate) = state.expect("level 0 is always solved");
+    Ok(AdaptResult { mesh, solution, estimate, records, termination })
 }

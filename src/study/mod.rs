@@ -377,7 +377,8 @@ fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Resul
         }
         ControlFlow::Continue(())
     })
-    .with_context(|| format!("{study}/{}", spec.id))?;
+    .with_context(|| format!("{study}/{}", spec.id))?
+    .records;
     pb.finish_and_clear();
     if let Some(e) = save_error {
         return Err(e);
