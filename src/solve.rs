@@ -142,7 +142,7 @@ pub fn solve(
     let strategy = options.strategy.unwrap_or(Strategy::auto(dofs.contact.len()));
     let mut solver = ContactSolver::with_strategy(&matrix, dofs.n_interior, &dofs.unknown_coords(&nodes), strategy)?;
     let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
-    let out = solver.solve_contact(&matrix, &rhs, &gap, options, observe)?;
+    let out = solver.solve_contact(&matrix, &rhs, &gap, options, observe)?.converged()?;
     // the residual F - K u: zero at free unknowns, lambda_p at contact normals
     let ku = matrix.mul(&out.u);
     let r: Vec<f64> = rhs.iter().zip(&ku).map(|(f, k)| f - k).collect();
