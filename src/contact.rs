@@ -203,7 +203,7 @@ impl ContactSolver {
     /// chosen by the number of contact nodes.
     /// `coords` holds the position of every unknown (its node's), for the ordering.
     pub fn new(matrix: &SymCsc, n_interior: usize, coords: &[[f64; 2]]) -> Result<Self, ContactError> {
-        Self::with_strategy(matrix, n_interior, coords, Strategy::auto(matrix.n - n_interior))
+        Self::with_strategy(matrix, n_interior, coords, Strategy::auto(matrix.n() - n_interior))
     }
 
     pub fn with_strategy(matrix: &SymCsc, n_interior: usize, coords: &[[f64; 2]], strategy: Strategy) -> Result<Self, ContactError> {
@@ -213,10 +213,10 @@ impl ContactSolver {
         let row_entries = match strategy {
             Strategy::Schur => Vec::new(),
             Strategy::Refactor => {
-                let mut rows = vec![Vec::new(); matrix.n - n_interior];
-                for j in 0..matrix.n {
-                    for k in matrix.col_ptr[j]..matrix.col_ptr[j + 1] {
-                        let i = matrix.row_idx[k];
+                let mut rows = vec![Vec::new(); matrix.n() - n_interior];
+                for j in 0..matrix.n() {
+                    for k in matrix.col_ptr()[j]..matrix.col_ptr()[j + 1] {
+                        let i = matrix.row_idx()[k];
                         if i >= n_interior && i != j {
                             rows[i - n_interior].push((j, k));
                         }
@@ -227,7 +227,7 @@ impl ContactSolver {
         };
         timings.symbolic = t0.elapsed().as_secs_f64();
         let mut solver = ContactSolver {
-            n: matrix.n,
+            n: matrix.n(),
             n_interior,
             strategy,
             l_values: vec![0.0; symbolic.len_val()],
@@ -249,7 +249,7 @@ impl ContactSolver {
     /// Schur complement).
     pub fn refactor(&mut self, matrix: &SymCsc) -> Result<(), ContactError> {
         self.timings.numeric = 0.0;
-        self.factor_values(matrix, &matrix.values)?;
+        self.factor_values(matrix, matrix.values())?;
         if self.strategy == Strategy::Schur {
             let t0 = Instant::now();
             let lcc = self.trailing_factor_block()?;
@@ -418,7 +418,7 @@ impl ContactSolver {
         observe: &mut dyn FnMut(&PdasIteration),
     ) -> Result<PdasResult, ContactError> {
         let (ni, m) = (self.n_interior, self.n_contact());
-        let diag = |k: usize| matrix.values[matrix.col_ptr[ni + k]];
+        let diag = |k: usize| matrix.values()[matrix.col_ptr()[ni + k]];
         let c = options.c_scale * (0..m).map(diag).sum::<f64>() / m as f64;
         let initial = match options.initial_active.clone().filter(|a| a.len() == m) {
             Some(a) => a,
@@ -430,18 +430,18 @@ impl ContactSolver {
         };
         let mut last_u = Vec::new();
         let mut step = |active: &[bool]| -> Result<(Vec<f64>, Vec<f64>), ContactError> {
-            let mut values = matrix.values.clone();
+            let mut values = matrix.values().to_vec();
             let mut b = rhs.to_vec();
             for k in (0..m).filter(|&k| active[k]) {
                 let col = ni + k;
                 // column entries below the diagonal, then row entries left of it: move the known
                 // value to the right-hand side and keep an explicit zero in the pattern
-                for pos in matrix.col_ptr[col] + 1..matrix.col_ptr[col + 1] {
-                    b[matrix.row_idx[pos]] -= matrix.values[pos] * gap[k];
+                for pos in matrix.col_ptr()[col] + 1..matrix.col_ptr()[col + 1] {
+                    b[matrix.row_idx()[pos]] -= matrix.values()[pos] * gap[k];
                     values[pos] = 0.0;
                 }
                 for &(j, pos) in &self.row_entries[k] {
-                    b[j] -= matrix.values[pos] * gap[k];
+                    b[j] -= matrix.values()[pos] * gap[k];
                     values[pos] = 0.0;
                 }
             }
@@ -473,7 +473,7 @@ fn symbolic_factorisation(
     coords: &[[f64; 2]],
     strategy: Strategy,
 ) -> Result<(SymbolicCholesky<usize>, OrderingChoice), ContactError> {
-    let n = matrix.n;
+    let n = matrix.n();
     let n_order = if strategy == Strategy::Schur { ni } else { n };
     let (fwd, choice) = crate::ordering::fill_reducing(matrix, n_order, coords);
     let mut inv = vec![0usize; n];

@@ -70,7 +70,7 @@ fn non_converged_active_set_method_returns_its_last_iterate() {
         let out = solver.solve_contact(&sys.matrix, &sys.rhs, &gap, &options, &mut |_| {}).unwrap();
         assert!(matches!(out.termination, Termination::MaxIterations { .. }), "{strategy:?}: {:?}", out.termination);
         assert!(!out.termination.is_converged());
-        assert_eq!((out.iterations.len(), out.u.len(), out.lambda.len(), out.active.len()), (2, sys.matrix.n, gap.len(), gap.len()));
+        assert_eq!((out.iterations.len(), out.u.len(), out.lambda.len(), out.active.len()), (2, sys.matrix.n(), gap.len(), gap.len()));
         assert!(out.u.iter().all(|v| v.is_finite()));
         let err = out.converged().unwrap_err().to_string();
         assert!(err.contains("did not converge in 2 iterations") && err.contains("residual"), "{err}");
