@@ -20,6 +20,7 @@ test: build
 	$(CARGO) fmt --check
 	$(CARGO) clippy --release --locked --all-targets -- -D warnings
 	$(CARGO) test --release --locked
+	$(CARGO) run --release --locked --example own_problem
 	$(BIN) drift
 	CROSSCHECK_OUT=target/crosscheck-report crosscheck/run.sh
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-after-test

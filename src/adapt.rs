@@ -7,20 +7,10 @@ use crate::mesh::Mesh;
 use crate::mesh::refine::{self, Refinement};
 use crate::norms::{self, Reference};
 use crate::problems::Problem;
+pub use crate::records::{LevelRecord, Refine};
 use crate::solve::{self, DiscreteSolution, SolveError};
-use serde::{Deserialize, Serialize};
 use std::ops::ControlFlow;
 use std::time::Instant;
-
-/// How the mesh is refined from level to level.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Refine {
-    /// Maximum strategy: mark T if eta_T >= theta max eta_T (Section 7, ref. \[35\]).
-    Adaptive,
-    /// Mark every element (one newest-vertex bisection each, so NDF about doubles per level).
-    Uniform,
-}
 
 /// Settings of the loop; [`AdaptConfig::validate`] checks them.
 #[derive(Clone, Debug)]
@@ -98,73 +88,6 @@ impl Default for AdaptConfig {
     }
 }
 
-/// Everything a study stores about one level: the one record type behind JSON, CSV, drift and
-/// plots. Flat, so that it is also one CSV row. Fields starting with `t_` are timings (seconds),
-/// never compared by the drift check.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct LevelRecord {
-    pub level: usize,
-    /// 2 x number of P2 nodes, Dirichlet nodes included (the NDF of every figure and table).
-    pub ndof: usize,
-    pub ndof_free: usize,
-    pub n_elements: usize,
-    pub h_min: f64,
-    pub h_max: f64,
-    pub min_angle: f64,
-    pub contact_nodes: usize,
-    pub active_nodes: usize,
-    pub full_contact_nodes: usize,
-    pub pdas_iterations: usize,
-    pub zone_min: Option<f64>,
-    pub zone_max: Option<f64>,
-    pub eta1: f64,
-    pub eta2: f64,
-    pub eta3: f64,
-    pub eta4: f64,
-    pub eta5: f64,
-    pub eta6: f64,
-    pub eta7: f64,
-    pub l_h: f64,
-    pub psi: f64,
-    pub eta_h: f64,
-    pub c0: f64,
-    pub estimate: f64,
-    /// ||u - u_h||_Linf at the quadrature points (the paper's way), where u is known.
-    pub err_quadrature: Option<f64>,
-    pub err_dense: Option<f64>,
-    pub err_nodal: Option<f64>,
-    /// estimate / err_quadrature
-    pub efficiency: Option<f64>,
-    /// ||u - u_h||_Linf on Gamma_C (`norms::linf_error_contact`: equally spaced points of every
-    /// contact edge), where u is known.
-    #[serde(default)]
-    pub err_contact: Option<f64>,
-    /// ||u - u_h||_Linf over the lattice points with x >= 1/2 (Example 7.2: away from the
-    /// corners of the clamped side x = 0), where u is known.
-    #[serde(default)]
-    pub err_right_half: Option<f64>,
-    /// Length of the longest contact edge whose three nodes are neither all active nor all
-    /// inactive: the edge straddling a free-boundary point, where eta_6 and eta_7 live. None
-    /// without such an edge.
-    #[serde(default)]
-    pub h_free_boundary: Option<f64>,
-    /// Centroid of the element with the largest marking indicator eta_T (on ties within 1e-8, the
-    /// smallest centroid by x, then y).
-    #[serde(default)]
-    pub max_indicator_x: f64,
-    #[serde(default)]
-    pub max_indicator_y: f64,
-    /// Elements marked for refinement at this level (also at the last level, not refined).
-    pub marked: usize,
-    pub t_assembly: f64,
-    pub t_factorisation: f64,
-    pub t_active_set: f64,
-    pub t_solve: f64,
-    pub t_estimate: f64,
-    pub t_refine: f64,
-    pub t_level: f64,
-}
-
 /// What the observer sees at each level.
 pub struct Level<'a> {
     pub record: &'a LevelRecord,
@@ -226,23 +149,75 @@ fn transfer_active_set(old_mesh: &Mesh, old: &DiscreteSolution, refinement: &Ref
         .collect()
 }
 
+/// Why [`run`] stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Termination {
+    /// All `AdaptConfig::levels` levels were solved.
+    LevelsReached,
+    /// The next level would have had more unknowns than `AdaptConfig::max_ndof` (it was not solved).
+    MaxNdofReached,
+    /// The observer returned `ControlFlow::Break` (checked before the other two: an observer that
+    /// stops at the last level is reported here).
+    StoppedByObserver,
+}
+
+/// What [`run`] returns: the state of the last level solved and why the loop stopped (in the
+/// shape of argmin's `OptimizationResult`).
+pub struct AdaptResult {
+    /// The mesh of the last level solved (not refined further).
+    pub mesh: Mesh,
+    /// The discrete solution on `mesh`.
+    pub solution: DiscreteSolution,
+    /// The estimate of that solution.
+    pub estimate: Estimate,
+    /// One record per level solved, in order; the last one describes `mesh`.
+    pub records: Vec<LevelRecord>,
+    pub termination: Termination,
+}
+
 /// Run the loop from `mesh`. `reference` gives the displacement errors are measured against
-/// (an exact solution or a reference solution), if any. The observer may stop the loop.
+/// (an exact solution or a reference solution), if any. The observer sees every level and may
+/// stop the loop.
+///
+/// `config` must be valid ([`AdaptConfig::validate`]); at least level 0 is always solved.
+///
+/// ```rust
+/// use signorini::adapt::{self, AdaptConfig, Termination};
+/// use signorini::mesh::MeshSpec;
+/// use signorini::problems::{self, Problem};
+/// use std::ops::ControlFlow;
+///
+/// let problem = problems::by_name("ex71").unwrap();
+/// let mesh = MeshSpec::parse("structured:2").unwrap().build(&|x| problem.part_of(x));
+/// let config = AdaptConfig { levels: 3, ..Default::default() };
+/// config.validate().unwrap();
+/// let exact = problem.exact().unwrap();
+/// let u = |x: [f64; 2]| exact.u(x);
+/// let result = adapt::run(problem.as_ref(), mesh, &config, Some(&u), &mut |_| ControlFlow::Continue(())).unwrap();
+/// assert_eq!(result.termination, Termination::LevelsReached);
+/// assert_eq!(result.records.len(), 3);
+/// assert_eq!(result.records[2].ndof, 2 * result.solution.nodes.len());
+/// assert!(result.records[2].err_quadrature.unwrap() < result.records[0].err_quadrature.unwrap());
+/// ```
 pub fn run(
     problem: &dyn Problem,
     mut mesh: Mesh,
     config: &AdaptConfig,
     reference: Option<Reference>,
     observer: &mut dyn FnMut(Level) -> ControlFlow<()>,
-) -> Result<Vec<LevelRecord>, SolveError> {
+) -> Result<AdaptResult, SolveError> {
     debug_assert_eq!(config.validate(), Ok(()), "adapt::run needs a validated AdaptConfig");
+    assert!(config.levels > 0, "adapt::run needs levels >= 1 (AdaptConfig::validate)");
     let mut records = Vec::new();
+    let mut state: Option<(Mesh, DiscreteSolution, Estimate)> = None;
+    let mut termination = Termination::LevelsReached;
     let mut initial_active: Option<Vec<bool>> = None;
     for level in 0..config.levels {
         if let Some(max) = config.max_ndof {
             // edges of a triangulation: (3 triangles + boundary edges) / 2; no need to number them
             let ndof = 2 * (mesh.n_vertices() + (3 * mesh.n_triangles() + mesh.boundary.len()) / 2);
             if level > 0 && ndof > max {
+                termination = Termination::MaxNdofReached;
                 break;
             }
         }
@@ -326,7 +301,9 @@ pub fn run(
         record.t_level = t_level.elapsed().as_secs_f64();
         let flow = observer(Level { record: &record, mesh: &mesh, solution: &sol, estimate: &est });
         records.push(record);
+        state = Some((mesh, sol, est));
         if flow.is_break() {
+            termination = Termination::StoppedByObserver;
             break;
         }
         match next {
@@ -337,5 +314,6 @@ pub fn run(
             None => break,
         }
     }
-    Ok(records)
+    let (mesh, solution, estimate) = state.expect("level 0 is always solved");
+    Ok(AdaptResult { mesh, solution, estimate, records, termination })
 }

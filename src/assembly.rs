@@ -116,20 +116,98 @@ impl DofMap {
 
 /// A symmetric sparse matrix stored as its lower triangle (diagonal included), compressed by
 /// columns with sorted row indices.
+///
+/// Invariant (checked by [`SymCsc::new`], the only constructor; the fields are private and only
+/// the values can change afterwards): `col_ptr` has n + 1 entries, starts at 0, is
+/// non-decreasing and ends at nnz = `row_idx.len()` = `values.len()`; the row indices of column
+/// j are strictly increasing, lie in j..n, and the first is j (every diagonal entry is stored,
+/// first in its column).
 #[derive(Clone, Debug)]
 pub struct SymCsc {
-    pub n: usize,
-    pub col_ptr: Vec<usize>,
-    pub row_idx: Vec<usize>,
-    pub values: Vec<f64>,
+    n: usize,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    values: Vec<f64>,
 }
 
+/// A compressed column layout that breaks the [`SymCsc`] invariant: what is wrong, where.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("not a lower-triangular compressed column matrix: {0}")]
+pub struct SymCscError(pub String);
+
 impl SymCsc {
+    /// The n x n lower triangle with columns `col_ptr`, row indices `row_idx` and `values`, after
+    /// checking the invariant (see [`SymCsc`]) in O(nnz).
+    ///
+    /// ```rust
+    /// use signorini::assembly::SymCsc;
+    /// // [[2, -1], [-1, 2]]: column 0 holds rows 0 and 1, column 1 holds row 1
+    /// let a = SymCsc::new(2, vec![0, 2, 3], vec![0, 1, 1], vec![2.0, -1.0, 2.0]).unwrap();
+    /// assert_eq!(a.mul(&[1.0, 1.0]), vec![1.0, 1.0]);
+    /// // an entry above the diagonal is refused
+    /// assert!(SymCsc::new(2, vec![0, 1, 3], vec![0, 0, 1], vec![2.0, -1.0, 2.0]).is_err());
+    /// ```
+    pub fn new(n: usize, col_ptr: Vec<usize>, row_idx: Vec<usize>, values: Vec<f64>) -> Result<Self, SymCscError> {
+        let bad = |s: String| Err(SymCscError(s));
+        if col_ptr.len() != n + 1 {
+            return bad(format!("{} column pointers for {n} columns (expected {})", col_ptr.len(), n + 1));
+        }
+        if col_ptr[0] != 0 {
+            return bad(format!("the first column pointer is {}, not 0", col_ptr[0]));
+        }
+        if col_ptr[n] != row_idx.len() || row_idx.len() != values.len() {
+            return bad(format!("last column pointer {}, {} row indices, {} values", col_ptr[n], row_idx.len(), values.len()));
+        }
+        // all pointers first: with them monotone, every column's range lies in 0..nnz
+        if let Some(j) = (0..n).find(|&j| col_ptr[j + 1] < col_ptr[j]) {
+            return bad(format!("column pointers decrease at column {j} ({} then {})", col_ptr[j], col_ptr[j + 1]));
+        }
+        for j in 0..n {
+            let (lo, hi) = (col_ptr[j], col_ptr[j + 1]);
+            let rows = &row_idx[lo..hi];
+            if rows.first() != Some(&j) {
+                return bad(format!("column {j} does not start with its diagonal entry"));
+            }
+            if let Some(w) = rows.windows(2).find(|w| w[0] >= w[1]) {
+                return bad(format!("row indices of column {j} are not strictly increasing ({} then {})", w[0], w[1]));
+            }
+            if let Some(&i) = rows.last().filter(|&&i| i >= n) {
+                return bad(format!("row index {i} in column {j} is out of range (n = {n})"));
+            }
+        }
+        Ok(SymCsc { n, col_ptr, row_idx, values })
+    }
+
+    /// Number of rows and columns.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// Column pointers: column j's entries are at `col_ptr()[j]..col_ptr()[j + 1]`.
+    pub fn col_ptr(&self) -> &[usize] {
+        &self.col_ptr
+    }
+
+    /// Row index of every stored entry.
+    pub fn row_idx(&self) -> &[usize] {
+        &self.row_idx
+    }
+
+    /// Value of every stored entry.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// The values, to fill or change (the pattern stays fixed).
+    pub fn values_mut(&mut self) -> &mut [f64] {
+        &mut self.values
+    }
+
     /// A faer view of the lower triangle.
     pub fn as_faer(&self) -> faer::sparse::SparseColMatRef<'_, usize, f64> {
-        // SAFETY: col_ptr is non-decreasing from 0 to nnz and row indices are sorted and < n by
-        // construction in `pattern` (checked in debug builds below).
-        debug_assert!(self.col_ptr.windows(2).all(|w| w[0] <= w[1]));
+        // SAFETY: faer needs col_ptr non-decreasing from 0 to nnz (n + 1 entries) and row indices
+        // < n, sorted within each column; `SymCsc::new`, the only way to build a SymCsc, checked
+        // that, and the pattern cannot change afterwards (private fields, only values_mut).
         let sym = unsafe { faer::sparse::SymbolicSparseColMatRef::new_unchecked(self.n, self.n, &self.col_ptr, None, &self.row_idx) };
         faer::sparse::SparseColMatRef::new(sym, &self.values)
     }
@@ -279,7 +357,8 @@ fn pattern(nodes: &P2Nodes, dofs: &DofMap) -> SymCsc {
         col.sort_unstable();
     });
     let nnz = row_idx.len();
-    SymCsc { n, col_ptr, row_idx, values: vec![0.0; nnz] }
+    SymCsc::new(n, col_ptr, row_idx, vec![0.0; nnz])
+        .expect("the stiffness pattern: every column holds its diagonal and sorted, unique rows below it")
 }
 
 /// Assemble stiffness and loads: body force f, Neumann traction g, Dirichlet data eliminated.
@@ -527,5 +606,25 @@ fn neumann_load(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sym_csc_checks_its_invariant() {
+        let ok = |p: Vec<usize>, r: Vec<usize>| SymCsc::new(3, p, r, vec![1.0; 5]);
+        assert!(ok(vec![0, 2, 4, 5], vec![0, 2, 1, 2, 2]).is_ok());
+        let err = |p: Vec<usize>, r: Vec<usize>| ok(p, r).unwrap_err().0;
+        assert!(err(vec![0, 2, 4], vec![0, 2, 1, 2, 2]).contains("column pointers"));
+        assert!(err(vec![1, 2, 4, 5], vec![0, 2, 1, 2, 2]).contains("first column pointer"));
+        assert!(err(vec![0, 2, 4, 4], vec![0, 2, 1, 2, 2]).contains("last column pointer"));
+        assert!(err(vec![0, 4, 2, 5], vec![0, 2, 1, 2, 2]).contains("decrease"));
+        assert!(err(vec![0, 9, 2, 5], vec![0, 2, 1, 2, 2]).contains("decrease"));
+        assert!(err(vec![0, 2, 4, 5], vec![0, 2, 0, 2, 2]).contains("diagonal"));
+        assert!(err(vec![0, 2, 4, 5], vec![0, 0, 1, 2, 2]).contains("strictly increasing"));
+        assert!(err(vec![0, 2, 4, 5], vec![0, 3, 1, 2, 2]).contains("out of range"));
     }
 }

@@ -85,13 +85,39 @@ pub struct PdasIteration {
     pub seconds: f64,
 }
 
-/// Why the iteration stopped.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+/// Why the iteration stopped. Only `Converged` and `NoContact` are solutions of the discrete
+/// problem; [`Termination::error`] turns the other two into the [`ContactError`] that
+/// [`crate::solve::solve`] reports.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub enum Termination {
     /// The active set repeated and the residual was below tolerance.
     Converged,
     /// No contact nodes: a single linear solve.
     NoContact,
+    /// `max_iterations` iterations without convergence: `residual` is the last iteration's NCP
+    /// residual, `next_active` the size of the active set the next iteration would have used.
+    MaxIterations { residual: f64, tolerance: f64, next_active: usize },
+    /// The next active set was already seen at iteration `first_seen` (other than the previous one).
+    Cycling { first_seen: usize, residual: f64 },
+}
+
+impl Termination {
+    /// Whether the iterate solves the discrete problem.
+    pub fn is_converged(&self) -> bool {
+        matches!(self, Termination::Converged | Termination::NoContact)
+    }
+
+    /// The error for a run that stopped without converging after `iterations` iterations; None
+    /// if it converged.
+    pub fn error(&self, iterations: usize) -> Option<ContactError> {
+        match *self {
+            Termination::Converged | Termination::NoContact => None,
+            Termination::MaxIterations { residual, tolerance, next_active } => {
+                Some(ContactError::NotConverged { iterations, residual, tolerance, active: next_active })
+            }
+            Termination::Cycling { first_seen, residual } => Some(ContactError::Cycling { iterations, first_seen, residual }),
+        }
+    }
 }
 
 /// Wall-clock seconds per phase.
@@ -105,7 +131,9 @@ pub struct Timings {
     pub active_set: f64,
 }
 
-/// The result of a contact solve, on the unknowns of the assembled system.
+/// The result of a contact solve, on the unknowns of the assembled system: the solution if
+/// `termination` is converged, otherwise the last iterate ([`PdasOutput::converged`] makes that
+/// an error).
 #[derive(Clone, Debug)]
 pub struct PdasOutput {
     /// All unknowns (local frames at contact nodes).
@@ -116,6 +144,17 @@ pub struct PdasOutput {
     pub iterations: Vec<PdasIteration>,
     pub termination: Termination,
     pub c: f64,
+}
+
+impl PdasOutput {
+    /// The output if the iteration converged, otherwise the error naming the iterations and the
+    /// residual.
+    pub fn converged(self) -> Result<Self, ContactError> {
+        match self.termination.error(self.iterations.len()) {
+            Some(e) => Err(e),
+            None => Ok(self),
+        }
+    }
 }
 
 /// How the complementarity problem is solved.
@@ -164,7 +203,7 @@ impl ContactSolver {
     /// chosen by the number of contact nodes.
     /// `coords` holds the position of every unknown (its node's), for the ordering.
     pub fn new(matrix: &SymCsc, n_interior: usize, coords: &[[f64; 2]]) -> Result<Self, ContactError> {
-        Self::with_strategy(matrix, n_interior, coords, Strategy::auto(matrix.n - n_interior))
+        Self::with_strategy(matrix, n_interior, coords, Strategy::auto(matrix.n() - n_interior))
     }
 
     pub fn with_strategy(matrix: &SymCsc, n_interior: usize, coords: &[[f64; 2]], strategy: Strategy) -> Result<Self, ContactError> {
@@ -174,10 +213,10 @@ impl ContactSolver {
         let row_entries = match strategy {
             Strategy::Schur => Vec::new(),
             Strategy::Refactor => {
-                let mut rows = vec![Vec::new(); matrix.n - n_interior];
-                for j in 0..matrix.n {
-                    for k in matrix.col_ptr[j]..matrix.col_ptr[j + 1] {
-                        let i = matrix.row_idx[k];
+                let mut rows = vec![Vec::new(); matrix.n() - n_interior];
+                for j in 0..matrix.n() {
+                    for k in matrix.col_ptr()[j]..matrix.col_ptr()[j + 1] {
+                        let i = matrix.row_idx()[k];
                         if i >= n_interior && i != j {
                             rows[i - n_interior].push((j, k));
                         }
@@ -188,7 +227,7 @@ impl ContactSolver {
         };
         timings.symbolic = t0.elapsed().as_secs_f64();
         let mut solver = ContactSolver {
-            n: matrix.n,
+            n: matrix.n(),
             n_interior,
             strategy,
             l_values: vec![0.0; symbolic.len_val()],
@@ -210,7 +249,7 @@ impl ContactSolver {
     /// Schur complement).
     pub fn refactor(&mut self, matrix: &SymCsc) -> Result<(), ContactError> {
         self.timings.numeric = 0.0;
-        self.factor_values(matrix, &matrix.values)?;
+        self.factor_values(matrix, matrix.values())?;
         if self.strategy == Strategy::Schur {
             let t0 = Instant::now();
             let lcc = self.trailing_factor_block()?;
@@ -294,7 +333,9 @@ impl ContactSolver {
 
     /// Solve the discrete Signorini problem K u = F - E lambda with u_C <= gap, lambda >= 0,
     /// complementarity (E places lambda on the contact normal unknowns). `matrix` is the one the
-    /// solver was built with. `observe` sees every iteration as it ends.
+    /// solver was built with. `observe` sees every iteration as it ends. An iteration that does
+    /// not converge is not an error here: the output holds the last iterate and its
+    /// `termination` says why it stopped (see [`PdasOutput::converged`]).
     pub fn solve_contact(
         &mut self,
         matrix: &SymCsc,
@@ -318,13 +359,13 @@ impl ContactSolver {
         // the rest of the contact solve: dense active-set work (Schur) or bookkeeping (Refactor)
         let inner = (self.timings.solves - solves0) + (self.timings.numeric - numeric0);
         self.timings.active_set = t_pdas.elapsed().as_secs_f64() - inner;
-        let (mut u, lambda, active, iterations, c) = out?;
+        let (mut u, PdasOutcome { lambda, active, iterations, termination, .. }, c) = out?;
         for k in 0..m {
             if active[k] {
                 u[ni + k] = gap[k]; // the constraint holds exactly, not to solver round-off
             }
         }
-        Ok(PdasOutput { u, lambda, active, iterations, termination: Termination::Converged, c })
+        Ok(PdasOutput { u, lambda, active, iterations, termination, c })
     }
 
     fn solve_schur(
@@ -358,14 +399,14 @@ impl ContactSolver {
             let lambda = (0..m).map(|i| if active[i] { (0..m).map(|j| s[(i, j)] * (yc[j] - u[j])).sum() } else { 0.0 }).collect();
             Ok((u, lambda))
         };
-        let (_, lambda, active, iterations) = pdas(gap, c, initial, options, observe, &mut step)?;
+        let outcome = pdas(gap, c, initial, options, observe, &mut step)?;
         // u = K^{-1} (F - E lambda)
         let mut b = rhs.to_vec();
         for k in 0..m {
-            b[ni + k] -= lambda[k];
+            b[ni + k] -= outcome.lambda[k];
         }
         let u = self.solve(&b);
-        Ok((u, lambda, active, iterations, c))
+        Ok((u, outcome, c))
     }
 
     fn solve_refactor(
@@ -377,7 +418,7 @@ impl ContactSolver {
         observe: &mut dyn FnMut(&PdasIteration),
     ) -> Result<PdasResult, ContactError> {
         let (ni, m) = (self.n_interior, self.n_contact());
-        let diag = |k: usize| matrix.values[matrix.col_ptr[ni + k]];
+        let diag = |k: usize| matrix.values()[matrix.col_ptr()[ni + k]];
         let c = options.c_scale * (0..m).map(diag).sum::<f64>() / m as f64;
         let initial = match options.initial_active.clone().filter(|a| a.len() == m) {
             Some(a) => a,
@@ -389,18 +430,18 @@ impl ContactSolver {
         };
         let mut last_u = Vec::new();
         let mut step = |active: &[bool]| -> Result<(Vec<f64>, Vec<f64>), ContactError> {
-            let mut values = matrix.values.clone();
+            let mut values = matrix.values().to_vec();
             let mut b = rhs.to_vec();
             for k in (0..m).filter(|&k| active[k]) {
                 let col = ni + k;
                 // column entries below the diagonal, then row entries left of it: move the known
                 // value to the right-hand side and keep an explicit zero in the pattern
-                for pos in matrix.col_ptr[col] + 1..matrix.col_ptr[col + 1] {
-                    b[matrix.row_idx[pos]] -= matrix.values[pos] * gap[k];
+                for pos in matrix.col_ptr()[col] + 1..matrix.col_ptr()[col + 1] {
+                    b[matrix.row_idx()[pos]] -= matrix.values()[pos] * gap[k];
                     values[pos] = 0.0;
                 }
                 for &(j, pos) in &self.row_entries[k] {
-                    b[j] -= matrix.values[pos] * gap[k];
+                    b[j] -= matrix.values()[pos] * gap[k];
                     values[pos] = 0.0;
                 }
             }
@@ -415,8 +456,11 @@ impl ContactSolver {
             last_u = u;
             Ok((uc, lambda))
         };
-        let (_, lambda, active, iterations) = pdas(gap, c, initial, options, observe, &mut step)?;
-        Ok((last_u, lambda, active, iterations, c))
+        let outcome = pdas(gap, c, initial, options, observe, &mut step)?;
+        if last_u.is_empty() {
+            last_u = self.solve(rhs); // no iteration: the unconstrained solution
+        }
+        Ok((last_u, outcome, c))
     }
 }
 
@@ -429,7 +473,7 @@ fn symbolic_factorisation(
     coords: &[[f64; 2]],
     strategy: Strategy,
 ) -> Result<(SymbolicCholesky<usize>, OrderingChoice), ContactError> {
-    let n = matrix.n;
+    let n = matrix.n();
     let n_order = if strategy == Strategy::Schur { ni } else { n };
     let (fwd, choice) = crate::ordering::fill_reducing(matrix, n_order, coords);
     let mut inv = vec![0usize; n];
@@ -448,18 +492,30 @@ fn symbolic_factorisation(
     Ok((symbolic, choice))
 }
 
-type PdasResult = (Vec<f64>, Vec<f64>, Vec<bool>, Vec<PdasIteration>, f64);
+/// All unknowns, the active-set outcome and the complementarity constant c.
+type PdasResult = (Vec<f64>, PdasOutcome, f64);
 
 /// The values of u and lambda at the contact normals (one active-set step's result).
 pub type Pair = (Vec<f64>, Vec<f64>);
-/// What [`pdas`] returns: u and lambda at the contact normals, the active set, the iterations.
-pub type PdasOutcome = (Vec<f64>, Vec<f64>, Vec<bool>, Vec<PdasIteration>);
+
+/// What [`pdas`] returns: the last iterate (u and lambda at the contact normals, the active set
+/// it was computed with), every iteration, and why the iteration stopped.
+#[derive(Clone, Debug)]
+pub struct PdasOutcome {
+    pub u: Vec<f64>,
+    pub lambda: Vec<f64>,
+    pub active: Vec<bool>,
+    pub iterations: Vec<PdasIteration>,
+    /// `Converged`, `MaxIterations` or `Cycling`.
+    pub termination: Termination,
+}
 
 /// The primal–dual active set iteration, whatever solves its linear systems.
 /// Active set A = {p : lambda_p + c (u_p - g_p) > 0}; `step(A)` returns (u_C, lambda) with
 /// u = g on A and lambda = 0 off A. Stops when A repeats and the NCP residual
 /// max |min(lambda, c (g - u))| / (c max(|u|, |g|)) is below tolerance; an active set seen
-/// before (other than the previous one) means cycling.
+/// before (other than the previous one) means cycling. Only a failing `step` is an error: a run
+/// that does not converge returns its last iterate with the reason (`MaxIterations`, `Cycling`).
 pub fn pdas(
     g: &[f64],
     c: f64,
@@ -472,6 +528,9 @@ pub fn pdas(
     let mut active = initial;
     let mut seen: Vec<(Vec<bool>, usize)> = Vec::new();
     let mut iterations = Vec::new();
+    // the last iterate (zeros with the initial active set if there was no iteration)
+    let mut last: Pair = (vec![0.0; m], vec![0.0; m]);
+    let mut last_active = active.clone();
     for it in 1..=options.max_iterations {
         let t0 = Instant::now();
         let (u, lambda) = step(&active)?;
@@ -489,20 +548,23 @@ pub fn pdas(
         observe(&record);
         iterations.push(record);
         if next == active && residual <= options.tolerance {
-            return Ok((u, lambda, active, iterations));
+            return Ok(PdasOutcome { u, lambda, active, iterations, termination: Termination::Converged });
         }
         if next != active
             && let Some((_, first_seen)) = seen.iter().find(|(a, _)| *a == next)
         {
-            return Err(ContactError::Cycling { iterations: it, first_seen: *first_seen, residual });
+            let termination = Termination::Cycling { first_seen: *first_seen, residual };
+            return Ok(PdasOutcome { u, lambda, active, iterations, termination });
         }
         seen.push((active.clone(), it));
-        active = next;
+        last = (u, lambda);
+        last_active = std::mem::replace(&mut active, next);
     }
-    Err(ContactError::NotConverged {
-        iterations: options.max_iterations,
+    let termination = Termination::MaxIterations {
         residual: iterations.last().map(|r| r.residual).unwrap_or(f64::NAN),
         tolerance: options.tolerance,
-        active: active.iter().filter(|a| **a).count(),
-    })
+        next_active: active.iter().filter(|a| **a).count(),
+    };
+    let (u, lambda) = last;
+    Ok(PdasOutcome { u, lambda, active: last_active, iterations, termination })
 }

@@ -220,6 +220,21 @@ fn edge_samples(sampling: Sampling) -> Vec<f64> {
 }
 
 /// Evaluate the estimator on a discrete solution.
+///
+/// ```rust
+/// use signorini::contact::PdasOptions;
+/// use signorini::estimate::{self, EstimatorConfig};
+/// use signorini::mesh::MeshSpec;
+/// use signorini::problems::{Ex71, Problem};
+///
+/// let mesh = MeshSpec::parse("structured:4").unwrap().build(&|x| Ex71.part_of(x));
+/// let sol = signorini::solve::solve(&mesh, &Ex71, &PdasOptions::default(), &mut |_| {}).unwrap();
+/// let est = estimate::estimate(&mesh, &Ex71, &sol, &EstimatorConfig::default());
+/// assert_eq!(est.element.len(), mesh.n_triangles());
+/// // an upper bound of the error (reliability), here with the exact solution known
+/// let u = |x: [f64; 2]| Ex71.exact().unwrap().u(x);
+/// assert!(est.terms.estimate >= signorini::norms::linf_error(&mesh, &sol, &u).linf_quadrature);
+/// ```
 pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, config: &EstimatorConfig) -> Estimate {
     let material = problem.material();
     let nodes = &sol.nodes;

@@ -264,17 +264,15 @@ fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::Discrete
     let mut mesh_name = spec.to_string();
     if adaptive {
         let min_ndof = args.adapt_min_ndof.unwrap_or(0);
-        let mut last = None;
-        adapt::run(problem.as_ref(), mesh.clone(), &config, None, &mut |l| {
-            last = Some((l.mesh.clone(), l.record.level));
+        let result = adapt::run(problem.as_ref(), mesh, &config, None, &mut |l| {
             if l.record.ndof >= min_ndof && args.adapt_min_ndof.is_some() {
                 std::ops::ControlFlow::Break(())
             } else {
                 std::ops::ControlFlow::Continue(())
             }
         })?;
-        let (m, level) = last.context("the adaptive loop solved no level")?;
-        mesh = m;
+        let level = result.records.last().context("the adaptive loop solved no level")?.level;
+        mesh = result.mesh;
         mesh_name = format!("{spec} refined adaptively to level {level} (theta {theta})");
     }
     let verbose = args.verbose;

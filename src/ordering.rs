@@ -43,7 +43,7 @@ impl Graph {
     fn new(matrix: &SymCsc, n: usize) -> Self {
         let mut count = vec![0usize; n + 1];
         for j in 0..n {
-            for &i in &matrix.row_idx[matrix.col_ptr[j]..matrix.col_ptr[j + 1]] {
+            for &i in &matrix.row_idx()[matrix.col_ptr()[j]..matrix.col_ptr()[j + 1]] {
                 if i != j && i < n {
                     count[i + 1] += 1;
                     count[j + 1] += 1;
@@ -56,7 +56,7 @@ impl Graph {
         let mut fill = count.clone();
         let mut adj = vec![0u32; count[n]];
         for j in 0..n {
-            for &i in &matrix.row_idx[matrix.col_ptr[j]..matrix.col_ptr[j + 1]] {
+            for &i in &matrix.row_idx()[matrix.col_ptr()[j]..matrix.col_ptr()[j + 1]] {
                 if i != j && i < n {
                     adj[fill[i]] = j as u32;
                     fill[i] += 1;
@@ -140,7 +140,7 @@ pub fn fill_reducing(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (V
         Method::NestedDissection => nd,
         Method::MinimumDegree => amd_order.into_iter().map(|i| i as usize).collect(),
     };
-    order.extend(n_order..matrix.n);
+    order.extend(n_order..matrix.n());
     (order, OrderingChoice { method, flops_nested_dissection: nd_flops, flops_minimum_degree: amd_flops })
 }
 
@@ -278,8 +278,8 @@ mod tests {
     #[test]
     fn nested_dissection_is_a_permutation_and_beats_amd_on_a_uniform_mesh() {
         let (matrix, coords) = system(32);
-        let (order, choice) = fill_reducing(&matrix, matrix.n, &coords);
-        let mut seen = vec![false; matrix.n];
+        let (order, choice) = fill_reducing(&matrix, matrix.n(), &coords);
+        let mut seen = vec![false; matrix.n()];
         for &i in &order {
             assert!(!seen[i], "{i} twice");
             seen[i] = true;
@@ -293,8 +293,8 @@ mod tests {
     fn flop_count_matches_amd_on_its_own_ordering() {
         // the column-count routine against AMD's own count of the same ordering
         let (matrix, _) = system(16);
-        let graph = Graph::new(&matrix, matrix.n);
-        let n = matrix.n;
+        let graph = Graph::new(&matrix, matrix.n());
+        let n = matrix.n();
         let pattern = faer::sparse::SymbolicSparseColMatRef::new_checked(n, n, &graph.ptr, None, &graph.adj);
         let (mut fwd, mut inv) = (vec![0u32; n], vec![0u32; n]);
         let mut mem = faer::dyn_stack::MemBuffer::new(faer::sparse::linalg::amd::order_maybe_unsorted_scratch::<u32>(n, graph.adj.len()));
@@ -316,11 +316,15 @@ mod tests {
     fn the_same_ordering_on_one_and_two_threads() {
         let (matrix, coords) = system(160); // large enough for the parallel recursion
         let run = |threads| {
-            rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| fill_reducing(&matrix, matrix.n - 7, &coords))
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| fill_reducing(&matrix, matrix.n() - 7, &coords))
         };
         let (one, two) = (run(1), run(2));
         assert_eq!(one.0, two.0);
         assert_eq!(one.1, two.1);
-        assert_eq!(&one.0[matrix.n - 7..], &(matrix.n - 7..matrix.n).collect::<Vec<_>>()[..], "the trailing unknowns stay last");
+        assert_eq!(&one.0[matrix.n() - 7..], &(matrix.n() - 7..matrix.n()).collect::<Vec<_>>()[..], "the trailing unknowns stay last");
     }
 }

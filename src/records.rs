@@ -40,10 +40,89 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Resul
     write_atomic(path, s.as_bytes())
 }
 
-use crate::adapt::{LevelRecord, Refine};
-use crate::estimate::EstimatorConfig;
+/// The option enums a [`RunSpec`] holds, re-exported so that readers of records need nothing
+/// from the solver modules.
+pub use crate::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
+pub use crate::norms::Sampling;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
+
+/// How the mesh is refined from level to level.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Refine {
+    /// Maximum strategy: mark T if eta_T >= theta max eta_T (Section 7, ref. \[35\]).
+    Adaptive,
+    /// Mark every element (one newest-vertex bisection each, so NDF about doubles per level).
+    Uniform,
+}
+
+/// Everything a study stores about one level: the one record type behind JSON, CSV, drift and
+/// plots. Flat, so that it is also one CSV row. Fields starting with `t_` are timings (seconds),
+/// never compared by the drift check.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct LevelRecord {
+    pub level: usize,
+    /// 2 x number of P2 nodes, Dirichlet nodes included (the NDF of every figure and table).
+    pub ndof: usize,
+    pub ndof_free: usize,
+    pub n_elements: usize,
+    pub h_min: f64,
+    pub h_max: f64,
+    pub min_angle: f64,
+    pub contact_nodes: usize,
+    pub active_nodes: usize,
+    pub full_contact_nodes: usize,
+    pub pdas_iterations: usize,
+    pub zone_min: Option<f64>,
+    pub zone_max: Option<f64>,
+    pub eta1: f64,
+    pub eta2: f64,
+    pub eta3: f64,
+    pub eta4: f64,
+    pub eta5: f64,
+    pub eta6: f64,
+    pub eta7: f64,
+    pub l_h: f64,
+    pub psi: f64,
+    pub eta_h: f64,
+    pub c0: f64,
+    pub estimate: f64,
+    /// ||u - u_h||_Linf at the quadrature points (the paper's way), where u is known.
+    pub err_quadrature: Option<f64>,
+    pub err_dense: Option<f64>,
+    pub err_nodal: Option<f64>,
+    /// estimate / err_quadrature
+    pub efficiency: Option<f64>,
+    /// ||u - u_h||_Linf on Gamma_C (`norms::linf_error_contact`: equally spaced points of every
+    /// contact edge), where u is known.
+    #[serde(default)]
+    pub err_contact: Option<f64>,
+    /// ||u - u_h||_Linf over the lattice points with x >= 1/2 (Example 7.2: away from the
+    /// corners of the clamped side x = 0), where u is known.
+    #[serde(default)]
+    pub err_right_half: Option<f64>,
+    /// Length of the longest contact edge whose three nodes are neither all active nor all
+    /// inactive: the edge straddling a free-boundary point, where eta_6 and eta_7 live. None
+    /// without such an edge.
+    #[serde(default)]
+    pub h_free_boundary: Option<f64>,
+    /// Centroid of the element with the largest marking indicator eta_T (on ties within 1e-8, the
+    /// smallest centroid by x, then y).
+    #[serde(default)]
+    pub max_indicator_x: f64,
+    #[serde(default)]
+    pub max_indicator_y: f64,
+    /// Elements marked for refinement at this level (also at the last level, not refined).
+    pub marked: usize,
+    pub t_assembly: f64,
+    pub t_factorisation: f64,
+    pub t_active_set: f64,
+    pub t_solve: f64,
+    pub t_estimate: f64,
+    pub t_refine: f64,
+    pub t_level: f64,
+}
 
 /// The float fields of a level record (the ones the drift check compares within tolerances;
 /// integers are compared exactly, timings `t_*` never), in record order.

@@ -124,7 +124,24 @@ pub struct Kkt {
     pub force_scale: f64,
 }
 
-/// Assemble, factorise and solve the contact problem on `mesh`.
+/// Assemble, factorise and solve the contact problem on `mesh`. `observe` sees every
+/// active-set iteration. An active-set method that does not converge is an error naming the
+/// iterations and the residual.
+///
+/// ```rust
+/// use signorini::contact::PdasOptions;
+/// use signorini::mesh::MeshSpec;
+/// use signorini::problems::{Ex72, Problem};
+///
+/// let mesh = MeshSpec::parse("structured:8").unwrap().build(&|x| Ex72.part_of(x));
+/// let sol = signorini::solve::solve(&mesh, &Ex72, &PdasOptions::default(), &mut |_| {}).unwrap();
+/// assert_eq!(sol.active.len(), sol.dofs.contact.len());
+/// assert!(sol.active_count() > 0 && sol.kkt().max_penetration <= 1e-12);
+/// // too few iterations: a clear error
+/// let few = PdasOptions { max_iterations: 1, ..Default::default() };
+/// let err = signorini::solve::solve(&mesh, &Ex72, &few, &mut |_| {}).err().unwrap();
+/// assert!(err.to_string().contains("did not converge in 1 iterations"));
+/// ```
 pub fn solve(
     mesh: &Mesh,
     problem: &dyn Problem,
@@ -142,7 +159,7 @@ pub fn solve(
     let strategy = options.strategy.unwrap_or(Strategy::auto(dofs.contact.len()));
     let mut solver = ContactSolver::with_strategy(&matrix, dofs.n_interior, &dofs.unknown_coords(&nodes), strategy)?;
     let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
-    let out = solver.solve_contact(&matrix, &rhs, &gap, options, observe)?;
+    let out = solver.solve_contact(&matrix, &rhs, &gap, options, observe)?.converged()?;
     // the residual F - K u: zero at free unknowns, lambda_p at contact normals
     let ku = matrix.mul(&out.u);
     let r: Vec<f64> = rhs.iter().zip(&ku).map(|(f, k)| f - k).collect();

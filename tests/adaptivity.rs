@@ -96,7 +96,8 @@ fn adaptive_run_keeps_meshes_valid(
         seen += 1;
         ControlFlow::Continue(())
     })
-    .expect("the adaptive loop runs");
+    .expect("the adaptive loop runs")
+    .records;
     let last = records.last().unwrap();
     eprintln!(
         "{}: {} levels in {:.1} s, last: ndof {}, {} elements, h_min {:.2e}, min angle {:.3}",
@@ -180,7 +181,8 @@ fn ex72_adaptive_mesh(levels: usize, contact_term: ContactTerm) -> (Mesh, [f64; 
         }
         ControlFlow::Continue(())
     })
-    .unwrap();
+    .unwrap()
+    .records;
     assert_eq!(records.len(), levels);
     last.expect("the last level was seen")
 }
@@ -399,4 +401,28 @@ fn ex71_observed_rates() {
     // (measured: NDF 278592, 1.17e-7, vs uniform NDF 66050, 1.29e-6)
     let (n_w, e_w) = (histories[3].last().unwrap().0, histories[3].last().unwrap().1[6]);
     assert!(e_w < uniform.last().unwrap().1[6] && n_w > uniform.last().unwrap().0);
+}
+
+/// `adapt::run` says why it stopped and returns the state of the last level solved.
+#[test]
+fn run_reports_termination_and_final_state() {
+    let p = Ex71;
+    let go = |config: AdaptConfig, stop_at: usize| {
+        adapt::run(&p, mesh(&p, "structured:2"), &config, None, &mut |l: Level| {
+            if l.record.level == stop_at { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
+        })
+        .unwrap()
+    };
+    let r = go(AdaptConfig { levels: 3, ..Default::default() }, usize::MAX);
+    assert_eq!((r.termination, r.records.len()), (adapt::Termination::LevelsReached, 3));
+    assert_eq!(r.records[2].n_elements, r.mesh.n_triangles());
+    assert_eq!(r.records[2].ndof, 2 * r.solution.nodes.len());
+    assert_eq!(r.records[2].estimate, r.estimate.terms.estimate);
+    let r = go(AdaptConfig { levels: 3, ..Default::default() }, 1);
+    assert_eq!((r.termination, r.records.len()), (adapt::Termination::StoppedByObserver, 2));
+    assert_eq!(r.records[1].n_elements, r.mesh.n_triangles());
+    let r = go(AdaptConfig { levels: 10, max_ndof: Some(200), ..Default::default() }, usize::MAX);
+    assert_eq!(r.termination, adapt::Termination::MaxNdofReached);
+    assert!(r.records.last().unwrap().ndof <= 200 && r.records.len() < 10);
+    assert_eq!(r.records.last().unwrap().n_elements, r.mesh.n_triangles());
 }

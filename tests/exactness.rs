@@ -102,7 +102,7 @@ fn schur_complement_inverts_the_contact_block_of_the_inverse() {
     assert_eq!(mc, 13);
     let s = solver.schur().clone();
     for j in 0..mc {
-        let mut e = vec![0.0; sys.matrix.n];
+        let mut e = vec![0.0; sys.matrix.n()];
         e[ni + j] = 1.0;
         let x = solver.solve(&e);
         for i in 0..mc {
@@ -111,7 +111,7 @@ fn schur_complement_inverts_the_contact_block_of_the_inverse() {
         }
     }
     // and K x = e really holds (the solve itself is right)
-    let mut e = vec![0.0; sys.matrix.n];
+    let mut e = vec![0.0; sys.matrix.n()];
     e[3] = 1.0;
     let x = solver.solve(&e);
     let kx = sys.matrix.mul(&x);

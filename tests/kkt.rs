@@ -50,3 +50,45 @@ fn schur_and_refactor_strategies_agree() {
         );
     }
 }
+
+/// A run that stops without converging returns its last iterate and the reason; `converged()`
+/// (what `solve::solve` calls) turns it into the error naming the iterations and the residual.
+#[test]
+fn non_converged_active_set_method_returns_its_last_iterate() {
+    use signorini::assembly::{self, DofMap};
+    use signorini::contact::{ContactSolver, PdasOptions, Strategy, Termination};
+    use signorini::mesh::P2Nodes;
+    let p = problems::Ex72;
+    let m = mesh(&p, "structured:16");
+    let nodes = P2Nodes::new(&m);
+    let dofs = DofMap::new(&nodes, &p);
+    let sys = assembly::assemble(&m, &nodes, &dofs, &p);
+    let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
+    for strategy in [Strategy::Schur, Strategy::Refactor] {
+        let mut solver = ContactSolver::with_strategy(&sys.matrix, dofs.n_interior, &dofs.unknown_coords(&nodes), strategy).unwrap();
+        let options = PdasOptions { max_iterations: 2, ..Default::default() };
+        let out = solver.solve_contact(&sys.matrix, &sys.rhs, &gap, &options, &mut |_| {}).unwrap();
+        assert!(matches!(out.termination, Termination::MaxIterations { .. }), "{strategy:?}: {:?}", out.termination);
+        assert!(!out.termination.is_converged());
+        assert_eq!((out.iterations.len(), out.u.len(), out.lambda.len(), out.active.len()), (2, sys.matrix.n(), gap.len(), gap.len()));
+        assert!(out.u.iter().all(|v| v.is_finite()));
+        let err = out.converged().unwrap_err().to_string();
+        assert!(err.contains("did not converge in 2 iterations") && err.contains("residual"), "{err}");
+    }
+    let err = signorini::solve::solve(&m, &p, &PdasOptions { max_iterations: 2, ..Default::default() }, &mut |_| {}).err().unwrap();
+    assert!(err.to_string().contains("did not converge in 2 iterations"), "{err}");
+}
+
+/// An active set seen before: the iteration stops with `Cycling` and the iterate that led there.
+#[test]
+fn cycling_active_set_method_returns_its_last_iterate() {
+    use signorini::contact::{PdasOptions, Termination, pdas};
+    let g = [0.5];
+    // inactive -> the node penetrates (next: active); active -> negative force (next: inactive)
+    let mut step = |a: &[bool]| Ok(if a[0] { (vec![0.5], vec![-1.0]) } else { (vec![1.5], vec![0.0]) });
+    let out = pdas(&g, 1.0, vec![false], &PdasOptions::default(), &mut |_| {}, &mut step).unwrap();
+    assert_eq!(out.termination, Termination::Cycling { first_seen: 1, residual: out.iterations[1].residual });
+    assert_eq!((out.u, out.lambda, out.active, out.iterations.len()), (vec![0.5], vec![-1.0], vec![true], 2));
+    let err = Termination::Cycling { first_seen: 1, residual: 0.25 }.error(2).unwrap().to_string();
+    assert!(err.contains("cycling") && err.contains("iteration 2") && err.contains("iteration 1"), "{err}");
+}

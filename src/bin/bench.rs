@@ -172,9 +172,9 @@ fn bench_size(n: usize, repeats: usize) -> Result<SizeResult> {
         solver.refactor(&sys.matrix)?;
         let (numeric_warm, schur) = (solver.timings.numeric, solver.timings.schur);
         let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
-        let out = solver.solve_contact(&sys.matrix, &sys.rhs, &gap, &PdasOptions::default(), &mut |_| {})?;
+        let out = solver.solve_contact(&sys.matrix, &sys.rhs, &gap, &PdasOptions::default(), &mut |_| {})?.converged()?;
         let t = &solver.timings;
-        unknowns = sys.matrix.n;
+        unknowns = sys.matrix.n();
         m = dofs.contact.len();
         its = out.iterations.len();
         ordering = serde_json::to_value(solver.ordering)?;

@@ -55,8 +55,8 @@ mod fb;
 mod render;
 mod rich;
 
-use crate::adapt::{LevelRecord, Refine};
 use crate::estimate::{ContactTerm, LogFactor};
+use crate::records::{LevelRecord, Refine};
 use crate::records::{MeshSnapshot, RunRecord, StudyDir};
 use anyhow::Context;
 use plotters::prelude::*;

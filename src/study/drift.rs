@@ -23,7 +23,7 @@
 //! ([`check_derived`]), so a hand edit or a bad merge of a view is drift too.
 
 use super::manifest::{DriftSpec, Manifest, Tolerance};
-use crate::adapt::LevelRecord;
+use crate::records::LevelRecord;
 use crate::records::{RunRecord, StudyDir};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;

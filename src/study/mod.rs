@@ -194,6 +194,33 @@ fn write_summaries(manifest: &Manifest, dir: &StudyDir, quick: bool) -> Result<V
 /// throughout. Every finished run is written at once and the summaries rewritten after it; on
 /// an interrupt ([`interrupt`]) the run in progress is dropped and an [`Interrupted`] error says
 /// what was kept.
+///
+/// ```rust
+/// use signorini::study::{self, RunOptions, manifest::Manifest};
+/// use std::path::Path;
+///
+/// let text = r#"
+/// description = "two short runs"
+/// [defaults]
+/// problem = "ex71"
+/// mesh = "structured:2"
+/// [[run]]
+/// id = "adaptive"
+/// levels = 3
+/// [[run]]
+/// id = "uniform"
+/// refine = "uniform"
+/// levels = 2
+/// "#;
+/// let manifest = Manifest::parse(Path::new("doc.toml"), text).unwrap();
+/// let results = std::env::temp_dir().join(format!("signorini-doc-{}", std::process::id()));
+/// let opts = RunOptions { quick: false, shard: None, fresh: true, results: results.clone(), progress: false, wait_for_lock: false };
+/// let ran = study::run_study(&manifest, &opts).unwrap();
+/// assert_eq!(ran, ["adaptive", "uniform"]);
+/// let runs = signorini::records::StudyDir::new(&results, &manifest.study).read_runs().unwrap();
+/// assert_eq!(runs.iter().map(|r| r.levels.len()).collect::<Vec<_>>(), [3, 2]);
+/// std::fs::remove_dir_all(&results).unwrap();
+/// ```
 pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> {
     let dir = StudyDir::new(&opts.results, &manifest.study);
     let _lock = StudyLock::acquire(&dir, opts.wait_for_lock)?;
@@ -377,7 +404,8 @@ fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Resul
         }
         ControlFlow::Continue(())
     })
-    .with_context(|| format!("{study}/{}", spec.id))?;
+    .with_context(|| format!("{study}/{}", spec.id))?
+    .records;
     pb.finish_and_clear();
     if let Some(e) = save_error {
         return Err(e);

@@ -80,14 +80,10 @@ pub fn compute(
     let mesh = mesh_spec.build(&|x| problem.part_of(x));
     let estimator = crate::estimate::EstimatorConfig { contact_term: spec.contact_term, ..Default::default() };
     let config = AdaptConfig { levels: 200, refine: Refine::Adaptive, theta: spec.theta, estimator, ..Default::default() };
-    let mut result: Option<ReferenceField> = None;
-    adapt::run(problem, mesh, &config, None, &mut |level| {
-        if level.record.ndof >= spec.min_ndof {
-            result = Some(ReferenceField::new(level.mesh.clone(), level.solution.nodes.elements.clone(), level.solution.u.clone()));
-            std::ops::ControlFlow::Break(())
-        } else {
-            on_level(level.record)
-        }
+    let out = adapt::run(problem, mesh, &config, None, &mut |level| {
+        if level.record.ndof >= spec.min_ndof { std::ops::ControlFlow::Break(()) } else { on_level(level.record) }
     })?;
-    Ok(result)
+    // the last level solved is the reference if it reached min_ndof (not if on_level stopped the loop)
+    let reached = out.termination == adapt::Termination::StoppedByObserver && out.records.last().is_some_and(|r| r.ndof >= spec.min_ndof);
+    Ok(reached.then(|| ReferenceField::new(out.mesh, out.solution.nodes.elements, out.solution.u)))
 }

@@ -1,0 +1,72 @@
+//! A user's own contact problem through the public API: an elastic block (E = 200, nu = 0.3,
+//! plane strain) pushed down by 0.02 at its top onto a parabolic rigid foundation below its
+//! bottom, solved by the adaptive loop with the paper's estimator.
+//!
+//! `cargo run --release --example own_problem`
+
+use signorini::adapt::{self, AdaptConfig, Termination};
+use signorini::mesh::{MeshSpec, Part};
+use signorini::problems::{Material, Problem};
+use std::ops::ControlFlow;
+
+/// The block [0, 1]^2: contact on the bottom y = 0, pushed at the top y = 1, free sides.
+struct Foundation;
+
+impl Problem for Foundation {
+    fn name(&self) -> &'static str {
+        "foundation"
+    }
+    fn description(&self) -> &'static str {
+        "block pressed onto a parabolic foundation"
+    }
+    fn material(&self) -> Material {
+        Material::from_young(200.0, 0.3)
+    }
+    fn part_of(&self, x: [f64; 2]) -> Part {
+        if x[1] < 1e-12 {
+            Part::Contact
+        } else if x[1] > 1.0 - 1e-12 {
+            Part::Dirichlet
+        } else {
+            Part::Neumann
+        }
+    }
+    fn body_force(&self, _: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn traction(&self, _: [f64; 2], _: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn dirichlet(&self, _: [f64; 2]) -> [f64; 2] {
+        [0.0, -0.02]
+    }
+    fn contact_normal(&self, _: [f64; 2]) -> [f64; 2] {
+        [0.0, -1.0]
+    }
+    /// The foundation lies chi(x) below the bottom: u . n = -u_y <= chi.
+    fn gap(&self, x: [f64; 2]) -> f64 {
+        0.01 + 0.2 * (x[0] - 0.5).powi(2)
+    }
+}
+
+fn main() -> anyhow::Result<()> {
+    let problem = Foundation;
+    let mesh = MeshSpec::parse("structured:4")?.build(&|x| problem.part_of(x));
+    let config = AdaptConfig { levels: 12, max_ndof: Some(20_000), ..Default::default() };
+    config.validate()?;
+    println!("{:>5} {:>7} {:>10} {:>6} {:>15}", "level", "ndof", "estimate", "active", "contact zone");
+    let result = adapt::run(&problem, mesh, &config, None, &mut |l| {
+        let (r, zone) = (l.record, l.solution.contact_zone());
+        let zone = zone.map_or("-".into(), |[a, b]| format!("[{a:.4}, {b:.4}]"));
+        println!("{:>5} {:>7} {:>10.3e} {:>6} {:>15}", r.level, r.ndof, r.estimate, r.active_nodes, zone);
+        ControlFlow::Continue(())
+    })?;
+    let why = match result.termination {
+        Termination::LevelsReached => "all levels solved",
+        Termination::MaxNdofReached => "the next level would exceed max_ndof",
+        Termination::StoppedByObserver => "stopped by the observer",
+    };
+    let kkt = result.solution.kkt();
+    println!("stopped: {why}; final mesh {} triangles, max penetration {:.1e}", result.mesh.n_triangles(), kkt.max_penetration);
+    Ok(())
+}
