@@ -37,6 +37,16 @@ pub struct ConfigError {
     pub got: String,
 }
 
+/// Why the loop could not run: settings out of range (checked before anything is solved) or a
+/// level whose solve failed.
+#[derive(Debug, thiserror::Error)]
+pub enum AdaptError {
+    #[error("adaptive loop settings: {0}")]
+    Config(#[from] ConfigError),
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+}
+
 impl AdaptConfig {
     /// The loop's settings for a study run.
     pub fn for_run(spec: &crate::records::RunSpec) -> Self {
@@ -205,9 +215,8 @@ pub fn run(
     config: &AdaptConfig,
     reference: Option<Reference>,
     observer: &mut dyn FnMut(Level) -> ControlFlow<()>,
-) -> Result<AdaptResult, SolveError> {
-    debug_assert_eq!(config.validate(), Ok(()), "adapt::run needs a validated AdaptConfig");
-    assert!(config.levels > 0, "adapt::run needs levels >= 1 (AdaptConfig::validate)");
+) -> Result<AdaptResult, AdaptError> {
+    config.validate()?;
     let mut records = Vec::new();
     let mut state: Option<(Mesh, DiscreteSolution, Estimate)> = None;
     let mut termination = Termination::LevelsReached;

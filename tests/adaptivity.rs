@@ -426,3 +426,14 @@ fn run_reports_termination_and_final_state() {
     assert!(r.records.last().unwrap().ndof <= 200 && r.records.len() < 10);
     assert_eq!(r.records.last().unwrap().n_elements, r.mesh.n_triangles());
 }
+
+/// Settings out of range are an error of the loop, before anything is solved (never a panic).
+#[test]
+fn adapt_run_rejects_bad_settings_with_an_error() {
+    let p = signorini::problems::Ex71;
+    for config in [AdaptConfig { levels: 0, ..Default::default() }, AdaptConfig { theta: 1.5, ..Default::default() }] {
+        let err = adapt::run(&p, mesh(&p, "structured:2"), &config, None, &mut |_| std::ops::ControlFlow::Continue(())).err().expect("rejected");
+        assert!(matches!(err, adapt::AdaptError::Config(_)), "{err}");
+        assert!(err.to_string().contains("expected"), "{err}");
+    }
+}

@@ -6,7 +6,6 @@ use crate::element::{self, Affine, N_NODES};
 use crate::mesh::{Mesh, MeshSpec};
 use crate::problems::Problem;
 use crate::records::ReferenceSpec;
-use crate::solve::SolveError;
 
 /// A P2 field on a mesh with a bucket grid for point location. Written by hand: a uniform grid
 /// of element bounding boxes is all the unit square needs, and spatial-index crates would add a
@@ -76,7 +75,7 @@ pub fn compute(
     mesh_spec: &MeshSpec,
     spec: &ReferenceSpec,
     on_level: &mut dyn FnMut(&crate::adapt::LevelRecord) -> std::ops::ControlFlow<()>,
-) -> Result<Option<ReferenceField>, SolveError> {
+) -> Result<Option<ReferenceField>, crate::adapt::AdaptError> {
     let mesh = mesh_spec.build(&|x| problem.part_of(x));
     let estimator = crate::estimate::EstimatorConfig { contact_term: spec.contact_term, ..Default::default() };
     let config = AdaptConfig { levels: 200, refine: Refine::Adaptive, theta: spec.theta, estimator, ..Default::default() };
