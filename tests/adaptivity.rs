@@ -432,7 +432,8 @@ fn run_reports_termination_and_final_state() {
 fn adapt_run_rejects_bad_settings_with_an_error() {
     let p = signorini::problems::Ex71;
     for config in [AdaptConfig { levels: 0, ..Default::default() }, AdaptConfig { theta: 1.5, ..Default::default() }] {
-        let err = adapt::run(&p, mesh(&p, "structured:2"), &config, None, &mut |_| std::ops::ControlFlow::Continue(())).err().expect("rejected");
+        let err =
+            adapt::run(&p, mesh(&p, "structured:2"), &config, None, &mut |_| std::ops::ControlFlow::Continue(())).err().expect("rejected");
         assert!(matches!(err, adapt::AdaptError::Config(_)), "{err}");
         assert!(err.to_string().contains("expected"), "{err}");
     }
