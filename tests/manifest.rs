@@ -2,22 +2,14 @@
 //! the same `AdaptConfig::validate` as the command line; unknown keys are errors everywhere;
 //! serde's Rust type names never reach the reader.
 
+mod common;
+use common::parse_err;
+
 use signorini::adapt::AdaptConfig;
 use signorini::study::manifest::Manifest;
 use std::path::Path;
 
 const BASE: &str = "[defaults]\nproblem = \"ex71\"\nlevels = 24\n";
-
-fn parse_err(text: &str) -> String {
-    match Manifest::parse(Path::new("experiments/bad_case.toml"), text) {
-        Ok(_) => panic!("accepted a bad manifest:\n{text}"),
-        Err(e) => {
-            let s = e.to_string();
-            assert!(s.starts_with("experiments/bad_case.toml"), "error does not name the file: {s}");
-            s
-        }
-    }
-}
 
 fn run_with(extra: &str) -> String {
     parse_err(&format!("{BASE}[[run]]\nid = \"a\"\n{extra}\n"))

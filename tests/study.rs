@@ -1,6 +1,9 @@
 //! Studies: malformed manifests are clear errors; results are the same on 1 and 2 threads; an
 //! interrupted study resumes; the quick form is an exact prefix of the full one.
 
+mod common;
+use common::parse_err;
+
 use signorini::records::{RunRecord, StudyDir};
 use signorini::study::manifest::{Manifest, ManifestError};
 use std::path::{Path, PathBuf};
@@ -31,17 +34,6 @@ fn numbers(r: &RunRecord) -> serde_json::Value {
         l.as_object_mut().unwrap().retain(|k, _| !k.starts_with("t_"));
     }
     v
-}
-
-fn parse_err(text: &str) -> String {
-    match Manifest::parse(Path::new("experiments/bad_case.toml"), text) {
-        Ok(_) => panic!("accepted a bad manifest:\n{text}"),
-        Err(e) => {
-            let s = e.to_string();
-            assert!(s.starts_with("experiments/bad_case.toml"), "error does not name the file: {s}");
-            s
-        }
-    }
 }
 
 #[test]

@@ -40,3 +40,15 @@ pub fn assert_kkt(problem: &dyn Problem, spec: &str) {
         }
     }
 }
+
+/// The error a bad manifest text gives, checked to name the file first.
+pub fn parse_err(text: &str) -> String {
+    match signorini::study::manifest::Manifest::parse(std::path::Path::new("experiments/bad_case.toml"), text) {
+        Ok(_) => panic!("accepted a bad manifest:\n{text}"),
+        Err(e) => {
+            let s = e.to_string();
+            assert!(s.starts_with("experiments/bad_case.toml"), "error does not name the file: {s}");
+            s
+        }
+    }
+}
