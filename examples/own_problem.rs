@@ -6,7 +6,7 @@
 
 use signorini::adapt::{self, AdaptConfig, Termination};
 use signorini::mesh::{MeshSpec, Part};
-use signorini::problems::{Material, Problem};
+use signorini::problems::{Material, Problem, contact_bottom_dirichlet_top};
 use std::ops::ControlFlow;
 
 /// The block [0, 1]^2: contact on the bottom y = 0, pushed at the top y = 1, free sides.
@@ -23,13 +23,7 @@ impl Problem for Foundation {
         Material::from_young(200.0, 0.3)
     }
     fn part_of(&self, x: [f64; 2]) -> Part {
-        if x[1] < 1e-12 {
-            Part::Contact
-        } else if x[1] > 1.0 - 1e-12 {
-            Part::Dirichlet
-        } else {
-            Part::Neumann
-        }
+        contact_bottom_dirichlet_top(x)
     }
     fn body_force(&self, _: [f64; 2]) -> [f64; 2] {
         [0.0, 0.0]

@@ -110,8 +110,8 @@ fn contact_right_dirichlet_left(x: [f64; 2]) -> Part {
 }
 
 /// The boundary parts of Example 7.1 (and `fb`): contact on the bottom y = 0, Dirichlet on the
-/// top y = 1, Neumann on the sides.
-fn contact_bottom_dirichlet_top(x: [f64; 2]) -> Part {
+/// top y = 1, Neumann on the sides. Public for problems of one's own on the unit square.
+pub fn contact_bottom_dirichlet_top(x: [f64; 2]) -> Part {
     if x[1] < EPS {
         Part::Contact
     } else if x[1] > 1.0 - EPS {
