@@ -13,10 +13,10 @@ use std::ops::ControlFlow;
 struct Foundation;
 
 impl Problem for Foundation {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         "foundation"
     }
-    fn description(&self) -> &'static str {
+    fn description(&self) -> &str {
         "block pressed onto a parabolic foundation"
     }
     fn material(&self) -> Material {

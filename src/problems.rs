@@ -4,7 +4,7 @@
 //! solver, estimator and studies only ever call the trait. Known problems are listed by
 //! [`KNOWN`] and built by [`by_name`].
 
-use crate::mesh::Part;
+use crate::mesh::{Curve, Part};
 
 /// Plane elasticity with Lamé constants: sigma(u) = 2 mu eps(u) + zeta tr(eps(u)) I
 /// (paper Section 1; the paper writes zeta for Lamé's lambda).
@@ -47,11 +47,22 @@ pub trait Exact: Send + Sync {
 /// A 2D frictionless unilateral contact problem on the unit square (paper eq. 1.1–1.8).
 pub trait Problem: Send + Sync {
     /// Short name used on the command line and in manifests.
-    fn name(&self) -> &'static str;
-    fn description(&self) -> &'static str;
+    fn name(&self) -> &str;
+    fn description(&self) -> &str;
     fn material(&self) -> Material;
-    /// The boundary part containing boundary point `x` (an edge midpoint).
+    /// The boundary part containing boundary point `x` (an edge midpoint): how the built-in
+    /// meshes (`structured:N`, `symmetric:N`) are tagged.
     fn part_of(&self, x: [f64; 2]) -> Part;
+    /// The boundary part of the edges in the mesh file's physical group `group` (how Gmsh meshes
+    /// are tagged); `None` if the problem does not name that group.
+    fn part_of_group(&self, _group: &str) -> Option<Part> {
+        None
+    }
+    /// The curve on which the boundary edges of physical group `group` lie, if they lie on one:
+    /// refinement puts new boundary vertices there.
+    fn curve_of_group(&self, _group: &str) -> Option<Curve> {
+        None
+    }
     /// Body force f.
     fn body_force(&self, x: [f64; 2]) -> [f64; 2];
     /// Neumann traction g at `x` on Gamma_N with outward unit normal `n`.
@@ -139,10 +150,10 @@ impl Exact for Ex71 {
 }
 
 impl Problem for Ex71 {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         "ex71"
     }
-    fn description(&self) -> &'static str {
+    fn description(&self) -> &str {
         "Example 7.1: smooth manufactured solution, contact along the whole bottom edge"
     }
     fn material(&self) -> Material {
@@ -182,10 +193,10 @@ impl Problem for Ex71 {
 pub struct Ex72;
 
 impl Problem for Ex72 {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         "ex72"
     }
-    fn description(&self) -> &'static str {
+    fn description(&self) -> &str {
         "Example 7.2: contact with a rigid wedge (no exact solution)"
     }
     fn material(&self) -> Material {
@@ -278,10 +289,10 @@ impl Exact for Fb {
 }
 
 impl Problem for Fb {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         "fb"
     }
-    fn description(&self) -> &'static str {
+    fn description(&self) -> &str {
         "Free boundary with an exact solution: contact on [a, 1] of the bottom edge, a = sqrt(2) - 1 (beyond the paper)"
     }
     fn material(&self) -> Material {
@@ -380,10 +391,10 @@ impl Exact for Patch {
 }
 
 impl Problem for Patch {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         "patch"
     }
-    fn description(&self) -> &'static str {
+    fn description(&self) -> &str {
         "Patch test: a quadratic displacement with its own f and g, obstacle far away"
     }
     fn material(&self) -> Material {

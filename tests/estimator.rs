@@ -221,10 +221,10 @@ struct Scaled<'a> {
 }
 
 impl Problem for Scaled<'_> {
-    fn name(&self) -> &'static str {
+    fn name(&self) -> &str {
         "scaled"
     }
-    fn description(&self) -> &'static str {
+    fn description(&self) -> &str {
         "a problem with all data scaled by k"
     }
     fn material(&self) -> Material {
