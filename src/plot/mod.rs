@@ -449,8 +449,8 @@ fn mesh_figure(s: &MeshSnapshot, note: &str) -> MeshFigure {
     MeshFigure {
         title: format!("{}: {} mesh at level {}{note}, NDF = {}", problem_title(&problem_of(s)), s.run, s.level, s.ndof),
         edges: edge_chains(&s.vertices, &s.triangles),
-        active: s.contact_nodes.iter().filter(|c| c.1).map(|c| p(c.0)).collect(),
-        inactive: s.contact_nodes.iter().filter(|c| !c.1).map(|c| p(c.0)).collect(),
+        active: s.contact_nodes.iter().filter(|c| c.active).map(|c| p(c.x)).collect(),
+        inactive: s.contact_nodes.iter().filter(|c| !c.active).map(|c| p(c.x)).collect(),
         kinks: s.kinks.iter().map(|&k| p(k)).collect(),
         vlines: Vec::new(),
         bbox,

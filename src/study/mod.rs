@@ -442,12 +442,10 @@ fn save_level(study: &str, spec: &RunSpec, dir: &StudyDir, level: &Level, proble
     let (mesh, sol) = (level.mesh, level.solution);
     let n = sol.nodes.len();
     let (mut lambda, mut active, mut contact) = (vec![0.0; n], vec![0i32; n], vec![0i32; n]);
-    let mut contact_nodes = Vec::new();
     for (k, c) in sol.dofs.contact.iter().enumerate() {
         lambda[c.node] = sol.lambda[k];
         active[c.node] = sol.active[k] as i32;
         contact[c.node] = 1;
-        contact_nodes.push((sol.nodes.coords[c.node], sol.active[k]));
     }
     let doc = io::vtu(
         mesh,
@@ -469,7 +467,7 @@ fn save_level(study: &str, spec: &RunSpec, dir: &StudyDir, level: &Level, proble
         ndof: level.record.ndof,
         vertices: mesh.vertices.clone(),
         triangles: mesh.triangles.clone(),
-        contact_nodes,
+        contact_nodes: crate::solve::contact_samples(mesh, sol),
         kinks: problem.required_vertices(),
     };
     records::write_json(&dir.mesh_file(&spec.id, l, "json"), &snapshot)?;
