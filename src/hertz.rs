@@ -11,7 +11,8 @@
 //! its flat side) deviates from them by terms that vanish as a / R -> 0, which a second, smaller
 //! load measures.
 
-use crate::problems::Material;
+use crate::mesh::Curve;
+use crate::problems::{Material, Problem};
 use crate::records::ContactSample;
 
 /// The closed-form solution for a cylinder of radius `radius` with the plane-strain modulus
@@ -44,6 +45,17 @@ impl Hertz {
     pub fn pressure(&self, force: f64, x: f64) -> f64 {
         let a = self.half_width(force);
         self.peak_pressure(force) * (1.0 - (x / a).powi(2)).max(0.0).sqrt()
+    }
+}
+
+/// The physical group of a Hertz problem's contact surface: a circle (`Problem::curve_of_group`).
+pub const CONTACT_GROUP: &str = "contact";
+
+/// Hertz's solution for a problem: its material and the radius of the circle its contact group
+/// lies on; `None` if the problem has no circular contact group.
+pub fn for_problem(problem: &dyn Problem) -> Option<Hertz> {
+    match problem.curve_of_group(CONTACT_GROUP)? {
+        Curve::Circle { radius, .. } => Some(Hertz::new(problem.material(), radius)),
     }
 }
 
