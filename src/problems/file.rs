@@ -160,7 +160,8 @@ const MAX_VARS: usize = 16;
 enum Expr {
     Const(f64),
     Flat {
-        flat: Flat,
+        /// Boxed: exmex keeps up to 32 nodes inline (about 20 kB).
+        flat: Box<Flat>,
         /// What each of the expression's variables (exmex orders them alphabetically) stands for.
         slots: Vec<Slot>,
     },
@@ -202,7 +203,7 @@ impl Expr {
                 None => Ok(Expr::Const(0.0)),
                 Some(i) => {
                     let d = flat.clone().partial(i).map_err(|e| e.msg().to_string())?;
-                    Ok(Expr::Flat { flat: d, slots: slots.clone() })
+                    Ok(Expr::Flat { flat: Box::new(d), slots: slots.clone() })
                 }
             },
         }
@@ -372,10 +373,10 @@ impl Reader<'_> {
             slots.push(slot);
         }
         if slots.iter().all(|s| matches!(s, Slot::Const(_))) {
-            let e = Expr::Flat { flat, slots };
+            let e = Expr::Flat { flat: Box::new(flat), slots };
             return Ok(Expr::Const(e.at([0.0, 0.0])));
         }
-        Ok(Expr::Flat { flat, slots })
+        Ok(Expr::Flat { flat: Box::new(flat), slots })
     }
 
     /// A number: a number or an expression of the constants alone.
@@ -597,9 +598,15 @@ impl FileProblem {
         // data
         let xy = ["x", "y"];
         let has_exact = raw.exact.is_some();
-        let body_force = match r.vector("body_force", raw.body_force.as_ref(), &xy, false)? {
-            VectorData::Exprs(e) => e,
-            VectorData::FromExact => unreachable!("has_exact is false"),
+        let body_force = match (r.vector("body_force", raw.body_force.as_ref(), &xy, true)?, &raw.body_force) {
+            (VectorData::Exprs(e), _) => e,
+            (VectorData::FromExact, value) => {
+                return Err(r.error(
+                    "body_force",
+                    value.as_ref().map_or(0..0, |v| v.span()),
+                    "two expressions: f = -div sigma(u) is not derived from [exact], write it out",
+                ));
+            }
         };
         let traction = r.vector("traction", raw.traction.as_ref(), &["x", "y", "nx", "ny"], has_exact)?;
         let dirichlet = r.vector("dirichlet", raw.dirichlet.as_ref(), &xy, has_exact)?;
@@ -698,10 +705,6 @@ impl FileProblem {
         })
     }
 
-    /// The physical groups the file names, with their parts.
-    pub fn groups(&self) -> &BTreeMap<String, Part> {
-        &self.groups
-    }
 }
 
 impl Problem for FileProblem {
@@ -727,6 +730,9 @@ impl Problem for FileProblem {
     }
     fn part_of_group(&self, group: &str) -> Option<Part> {
         self.groups.get(group).copied()
+    }
+    fn groups(&self) -> Vec<String> {
+        self.groups.keys().cloned().collect()
     }
     fn curve_of_group(&self, group: &str) -> Option<Curve> {
         self.curves.get(group).copied()

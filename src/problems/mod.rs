@@ -73,6 +73,11 @@ pub trait Problem: Send + Sync {
     fn part_of_group(&self, _group: &str) -> Option<Part> {
         None
     }
+    /// The physical groups the problem names (in `part_of_group`): a mesh file lacking one of
+    /// them is an error.
+    fn groups(&self) -> Vec<String> {
+        Vec::new()
+    }
     /// The curve on which the boundary edges of physical group `group` lie, if they lie on one:
     /// refinement puts new boundary vertices there.
     fn curve_of_group(&self, _group: &str) -> Option<Curve> {
