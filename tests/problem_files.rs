@@ -208,6 +208,15 @@ fn a_good_file_reads_and_plane_stress_is_plane_stress() {
     assert_eq!(p.contact_normal([0.25, 0.0]), [0.0, -1.0]);
     assert_eq!(p.body_force([0.3, 0.3]), [0.0, -1.0]);
     assert_eq!(p.gap([0.5, 0.0]), 0.005);
+    // predicates: && binds tighter than ||
+    let q = FileProblem::parse(Path::new("q.toml"), &edit("contact = \"y < 1e-12\"", "contact = \"y < 1e-12 && x >= 0.5 || x > 1 - 1e-12\"")).unwrap();
+    assert_eq!(q.part_of([0.25, 0.0]), Part::Neumann);
+    assert_eq!(q.part_of([0.75, 0.0]), Part::Contact);
+    assert_eq!(q.part_of([1.0, 0.5]), Part::Contact);
+    assert_eq!(q.part_of([0.5, 1.0]), Part::Dirichlet);
+    // outward on two sides: the nearer one's normal
+    assert_eq!(q.contact_normal([1.0, 0.5]), [1.0, 0.0]);
+    assert_eq!(q.contact_normal([0.75, 0.0]), [0.0, -1.0]);
 }
 
 #[test]
@@ -335,4 +344,54 @@ fn manifests_resolve_problem_files_relative_to_themselves() {
 fn built_in_problems_add_nothing_to_the_provenance() {
     let m = signorini::study::manifest::Manifest::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/ex72.toml")).unwrap();
     assert!(m.problem_files().is_empty());
+}
+
+mod random_input {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// Strings of expression characters: operators, parentheses, variables, numbers, names.
+    fn expression() -> impl Strategy<Value = String> {
+        prop_oneof![
+            "[-+*/^(), xyna0-9.eE<>=&|]{0,24}",
+            proptest::collection::vec(
+                proptest::sample::select(&["x", "y", "nx", "a", "q", "1e-3", "2", ".5", "+", "-", "*", "/", "^", "(", ")", "sqrt", "max", "abs", ",", "<", "&&", "||", "e", "PI"][..]),
+                0..12
+            )
+            .prop_map(|v| v.join(" ")),
+        ]
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 1024, failure_persistence: None, rng_seed: proptest::test_runner::RngSeed::Fixed(7), ..ProptestConfig::default() })]
+
+        /// Random expressions in every expression-bearing place: never a panic, and an accepted file
+        /// evaluates everywhere without one; a rejection names the file and a key.
+        #[test]
+        fn random_expressions_never_panic(chi in expression(), f in expression(), c in expression(), pred in expression(), constant in expression()) {
+            let text = GOOD
+                .replace("chi = \"0.01*x\"", &format!("chi = {chi:?}"))
+                .replace("body_force = [0, \"-1\"]", &format!("body_force = [{f:?}, 0]\ntraction = [0, {c:?}]"))
+                .replace("contact = \"y < 1e-12\"", &format!("contact = {pred:?}"))
+                + &format!("\n[constants]\na = {constant:?}\n");
+            match FileProblem::parse(Path::new("problems/random.toml"), &text) {
+                Ok(p) => {
+                    for x in [[0.5, 0.0], [0.0, 0.0], [1.0, 0.25]] {
+                        let _ = (p.gap(x), p.body_force(x), p.traction(x, [0.0, -1.0]), p.part_of(x), p.contact_normal(x));
+                    }
+                }
+                Err(e) => {
+                    let m = e.to_string();
+                    prop_assert!(m.starts_with("problems/random.toml:") && (m.contains("key `") || m.contains("TOML")), "{}", m);
+                }
+            }
+        }
+
+        #[test]
+        fn random_text_never_panics(text in "\\PC{0,200}") {
+            if let Err(e) = FileProblem::parse(Path::new("problems/random.toml"), &text) {
+                prop_assert!(e.to_string().starts_with("problems/random.toml:"), "{}", e);
+            }
+        }
+    }
 }
