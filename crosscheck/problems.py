@@ -1,5 +1,5 @@
 """Problem data of Examples 7.1 and 7.2, transcribed from the paper's Section 7, and of the
-free-boundary problem `fb` (beyond the paper), transcribed from its definition (the doc comment of `Fb` in src/problems.rs).
+free-boundary problem `fb` (beyond the paper), transcribed from its definition (the doc comment of `Fb` in src/problems/builtin.rs).
 
 Written independently of the Rust code on purpose: the cross-check is only worth something if the
 data enter twice, once on each side. `check_data` verifies the transcribed f, g and contact stresses

@@ -165,7 +165,8 @@ impl EstimatorArgs {
 
 #[derive(clap::Args)]
 struct AdaptArgs {
-    /// Problem name (ex71, ex72, patch).
+    /// A built-in problem (ex71, ex72, fb, patch) or the path of a problem file (NAME.toml; see
+    /// experiments/problems/README.md).
     #[arg(long)]
     problem: String,
     /// Initial mesh: structured:N (or symmetric:N, mirrored about y = 0.5).
@@ -190,7 +191,8 @@ struct AdaptArgs {
 #[derive(clap::Args)]
 #[command(group(clap::ArgGroup::new("adaptive").args(["adapt_levels", "adapt_min_ndof"]).multiple(true)))]
 struct SolveArgs {
-    /// Problem name (ex71, ex72, patch).
+    /// A built-in problem (ex71, ex72, fb, patch) or the path of a problem file (NAME.toml; see
+    /// experiments/problems/README.md).
     #[arg(long)]
     problem: String,
     /// Mesh: structured:N (or symmetric:N, mirrored about y = 0.5).

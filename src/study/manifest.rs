@@ -4,7 +4,8 @@
 //! description = "Example 7.1, adaptive and uniform"
 //!
 //! [defaults]                 # every run starts from these
-//! problem = "ex71"
+//! problem = "ex71"           # a built-in problem, or a problem file: "problems/hertz.toml"
+//!                            # (a relative path is relative to this manifest's folder)
 //! mesh = "structured:4"
 //! levels = 24
 //! quick_levels = 8           # the --quick form: the first levels of the same runs
@@ -227,8 +228,15 @@ impl Manifest {
             }
             let problem =
                 r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid(key("problem"), "a problem name", "nothing".into()))?;
-            if crate::problems::by_name(&problem).is_err() {
-                return Err(invalid(key("problem"), &format!("one of {}", crate::problems::KNOWN.join(", ")), format!("{problem:?}")));
+            if let Err(e) = crate::problems::by_name(&resolve_problem(path, &problem)) {
+                let expected = match e {
+                    crate::problems::ProblemError::Unknown(_) => format!(
+                        "a built-in problem ({}) or the path of a problem file (NAME.toml, relative to the manifest)",
+                        crate::problems::KNOWN.join(", ")
+                    ),
+                    crate::problems::ProblemError::File(e) => format!("a valid problem file ({e})"),
+                };
+                return Err(invalid(key("problem"), &expected, format!("{problem:?}")));
             }
             let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| "structured:4".into());
             MeshSpec::parse(&mesh).map_err(|_| invalid(key("mesh"), "'structured:N' or 'symmetric:N'", format!("{mesh:?}")))?;
@@ -318,6 +326,30 @@ impl Manifest {
             }
         }
         Ok(Manifest { study, file, description: raw.description.unwrap_or_default(), runs, drift, bytes: text.as_bytes().to_vec() })
+    }
+}
+
+/// The problem a manifest at `manifest` means by `problem`: a built-in name as it is, the path of
+/// a problem file relative to the manifest's folder (an absolute path as it is). The run's spec
+/// (and so its record) keeps `problem` as written; the provenance records the file and its hash.
+pub fn resolve_problem(manifest: &Path, problem: &str) -> String {
+    if !crate::problems::is_file(problem) || Path::new(problem).is_absolute() {
+        return problem.to_string();
+    }
+    manifest.parent().unwrap_or(Path::new("")).join(problem).display().to_string()
+}
+
+impl Manifest {
+    /// The problem files the runs name, resolved ([`resolve_problem`]), without repetition.
+    pub fn problem_files(&self) -> Vec<PathBuf> {
+        let mut files: Vec<PathBuf> = self
+            .runs
+            .iter()
+            .filter(|r| crate::problems::is_file(&r.spec.problem))
+            .map(|r| PathBuf::from(resolve_problem(&self.file, &r.spec.problem)))
+            .collect();
+        files.dedup();
+        files
     }
 }
 

@@ -28,6 +28,23 @@ pub struct Provenance {
     pub date: String,
     /// Runs present in the study directory (merged by run id across shards and sessions).
     pub runs: Vec<String>,
+    /// The problem files the manifest's runs name (absent for built-in problems only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub problem_files: Vec<ProblemFile>,
+}
+
+/// A problem file a study used: its path (as resolved from the manifest) and the SHA-256 of its
+/// bytes (`None` if it could not be read).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ProblemFile {
+    pub path: String,
+    pub sha256: Option<String>,
+}
+
+impl ProblemFile {
+    pub fn of(path: &Path) -> Self {
+        ProblemFile { path: path.display().to_string(), sha256: std::fs::read(path).ok().map(|b| sha256_hex(&b)) }
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -107,5 +124,6 @@ pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: 
         },
         date: utc_now(),
         runs,
+        problem_files: Vec::new(),
     }
 }

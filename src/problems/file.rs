@@ -1,0 +1,790 @@
+//! Problem files: a contact problem as data (`experiments/problems/NAME.toml`).
+//!
+//! The material, the loads, the Dirichlet data, the obstacle chi and an exact solution are
+//! expressions in `x` and `y`, the boundary parts predicates in `x`, `y` (the built-in meshes) or
+//! lists of Gmsh physical groups. Every key is described, with an example, in
+//! `experiments/problems/README.md`; `ex71.toml`, `ex72.toml` and `fb.toml` there state the
+//! built-in problems (`tests/problem_files.rs` solves both and compares).
+//!
+//! Expressions are parsed once, when the file is read, by the `exmex` crate, chosen because it
+//! parses into a flat expression (operands and operators in evaluation order: no tree to walk,
+//! no allocation per evaluation), which keeps evaluation at every quadrature point affordable
+//! (assembly about 4 times the built-in's, measured in `experiments/problems/README.md`); it
+//! differentiates expressions symbolically (an exact solution's gradient need not be written
+//! out); it is maintained, small (regex and smallvec) and has `min`, `max`, `abs` and `sqrt`,
+//! all that the kinks and roots of the problems here need.
+//!
+//! Every error names the file, the key, the line and column of its value, and what was
+//! expected (for an expression, what exmex said).
+
+use super::{Exact, Material, Problem};
+use crate::mesh::{Curve, Part};
+use exmex::prelude::*;
+use exmex::{FloatOpsFactory, MatchLiteral, literal_matcher_from_pattern};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// What is wrong with a problem file.
+#[derive(Debug, thiserror::Error)]
+pub enum ProblemFileError {
+    #[error("{file}: cannot read the problem file: {error}")]
+    Read { file: PathBuf, error: std::io::Error },
+    /// TOML syntax, an unknown or missing key, a value of the wrong type (toml's message).
+    #[error("{file}:{line}:{column}: {message}")]
+    Syntax { file: PathBuf, line: usize, column: usize, message: String },
+    #[error("{file}:{line}:{column}: key `{key}`: {message}")]
+    Invalid { file: PathBuf, key: String, line: usize, column: usize, message: String },
+}
+
+/// A number or an expression.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged, expecting = "a number or an expression (a string)")]
+enum Scalar {
+    Number(f64),
+    Text(String),
+}
+
+/// A vector: two numbers or expressions, or `"exact"` (from the `[exact]` table).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged, expecting = "an array of two numbers or expressions, or \"exact\"")]
+enum VectorToml {
+    Pair([Scalar; 2]),
+    Word(String),
+}
+
+/// The constraint direction: `"outward"` or a fixed direction (two numbers or expressions).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged, expecting = "\"outward\" or an array of two numbers or expressions")]
+enum NormalToml {
+    Pair([Scalar; 2]),
+    Word(String),
+}
+
+/// A boundary part: a predicate in x, y (built-in meshes) or a list of physical groups (Gmsh).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged, expecting = "a predicate in x, y (a string such as \"y < 1e-12\") or an array of physical-group names")]
+enum PartToml {
+    Predicate(String),
+    Groups(Vec<String>),
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialToml {
+    #[serde(rename = "E")]
+    e: Option<Spanned<Scalar>>,
+    nu: Option<Spanned<Scalar>>,
+    model: Option<Spanned<String>>,
+    mu: Option<Spanned<Scalar>>,
+    lambda: Option<Spanned<Scalar>>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PartsToml {
+    contact: Spanned<PartToml>,
+    dirichlet: Option<Spanned<PartToml>>,
+    neumann: Option<Spanned<PartToml>>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CircleToml {
+    centre: [f64; 2],
+    radius: f64,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CurveToml {
+    circle: CircleToml,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ContactToml {
+    chi: Spanned<Scalar>,
+    normal: Spanned<NormalToml>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExactToml {
+    u: Spanned<[Scalar; 2]>,
+    grad: Option<Spanned<[[Scalar; 2]; 2]>>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileToml {
+    description: Option<String>,
+    body_force: Option<Spanned<VectorToml>>,
+    traction: Option<Spanned<VectorToml>>,
+    dirichlet: Option<Spanned<VectorToml>>,
+    required_vertices: Option<Spanned<Vec<[Scalar; 2]>>>,
+    load_breaks: Option<Spanned<Vec<Scalar>>>,
+    #[serde(default)]
+    constants: BTreeMap<String, Spanned<Scalar>>,
+    material: MaterialToml,
+    parts: PartsToml,
+    #[serde(default)]
+    curves: BTreeMap<String, Spanned<CurveToml>>,
+    contact: ContactToml,
+    exact: Option<ExactToml>,
+}
+
+// Numbers in expressions: exmex's default literals have no exponent ("1e-12" would read as
+// 1, Euler's e, -12); these do (and `e` alone is still Euler's number).
+literal_matcher_from_pattern!(Number, r"^([0-9]+(\.[0-9]*)?|\.[0-9]+)([eE][+-]?[0-9]+)?");
+
+/// A parsed expression: exmex's default float operators, numbers with exponents.
+type Flat = FlatEx<f64, FloatOpsFactory<f64>, Number>;
+
+/// What an expression's variable stands for.
+#[derive(Clone, Copy, Debug)]
+enum Slot {
+    X,
+    Y,
+    /// The outward unit normal (traction only).
+    Nx,
+    Ny,
+    Const(f64),
+}
+
+/// At most this many distinct variables and constants in one expression.
+const MAX_VARS: usize = 16;
+
+/// A scalar expression in x, y (and nx, ny in a traction), parsed once.
+#[derive(Clone, Debug)]
+enum Expr {
+    Const(f64),
+    Flat {
+        /// Boxed: exmex keeps up to 32 nodes inline (about 20 kB).
+        flat: Box<Flat>,
+        /// What each of the expression's variables (exmex orders them alphabetically) stands for.
+        slots: Vec<Slot>,
+    },
+}
+
+impl Expr {
+    #[inline]
+    fn eval(&self, x: [f64; 2], n: [f64; 2]) -> f64 {
+        match self {
+            Expr::Const(c) => *c,
+            Expr::Flat { flat, slots } => {
+                let mut v = [0.0; MAX_VARS];
+                for (v, s) in v.iter_mut().zip(slots) {
+                    *v = match *s {
+                        Slot::X => x[0],
+                        Slot::Y => x[1],
+                        Slot::Nx => n[0],
+                        Slot::Ny => n[1],
+                        Slot::Const(c) => c,
+                    };
+                }
+                // the number of values is the expression's number of variables (checked when parsed)
+                flat.eval(&v[..slots.len()]).unwrap_or(f64::NAN)
+            }
+        }
+    }
+
+    #[inline]
+    fn at(&self, x: [f64; 2]) -> f64 {
+        self.eval(x, [0.0, 0.0])
+    }
+
+    /// The partial derivative in x (`var` = "x") or y, symbolically; `Err` with exmex's message
+    /// where an operator has no derivative (`abs`, `min`, `max`, ...).
+    fn derivative(&self, var: &str) -> Result<Expr, String> {
+        match self {
+            Expr::Const(_) => Ok(Expr::Const(0.0)),
+            Expr::Flat { flat, slots } => match flat.var_names().iter().position(|v| v == var) {
+                None => Ok(Expr::Const(0.0)),
+                Some(i) => {
+                    let d = flat.clone().partial(i).map_err(|e| e.msg().to_string())?;
+                    Ok(Expr::Flat { flat: Box::new(d), slots: slots.clone() })
+                }
+            },
+        }
+    }
+}
+
+/// A comparison `lhs op rhs`.
+#[derive(Clone, Debug)]
+struct Comparison {
+    lhs: Expr,
+    op: Cmp,
+    rhs: Expr,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Cmp {
+    Lt,
+    Le,
+    Gt,
+    Ge,
+}
+
+/// A predicate in x, y: comparisons joined by `&&` and `||` (`&&` binding tighter).
+#[derive(Clone, Debug)]
+struct Predicate {
+    /// Disjunction of conjunctions.
+    any: Vec<Vec<Comparison>>,
+}
+
+impl Predicate {
+    fn holds(&self, x: [f64; 2]) -> bool {
+        self.any.iter().any(|all| {
+            all.iter().all(|c| {
+                let (a, b) = (c.lhs.at(x), c.rhs.at(x));
+                match c.op {
+                    Cmp::Lt => a < b,
+                    Cmp::Le => a <= b,
+                    Cmp::Gt => a > b,
+                    Cmp::Ge => a >= b,
+                }
+            })
+        })
+    }
+}
+
+/// Dirichlet data or a traction: two expressions, or the exact solution's (u, or sigma(u) n).
+#[derive(Clone, Debug)]
+enum VectorData {
+    Exprs([Expr; 2]),
+    FromExact,
+}
+
+/// How the constraint direction (`Problem::contact_normal`) is found.
+#[derive(Clone, Debug)]
+enum Normal {
+    /// A declared direction (normalised), possibly varying with x, y.
+    Fixed([Expr; 2]),
+    /// The outward normal of the circles declared for the contact groups: away from the centre
+    /// of the circle `x` lies nearest (the body is inside the circle).
+    Circles(Vec<([f64; 2], f64)>),
+    /// The outward normal of the unit square's side that `x` lies nearest, among the sides on
+    /// which the contact predicate holds (the built-in meshes): outward normals in this order.
+    SquareSides(Vec<usize>),
+}
+
+/// The unit square's sides: bottom, right, top, left, with their outward normals.
+const SIDE_NORMALS: [[f64; 2]; 4] = [[0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]];
+
+fn side_point(side: usize, t: f64) -> [f64; 2] {
+    [[t, 0.0], [1.0, t], [t, 1.0], [0.0, t]][side]
+}
+
+fn side_distance(side: usize, x: [f64; 2]) -> f64 {
+    [x[1], 1.0 - x[0], 1.0 - x[1], x[0]][side].abs()
+}
+
+/// The exact solution of a problem file: u and its gradient (given or differentiated by exmex).
+#[derive(Clone, Debug)]
+struct ExactExprs {
+    u: [Expr; 2],
+    /// `grad[i][j] = d u_i / d x_j`.
+    grad: [[Expr; 2]; 2],
+}
+
+impl Exact for ExactExprs {
+    fn u(&self, x: [f64; 2]) -> [f64; 2] {
+        [self.u[0].at(x), self.u[1].at(x)]
+    }
+    fn grad(&self, x: [f64; 2]) -> [[f64; 2]; 2] {
+        let g = &self.grad;
+        [[g[0][0].at(x), g[0][1].at(x)], [g[1][0].at(x), g[1][1].at(x)]]
+    }
+}
+
+/// A contact problem read from a problem file.
+#[derive(Clone, Debug)]
+pub struct FileProblem {
+    name: String,
+    description: String,
+    material: Material,
+    /// Predicates on boundary-edge midpoints (built-in meshes): contact, then Dirichlet; the
+    /// rest is Neumann.
+    contact_predicate: Option<Predicate>,
+    dirichlet_predicate: Option<Predicate>,
+    /// Physical group -> part (Gmsh meshes).
+    groups: BTreeMap<String, Part>,
+    curves: BTreeMap<String, Curve>,
+    body_force: [Expr; 2],
+    traction: VectorData,
+    dirichlet: VectorData,
+    chi: Expr,
+    normal: Normal,
+    required_vertices: Vec<[f64; 2]>,
+    load_breaks: Vec<f64>,
+    exact: Option<ExactExprs>,
+}
+
+/// Line and column (from 1) of byte `offset` in `text`.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+/// Reads a problem file's values, naming file, key and position in its errors.
+struct Reader<'a> {
+    file: &'a Path,
+    text: &'a str,
+    constants: BTreeMap<String, f64>,
+}
+
+impl Reader<'_> {
+    fn error(&self, key: &str, span: std::ops::Range<usize>, message: impl Into<String>) -> ProblemFileError {
+        let (line, column) = line_column(self.text, span.start);
+        ProblemFileError::Invalid { file: self.file.to_path_buf(), key: key.to_string(), line, column, message: message.into() }
+    }
+
+    /// Parse `text` as an expression whose variables may be `vars` (and the constants).
+    fn expr(&self, key: &str, span: std::ops::Range<usize>, value: &Scalar, vars: &[&str]) -> Result<Expr, ProblemFileError> {
+        let text = match value {
+            Scalar::Number(v) => return Ok(Expr::Const(*v)),
+            Scalar::Text(t) => t,
+        };
+        let flat = Flat::parse(text).map_err(|e| self.error(key, span.clone(), format!("cannot parse {text:?}: {}", e.msg())))?;
+        let names = flat.var_names();
+        if names.len() > MAX_VARS {
+            return Err(self.error(key, span, format!("{text:?} has {} variables and constants, at most {MAX_VARS} are allowed", names.len())));
+        }
+        let mut slots = Vec::with_capacity(names.len());
+        for name in names {
+            let slot = match name.as_str() {
+                "x" if vars.contains(&"x") => Slot::X,
+                "y" if vars.contains(&"y") => Slot::Y,
+                "nx" if vars.contains(&"nx") => Slot::Nx,
+                "ny" if vars.contains(&"ny") => Slot::Ny,
+                c => match self.constants.get(c) {
+                    Some(&v) => Slot::Const(v),
+                    None => {
+                        let mut known: Vec<&str> = vars.to_vec();
+                        known.extend(self.constants.keys().map(String::as_str));
+                        let known = if known.is_empty() { "none here".to_string() } else { known.join(", ") };
+                        return Err(self.error(key, span, format!("unknown variable `{c}` in {text:?} (variables and constants here: {known})")));
+                    }
+                },
+            };
+            slots.push(slot);
+        }
+        if slots.iter().all(|s| matches!(s, Slot::Const(_))) {
+            let e = Expr::Flat { flat: Box::new(flat), slots };
+            return Ok(Expr::Const(e.at([0.0, 0.0])));
+        }
+        Ok(Expr::Flat { flat: Box::new(flat), slots })
+    }
+
+    /// A number: a number or an expression of the constants alone.
+    fn number(&self, key: &str, value: &Spanned<Scalar>) -> Result<f64, ProblemFileError> {
+        match self.expr(key, value.span(), value.get_ref(), &[])? {
+            Expr::Const(v) if v.is_finite() => Ok(v),
+            Expr::Const(v) => Err(self.error(key, value.span(), format!("a finite number, got {v}"))),
+            Expr::Flat { .. } => unreachable!("an expression without variables is a constant"),
+        }
+    }
+
+    fn pair(&self, key: &str, span: std::ops::Range<usize>, value: &[Scalar; 2], vars: &[&str]) -> Result<[Expr; 2], ProblemFileError> {
+        Ok([self.expr(&format!("{key}[0]"), span.clone(), &value[0], vars)?, self.expr(&format!("{key}[1]"), span, &value[1], vars)?])
+    }
+
+    fn vector(&self, key: &str, value: Option<&Spanned<VectorToml>>, vars: &[&str], has_exact: bool) -> Result<VectorData, ProblemFileError> {
+        let Some(value) = value else { return Ok(VectorData::Exprs([Expr::Const(0.0), Expr::Const(0.0)])) };
+        match value.get_ref() {
+            VectorToml::Pair(p) => Ok(VectorData::Exprs(self.pair(key, value.span(), p, vars)?)),
+            VectorToml::Word(w) if w == "exact" && has_exact => Ok(VectorData::FromExact),
+            VectorToml::Word(w) if w == "exact" => Err(self.error(key, value.span(), "\"exact\" needs an [exact] table")),
+            VectorToml::Word(w) => Err(self.error(key, value.span(), format!("an array of two numbers or expressions, or \"exact\"; got {w:?}"))),
+        }
+    }
+
+    /// `lhs op rhs [&& ...] [|| ...]`.
+    fn predicate(&self, key: &str, span: std::ops::Range<usize>, text: &str) -> Result<Predicate, ProblemFileError> {
+        let mut any = Vec::new();
+        for alternative in text.split("||") {
+            let mut all = Vec::new();
+            for comparison in alternative.split("&&") {
+                let (at, op, len) = ["<=", ">=", "<", ">"]
+                    .iter()
+                    .filter_map(|o| comparison.find(o).map(|i| (i, *o, o.len())))
+                    .min_by_key(|&(i, _, _)| i)
+                    .ok_or_else(|| {
+                        self.error(key, span.clone(), format!("a comparison (<, <=, >, >=) in {comparison:?} (a predicate is comparisons joined by && and ||)"))
+                    })?;
+                let op = match op {
+                    "<=" => Cmp::Le,
+                    ">=" => Cmp::Ge,
+                    "<" => Cmp::Lt,
+                    _ => Cmp::Gt,
+                };
+                let (lhs, rhs) = (&comparison[..at], &comparison[at + len..]);
+                if ["<", ">", "="].iter().any(|o| rhs.contains(o)) {
+                    return Err(self.error(key, span.clone(), format!("one comparison in {comparison:?} (join several with && or ||)")));
+                }
+                let side = |s: &str| self.expr(key, span.clone(), &Scalar::Text(s.trim().to_string()), &["x", "y"]);
+                all.push(Comparison { lhs: side(lhs)?, op, rhs: side(rhs)? });
+            }
+            any.push(all);
+        }
+        Ok(Predicate { any })
+    }
+
+    /// Resolve `[constants]`: numbers, or expressions of other constants (in any order).
+    fn resolve_constants(&mut self, table: &BTreeMap<String, Spanned<Scalar>>) -> Result<(), ProblemFileError> {
+        for name in table.keys() {
+            if matches!(name.as_str(), "x" | "y" | "nx" | "ny") {
+                return Err(self.error(&format!("constants.{name}"), table[name].span(), "a name other than x, y, nx, ny (the variables)"));
+            }
+            if Flat::parse(name).map(|f| f.var_names().len() != 1).unwrap_or(true) {
+                return Err(self.error(
+                    &format!("constants.{name}"),
+                    table[name].span(),
+                    format!("a name usable in an expression (letters, digits, '_'; not an operator or a built-in constant such as e, E, PI); got {name:?}"),
+                ));
+            }
+        }
+        let mut pending: Vec<&String> = table.keys().collect();
+        while !pending.is_empty() {
+            let before = pending.len();
+            let mut next = Vec::new();
+            for name in pending {
+                let value = &table[name];
+                let ready = match value.get_ref() {
+                    Scalar::Number(_) => true,
+                    Scalar::Text(t) => {
+                        Flat::parse(t).map(|f| f.var_names().iter().all(|v| self.constants.contains_key(v))).unwrap_or(true)
+                    }
+                };
+                if ready {
+                    let v = self.number(&format!("constants.{name}"), value)?;
+                    self.constants.insert(name.clone(), v);
+                } else {
+                    next.push(name);
+                }
+            }
+            if next.len() == before {
+                // an unknown name or a cycle: report the first with its unknown variable
+                let name = next[0];
+                let key = format!("constants.{name}");
+                let mut known = self.constants.clone();
+                for n in &next {
+                    known.insert((*n).clone(), 0.0);
+                }
+                let Scalar::Text(t) = table[name].get_ref() else { unreachable!("numbers are always ready") };
+                let unknown = Flat::parse(t)
+                    .map(|f| f.var_names().iter().find(|v| !known.contains_key(*v)).cloned())
+                    .unwrap_or_default();
+                let message = match unknown {
+                    Some(v) => format!("unknown variable `{v}` in {t:?} (a constant is a number or an expression of other constants)"),
+                    None => format!("{t:?}: the constants {} refer to each other in a cycle", next.iter().map(|n| n.as_str()).collect::<Vec<_>>().join(", ")),
+                };
+                return Err(self.error(&key, table[name].span(), message));
+            }
+            pending = next;
+        }
+        Ok(())
+    }
+}
+
+impl FileProblem {
+    /// Read and check a problem file. The problem's name is the file stem.
+    pub fn load(path: &Path) -> Result<Self, ProblemFileError> {
+        let text = std::fs::read_to_string(path).map_err(|error| ProblemFileError::Read { file: path.to_path_buf(), error })?;
+        Self::parse(path, &text)
+    }
+
+    /// Parse a problem file's text; `path` names it in errors and gives the problem's name.
+    pub fn parse(path: &Path, text: &str) -> Result<Self, ProblemFileError> {
+        let raw: FileToml = toml::from_str(text).map_err(|e| {
+            let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
+            ProblemFileError::Syntax { file: path.to_path_buf(), line, column, message: e.message().trim_end().to_string() }
+        })?;
+        let mut r = Reader { file: path, text, constants: BTreeMap::new() };
+        r.resolve_constants(&raw.constants)?;
+        let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+
+        // material
+        let m = &raw.material;
+        let material_span = [&m.e, &m.nu, &m.mu, &m.lambda].iter().find_map(|v| v.as_ref().map(|v| v.span())).unwrap_or(0..0);
+        let material = match (&m.e, &m.nu, &m.mu, &m.lambda) {
+            (Some(e), Some(nu), None, None) => {
+                let (e, nu) = (r.number("material.E", e)?, r.number("material.nu", nu)?);
+                let model = m.model.as_ref().ok_or_else(|| {
+                    r.error("material.model", material_span.clone(), "model = \"plane_strain\" or \"plane_stress\" with E and nu (missing)")
+                })?;
+                if !(e > 0.0) {
+                    return Err(r.error("material.E", m.e.as_ref().map_or(0..0, |v| v.span()), format!("a positive Young's modulus, got {e}")));
+                }
+                let nu_span = m.nu.as_ref().map_or(0..0, |v| v.span());
+                match model.get_ref().as_str() {
+                    "plane_strain" if nu > -1.0 && nu < 0.5 => Material::from_young(e, nu),
+                    "plane_stress" if nu > -1.0 && nu < 1.0 => Material::from_young_plane_stress(e, nu),
+                    "plane_strain" => return Err(r.error("material.nu", nu_span, format!("a Poisson ratio in (-1, 0.5) in plane strain, got {nu}"))),
+                    "plane_stress" => return Err(r.error("material.nu", nu_span, format!("a Poisson ratio in (-1, 1) in plane stress, got {nu}"))),
+                    other => return Err(r.error("material.model", model.span(), format!("\"plane_strain\" or \"plane_stress\", got {other:?}"))),
+                }
+            }
+            (None, None, Some(mu), Some(lambda)) => {
+                if let Some(model) = &m.model {
+                    return Err(r.error("material.model", model.span(), "no model with Lamé constants (mu and lambda are the plane ones)"));
+                }
+                let material = Material { mu: r.number("material.mu", mu)?, zeta: r.number("material.lambda", lambda)? };
+                if !(material.mu > 0.0 && material.zeta + material.mu > 0.0) {
+                    return Err(r.error("material", mu.span(), format!("mu > 0 and lambda + mu > 0 (coercive), got mu = {}, lambda = {}", material.mu, material.zeta)));
+                }
+                material
+            }
+            _ => {
+                return Err(r.error(
+                    "material",
+                    material_span,
+                    "either E, nu and model (\"plane_strain\" or \"plane_stress\"), or the Lamé constants mu and lambda",
+                ));
+            }
+        };
+
+        // parts
+        let mut groups = BTreeMap::new();
+        let mut predicates = [None, None];
+        for (key, part, value) in [
+            ("parts.contact", Part::Contact, Some(&raw.parts.contact)),
+            ("parts.dirichlet", Part::Dirichlet, raw.parts.dirichlet.as_ref()),
+            ("parts.neumann", Part::Neumann, raw.parts.neumann.as_ref()),
+        ] {
+            let Some(value) = value else { continue };
+            match value.get_ref() {
+                PartToml::Predicate(_) if part == Part::Neumann => {
+                    return Err(r.error(
+                        key,
+                        value.span(),
+                        "a list of physical groups (with predicates, the edges neither the contact nor the Dirichlet predicate takes are Neumann)",
+                    ));
+                }
+                PartToml::Predicate(p) => predicates[(part == Part::Dirichlet) as usize] = Some(r.predicate(key, value.span(), p)?),
+                PartToml::Groups(list) => {
+                    for g in list {
+                        if let Some(other) = groups.insert(g.clone(), part) {
+                            return Err(r.error(key, value.span(), format!("physical group {g:?} is already in the {other:?} part")));
+                        }
+                    }
+                }
+            }
+        }
+        let [contact_predicate, dirichlet_predicate] = predicates;
+        let mut curves = BTreeMap::new();
+        for (group, curve) in &raw.curves {
+            let key = format!("curves.{group}");
+            if !groups.contains_key(group) {
+                return Err(r.error(
+                    &key,
+                    curve.span(),
+                    format!(
+                        "a physical group named in [parts]; {group:?} is referenced nowhere (groups there: {})",
+                        if groups.is_empty() { "none".to_string() } else { groups.keys().cloned().collect::<Vec<_>>().join(", ") }
+                    ),
+                ));
+            }
+            let c = &curve.get_ref().circle;
+            if !(c.radius > 0.0 && c.radius.is_finite() && c.centre.iter().all(|v| v.is_finite())) {
+                return Err(r.error(&format!("{key}.circle"), curve.span(), format!("a finite centre and a positive radius, got radius {}", c.radius)));
+            }
+            curves.insert(group.clone(), Curve::Circle { centre: c.centre, radius: c.radius });
+        }
+
+        // data
+        let xy = ["x", "y"];
+        let has_exact = raw.exact.is_some();
+        let body_force = match (r.vector("body_force", raw.body_force.as_ref(), &xy, true)?, &raw.body_force) {
+            (VectorData::Exprs(e), _) => e,
+            (VectorData::FromExact, value) => {
+                return Err(r.error(
+                    "body_force",
+                    value.as_ref().map_or(0..0, |v| v.span()),
+                    "two expressions: f = -div sigma(u) is not derived from [exact], write it out",
+                ));
+            }
+        };
+        let traction = r.vector("traction", raw.traction.as_ref(), &["x", "y", "nx", "ny"], has_exact)?;
+        let dirichlet = r.vector("dirichlet", raw.dirichlet.as_ref(), &xy, has_exact)?;
+        let chi = r.expr("contact.chi", raw.contact.chi.span(), raw.contact.chi.get_ref(), &xy)?;
+        let normal_value = &raw.contact.normal;
+        let normal = match normal_value.get_ref() {
+            NormalToml::Pair(p) => {
+                let n = r.pair("contact.normal", normal_value.span(), p, &xy)?;
+                if let [Expr::Const(a), Expr::Const(b)] = &n
+                    && !(a.hypot(*b) > 0.0 && a.is_finite() && b.is_finite())
+                {
+                    return Err(r.error("contact.normal", normal_value.span(), format!("a nonzero direction, got [{a}, {b}]")));
+                }
+                Normal::Fixed(n)
+            }
+            NormalToml::Word(w) if w == "outward" => {
+                let circles: Vec<([f64; 2], f64)> = groups
+                    .iter()
+                    .filter(|(_, p)| **p == Part::Contact)
+                    .filter_map(|(g, _)| curves.get(g))
+                    .map(|Curve::Circle { centre, radius }| (*centre, *radius))
+                    .collect();
+                if !circles.is_empty() {
+                    Normal::Circles(circles)
+                } else if let Some(p) = &contact_predicate {
+                    let sides: Vec<usize> = (0..4).filter(|&s| (1..16).any(|k| p.holds(side_point(s, k as f64 / 16.0)))).collect();
+                    if sides.is_empty() {
+                        return Err(r.error(
+                            "contact.normal",
+                            normal_value.span(),
+                            "\"outward\" with a contact predicate takes the unit square's sides (the built-in meshes), but the predicate holds on none of them: give a direction [nx, ny]",
+                        ));
+                    }
+                    Normal::SquareSides(sides)
+                } else {
+                    return Err(r.error(
+                        "contact.normal",
+                        normal_value.span(),
+                        "\"outward\" needs a circle in [curves] for a contact group (or a contact predicate on the unit square): give a direction [nx, ny] otherwise",
+                    ));
+                }
+            }
+            NormalToml::Word(w) => return Err(r.error("contact.normal", normal_value.span(), format!("\"outward\" or [nx, ny], got {w:?}"))),
+        };
+        let mut required_vertices = Vec::new();
+        if let Some(v) = &raw.required_vertices {
+            for (i, p) in v.get_ref().iter().enumerate() {
+                let key = format!("required_vertices[{i}]");
+                let s = |k: usize| Spanned::new(v.span(), p[k].clone());
+                required_vertices.push([r.number(&key, &s(0))?, r.number(&key, &s(1))?]);
+            }
+        }
+        let mut load_breaks = Vec::new();
+        if let Some(v) = &raw.load_breaks {
+            for (i, c) in v.get_ref().iter().enumerate() {
+                load_breaks.push(r.number(&format!("load_breaks[{i}]"), &Spanned::new(v.span(), c.clone()))?);
+            }
+        }
+        let exact = match &raw.exact {
+            None => None,
+            Some(e) => {
+                let u = r.pair("exact.u", e.u.span(), e.u.get_ref(), &xy)?;
+                let grad = match &e.grad {
+                    Some(g) => {
+                        let [g0, g1] = g.get_ref();
+                        [r.pair("exact.grad[0]", g.span(), g0, &xy)?, r.pair("exact.grad[1]", g.span(), g1, &xy)?]
+                    }
+                    None => {
+                        let d = |i: usize, var: &str| {
+                            u[i].derivative(var).map_err(|m| {
+                                r.error(&format!("exact.u[{i}]"), e.u.span(), format!("cannot differentiate it ({m}): give exact.grad = [[du1/dx, du1/dy], [du2/dx, du2/dy]]"))
+                            })
+                        };
+                        [[d(0, "x")?, d(0, "y")?], [d(1, "x")?, d(1, "y")?]]
+                    }
+                };
+                Some(ExactExprs { u, grad })
+            }
+        };
+        Ok(FileProblem {
+            name,
+            description: raw.description.unwrap_or_default(),
+            material,
+            contact_predicate,
+            dirichlet_predicate,
+            groups,
+            curves,
+            body_force,
+            traction,
+            dirichlet,
+            chi,
+            normal,
+            required_vertices,
+            load_breaks,
+            exact,
+        })
+    }
+
+}
+
+impl Problem for FileProblem {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn description(&self) -> &str {
+        &self.description
+    }
+    fn material(&self) -> Material {
+        self.material
+    }
+    /// Contact where the contact predicate holds, else Dirichlet where the Dirichlet predicate
+    /// holds, else Neumann.
+    fn part_of(&self, x: [f64; 2]) -> Part {
+        if self.contact_predicate.as_ref().is_some_and(|p| p.holds(x)) {
+            Part::Contact
+        } else if self.dirichlet_predicate.as_ref().is_some_and(|p| p.holds(x)) {
+            Part::Dirichlet
+        } else {
+            Part::Neumann
+        }
+    }
+    fn part_of_group(&self, group: &str) -> Option<Part> {
+        self.groups.get(group).copied()
+    }
+    fn groups(&self) -> Vec<String> {
+        self.groups.keys().cloned().collect()
+    }
+    fn curve_of_group(&self, group: &str) -> Option<Curve> {
+        self.curves.get(group).copied()
+    }
+    fn body_force(&self, x: [f64; 2]) -> [f64; 2] {
+        [self.body_force[0].at(x), self.body_force[1].at(x)]
+    }
+    fn traction(&self, x: [f64; 2], n: [f64; 2]) -> [f64; 2] {
+        match (&self.traction, &self.exact) {
+            (VectorData::Exprs(t), _) => [t[0].eval(x, n), t[1].eval(x, n)],
+            (VectorData::FromExact, Some(e)) => self.material.traction(e.grad(x), n),
+            (VectorData::FromExact, None) => unreachable!("\"exact\" is refused without [exact]"),
+        }
+    }
+    fn dirichlet(&self, x: [f64; 2]) -> [f64; 2] {
+        match (&self.dirichlet, &self.exact) {
+            (VectorData::Exprs(u), _) => [u[0].at(x), u[1].at(x)],
+            (VectorData::FromExact, Some(e)) => e.u(x),
+            (VectorData::FromExact, None) => unreachable!("\"exact\" is refused without [exact]"),
+        }
+    }
+    fn contact_normal(&self, x: [f64; 2]) -> [f64; 2] {
+        match &self.normal {
+            Normal::Fixed(n) => {
+                let (a, b) = (n[0].at(x), n[1].at(x));
+                let l = a.hypot(b);
+                [a / l, b / l]
+            }
+            Normal::Circles(circles) => {
+                let dist = |c: &([f64; 2], f64)| ((x[0] - c.0[0]).hypot(x[1] - c.0[1]) - c.1).abs();
+                let (c, _) = circles.iter().min_by(|a, b| dist(a).total_cmp(&dist(b))).expect("at least one circle");
+                let d = [x[0] - c[0], x[1] - c[1]];
+                let l = d[0].hypot(d[1]);
+                [d[0] / l, d[1] / l]
+            }
+            Normal::SquareSides(sides) => {
+                let s = sides.iter().copied().min_by(|&a, &b| side_distance(a, x).total_cmp(&side_distance(b, x))).expect("at least one side");
+                SIDE_NORMALS[s]
+            }
+        }
+    }
+    fn gap(&self, x: [f64; 2]) -> f64 {
+        self.chi.at(x)
+    }
+    fn required_vertices(&self) -> Vec<[f64; 2]> {
+        self.required_vertices.clone()
+    }
+    fn load_breaks(&self) -> Vec<f64> {
+        self.load_breaks.clone()
+    }
+    fn exact(&self) -> Option<&dyn Exact> {
+        self.exact.as_ref().map(|e| e as &dyn Exact)
+    }
+}

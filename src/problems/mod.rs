@@ -1,0 +1,143 @@
+//! The contact problems as data: material, loads, boundary parts, obstacle, exact solution.
+//!
+//! A problem is data, not branches in the solver: every problem implements [`Problem`] and the
+//! solver, estimator and studies only ever call the trait. The built-in problems ([`KNOWN`],
+//! module [`builtin`]) are written in Rust; a problem file (`experiments/problems/NAME.toml`,
+//! module [`file`]) states one as data, with its loads, obstacle and exact solution as
+//! expressions in x and y. [`by_name`] takes either.
+
+pub mod builtin;
+pub mod file;
+
+pub use builtin::{Ex71, Ex72, Fb, Patch, contact_bottom_dirichlet_top};
+pub use file::{FileProblem, ProblemFileError};
+
+use crate::mesh::{Curve, Part};
+use std::path::Path;
+
+/// Plane elasticity with Lamé constants: sigma(u) = 2 mu eps(u) + zeta tr(eps(u)) I
+/// (paper Section 1; the paper writes zeta for Lamé's lambda).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Material {
+    pub mu: f64,
+    pub zeta: f64,
+}
+
+impl Material {
+    /// From Young's modulus and Poisson's ratio (plane strain):
+    /// zeta = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)).
+    pub fn from_young(e: f64, nu: f64) -> Self {
+        Material { mu: e / (2.0 * (1.0 + nu)), zeta: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)) }
+    }
+
+    /// From Young's modulus and Poisson's ratio in plane stress (a thin plate, sigma_33 = 0):
+    /// the same mu, and zeta = E nu / (1 - nu^2) = 2 mu zeta_3d / (zeta_3d + 2 mu).
+    pub fn from_young_plane_stress(e: f64, nu: f64) -> Self {
+        Material { mu: e / (2.0 * (1.0 + nu)), zeta: e * nu / (1.0 - nu * nu) }
+    }
+
+    /// Stress from a displacement gradient `g[i][j] = d u_i / d x_j`, as (s11, s12, s22).
+    #[inline]
+    pub fn stress(&self, g: [[f64; 2]; 2]) -> [f64; 3] {
+        let tr = g[0][0] + g[1][1];
+        let s12 = self.mu * (g[0][1] + g[1][0]);
+        [2.0 * self.mu * g[0][0] + self.zeta * tr, s12, 2.0 * self.mu * g[1][1] + self.zeta * tr]
+    }
+
+    /// Traction sigma(u) n from a displacement gradient and a unit normal.
+    #[inline]
+    pub fn traction(&self, g: [[f64; 2]; 2], n: [f64; 2]) -> [f64; 2] {
+        let s = self.stress(g);
+        [s[0] * n[0] + s[1] * n[1], s[1] * n[0] + s[2] * n[1]]
+    }
+}
+
+/// An exact solution, where one is known.
+pub trait Exact: Send + Sync {
+    fn u(&self, x: [f64; 2]) -> [f64; 2];
+    /// `grad[i][j] = d u_i / d x_j`.
+    fn grad(&self, x: [f64; 2]) -> [[f64; 2]; 2];
+}
+
+/// A 2D frictionless unilateral contact problem (paper eq. 1.1–1.8).
+pub trait Problem: Send + Sync {
+    /// Short name used on the command line and in manifests.
+    fn name(&self) -> &str;
+    fn description(&self) -> &str;
+    fn material(&self) -> Material;
+    /// The boundary part containing boundary point `x` (an edge midpoint): how the built-in
+    /// meshes (`structured:N`, `symmetric:N`) are tagged.
+    fn part_of(&self, x: [f64; 2]) -> Part;
+    /// The boundary part of the edges in the mesh file's physical group `group` (how Gmsh meshes
+    /// are tagged); `None` if the problem does not name that group.
+    fn part_of_group(&self, _group: &str) -> Option<Part> {
+        None
+    }
+    /// The physical groups the problem names (in `part_of_group`): a mesh file lacking one of
+    /// them is an error.
+    fn groups(&self) -> Vec<String> {
+        Vec::new()
+    }
+    /// The curve on which the boundary edges of physical group `group` lie, if they lie on one:
+    /// refinement puts new boundary vertices there.
+    fn curve_of_group(&self, _group: &str) -> Option<Curve> {
+        None
+    }
+    /// Body force f.
+    fn body_force(&self, x: [f64; 2]) -> [f64; 2];
+    /// Neumann traction g at `x` on Gamma_N with outward unit normal `n`.
+    fn traction(&self, x: [f64; 2], n: [f64; 2]) -> [f64; 2];
+    /// Dirichlet value on Gamma_D.
+    fn dirichlet(&self, x: [f64; 2]) -> [f64; 2];
+    /// Outward unit normal of Gamma_C at `x`.
+    fn contact_normal(&self, x: [f64; 2]) -> [f64; 2];
+    /// The gap chi: the constraint is u . n <= chi on Gamma_C.
+    fn gap(&self, x: [f64; 2]) -> f64;
+    /// Points that must be mesh vertices (kinks of chi), so that chi_h interpolates chi well.
+    fn required_vertices(&self) -> Vec<[f64; 2]> {
+        Vec::new()
+    }
+    /// Vertical lines x = c across which the body force is not smooth (a root singularity of a
+    /// derivative, such as ((x - c)_+)^(1/2)): the load of an element crossing one is integrated
+    /// piecewise (`assembly::split_load`), exact to round-off where a Gauss rule on the whole
+    /// element would converge only algebraically.
+    fn load_breaks(&self) -> Vec<f64> {
+        Vec::new()
+    }
+    fn exact(&self) -> Option<&dyn Exact> {
+        None
+    }
+}
+
+/// The built-in problems' names.
+pub const KNOWN: [&str; 4] = ["ex71", "ex72", "fb", "patch"];
+
+/// Why `--problem` (or a manifest's `problem`) names no problem.
+#[derive(Debug, thiserror::Error)]
+pub enum ProblemError {
+    #[error(
+        "unknown problem '{0}': expected a built-in problem ({known}) or the path of a problem file (NAME.toml, e.g. experiments/problems/ex72.toml)",
+        known = KNOWN.join(", ")
+    )]
+    Unknown(String),
+    #[error(transparent)]
+    File(#[from] ProblemFileError),
+}
+
+/// Whether `s` names a problem file rather than a built-in problem: it ends in `.toml`.
+pub fn is_file(s: &str) -> bool {
+    s.ends_with(".toml")
+}
+
+/// The problem `s` names: a built-in name ([`KNOWN`]) or the path of a problem file (ending in
+/// `.toml`, read and checked here; see [`file`] for the format).
+pub fn by_name(s: &str) -> Result<Box<dyn Problem>, ProblemError> {
+    match s {
+        "ex71" => Ok(Box::new(Ex71)),
+        "ex72" => Ok(Box::new(Ex72)),
+        "fb" => Ok(Box::new(Fb)),
+        "patch" => Ok(Box::new(Patch::default())),
+        _ if is_file(s) => Ok(Box::new(FileProblem::load(Path::new(s))?)),
+        _ => Err(ProblemError::Unknown(s.to_string())),
+    }
+}
