@@ -235,6 +235,7 @@ impl Manifest {
                         crate::problems::KNOWN.join(", ")
                     ),
                     crate::problems::ProblemError::File(e) => format!("a valid problem file ({e})"),
+                    crate::problems::ProblemError::Constants(_) => "a problem file (NAME.toml): the run sets constants".to_string(),
                 };
                 return Err(invalid(key("problem"), &expected, format!("{problem:?}")));
             }
