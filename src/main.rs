@@ -241,14 +241,7 @@ fn validate(config: &AdaptConfig) -> Result<()> {
 fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::DiscreteSolution, report::SolveReport)> {
     let problem = problems::by_name(&args.problem)?;
     let spec = MeshSpec::parse(&args.mesh)?;
-    let mut probes = Vec::new();
-    for p in &args.probes {
-        let [x, y] = report::parse_probe(p)?;
-        if !spec.contains([x, y]) {
-            bail!(report::ProbeError::Outside { x, y });
-        }
-        probes.push([x, y]);
-    }
+    let probes = args.probes.iter().map(|p| report::parse_probe(p)).collect::<Result<Vec<_>, _>>()?;
     let pdas = PdasOptions { max_iterations: args.max_pdas_iterations, ..Default::default() };
     let estimator = args.estimator.config()?;
     let adaptive = args.adapt_levels.is_some() || args.adapt_min_ndof.is_some();
@@ -256,11 +249,16 @@ fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::Discrete
     let config =
         AdaptConfig { levels: args.adapt_levels.map_or(200, |l| l + 1), theta, estimator, pdas: pdas.clone(), ..Default::default() };
     validate(&config)?;
-    solve::check_memory(&spec.to_string(), spec.ndof())?;
+    solve::check_memory(&spec.to_string(), spec.ndof()?)?;
     if let Some(n) = args.adapt_min_ndof {
         solve::check_memory(&format!("an adaptive level reaching --adapt-min-ndof {n}"), n as f64)?;
     }
-    let mut mesh = spec.build(&|x| problem.part_of(x));
+    let mut mesh = spec.build(problem.as_ref())?;
+    // probes outside the initial mesh fail before anything is solved
+    let locator = signorini::mesh::locate::Locator::new(&mesh);
+    if let Some(&[x, y]) = probes.iter().find(|&&x| locator.locate(&mesh, x).is_none()) {
+        bail!(report::ProbeError::Outside { x, y });
+    }
     let mut mesh_name = spec.to_string();
     if adaptive {
         let min_ndof = args.adapt_min_ndof.unwrap_or(0);
@@ -301,8 +299,8 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
         ..Default::default()
     };
     validate(&config)?;
-    solve::check_memory(&spec.to_string(), spec.ndof())?;
-    let mesh = spec.build(&|x| problem.part_of(x));
+    solve::check_memory(&spec.to_string(), spec.ndof()?)?;
+    let mesh = spec.build(problem.as_ref())?;
     let exact = problem.exact();
     let reference = exact.map(|e| move |x: [f64; 2]| e.u(x));
     if exact.is_none() {

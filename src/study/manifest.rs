@@ -5,7 +5,8 @@
 //!
 //! [defaults]                 # every run starts from these
 //! problem = "ex71"
-//! mesh = "structured:4"
+//! mesh = "structured:4"       # or "symmetric:N", or "gmsh:meshes/NAME.msh" (a Gmsh file; a
+//!                            # relative path is relative to the manifest's folder)
 //! levels = 24
 //! quick_levels = 8           # the --quick form: the first levels of the same runs
 //! theta = 0.5
@@ -231,7 +232,13 @@ impl Manifest {
                 return Err(invalid(key("problem"), &format!("one of {}", crate::problems::KNOWN.join(", ")), format!("{problem:?}")));
             }
             let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| "structured:4".into());
-            MeshSpec::parse(&mesh).map_err(|_| invalid(key("mesh"), "'structured:N' or 'symmetric:N'", format!("{mesh:?}")))?;
+            let parsed = MeshSpec::parse(&mesh)
+                .map_err(|_| invalid(key("mesh"), "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'", format!("{mesh:?}")))?;
+            // a relative mesh file is relative to the manifest's folder
+            let mesh = match parsed.file() {
+                Some(f) if f.is_relative() => format!("gmsh:{}", path.parent().unwrap_or(Path::new("")).join(f).display()),
+                _ => mesh,
+            };
             let levels = r.levels.or(d.levels).ok_or_else(|| invalid(key("levels"), "a number of levels >= 1", "nothing".into()))?;
             let theta = r.theta.or(d.theta).unwrap_or(0.5);
             let e = EstimatorConfig::default();

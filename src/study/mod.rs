@@ -184,8 +184,16 @@ fn remove_meshes(dir: &StudyDir, id: &str) -> Result<()> {
 fn write_summaries(manifest: &Manifest, dir: &StudyDir, quick: bool) -> Result<Vec<RunRecord>> {
     let runs = dir.read_runs().with_context(|| format!("reading the runs in {}", dir.root.join("runs").display()))?;
     dir.write_csv(&runs).with_context(|| format!("writing {}", dir.csv_file().display()))?;
-    let prov =
-        provenance::collect(&manifest.study, &manifest.file, &manifest.bytes, quick, runs.iter().map(|r| r.run.id.clone()).collect());
+    let specs: Vec<MeshSpec> = manifest.runs.iter().filter_map(|r| MeshSpec::parse(&r.spec.mesh).ok()).collect();
+    let meshes: Vec<&std::path::Path> = specs.iter().filter_map(MeshSpec::file).collect();
+    let prov = provenance::collect(
+        &manifest.study,
+        &manifest.file,
+        &manifest.bytes,
+        quick,
+        runs.iter().map(|r| r.run.id.clone()).collect(),
+        &meshes,
+    );
     records::write_json(&dir.provenance_file(), &prov).with_context(|| format!("writing {}", dir.provenance_file().display()))?;
     Ok(runs)
 }
@@ -339,7 +347,7 @@ fn reference_key(spec: &RunSpec) -> Option<String> {
 fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Result<Option<RunRecord>> {
     let problem = problems::by_name(&spec.problem)?;
     let mesh_spec = MeshSpec::parse(&spec.mesh)?;
-    crate::solve::check_memory(&format!("{study}/{}: the initial mesh {}", spec.id, spec.mesh), mesh_spec.ndof())?;
+    crate::solve::check_memory(&format!("{study}/{}: the initial mesh {}", spec.id, spec.mesh), mesh_spec.ndof()?)?;
     if spec.reference.is_some() && problem.exact().is_some() {
         bail!("{study}/{}: problem {} has an exact solution; a reference solution is not needed", spec.id, spec.problem);
     }
@@ -381,7 +389,7 @@ fn run_one(study: &str, spec: &RunSpec, dir: &StudyDir, progress: bool) -> Resul
     let pb = bar(progress, spec.levels as u64, &format!("{study}/{}", spec.id));
     let mut save_error: Option<anyhow::Error> = None;
     let mut stopped = false;
-    let mesh = mesh_spec.build(&|x| problem.part_of(x));
+    let mesh = mesh_spec.build(problem.as_ref())?;
     let levels = adapt::run(problem.as_ref(), mesh, &config, error_against, &mut |level: Level| {
         let r = level.record;
         pb.set_message(format!(
