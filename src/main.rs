@@ -168,7 +168,7 @@ struct AdaptArgs {
     /// Problem name (ex71, ex72, patch).
     #[arg(long)]
     problem: String,
-    /// Initial mesh: structured:N (or symmetric:N, mirrored about y = 0.5).
+    /// Initial mesh: structured:N (or symmetric:N, mirrored about y = 0.5), or gmsh:PATH.msh.
     #[arg(long, default_value = "structured:4")]
     mesh: String,
     /// Number of levels solved (level 0 is the initial mesh).
@@ -193,10 +193,10 @@ struct SolveArgs {
     /// Problem name (ex71, ex72, patch).
     #[arg(long)]
     problem: String,
-    /// Mesh: structured:N (or symmetric:N, mirrored about y = 0.5).
+    /// Mesh: structured:N (or symmetric:N, mirrored about y = 0.5), or gmsh:PATH.msh (a Gmsh file).
     #[arg(long)]
     mesh: String,
-    /// Evaluate u_h at X,Y in the unit square (repeatable; negative numbers are read as values).
+    /// Evaluate u_h at X,Y, a point of the mesh (repeatable; negative numbers are read as values).
     #[arg(long = "probe", value_name = "X,Y", allow_hyphen_values = true)]
     probes: Vec<String>,
     /// Maximum number of active-set iterations.

@@ -4,10 +4,10 @@
 
 use crate::contact::PdasIteration;
 use crate::estimate::{Estimate, EstimatorConfig, Terms};
+use crate::mesh::locate::Locator;
 use crate::mesh::{Mesh, io};
 use crate::norms::LinfError;
 use crate::records;
-use crate::mesh::locate::Locator;
 use crate::solve::{ContactInterval, DiscreteSolution, Kkt, SolveTimings};
 use anyhow::Result;
 use serde::Serialize;
@@ -136,7 +136,8 @@ impl SolveReport {
             self.problem, self.mesh, self.n_elements, self.ndof, self.ndof_free, self.h_min, self.h_max
         );
         let interval = |z: &ContactInterval| {
-            let component = if self.contact_zones.iter().any(|z| z.component > 0) { format!(" of part {}", z.component + 1) } else { String::new() };
+            let component =
+                if self.contact_zones.iter().any(|z| z.component > 0) { format!(" of part {}", z.component + 1) } else { String::new() };
             format!("[{}, {}]{component}", z.s[0], z.s[1])
         };
         let zone = match self.contact_zones.as_slice() {

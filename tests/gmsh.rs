@@ -125,7 +125,7 @@ fn line_of(text: &str, line: &str) -> usize {
 }
 
 fn build_err(path: &Path, problem: &dyn Problem) -> String {
-    let err = MeshSpec::Gmsh(path.to_path_buf()).build(problem).err().expect("an error");
+    let err = MeshSpec::Gmsh(path.to_path_buf()).build(problem).expect_err("an error");
     assert!(matches!(err, MeshError::Gmsh { .. }), "{err:?}");
     err.to_string()
 }
@@ -228,7 +228,9 @@ fn quarter_disc_counts_area_and_tags() {
             }
         }
     }
-    let len = |part| m.boundary.iter().filter(|e| e.part == part).map(|e| signorini::mesh::dist(m.vertices[e.v[0]], m.vertices[e.v[1]])).sum::<f64>();
+    let len = |part| {
+        m.boundary.iter().filter(|e| e.part == part).map(|e| signorini::mesh::dist(m.vertices[e.v[0]], m.vertices[e.v[1]])).sum::<f64>()
+    };
     assert!((len(Part::Contact) - 1.0).abs() < 1e-14 && (len(Part::Dirichlet) - 1.0).abs() < 1e-14);
 }
 
@@ -257,6 +259,10 @@ fn quarter_disc_refined_onto_the_arc() {
     // a solve on the refined mesh: the body rests on the foundation
     let sol = solve_on(&p, &m);
     assert!(sol.active_count() > 0 && sol.kkt().max_penetration <= 1e-12);
+    // VTU as for the built-in meshes: one quadratic triangle per triangle, one line per boundary edge
+    let doc = signorini::mesh::io::vtu(&m, &sol.nodes, &[("u", signorini::mesh::io::Field::Vector(&sol.u))], &[]);
+    assert!(doc.contains(&format!("NumberOfPoints=\"{}\" NumberOfCells=\"{}\"", sol.nodes.len(), m.n_triangles() + m.boundary.len())));
+    write("quarter_disc_refined.vtu", &doc);
 }
 
 #[test]
@@ -403,7 +409,8 @@ fn contact_zone_arc_length_along_a_curve() {
     let m = MeshSpec::Gmsh(meshes_dir().join("quarter_disc.msh")).build(&Ring).unwrap();
     let sol = solve_on(&Ring, &m);
     let zones = sol.contact_zones();
-    let arc: Vec<[f64; 2]> = m.boundary.iter().filter(|e| e.part == Part::Contact).map(|e| [m.vertices[e.v[0]], m.vertices[e.v[1]]]).flat_map(|[a, b]| [a, b]).collect();
+    let arc: Vec<[f64; 2]> =
+        m.boundary.iter().filter(|e| e.part == Part::Contact).flat_map(|e| [m.vertices[e.v[0]], m.vertices[e.v[1]]]).collect();
     let lengths: Vec<f64> = arc.chunks(2).map(|e| signorini::mesh::dist(e[0], e[1])).collect();
     let arc_len: f64 = lengths.iter().sum();
     assert_eq!(zones.len(), 1, "{zones:?}");
@@ -411,5 +418,39 @@ fn contact_zone_arc_length_along_a_curve() {
     let last = lengths.iter().zip(arc.chunks(2)).find(|(_, e)| e[1] == [0.0, 1.0]).map(|(l, _)| *l).unwrap();
     assert!((zones[0].s[1] - (arc_len - 0.5 * last)).abs() < 1e-14, "{zones:?} vs {arc_len} - {last} / 2");
     assert_eq!(zones[0].from, [1.0, 0.0]);
-    assert!(zones[0].to[0] > 0.0 && (zones[0].to[0].hypot(zones[0].to[1]) - 1.0).abs() < 0.01, "counter-clockwise from (1, 0) to near (0, 1): {zones:?}");
+    assert!(
+        zones[0].to[0] > 0.0 && (zones[0].to[0].hypot(zones[0].to[1]) - 1.0).abs() < 0.01,
+        "counter-clockwise from (1, 0) to near (0, 1): {zones:?}"
+    );
+}
+
+/// A manifest's relative mesh path is relative to the manifest's folder; an absolute one and the
+/// built-in meshes are kept as written.
+#[test]
+fn manifest_mesh_paths_are_relative_to_the_manifest() {
+    use signorini::study::manifest::Manifest;
+    let text = |mesh: &str| format!("[defaults]\nproblem = \"ex71\"\nlevels = 2\nmesh = \"{mesh}\"\n[[run]]\nid = \"a\"\n");
+    let m = Manifest::parse(Path::new("studies/own/hertz.toml"), &text("gmsh:meshes/hertz.msh")).unwrap();
+    assert_eq!(m.runs[0].spec.mesh, "gmsh:studies/own/meshes/hertz.msh");
+    let m = Manifest::parse(Path::new("hertz.toml"), &text("gmsh:meshes/hertz.msh")).unwrap();
+    assert_eq!(m.runs[0].spec.mesh, "gmsh:meshes/hertz.msh");
+    let m = Manifest::parse(Path::new("studies/hertz.toml"), &text("gmsh:/abs/hertz.msh")).unwrap();
+    assert_eq!(m.runs[0].spec.mesh, "gmsh:/abs/hertz.msh");
+    let m = Manifest::parse(Path::new("studies/hertz.toml"), &text("structured:4")).unwrap();
+    assert_eq!(m.runs[0].spec.mesh, "structured:4");
+    let e = Manifest::parse(Path::new("studies/hertz.toml"), &text("gmsh:")).unwrap_err().to_string();
+    assert!(e.contains("run[0].mesh") && e.contains("gmsh:PATH.msh"), "{e}");
+}
+
+/// On the command line: a Gmsh mesh whose groups the problem does not name is a clear error, and
+/// a probe outside the mesh too.
+#[test]
+fn command_line_names_the_mesh_file_and_its_groups() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["solve", "--problem", "ex71", "--mesh", &format!("gmsh:{}", meshes_dir().join("quarter_disc.msh").display())])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("quarter_disc.msh") && err.contains("\"bottom\" (not named by ex71)") && !err.contains("panicked"), "{err}");
 }

@@ -62,7 +62,9 @@ fn line_at(bytes: &[u8], offset: usize) -> usize {
 }
 
 /// `$PhysicalNames`: (dimension, tag) -> (name, line).
-fn physical_names(path: &Path, bytes: &[u8]) -> Result<HashMap<(i32, i32), (String, usize)>, MeshError> {
+type PhysicalNames = HashMap<(i32, i32), (String, usize)>;
+
+fn physical_names(path: &Path, bytes: &[u8]) -> Result<PhysicalNames, MeshError> {
     let mut names = HashMap::new();
     let text = String::from_utf8_lossy(bytes);
     let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l.trim()));
@@ -70,7 +72,8 @@ fn physical_names(path: &Path, bytes: &[u8]) -> Result<HashMap<(i32, i32), (Stri
     let (n_line, n) = lines.next().ok_or_else(|| error(path, Some(start), "$PhysicalNames: the file ends before the number of names"))?;
     let n: usize = n.parse().map_err(|_| error(path, Some(n_line), format!("$PhysicalNames: expected the number of names, got {n:?}")))?;
     for _ in 0..n {
-        let (i, l) = lines.next().ok_or_else(|| error(path, Some(n_line), format!("$PhysicalNames: the file ends before its {n} names")))?;
+        let (i, l) =
+            lines.next().ok_or_else(|| error(path, Some(n_line), format!("$PhysicalNames: the file ends before its {n} names")))?;
         let bad = || error(path, Some(i), format!("$PhysicalNames: expected `dimension tag \"name\"`, got {l:?}"));
         let mut parts = l.splitn(3, char::is_whitespace);
         let dim: i32 = parts.next().and_then(|s| s.parse().ok()).ok_or_else(bad)?;
@@ -114,7 +117,8 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     // mshio has a few `expect`s left on malformed input: a panic there is a malformed file too
     let parsed = std::panic::catch_unwind(|| {
         mshio::parse_msh_bytes(&bytes).map_err(|e| {
-            let (rest, kind) = e.begin_msh_errors().next().or(e.backtrace.first()).map(|(r, k)| (r.len(), k.to_string())).unwrap_or((0, String::new()));
+            let (rest, kind) =
+                e.begin_msh_errors().next().or(e.backtrace.first()).map(|(r, k)| (r.len(), k.to_string())).unwrap_or((0, String::new()));
             let offset = bytes.len() - rest;
             let within: Vec<String> = e.filter_msh_errors().skip(1).filter_map(|(_, k)| k.context().map(str::to_string)).collect();
             let end = if rest == 0 { " (the file ends here: truncated?)" } else { "" };
@@ -164,7 +168,9 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     for block in &elements.element_blocks {
         let first = block.elements.first().map(|e| e.element_tag);
         match (block.entity_dim, block.element_type) {
-            (2, ElementType::Tri3) => tri_nodes.extend(block.elements.iter().map(|e| ([e.nodes[0], e.nodes[1], e.nodes[2]], e.element_tag))),
+            (2, ElementType::Tri3) => {
+                tri_nodes.extend(block.elements.iter().map(|e| ([e.nodes[0], e.nodes[1], e.nodes[2]], e.element_tag)))
+            }
             (1, ElementType::Lin2) => {
                 let groups = curve_groups.get(&block.entity_tag).cloned().unwrap_or_default();
                 if groups.len() > 1 {
@@ -304,7 +310,10 @@ impl GmshFile {
                     return Err(MeshError::Gmsh {
                         file: path.clone(),
                         line: self.triangle_lines[t],
-                        message: format!("the mesh is not conforming: this triangle's edge ({}, {}) is in three triangles", tri[*i], tri[*j]),
+                        message: format!(
+                            "the mesh is not conforming: this triangle's edge ({}, {}) is in three triangles",
+                            tri[*i], tri[*j]
+                        ),
                     });
                 }
             }

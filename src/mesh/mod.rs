@@ -1,8 +1,11 @@
 //! Triangle meshes with tagged boundary edges and the P2 node numbering.
 //!
 //! A [`Mesh`] holds vertices, counter-clockwise triangles and every boundary edge with the part of
-//! the boundary it belongs to (Dirichlet, Neumann or contact). [`P2Nodes`] numbers the P2 nodes:
-//! the mesh vertices first (node `v` is vertex `v`), then one midpoint per edge.
+//! the boundary it belongs to (Dirichlet, Neumann or contact) and, on a curved part, the curve
+//! it approximates. [`P2Nodes`] numbers the P2 nodes: the mesh vertices first (node `v` is vertex
+//! `v`), then one midpoint per edge (on the straight edge: the elements are not isoparametric).
+//! [`MeshSpec`] describes a mesh: the unit square (`structured:N`, `symmetric:N`) or a Gmsh file
+//! (`gmsh:PATH.msh`, [`gmsh`]). [`locate`] finds the triangle holding a point.
 
 pub mod gmsh;
 pub mod io;

@@ -545,7 +545,11 @@ mod tests {
             let n = mesh.boundary.len() as f64;
             let polygon = 0.5 * n * radius * radius * (2.0 * std::f64::consts::PI / n).sin();
             // to the round-off of summing up to 2^15 triangle areas
-            assert!((total_area(&mesh) - polygon).abs() < 1e-12 * polygon, "area {} against the inscribed {n}-gon's {polygon}", total_area(&mesh));
+            assert!(
+                (total_area(&mesh) - polygon).abs() < 1e-12 * polygon,
+                "area {} against the inscribed {n}-gon's {polygon}",
+                total_area(&mesh)
+            );
             rows.push((n, std::f64::consts::PI * radius * radius - total_area(&mesh)));
         }
         // the last levels: the error falls like N^-2 (the slope of log error in log N)
@@ -560,7 +564,9 @@ mod tests {
         for level in 0..30 {
             let nt = mesh.n_triangles();
             let p = if nt < 1500 { 0.1 } else { 8.0 / nt as f64 };
-            let marked: Vec<bool> = (0..nt).map(|t| rng.next_f64() < p || (level % 2 == 1 && mesh.corners(t).iter().any(|&c| dist(c, focus) < 1.5 * mesh.diameter(t)))).collect();
+            let marked: Vec<bool> = (0..nt)
+                .map(|t| rng.next_f64() < p || (level % 2 == 1 && mesh.corners(t).iter().any(|&c| dist(c, focus) < 1.5 * mesh.diameter(t))))
+                .collect();
             let r = refine(&mesh, &marked);
             r.mesh.check().unwrap(); // positive areas, conforming, boundary tagged
             on_circle(&r.mesh);
