@@ -454,3 +454,86 @@ fn command_line_names_the_mesh_file_and_its_groups() {
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(err.contains("quarter_disc.msh") && err.contains("\"bottom\" (not named by ex71)") && !err.contains("panicked"), "{err}");
 }
+
+/// The binary encoding of the quarter disc gives the same mesh as the ASCII one (vertices to the
+/// ASCII file's 16 digits).
+#[test]
+fn binary_and_ascii_files_give_the_same_mesh() {
+    let p = quarter_disc_problem();
+    let ascii = MeshSpec::Gmsh(meshes_dir().join("quarter_disc.msh")).build(&p).unwrap();
+    let binary = MeshSpec::Gmsh(meshes_dir().join("quarter_disc_binary.msh")).build(&p).unwrap();
+    assert!(std::fs::read(meshes_dir().join("quarter_disc_binary.msh")).unwrap().contains(&0u8), "the file is binary");
+    // ASCII files hold 16 significant digits, binary ones the doubles themselves
+    assert_eq!(ascii.n_vertices(), binary.n_vertices());
+    for (a, b) in ascii.vertices.iter().zip(&binary.vertices) {
+        assert!((a[0] - b[0]).abs() <= 1e-15 && (a[1] - b[1]).abs() <= 1e-15, "{a:?} vs {b:?}");
+    }
+    assert_eq!(ascii.triangles, binary.triangles);
+    assert_eq!(ascii.boundary, binary.boundary);
+}
+
+/// A cylinder pressed onto a flat foundation on the Hertz mesh: the top moved down by 0.002, the
+/// constraint the vertical gap to y = 0 (n = (0, -1), chi = y). One contact interval around the
+/// lowest point, inside the contact group, refined adaptively with new arc vertices on the circle.
+#[test]
+fn hertz_mesh_gives_one_contact_interval_around_the_lowest_point() {
+    struct Pressed;
+    const ROLLER: Curve = Curve::Circle { centre: [0.0, 1.0], radius: 1.0 };
+    impl Problem for Pressed {
+        fn name(&self) -> &str {
+            "pressed"
+        }
+        fn description(&self) -> &str {
+            "a half cylinder pressed onto a flat foundation"
+        }
+        fn material(&self) -> Material {
+            Material::from_young(1.0, 0.3)
+        }
+        fn part_of(&self, _x: [f64; 2]) -> Part {
+            Part::Neumann
+        }
+        fn part_of_group(&self, g: &str) -> Option<Part> {
+            match g {
+                "top" => Some(Part::Dirichlet),
+                "contact" => Some(Part::Contact),
+                "free" => Some(Part::Neumann),
+                _ => None,
+            }
+        }
+        fn curve_of_group(&self, g: &str) -> Option<Curve> {
+            (g != "top").then_some(ROLLER)
+        }
+        fn body_force(&self, _x: [f64; 2]) -> [f64; 2] {
+            [0.0, 0.0]
+        }
+        fn traction(&self, _x: [f64; 2], _n: [f64; 2]) -> [f64; 2] {
+            [0.0, 0.0]
+        }
+        fn dirichlet(&self, _x: [f64; 2]) -> [f64; 2] {
+            [0.0, -0.002]
+        }
+        fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+            [0.0, -1.0]
+        }
+        fn gap(&self, x: [f64; 2]) -> f64 {
+            x[1]
+        }
+    }
+    let m = MeshSpec::Gmsh(meshes_dir().join("hertz.msh")).build(&Pressed).unwrap();
+    let config = signorini::adapt::AdaptConfig { levels: 4, ..Default::default() };
+    let out = signorini::adapt::run(&Pressed, m, &config, None, &mut |_| std::ops::ControlFlow::Continue(())).unwrap();
+    let (m, sol) = (&out.mesh, &out.solution);
+    for e in m.boundary.iter().filter(|e| e.curve.is_some()) {
+        for v in e.v {
+            let x = m.vertices[v];
+            assert!((x[0].hypot(x[1] - 1.0) - 1.0).abs() <= 1e-14, "{x:?} off the circle");
+        }
+    }
+    let zones = sol.contact_zones();
+    assert_eq!(zones.len(), 1, "{zones:?}");
+    let z = zones[0];
+    // the arc length of (0, 0) from (-0.3, 1 - sqrt(0.91)) along the polygon: about asin(0.3)
+    assert!(z.from[0] < 0.0 && z.to[0] > 0.0 && z.s[1] - z.s[0] < 0.3, "{z:?}");
+    assert!(z.s[0] < 0.3f64.asin() && 0.3f64.asin() - 1e-3 < z.s[1], "{z:?}");
+    assert!(sol.kkt().max_penetration <= 1e-12);
+}

@@ -9,7 +9,7 @@ import sys
 import gmsh
 
 here = pathlib.Path(__file__).resolve().parent
-geos = sorted(here.glob("*.geo")) if len(sys.argv) == 1 else [pathlib.Path(a) for a in sys.argv[1:]]
+geos = sorted(here.glob("*.geo")) if len(sys.argv) == 1 else [pathlib.Path(a).resolve() for a in sys.argv[1:]]
 for geo in geos:
     gmsh.initialize(readConfigFiles=False)
     gmsh.option.setNumber("General.Terminal", 0)
