@@ -158,6 +158,10 @@ fn truncated_file_is_an_error_naming_file_and_line() {
     let err = build_err(&path, &square_problem());
     let last = cut.lines().count();
     assert!(err.contains("truncated.msh") && err.contains(&format!("line {last}")) && err.contains("truncated"), "{err}");
+    // another version of the format: the line after $MeshFormat
+    let path = write("version.msh", &SQUARE.replace("4.1 0 8", "2.2 0 8"));
+    let err = build_err(&path, &square_problem());
+    assert!(err.contains("version.msh, line 2") && err.contains("4.1"), "{err}");
     // a missing section
     let path = write("no_elements.msh", &SQUARE[..SQUARE.find("$Elements").unwrap()]);
     let err = build_err(&path, &square_problem());

@@ -117,9 +117,18 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     // mshio has a few `expect`s left on malformed input: a panic there is a malformed file too
     let parsed = std::panic::catch_unwind(|| {
         mshio::parse_msh_bytes(&bytes).map_err(|e| {
-            let (rest, kind) =
-                e.begin_msh_errors().next().or(e.backtrace.first()).map(|(r, k)| (r.len(), k.to_string())).unwrap_or((0, String::new()));
-            let offset = bytes.len() - rest;
+            let first = e.begin_msh_errors().next().or(e.backtrace.first());
+            let (rest, kind) = first
+                .map(|(r, k)| (r.len(), k.context().map_or_else(|| k.to_string(), |c| format!("cannot read the {c}"))))
+                .unwrap_or((0, String::new()));
+            let header = first.is_some_and(|(_, k)| {
+                matches!(k, mshio::error::MshParserErrorKind::UnsupportedMshVersion | mshio::error::MshParserErrorKind::InvalidFileHeader)
+            });
+            // mshio places header errors past the header: they are on the line after $MeshFormat
+            let offset = match header {
+                true => bytes.windows(12).position(|w| w == b"$MeshFormat\n").map_or(0, |p| p + 12),
+                false => bytes.len() - rest,
+            };
             let within: Vec<String> = e.filter_msh_errors().skip(1).filter_map(|(_, k)| k.context().map(str::to_string)).collect();
             let end = if rest == 0 { " (the file ends here: truncated?)" } else { "" };
             let within = if within.is_empty() { String::new() } else { format!(" (in the {})", within.join(" of the ")) };
