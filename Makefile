@@ -3,7 +3,7 @@
 CARGO ?= cargo
 BIN := target/release/signorini
 
-.PHONY: all build test figures reproduce drift crosscheck bench roundoff clean
+.PHONY: all build test figures reproduce drift crosscheck bench roundoff meshes clean
 
 all: build
 
@@ -65,6 +65,13 @@ roundoff: build
 		SIGNORINI_ORDERING=$$ordering $(BIN) run --fresh --jobs $$jobs --results target/roundoff/$$name experiments/*.toml; \
 		$(BIN) drift --against target/roundoff/$$name --report results/roundoff/$$name.json || true; \
 	done
+
+# Regenerate every experiments/meshes/*.msh from its .geo with gmsh's Python module, installed in
+# the cross-check environment (crosscheck/requirements.txt pins it). The .msh files are committed:
+# nothing else needs gmsh.
+meshes:
+	crosscheck/setup.sh
+	crosscheck/.venv/bin/python experiments/meshes/generate.py
 
 clean:
 	$(CARGO) clean

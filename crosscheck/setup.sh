@@ -15,5 +15,5 @@ echo "crosscheck/setup.sh: creating $venv from requirements.txt"
 rm -f "$stamp"
 python3 -m venv --clear "$venv"
 "$venv/bin/python" -m pip install --disable-pip-version-check --quiet -r "$req"
-"$venv/bin/python" -c "import ngsolve, meshio, numpy" # fail here, not in the first check
+"$venv/bin/python" -c "import ngsolve, meshio, numpy, gmsh" # fail here, not in the first check
 touch "$stamp"

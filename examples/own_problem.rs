@@ -45,7 +45,7 @@ impl Problem for Foundation {
 
 fn main() -> anyhow::Result<()> {
     let problem = Foundation;
-    let mesh = MeshSpec::parse("structured:4")?.build(&|x| problem.part_of(x));
+    let mesh = MeshSpec::parse("structured:4")?.build(&problem)?;
     let config = AdaptConfig { levels: 12, max_ndof: Some(20_000), ..Default::default() };
     config.validate()?;
     println!("{:>5} {:>7} {:>10} {:>6} {:>15}", "level", "ndof", "estimate", "active", "contact zone");

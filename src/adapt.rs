@@ -198,7 +198,7 @@ pub struct AdaptResult {
 /// use std::ops::ControlFlow;
 ///
 /// let problem = problems::by_name("ex71").unwrap();
-/// let mesh = MeshSpec::parse("structured:2").unwrap().build(&|x| problem.part_of(x));
+/// let mesh = MeshSpec::parse("structured:2").unwrap().build(problem.as_ref()).unwrap();
 /// let config = AdaptConfig { levels: 3, ..Default::default() };
 /// config.validate().unwrap();
 /// let exact = problem.exact().unwrap();

@@ -227,7 +227,7 @@ fn edge_samples(sampling: Sampling) -> Vec<f64> {
 /// use signorini::mesh::MeshSpec;
 /// use signorini::problems::{Ex71, Problem};
 ///
-/// let mesh = MeshSpec::parse("structured:4").unwrap().build(&|x| Ex71.part_of(x));
+/// let mesh = MeshSpec::parse("structured:4").unwrap().build(&Ex71).unwrap();
 /// let sol = signorini::solve::solve(&mesh, &Ex71, &PdasOptions::default(), &mut |_| {}).unwrap();
 /// let est = estimate::estimate(&mesh, &Ex71, &sol, &EstimatorConfig::default());
 /// assert_eq!(est.element.len(), mesh.n_triangles());

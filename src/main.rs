@@ -169,7 +169,7 @@ struct AdaptArgs {
     /// experiments/problems/README.md).
     #[arg(long)]
     problem: String,
-    /// Initial mesh: structured:N (or symmetric:N, mirrored about y = 0.5).
+    /// Initial mesh: structured:N (or symmetric:N, mirrored about y = 0.5), or gmsh:PATH.msh.
     #[arg(long, default_value = "structured:4")]
     mesh: String,
     /// Number of levels solved (level 0 is the initial mesh).
@@ -195,10 +195,10 @@ struct SolveArgs {
     /// experiments/problems/README.md).
     #[arg(long)]
     problem: String,
-    /// Mesh: structured:N (or symmetric:N, mirrored about y = 0.5).
+    /// Mesh: structured:N (or symmetric:N, mirrored about y = 0.5), or gmsh:PATH.msh (a Gmsh file).
     #[arg(long)]
     mesh: String,
-    /// Evaluate u_h at X,Y in the unit square (repeatable; negative numbers are read as values).
+    /// Evaluate u_h at X,Y, a point of the mesh (repeatable; negative numbers are read as values).
     #[arg(long = "probe", value_name = "X,Y", allow_hyphen_values = true)]
     probes: Vec<String>,
     /// Maximum number of active-set iterations.
@@ -243,14 +243,7 @@ fn validate(config: &AdaptConfig) -> Result<()> {
 fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::DiscreteSolution, report::SolveReport)> {
     let problem = problems::by_name(&args.problem)?;
     let spec = MeshSpec::parse(&args.mesh)?;
-    let mut probes = Vec::new();
-    for p in &args.probes {
-        let [x, y] = report::parse_probe(p)?;
-        if !spec.contains([x, y]) {
-            bail!(report::ProbeError::Outside { x, y });
-        }
-        probes.push([x, y]);
-    }
+    let probes = args.probes.iter().map(|p| report::parse_probe(p)).collect::<Result<Vec<_>, _>>()?;
     let pdas = PdasOptions { max_iterations: args.max_pdas_iterations, ..Default::default() };
     let estimator = args.estimator.config()?;
     let adaptive = args.adapt_levels.is_some() || args.adapt_min_ndof.is_some();
@@ -258,11 +251,16 @@ fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::Discrete
     let config =
         AdaptConfig { levels: args.adapt_levels.map_or(200, |l| l + 1), theta, estimator, pdas: pdas.clone(), ..Default::default() };
     validate(&config)?;
-    solve::check_memory(&spec.to_string(), spec.ndof())?;
+    solve::check_memory(&spec.to_string(), spec.ndof()?)?;
     if let Some(n) = args.adapt_min_ndof {
         solve::check_memory(&format!("an adaptive level reaching --adapt-min-ndof {n}"), n as f64)?;
     }
-    let mut mesh = spec.build(&|x| problem.part_of(x));
+    let mut mesh = spec.build(problem.as_ref())?;
+    // probes outside the initial mesh fail before anything is solved
+    let locator = signorini::mesh::locate::Locator::new(&mesh);
+    if let Some(&[x, y]) = probes.iter().find(|&&x| locator.locate(&mesh, x).is_none()) {
+        bail!(report::ProbeError::Outside { x, y });
+    }
     let mut mesh_name = spec.to_string();
     if adaptive {
         let min_ndof = args.adapt_min_ndof.unwrap_or(0);
@@ -303,8 +301,8 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
         ..Default::default()
     };
     validate(&config)?;
-    solve::check_memory(&spec.to_string(), spec.ndof())?;
-    let mesh = spec.build(&|x| problem.part_of(x));
+    solve::check_memory(&spec.to_string(), spec.ndof()?)?;
+    let mesh = spec.build(problem.as_ref())?;
     let exact = problem.exact();
     let reference = exact.map(|e| move |x: [f64; 2]| e.u(x));
     if exact.is_none() {

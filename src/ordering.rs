@@ -264,11 +264,11 @@ mod tests {
     use super::*;
     use crate::assembly::{self, DofMap};
     use crate::mesh::{MeshSpec, P2Nodes};
-    use crate::problems::{Ex72, Problem};
+    use crate::problems::Ex72;
 
     fn system(n: usize) -> (SymCsc, Vec<[f64; 2]>) {
         let p = Ex72;
-        let mesh = MeshSpec::Structured(n).build(&|x| p.part_of(x));
+        let mesh = MeshSpec::Structured(n).build(&p).expect("the unit square");
         let nodes = P2Nodes::new(&mesh);
         let dofs = DofMap::new(&nodes, &p);
         let sys = assembly::assemble(&mesh, &nodes, &dofs, &p);

@@ -4,10 +4,11 @@
 
 use crate::contact::PdasIteration;
 use crate::estimate::{Estimate, EstimatorConfig, Terms};
+use crate::mesh::locate::Locator;
 use crate::mesh::{Mesh, io};
 use crate::norms::LinfError;
 use crate::records;
-use crate::solve::{DiscreteSolution, Kkt, SolveTimings};
+use crate::solve::{ContactInterval, DiscreteSolution, Kkt, SolveTimings};
 use anyhow::Result;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -26,7 +27,7 @@ pub struct Probe {
 pub enum ProbeError {
     #[error("malformed --probe '{0}': expected X,Y with two finite numbers, e.g. 0.5,0.25")]
     Malformed(String),
-    #[error("--probe {x},{y}: the point is outside the domain, the unit square [0, 1] x [0, 1]")]
+    #[error("--probe {x},{y}: the point is outside the domain (no triangle of the mesh contains it)")]
     Outside { x: f64, y: f64 },
 }
 
@@ -55,7 +56,11 @@ pub struct SolveReport {
     pub contact_nodes: usize,
     pub pdas_iterations: usize,
     pub active_nodes: usize,
+    /// [min, max] of the arc length along Gamma_C over the active contact nodes.
     pub contact_zone: Option<[f64; 2]>,
+    /// The contact zone as arc-length intervals along Gamma_C, one per connected active part
+    /// ([`DiscreteSolution::contact_zones`]).
+    pub contact_zones: Vec<ContactInterval>,
     pub kkt: Kkt,
     /// Largest |F - K u_h| over unknowns other than contact normals, relative to max |F|.
     pub free_residual: f64,
@@ -88,9 +93,10 @@ impl SolveReport {
         probes: &[[f64; 2]],
     ) -> Result<Self, ProbeError> {
         let (h_min, h_max) = mesh.h_range();
+        let locator = Locator::new(mesh);
         let probes = probes
             .iter()
-            .map(|&[x, y]| sol.probe(mesh, [x, y]).map(|u| Probe { x, y, u }).ok_or(ProbeError::Outside { x, y }))
+            .map(|&[x, y]| sol.probe(mesh, &locator, [x, y]).map(|u| Probe { x, y, u }).ok_or(ProbeError::Outside { x, y }))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(SolveReport {
             problem: problem.to_string(),
@@ -104,6 +110,7 @@ impl SolveReport {
             pdas_iterations: sol.pdas.len(),
             active_nodes: sol.active_count(),
             contact_zone: sol.contact_zone(),
+            contact_zones: sol.contact_zones(),
             kkt: sol.kkt(),
             free_residual: sol.free_residual,
             error,
@@ -128,9 +135,15 @@ impl SolveReport {
             "{} on {}: {} elements, ndof {} ({} free), h in [{:.3e}, {:.3e}]",
             self.problem, self.mesh, self.n_elements, self.ndof, self.ndof_free, self.h_min, self.h_max
         );
-        let zone = match self.contact_zone {
-            Some([a, b]) => format!("contact zone [{a}, {b}] along Gamma_C"),
-            None => "no contact zone".to_string(),
+        let interval = |z: &ContactInterval| {
+            let component =
+                if self.contact_zones.iter().any(|z| z.component > 0) { format!(" of part {}", z.component + 1) } else { String::new() };
+            format!("[{}, {}]{component}", z.s[0], z.s[1])
+        };
+        let zone = match self.contact_zones.as_slice() {
+            [] => "no contact zone".to_string(),
+            [z] => format!("contact zone {} along Gamma_C (arc length)", interval(z)),
+            zs => format!("contact zones {} along Gamma_C (arc length)", zs.iter().map(interval).collect::<Vec<_>>().join(", ")),
         };
         let _ = writeln!(
             s,

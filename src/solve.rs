@@ -4,6 +4,7 @@
 use crate::assembly::{self, DofMap, System};
 use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, Strategy, Termination, Timings};
 use crate::element::{self, Affine};
+use crate::mesh::locate::Locator;
 use crate::mesh::{Mesh, MeshError, P2Nodes};
 use crate::problems::Problem;
 use std::time::Instant;
@@ -133,7 +134,7 @@ pub struct Kkt {
 /// use signorini::mesh::MeshSpec;
 /// use signorini::problems::{Ex72, Problem};
 ///
-/// let mesh = MeshSpec::parse("structured:8").unwrap().build(&|x| Ex72.part_of(x));
+/// let mesh = MeshSpec::parse("structured:8").unwrap().build(&Ex72).unwrap();
 /// let sol = signorini::solve::solve(&mesh, &Ex72, &PdasOptions::default(), &mut |_| {}).unwrap();
 /// assert_eq!(sol.active.len(), sol.dofs.contact.len());
 /// assert!(sol.active_count() > 0 && sol.kkt().max_penetration <= 1e-12);
@@ -221,22 +222,80 @@ impl DiscreteSolution {
         self.active.iter().filter(|a| **a).count()
     }
 
-    /// [min, max] of the tangential coordinate over active contact nodes (y on a vertical
-    /// contact boundary, x on a horizontal one).
-    pub fn contact_zone(&self) -> Option<[f64; 2]> {
-        let mut zone: Option<[f64; 2]> = None;
-        for (i, c) in self.dofs.contact.iter().enumerate() {
-            if !self.active[i] {
-                continue;
-            }
-            let x = self.nodes.coords[c.node];
-            let s = if c.normal[0].abs() > c.normal[1].abs() { x[1] } else { x[0] };
-            zone = Some(match zone {
-                None => [s, s],
-                Some([a, b]) => [a.min(s), b.max(s)],
-            });
+    /// The contact zone as arc-length intervals along Gamma_C, one per connected active part.
+    ///
+    /// Gamma_C is split into its connected components, each walked counter-clockwise along the
+    /// boundary (the direction of `Mesh::boundary`) from its start (for a closed component, from
+    /// its edge of smallest first vertex); the arc length s of a P2 node is measured along the
+    /// straight boundary edges from that start. A run of consecutive active contact nodes (vertices
+    /// and edge midpoints, in that order) is one interval `[s_first, s_last]`; a node of Gamma_C
+    /// that is no contact node (on the closure of Gamma_D) ends a run. On the unit square s is x
+    /// along the bottom from (0, 0) and y along the right side from (1, 0).
+    pub fn contact_zones(&self) -> Vec<ContactInterval> {
+        // contact edges: boundary edges whose midpoint is a contact node
+        let edges: Vec<[usize; 3]> =
+            self.nodes.boundary_nodes.iter().copied().filter(|b| self.dofs.contact_index[b[2]].is_some()).collect();
+        let mut from: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+        let mut is_end = std::collections::HashSet::new();
+        for (i, e) in edges.iter().enumerate() {
+            from.insert(e[0], i);
+            is_end.insert(e[1]);
         }
-        zone
+        let mut starts: Vec<usize> = (0..edges.len()).filter(|&i| !is_end.contains(&edges[i][0])).collect();
+        let mut walked = vec![false; edges.len()];
+        let mut zones = Vec::new();
+        let mut component = 0;
+        loop {
+            let start = match starts.first() {
+                Some(&i) => {
+                    starts.remove(0);
+                    i
+                }
+                // what is left are closed loops: start at the edge of smallest first vertex
+                None => match (0..edges.len()).filter(|&i| !walked[i]).min_by_key(|&i| edges[i][0]) {
+                    Some(i) => i,
+                    None => break,
+                },
+            };
+            let mut run: Option<ContactInterval> = None;
+            let mut visit = |p: usize, s: f64, zones: &mut Vec<ContactInterval>| {
+                let x = self.nodes.coords[p];
+                if self.dofs.contact_index[p].is_some_and(|k| self.active[k]) {
+                    match &mut run {
+                        Some(z) => {
+                            z.s[1] = s;
+                            z.to = x;
+                        }
+                        None => run = Some(ContactInterval { component, s: [s, s], from: x, to: x }),
+                    }
+                } else if let Some(z) = run.take() {
+                    zones.push(z);
+                }
+            };
+            let (mut e, mut s) = (start, 0.0);
+            visit(edges[e][0], s, &mut zones);
+            while !walked[e] {
+                walked[e] = true;
+                let [a, b, m] = edges[e];
+                let len = crate::mesh::dist(self.nodes.coords[a], self.nodes.coords[b]);
+                visit(m, s + 0.5 * len, &mut zones);
+                s += len;
+                visit(b, s, &mut zones);
+                match from.get(&b) {
+                    Some(&next) if !walked[next] => e = next,
+                    _ => break,
+                }
+            }
+            zones.extend(run);
+            component += 1;
+        }
+        zones
+    }
+
+    /// [min, max] of the arc length over active contact nodes ([`Self::contact_zones`]): on the
+    /// unit square, x on the bottom and y on the right side.
+    pub fn contact_zone(&self) -> Option<[f64; 2]> {
+        self.contact_zones().iter().fold(None, |z, c| Some(z.map_or(c.s, |[a, b]: [f64; 2]| [a.min(c.s[0]), b.max(c.s[1])])))
     }
 
     /// Values of u_h at the reference points `refs` of triangle `t`.
@@ -256,14 +315,21 @@ impl DiscreteSolution {
             .collect()
     }
 
-    /// u_h at a physical point, or None outside the mesh.
-    pub fn probe(&self, mesh: &Mesh, x: [f64; 2]) -> Option<[f64; 2]> {
-        (0..mesh.n_triangles()).find_map(|t| {
-            let r = Affine::new(mesh.corners(t)).inverse(x);
-            let tol = 1e-12;
-            (r[0] >= -tol && r[1] >= -tol && r[0] + r[1] <= 1.0 + tol).then(|| self.eval_element(mesh, t, &[r])[0].1)
-        })
+    /// u_h at a physical point, or None outside the mesh (found through `locator`, the mesh's
+    /// R*-tree).
+    pub fn probe(&self, mesh: &Mesh, locator: &Locator, x: [f64; 2]) -> Option<[f64; 2]> {
+        locator.locate(mesh, x).map(|h| self.eval_element(mesh, h.triangle, &[h.reference])[0].1)
     }
+}
+
+/// One connected active part of the contact zone: arc lengths `s = [start, end]` along
+/// component `component` of Gamma_C (numbered in the order they are walked), and its end points.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct ContactInterval {
+    pub component: usize,
+    pub s: [f64; 2],
+    pub from: [f64; 2],
+    pub to: [f64; 2],
 }
 
 /// The discrete contact force density lambda_h(p) = lambda_p / int psi_p ds (eq. 4.5, 4.6):

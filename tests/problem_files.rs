@@ -45,7 +45,11 @@ fn points() -> Vec<[f64; 2]> {
 /// normal, parts, exact solution and its gradient (ex71's differentiated symbolically by exmex).
 #[test]
 fn built_ins_as_files_state_the_same_data() {
-    for (name, builtin) in [("ex71", problems::by_name("ex71").unwrap()), ("ex72", problems::by_name("ex72").unwrap()), ("fb", problems::by_name("fb").unwrap())] {
+    for (name, builtin) in [
+        ("ex71", problems::by_name("ex71").unwrap()),
+        ("ex72", problems::by_name("ex72").unwrap()),
+        ("fb", problems::by_name("fb").unwrap()),
+    ] {
         let f = file(name);
         let b = builtin.as_ref();
         assert_eq!(f.name(), name);
@@ -209,7 +213,9 @@ fn a_good_file_reads_and_plane_stress_is_plane_stress() {
     assert_eq!(p.body_force([0.3, 0.3]), [0.0, -1.0]);
     assert_eq!(p.gap([0.5, 0.0]), 0.005);
     // predicates: && binds tighter than ||
-    let q = FileProblem::parse(Path::new("q.toml"), &edit("contact = \"y < 1e-12\"", "contact = \"y < 1e-12 && x >= 0.5 || x > 1 - 1e-12\"")).unwrap();
+    let q =
+        FileProblem::parse(Path::new("q.toml"), &edit("contact = \"y < 1e-12\"", "contact = \"y < 1e-12 && x >= 0.5 || x > 1 - 1e-12\""))
+            .unwrap();
     assert_eq!(q.part_of([0.25, 0.0]), Part::Neumann);
     assert_eq!(q.part_of([0.75, 0.0]), Part::Contact);
     assert_eq!(q.part_of([1.0, 0.5]), Part::Contact);
@@ -276,8 +282,9 @@ fn constants_resolve_in_any_order_and_bad_ones_are_errors() {
 
 #[test]
 fn group_errors() {
-    let groups = edit("contact = \"y < 1e-12\"\ndirichlet = \"y > 1 - 1e-12\"", "contact = [\"arc\"]\ndirichlet = [\"top\"]\nneumann = [\"side\"]")
-        .replace("normal = \"outward\"", "normal = [0, -1]");
+    let groups =
+        edit("contact = \"y < 1e-12\"\ndirichlet = \"y > 1 - 1e-12\"", "contact = [\"arc\"]\ndirichlet = [\"top\"]\nneumann = [\"side\"]")
+            .replace("normal = \"outward\"", "normal = [0, -1]");
     FileProblem::parse(Path::new("g.toml"), &groups).unwrap();
     // a curve for a group named nowhere
     let e = err(&(groups.clone() + "\n[curves]\nrim = { circle = { centre = [0, 1], radius = 1 } }\n"));
@@ -288,7 +295,8 @@ fn group_errors() {
     // outward needs a circle (or predicate parts on the unit square)
     let e = err(&groups.replace("normal = [0, -1]", "normal = \"outward\""));
     assert!(e.contains("key `contact.normal`") && e.contains("circle"), "{e}");
-    let with_circle = groups.replace("normal = [0, -1]", "normal = \"outward\"") + "\n[curves]\narc = { circle = { centre = [0, 1], radius = 1 } }\n";
+    let with_circle =
+        groups.replace("normal = [0, -1]", "normal = \"outward\"") + "\n[curves]\narc = { circle = { centre = [0, 1], radius = 1 } }\n";
     let p = FileProblem::parse(Path::new("g.toml"), &with_circle).unwrap();
     let n = p.contact_normal([0.6, 0.2]);
     assert!((n[0] - 0.6).abs() < 1e-15 && (n[1] + 0.8).abs() < 1e-15, "{n:?}");
@@ -323,9 +331,13 @@ fn manifests_resolve_problem_files_relative_to_themselves() {
     study::run_study(&manifest, &opts).unwrap();
     let runs = signorini::records::StudyDir::new(&results, "wedge").read_runs().unwrap();
     assert_eq!(runs[0].run.problem, "problems/wedge.toml");
-    let builtin = adapt::run(&problems::Ex72, mesh(&problems::Ex72, "structured:2"), &AdaptConfig { levels: 2, ..Default::default() }, None, &mut |_| {
-        std::ops::ControlFlow::Continue(())
-    })
+    let builtin = adapt::run(
+        &problems::Ex72,
+        mesh(&problems::Ex72, "structured:2"),
+        &AdaptConfig { levels: 2, ..Default::default() },
+        None,
+        &mut |_| std::ops::ControlFlow::Continue(()),
+    )
     .unwrap();
     assert_eq!(runs[0].levels.iter().map(|l| l.ndof).collect::<Vec<_>>(), builtin.records.iter().map(|l| l.ndof).collect::<Vec<_>>());
     let prov: serde_json::Value = serde_json::from_slice(&std::fs::read(results.join("wedge/provenance.json")).unwrap()).unwrap();
@@ -355,7 +367,12 @@ mod random_input {
         prop_oneof![
             "[-+*/^(), xyna0-9.eE<>=&|]{0,24}",
             proptest::collection::vec(
-                proptest::sample::select(&["x", "y", "nx", "a", "q", "1e-3", "2", ".5", "+", "-", "*", "/", "^", "(", ")", "sqrt", "max", "abs", ",", "<", "&&", "||", "e", "PI"][..]),
+                proptest::sample::select(
+                    &[
+                        "x", "y", "nx", "a", "q", "1e-3", "2", ".5", "+", "-", "*", "/", "^", "(", ")", "sqrt", "max", "abs", ",", "<",
+                        "&&", "||", "e", "PI"
+                    ][..]
+                ),
                 0..12
             )
             .prop_map(|v| v.join(" ")),

@@ -10,7 +10,7 @@ use clap::Parser;
 use signorini::assembly::{self, DofMap};
 use signorini::contact::{ContactSolver, PdasOptions};
 use signorini::mesh::{MeshSpec, P2Nodes};
-use signorini::problems::{Ex72, Problem};
+use signorini::problems::Ex72;
 use signorini::records;
 use std::time::Instant;
 
@@ -161,7 +161,7 @@ fn bench_size(n: usize, repeats: usize) -> Result<SizeResult> {
     let mut per_iteration = Vec::new();
     let (mut unknowns, mut m, mut its, mut ordering) = (0, 0, 0, serde_json::Value::Null);
     for _ in 0..repeats.max(1) {
-        let mesh = spec.build(&|x| problem.part_of(x));
+        let mesh = spec.build(&problem)?;
         let t0 = Instant::now();
         let nodes = P2Nodes::new(&mesh);
         let dofs = DofMap::new(&nodes, &problem);

@@ -1,14 +1,21 @@
 //! Triangle meshes with tagged boundary edges and the P2 node numbering.
 //!
 //! A [`Mesh`] holds vertices, counter-clockwise triangles and every boundary edge with the part of
-//! the boundary it belongs to (Dirichlet, Neumann or contact). [`P2Nodes`] numbers the P2 nodes:
-//! the mesh vertices first (node `v` is vertex `v`), then one midpoint per edge.
+//! the boundary it belongs to (Dirichlet, Neumann or contact) and, on a curved part, the curve
+//! it approximates. [`P2Nodes`] numbers the P2 nodes: the mesh vertices first (node `v` is vertex
+//! `v`), then one midpoint per edge (on the straight edge: the elements are not isoparametric).
+//! [`MeshSpec`] describes a mesh: the unit square (`structured:N`, `symmetric:N`) or a Gmsh file
+//! (`gmsh:PATH.msh`, [`gmsh`]). [`locate`] finds the triangle holding a point.
 
+pub mod gmsh;
 pub mod io;
+pub mod locate;
 pub mod refine;
 
+use crate::problems::Problem;
 use std::collections::HashMap;
 use std::fmt;
+use std::path::PathBuf;
 
 /// The part of the boundary an edge belongs to (paper Section 1: Gamma_D, Gamma_N, Gamma_C).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -50,11 +57,14 @@ impl Curve {
     }
 }
 
-/// A boundary edge `v[0] -> v[1]` (counter-clockwise along the boundary) and its part.
+/// A boundary edge `v[0] -> v[1]` (counter-clockwise along the boundary), its part and, on a
+/// curved part of the boundary, the curve it approximates (refinement puts the vertex it adds on
+/// that curve; the edge itself, and so the P2 element and its edge midpoint, stay straight).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoundaryEdge {
     pub v: [usize; 2],
     pub part: Part,
+    pub curve: Option<Curve>,
 }
 
 /// A conforming triangulation with tagged boundary.
@@ -70,7 +80,7 @@ pub struct Mesh {
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
     #[error(
-        "malformed mesh description '{0}': expected 'structured:N' or 'symmetric:N' with N a positive integer (N even keeps y = 0.5 a vertex)"
+        "malformed mesh description '{0}': expected 'structured:N' or 'symmetric:N' with N a positive integer (N even keeps y = 0.5 a vertex), or 'gmsh:PATH.msh'"
     )]
     BadSpec(String),
     #[error("triangle {t} has non-positive area {area:e} (vertices must be counter-clockwise and distinct)")]
@@ -85,23 +95,33 @@ pub enum MeshError {
     BadVertex { t: usize, v: usize, n: usize },
     #[error("required vertex ({x}, {y}) (a kink of the obstacle) is not a mesh vertex")]
     MissingVertex { x: f64, y: f64 },
+    /// A Gmsh file that cannot be read, is malformed or does not fit the problem; `line` is the
+    /// 1-based line of the file where that shows (None for a binary file or a missing section).
+    #[error("{}{}: {message}", file.display(), line.map(|l| format!(", line {l}")).unwrap_or_default())]
+    Gmsh { file: PathBuf, line: Option<usize>, message: String },
 }
 
 /// How a mesh is described on the command line and in manifests.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum MeshSpec {
     /// The unit square, N x N squares, each cut by the diagonal from lower-left to upper-right.
     Structured(usize),
     /// The unit square with the structured mesh on the lower half mirrored onto the upper half:
     /// symmetric about y = 0.5 (N even).
     Symmetric(usize),
+    /// A Gmsh file (MSH 4.1, ASCII or binary): its linear triangles, its boundary edges tagged by
+    /// physical group through [`Problem::part_of_group`] ([`gmsh`]).
+    Gmsh(PathBuf),
 }
 
 impl MeshSpec {
     pub fn parse(s: &str) -> Result<Self, MeshError> {
         let bad = || MeshError::BadSpec(s.to_string());
-        let (kind, n) = s.split_once(':').ok_or_else(bad)?;
-        let n: usize = n.trim().parse().map_err(|_| bad())?;
+        let (kind, rest) = s.split_once(':').ok_or_else(bad)?;
+        if kind.trim() == "gmsh" {
+            return if rest.trim().is_empty() { Err(bad()) } else { Ok(MeshSpec::Gmsh(PathBuf::from(rest.trim()))) };
+        }
+        let n: usize = rest.trim().parse().map_err(|_| bad())?;
         match kind.trim() {
             "structured" if n >= 1 => Ok(MeshSpec::Structured(n)),
             "symmetric" if n >= 2 && n.is_multiple_of(2) => Ok(MeshSpec::Symmetric(n)),
@@ -109,23 +129,33 @@ impl MeshSpec {
         }
     }
 
-    /// Whether `x` lies in the meshed domain: every described mesh covers the unit square.
-    pub fn contains(&self, x: [f64; 2]) -> bool {
-        (0.0..=1.0).contains(&x[0]) && (0.0..=1.0).contains(&x[1])
+    /// The mesh file this description reads, if any.
+    pub fn file(&self) -> Option<&std::path::Path> {
+        match self {
+            MeshSpec::Gmsh(p) => Some(p),
+            _ => None,
+        }
     }
 
-    /// Number of P2 unknowns of the mesh, 2 (2N + 1)^2, before building it (as a float: a
-    /// mistyped N overflows any integer type).
-    pub fn ndof(&self) -> f64 {
-        let (MeshSpec::Structured(n) | MeshSpec::Symmetric(n)) = *self;
-        2.0 * (2.0 * n as f64 + 1.0).powi(2)
+    /// Number of P2 unknowns of the mesh before building it, as a float (a mistyped N overflows
+    /// any integer type): 2 (2N + 1)^2 for the unit square; for a Gmsh file 2 (V + E), V vertices
+    /// and E = (3 T + B) / 2 edges of its T triangles and B boundary edges (the file is read).
+    pub fn ndof(&self) -> Result<f64, MeshError> {
+        match self {
+            MeshSpec::Structured(n) | MeshSpec::Symmetric(n) => Ok(2.0 * (2.0 * *n as f64 + 1.0).powi(2)),
+            MeshSpec::Gmsh(path) => gmsh::read(path).map(|f| f.ndof()),
+        }
     }
 
-    /// Build the mesh, tagging each boundary edge by `part_of(edge midpoint)`.
-    pub fn build(&self, part_of: &dyn Fn([f64; 2]) -> Part) -> Mesh {
-        match *self {
-            MeshSpec::Structured(n) => Mesh::unit_square(n, false, part_of),
-            MeshSpec::Symmetric(n) => Mesh::unit_square(n, true, part_of),
+    /// Build the mesh. The unit square's boundary edges are tagged by `problem.part_of(edge
+    /// midpoint)`, a Gmsh mesh's by `problem.part_of_group(physical group)` (with the group's
+    /// `problem.curve_of_group`).
+    pub fn build(&self, problem: &dyn Problem) -> Result<Mesh, MeshError> {
+        let part_of = |x: [f64; 2]| problem.part_of(x);
+        match self {
+            MeshSpec::Structured(n) => Ok(Mesh::unit_square(*n, false, &part_of)),
+            MeshSpec::Symmetric(n) => Ok(Mesh::unit_square(*n, true, &part_of)),
+            MeshSpec::Gmsh(path) => gmsh::read(path)?.mesh(problem),
         }
     }
 }
@@ -135,6 +165,7 @@ impl fmt::Display for MeshSpec {
         match self {
             MeshSpec::Structured(n) => write!(f, "structured:{n}"),
             MeshSpec::Symmetric(n) => write!(f, "symmetric:{n}"),
+            MeshSpec::Gmsh(p) => write!(f, "gmsh:{}", p.display()),
         }
     }
 }
@@ -181,7 +212,7 @@ impl Mesh {
             .into_iter()
             .map(|(a, b)| {
                 let m = [0.5 * (vertices[a][0] + vertices[b][0]), 0.5 * (vertices[a][1] + vertices[b][1])];
-                BoundaryEdge { v: [a, b], part: part_of(m) }
+                BoundaryEdge { v: [a, b], part: part_of(m), curve: None }
             })
             .collect();
         Mesh { vertices, triangles, boundary }
@@ -435,8 +466,25 @@ impl P2Nodes {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// The disc bounded by `circle`, as eight triangles around its centre (refinement edges on
+    /// the circle), its boundary Neumann on that curve.
+    pub(crate) fn disc(circle: Curve) -> Mesh {
+        let Curve::Circle { centre, radius } = circle;
+        let mut vertices = vec![centre];
+        for k in 0..8 {
+            let a = std::f64::consts::FRAC_PI_4 * k as f64;
+            vertices.push([centre[0] + radius * a.cos(), centre[1] + radius * a.sin()]);
+        }
+        let ring = |k: usize| 1 + k % 8;
+        let triangles = (0..8).map(|k| [0, ring(k), ring(k + 1)]).collect();
+        let boundary = (0..8).map(|k| BoundaryEdge { v: [ring(k), ring(k + 1)], part: Part::Neumann, curve: Some(circle) }).collect();
+        let m = Mesh { vertices, triangles, boundary };
+        m.check().unwrap();
+        m
+    }
 
     fn tag(x: [f64; 2]) -> Part {
         if x[1] < 1e-12 {

@@ -31,9 +31,15 @@
 //!   constant times the number of marked triangles.
 //! * Vertices are only added, never moved or removed: old vertex `v` keeps index `v` and its
 //!   coordinates (so special vertices, such as the kink of an obstacle, survive). New vertices
-//!   are the edge midpoints `0.5 * (p + q)`, appended after the old vertices.
+//!   are the edge midpoints `0.5 * (p + q)`, appended after the old vertices, except on a curved
+//!   boundary edge (one with a [`Curve`](super::Curve)): there the new vertex is the point of the
+//!   curve closest to the midpoint ([`Curve::project`](super::Curve::project)), so the mesh's
+//!   boundary converges to the curve. The children of such a triangle are then not similar to
+//!   the four shapes above, but close to them once the edge is short (the displacement is
+//!   O(h^2) against the edge's O(h)); `tests` check that no triangle inverts on a disc refined
+//!   many times. The P2 edge midpoints stay on the straight edges (no isoparametric elements).
 //! * Boundary edges that are bisected are replaced by their two halves, in place and in the same
-//!   direction, with the same [`Part`](super::Part).
+//!   direction, with the same [`Part`](super::Part) and curve.
 //! * The result is deterministic: edges are numbered in triangle order, new vertices in edge
 //!   order, and children are listed in the order of their parents. No hash-map iteration order
 //!   is involved.
@@ -171,6 +177,14 @@ pub fn refine(mesh: &Mesh, marked: &[bool]) -> Refinement {
     // New vertices: the midpoints of the bisected edges, in edge order.
     let mut vertices = mesh.vertices.clone();
     let mut midpoint = vec![NONE; edges.len()];
+    // the curve of every curved boundary edge, by edge number
+    let mut curve_of = vec![None; edges.len()];
+    for be in mesh.boundary.iter().filter(|be| be.curve.is_some()) {
+        let (lo, hi) = super::key(be.v[0], be.v[1]);
+        if let Some(e) = edges.find(lo, hi) {
+            curve_of[e] = be.curve;
+        }
+    }
     let n_split = split.iter().filter(|&&s| s).count();
     vertices.reserve(n_split);
     for (t, tri) in mesh.triangles.iter().enumerate() {
@@ -180,7 +194,8 @@ pub fn refine(mesh: &Mesh, marked: &[bool]) -> Refinement {
             if split[e] && midpoint[e] == NONE {
                 let (p, q) = (mesh.vertices[tri[*i]], mesh.vertices[tri[*j]]);
                 midpoint[e] = vertices.len();
-                vertices.push([0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])]);
+                let m = [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])];
+                vertices.push(curve_of[e].map_or(m, |c: super::Curve| c.project(m)));
             }
         }
     }
@@ -227,8 +242,8 @@ pub fn refine(mesh: &Mesh, marked: &[bool]) -> Refinement {
         let e = edges.find(lo, hi).unwrap_or_else(|| panic!("boundary edge ({u}, {v}) is not an edge of any triangle"));
         if split[e] {
             let m = midpoint[e];
-            boundary.push(BoundaryEdge { v: [u, m], part: be.part });
-            boundary.push(BoundaryEdge { v: [m, v], part: be.part });
+            boundary.push(BoundaryEdge { v: [u, m], ..*be });
+            boundary.push(BoundaryEdge { v: [m, v], ..*be });
         } else {
             boundary.push(*be);
         }
@@ -501,6 +516,67 @@ mod tests {
         assert_eq!(a.mesh.triangles, b.mesh.triangles);
         assert_eq!(a.mesh.boundary, b.mesh.boundary);
         assert_eq!(a.parent, b.parent);
+    }
+
+    /// Refinement of a disc with its boundary on the circle: new boundary vertices lie on the
+    /// circle, no triangle inverts, and under uniform refinement the mesh is the regular polygon
+    /// inscribed in the circle, whose area N/2 r^2 sin(2 pi / N) tends to pi r^2 like N^-2.
+    #[test]
+    fn curved_boundary_refinement_stays_on_the_circle() {
+        let (centre, radius) = ([0.3, -0.2], 1.7);
+        let circle = super::super::Curve::Circle { centre, radius };
+        let on_circle = |m: &Mesh| {
+            for e in &m.boundary {
+                assert_eq!(e.curve, Some(circle));
+                for v in e.v {
+                    let p = m.vertices[v];
+                    let r = (p[0] - centre[0]).hypot(p[1] - centre[1]);
+                    assert!((r - radius).abs() <= 1e-14 * radius, "boundary vertex {p:?} at distance {r} from the centre");
+                }
+            }
+        };
+        // uniform: every triangle marked
+        let mut mesh = super::super::tests::disc(circle);
+        let mut rows = Vec::new();
+        for _ in 0..14 {
+            mesh = refine(&mesh, &vec![true; mesh.n_triangles()]).mesh;
+            mesh.check().unwrap();
+            on_circle(&mesh);
+            let n = mesh.boundary.len() as f64;
+            let polygon = 0.5 * n * radius * radius * (2.0 * std::f64::consts::PI / n).sin();
+            // to the round-off of summing up to 2^15 triangle areas
+            assert!(
+                (total_area(&mesh) - polygon).abs() < 1e-12 * polygon,
+                "area {} against the inscribed {n}-gon's {polygon}",
+                total_area(&mesh)
+            );
+            rows.push((n, std::f64::consts::PI * radius * radius - total_area(&mesh)));
+        }
+        // the last levels: the error falls like N^-2 (the slope of log error in log N)
+        let (a, b) = (rows[rows.len() - 3], rows[rows.len() - 1]);
+        let slope = (b.1 / a.1).ln() / (b.0 / a.0).ln();
+        assert!((slope + 2.0).abs() < 0.01, "area error falls like N^{slope}: {rows:?}");
+        assert!(rows.last().unwrap().1 > 0.0 && rows.last().unwrap().1 < 1e-4, "{rows:?}");
+        // local: random marks and marks near a boundary point, 30 levels
+        let mut mesh = super::super::tests::disc(circle);
+        let mut rng = Lcg(5);
+        let focus = [centre[0] + radius * 0.6, centre[1] - radius * 0.8];
+        for level in 0..30 {
+            let nt = mesh.n_triangles();
+            let p = if nt < 1500 { 0.1 } else { 8.0 / nt as f64 };
+            let marked: Vec<bool> = (0..nt)
+                .map(|t| rng.next_f64() < p || (level % 2 == 1 && mesh.corners(t).iter().any(|&c| dist(c, focus) < 1.5 * mesh.diameter(t))))
+                .collect();
+            let r = refine(&mesh, &marked);
+            r.mesh.check().unwrap(); // positive areas, conforming, boundary tagged
+            on_circle(&r.mesh);
+            assert!(r.mesh.min_angle_degrees() > 10.0, "min angle {}", r.mesh.min_angle_degrees());
+            // the inscribed polygon only grows (up to the round-off of the sum), inside the disc
+            let (before, after) = (total_area(&mesh), total_area(&r.mesh));
+            assert!(after >= before * (1.0 - 1e-13) && after < std::f64::consts::PI * radius * radius, "area {before} -> {after}");
+            mesh = r.mesh;
+        }
+        assert!(mesh.h_range().0 < 1e-2, "the refinement went deep: {:?}", mesh.h_range());
     }
 
     #[test]

@@ -352,7 +352,11 @@ impl Reader<'_> {
         let flat = Flat::parse(text).map_err(|e| self.error(key, span.clone(), format!("cannot parse {text:?}: {}", e.msg())))?;
         let names = flat.var_names();
         if names.len() > MAX_VARS {
-            return Err(self.error(key, span, format!("{text:?} has {} variables and constants, at most {MAX_VARS} are allowed", names.len())));
+            return Err(self.error(
+                key,
+                span,
+                format!("{text:?} has {} variables and constants, at most {MAX_VARS} are allowed", names.len()),
+            ));
         }
         let mut slots = Vec::with_capacity(names.len());
         for name in names {
@@ -367,7 +371,11 @@ impl Reader<'_> {
                         let mut known: Vec<&str> = vars.to_vec();
                         known.extend(self.constants.keys().map(String::as_str));
                         let known = if known.is_empty() { "none here".to_string() } else { known.join(", ") };
-                        return Err(self.error(key, span, format!("unknown variable `{c}` in {text:?} (variables and constants here: {known})")));
+                        return Err(self.error(
+                            key,
+                            span,
+                            format!("unknown variable `{c}` in {text:?} (variables and constants here: {known})"),
+                        ));
                     }
                 },
             };
@@ -393,13 +401,21 @@ impl Reader<'_> {
         Ok([self.expr(&format!("{key}[0]"), span.clone(), &value[0], vars)?, self.expr(&format!("{key}[1]"), span, &value[1], vars)?])
     }
 
-    fn vector(&self, key: &str, value: Option<&Spanned<VectorToml>>, vars: &[&str], has_exact: bool) -> Result<VectorData, ProblemFileError> {
+    fn vector(
+        &self,
+        key: &str,
+        value: Option<&Spanned<VectorToml>>,
+        vars: &[&str],
+        has_exact: bool,
+    ) -> Result<VectorData, ProblemFileError> {
         let Some(value) = value else { return Ok(VectorData::Exprs([Expr::Const(0.0), Expr::Const(0.0)])) };
         match value.get_ref() {
             VectorToml::Pair(p) => Ok(VectorData::Exprs(self.pair(key, value.span(), p, vars)?)),
             VectorToml::Word(w) if w == "exact" && has_exact => Ok(VectorData::FromExact),
             VectorToml::Word(w) if w == "exact" => Err(self.error(key, value.span(), "\"exact\" needs an [exact] table")),
-            VectorToml::Word(w) => Err(self.error(key, value.span(), format!("an array of two numbers or expressions, or \"exact\"; got {w:?}"))),
+            VectorToml::Word(w) => {
+                Err(self.error(key, value.span(), format!("an array of two numbers or expressions, or \"exact\"; got {w:?}")))
+            }
         }
     }
 
@@ -414,7 +430,11 @@ impl Reader<'_> {
                     .filter_map(|o| comparison.find(o).map(|i| (i, *o, o.len())))
                     .min_by_key(|&(i, _, _)| i)
                     .ok_or_else(|| {
-                        self.error(key, span.clone(), format!("a comparison (<, <=, >, >=) in {comparison:?} (a predicate is comparisons joined by && and ||)"))
+                        self.error(
+                            key,
+                            span.clone(),
+                            format!("a comparison (<, <=, >, >=) in {comparison:?} (a predicate is comparisons joined by && and ||)"),
+                        )
                     })?;
                 let op = match op {
                     "<=" => Cmp::Le,
@@ -456,9 +476,7 @@ impl Reader<'_> {
                 let value = &table[name];
                 let ready = match value.get_ref() {
                     Scalar::Number(_) => true,
-                    Scalar::Text(t) => {
-                        Flat::parse(t).map(|f| f.var_names().iter().all(|v| self.constants.contains_key(v))).unwrap_or(true)
-                    }
+                    Scalar::Text(t) => Flat::parse(t).map(|f| f.var_names().iter().all(|v| self.constants.contains_key(v))).unwrap_or(true),
                 };
                 if ready {
                     let v = self.number(&format!("constants.{name}"), value)?;
@@ -476,12 +494,13 @@ impl Reader<'_> {
                     known.insert((*n).clone(), 0.0);
                 }
                 let Scalar::Text(t) = table[name].get_ref() else { unreachable!("numbers are always ready") };
-                let unknown = Flat::parse(t)
-                    .map(|f| f.var_names().iter().find(|v| !known.contains_key(*v)).cloned())
-                    .unwrap_or_default();
+                let unknown = Flat::parse(t).map(|f| f.var_names().iter().find(|v| !known.contains_key(*v)).cloned()).unwrap_or_default();
                 let message = match unknown {
                     Some(v) => format!("unknown variable `{v}` in {t:?} (a constant is a number or an expression of other constants)"),
-                    None => format!("{t:?}: the constants {} refer to each other in a cycle", next.iter().map(|n| n.as_str()).collect::<Vec<_>>().join(", ")),
+                    None => format!(
+                        "{t:?}: the constants {} refer to each other in a cycle",
+                        next.iter().map(|n| n.as_str()).collect::<Vec<_>>().join(", ")
+                    ),
                 };
                 return Err(self.error(&key, table[name].span(), message));
             }
@@ -545,15 +564,25 @@ impl FileProblem {
                     r.error("material.model", material_span.clone(), "model = \"plane_strain\" or \"plane_stress\" with E and nu (missing)")
                 })?;
                 if !(e > 0.0) {
-                    return Err(r.error("material.E", m.e.as_ref().map_or(0..0, |v| v.span()), format!("a positive Young's modulus, got {e}")));
+                    return Err(r.error(
+                        "material.E",
+                        m.e.as_ref().map_or(0..0, |v| v.span()),
+                        format!("a positive Young's modulus, got {e}"),
+                    ));
                 }
                 let nu_span = m.nu.as_ref().map_or(0..0, |v| v.span());
                 match model.get_ref().as_str() {
                     "plane_strain" if nu > -1.0 && nu < 0.5 => Material::from_young(e, nu),
                     "plane_stress" if nu > -1.0 && nu < 1.0 => Material::from_young_plane_stress(e, nu),
-                    "plane_strain" => return Err(r.error("material.nu", nu_span, format!("a Poisson ratio in (-1, 0.5) in plane strain, got {nu}"))),
-                    "plane_stress" => return Err(r.error("material.nu", nu_span, format!("a Poisson ratio in (-1, 1) in plane stress, got {nu}"))),
-                    other => return Err(r.error("material.model", model.span(), format!("\"plane_strain\" or \"plane_stress\", got {other:?}"))),
+                    "plane_strain" => {
+                        return Err(r.error("material.nu", nu_span, format!("a Poisson ratio in (-1, 0.5) in plane strain, got {nu}")));
+                    }
+                    "plane_stress" => {
+                        return Err(r.error("material.nu", nu_span, format!("a Poisson ratio in (-1, 1) in plane stress, got {nu}")));
+                    }
+                    other => {
+                        return Err(r.error("material.model", model.span(), format!("\"plane_strain\" or \"plane_stress\", got {other:?}")));
+                    }
                 }
             }
             (None, None, Some(mu), Some(lambda)) => {
@@ -562,7 +591,11 @@ impl FileProblem {
                 }
                 let material = Material { mu: r.number("material.mu", mu)?, zeta: r.number("material.lambda", lambda)? };
                 if !(material.mu > 0.0 && material.zeta + material.mu > 0.0) {
-                    return Err(r.error("material", mu.span(), format!("mu > 0 and lambda + mu > 0 (coercive), got mu = {}, lambda = {}", material.mu, material.zeta)));
+                    return Err(r.error(
+                        "material",
+                        mu.span(),
+                        format!("mu > 0 and lambda + mu > 0 (coercive), got mu = {}, lambda = {}", material.mu, material.zeta),
+                    ));
                 }
                 material
             }
@@ -618,7 +651,11 @@ impl FileProblem {
             }
             let c = &curve.get_ref().circle;
             if !(c.radius > 0.0 && c.radius.is_finite() && c.centre.iter().all(|v| v.is_finite())) {
-                return Err(r.error(&format!("{key}.circle"), curve.span(), format!("a finite centre and a positive radius, got radius {}", c.radius)));
+                return Err(r.error(
+                    &format!("{key}.circle"),
+                    curve.span(),
+                    format!("a finite centre and a positive radius, got radius {}", c.radius),
+                ));
             }
             curves.insert(group.clone(), Curve::Circle { centre: c.centre, radius: c.radius });
         }
@@ -677,7 +714,9 @@ impl FileProblem {
                     ));
                 }
             }
-            NormalToml::Word(w) => return Err(r.error("contact.normal", normal_value.span(), format!("\"outward\" or [nx, ny], got {w:?}"))),
+            NormalToml::Word(w) => {
+                return Err(r.error("contact.normal", normal_value.span(), format!("\"outward\" or [nx, ny], got {w:?}")));
+            }
         };
         let mut required_vertices = Vec::new();
         if let Some(v) = &raw.required_vertices {
@@ -705,7 +744,11 @@ impl FileProblem {
                     None => {
                         let d = |i: usize, var: &str| {
                             u[i].derivative(var).map_err(|m| {
-                                r.error(&format!("exact.u[{i}]"), e.u.span(), format!("cannot differentiate it ({m}): give exact.grad = [[du1/dx, du1/dy], [du2/dx, du2/dy]]"))
+                                r.error(
+                                    &format!("exact.u[{i}]"),
+                                    e.u.span(),
+                                    format!("cannot differentiate it ({m}): give exact.grad = [[du1/dx, du1/dy], [du2/dx, du2/dy]]"),
+                                )
                             })
                         };
                         [[d(0, "x")?, d(0, "y")?], [d(1, "x")?, d(1, "y")?]]
@@ -732,7 +775,6 @@ impl FileProblem {
             exact,
         })
     }
-
 }
 
 impl Problem for FileProblem {
@@ -797,7 +839,8 @@ impl Problem for FileProblem {
                 [d[0] / l, d[1] / l]
             }
             Normal::SquareSides(sides) => {
-                let s = sides.iter().copied().min_by(|&a, &b| side_distance(a, x).total_cmp(&side_distance(b, x))).expect("at least one side");
+                let s =
+                    sides.iter().copied().min_by(|&a, &b| side_distance(a, x).total_cmp(&side_distance(b, x))).expect("at least one side");
                 SIDE_NORMALS[s]
             }
         }

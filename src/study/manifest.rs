@@ -5,8 +5,8 @@
 //!
 //! [defaults]                 # every run starts from these
 //! problem = "ex71"           # a built-in problem, or a problem file: "problems/hertz.toml"
-//!                            # (a relative path is relative to this manifest's folder)
-//! mesh = "structured:4"
+//! mesh = "structured:4"       # or "symmetric:N", or "gmsh:meshes/NAME.msh" (a Gmsh file)
+//!                            # (relative paths are relative to this manifest's folder)
 //! levels = 24
 //! quick_levels = 8           # the --quick form: the first levels of the same runs
 //! theta = 0.5
@@ -240,7 +240,8 @@ impl Manifest {
                 return Err(invalid(key("problem"), &expected, format!("{problem:?}")));
             }
             let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| "structured:4".into());
-            MeshSpec::parse(&mesh).map_err(|_| invalid(key("mesh"), "'structured:N' or 'symmetric:N'", format!("{mesh:?}")))?;
+            MeshSpec::parse(&resolve_mesh(path, &mesh))
+                .map_err(|_| invalid(key("mesh"), "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'", format!("{mesh:?}")))?;
             let levels = r.levels.or(d.levels).ok_or_else(|| invalid(key("levels"), "a number of levels >= 1", "nothing".into()))?;
             let theta = r.theta.or(d.theta).unwrap_or(0.5);
             let e = EstimatorConfig::default();
@@ -340,7 +341,31 @@ pub fn resolve_problem(manifest: &Path, problem: &str) -> String {
     manifest.parent().unwrap_or(Path::new("")).join(problem).display().to_string()
 }
 
+/// The mesh a manifest at `manifest` means by `mesh`: a built-in mesh as it is, a Gmsh file
+/// (`gmsh:PATH`) relative to the manifest's folder (an absolute path as it is). Like the problem,
+/// the run's spec keeps `mesh` as written; the provenance records the file and its hash.
+pub fn resolve_mesh(manifest: &Path, mesh: &str) -> String {
+    match mesh.strip_prefix("gmsh:") {
+        Some(f) if !f.trim().is_empty() && Path::new(f.trim()).is_relative() => {
+            format!("gmsh:{}", manifest.parent().unwrap_or(Path::new("")).join(f.trim()).display())
+        }
+        _ => mesh.to_string(),
+    }
+}
+
 impl Manifest {
+    /// The mesh files the runs read, resolved ([`resolve_mesh`]), without repetition.
+    pub fn mesh_files(&self) -> Vec<PathBuf> {
+        let mut files: Vec<PathBuf> = self
+            .runs
+            .iter()
+            .filter_map(|r| MeshSpec::parse(&resolve_mesh(&self.file, &r.spec.mesh)).ok()?.file().map(Path::to_path_buf))
+            .collect();
+        files.sort();
+        files.dedup();
+        files
+    }
+
     /// The problem files the runs name, resolved ([`resolve_problem`]), without repetition.
     pub fn problem_files(&self) -> Vec<PathBuf> {
         let mut files: Vec<PathBuf> = self

@@ -184,8 +184,16 @@ fn remove_meshes(dir: &StudyDir, id: &str) -> Result<()> {
 fn write_summaries(manifest: &Manifest, dir: &StudyDir, quick: bool) -> Result<Vec<RunRecord>> {
     let runs = dir.read_runs().with_context(|| format!("reading the runs in {}", dir.root.join("runs").display()))?;
     dir.write_csv(&runs).with_context(|| format!("writing {}", dir.csv_file().display()))?;
-    let mut prov =
-        provenance::collect(&manifest.study, &manifest.file, &manifest.bytes, quick, runs.iter().map(|r| r.run.id.clone()).collect());
+    let meshes = manifest.mesh_files();
+    let meshes: Vec<&std::path::Path> = meshes.iter().map(|p| p.as_path()).collect();
+    let mut prov = provenance::collect(
+        &manifest.study,
+        &manifest.file,
+        &manifest.bytes,
+        quick,
+        runs.iter().map(|r| r.run.id.clone()).collect(),
+        &meshes,
+    );
     prov.problem_files = manifest.problem_files().iter().map(|f| provenance::ProblemFile::of(f)).collect();
     records::write_json(&dir.provenance_file(), &prov).with_context(|| format!("writing {}", dir.provenance_file().display()))?;
     Ok(runs)
@@ -261,7 +269,7 @@ pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> 
             }
             eprintln!("{}/{}: stored run has another spec, running it again", manifest.study, spec.id);
         }
-        let record = match run_one(&manifest.study, &spec, &manifest::resolve_problem(&manifest.file, &spec.problem), &dir, opts.progress)? {
+        let record = match run_one(&manifest.study, &spec, &manifest.file, &dir, opts.progress)? {
             Some(r) => r,
             None => {
                 // interrupted: drop what the unfinished run saved, keep the finished ones
@@ -331,22 +339,24 @@ pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<
     Ok(())
 }
 
-/// The key of a run's reference solution in the cache: `problem` as resolved (two manifests may
-/// name different files by the same relative path).
-fn reference_key(spec: &RunSpec, problem: &str) -> Option<String> {
-    spec.reference.as_ref().map(|r| format!("{}|{}|{}|{}|{:?}", problem, spec.mesh, r.theta, r.min_ndof, r.contact_term))
+/// The key of a run's reference solution in the cache: problem and mesh as resolved (two
+/// manifests may name different files by the same relative path).
+fn reference_key(spec: &RunSpec, problem: &str, mesh: &str) -> Option<String> {
+    spec.reference.as_ref().map(|r| format!("{}|{}|{}|{}|{:?}", problem, mesh, r.theta, r.min_ndof, r.contact_term))
 }
 
-/// One run of `problem` (`spec.problem` resolved against the manifest): the adaptive loop with a
-/// progress bar, saving the declared levels. `None` when interrupted.
-fn run_one(study: &str, spec: &RunSpec, problem_path: &str, dir: &StudyDir, progress: bool) -> Result<Option<RunRecord>> {
-    let problem = problems::by_name(problem_path)?;
-    let mesh_spec = MeshSpec::parse(&spec.mesh)?;
-    crate::solve::check_memory(&format!("{study}/{}: the initial mesh {}", spec.id, spec.mesh), mesh_spec.ndof())?;
+/// One run of the manifest at `manifest_file` (its problem and mesh files are relative to it): the
+/// adaptive loop with a progress bar, saving the declared levels. `None` when interrupted.
+fn run_one(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, dir: &StudyDir, progress: bool) -> Result<Option<RunRecord>> {
+    let problem_path = manifest::resolve_problem(manifest_file, &spec.problem);
+    let mesh_path = manifest::resolve_mesh(manifest_file, &spec.mesh);
+    let problem = problems::by_name(&problem_path)?;
+    let mesh_spec = MeshSpec::parse(&mesh_path)?;
+    crate::solve::check_memory(&format!("{study}/{}: the initial mesh {}", spec.id, spec.mesh), mesh_spec.ndof()?)?;
     if spec.reference.is_some() && problem.exact().is_some() {
         bail!("{study}/{}: problem {} has an exact solution; a reference solution is not needed", spec.id, spec.problem);
     }
-    let reference = match (reference_key(spec, problem_path), &spec.reference) {
+    let reference = match (reference_key(spec, &problem_path, &mesh_path), &spec.reference) {
         (Some(key), Some(rs)) => {
             let computed = reference_for(&key, || {
                 let started = std::time::Instant::now();
@@ -384,7 +394,7 @@ fn run_one(study: &str, spec: &RunSpec, problem_path: &str, dir: &StudyDir, prog
     let pb = bar(progress, spec.levels as u64, &format!("{study}/{}", spec.id));
     let mut save_error: Option<anyhow::Error> = None;
     let mut stopped = false;
-    let mesh = mesh_spec.build(&|x| problem.part_of(x));
+    let mesh = mesh_spec.build(problem.as_ref())?;
     let levels = adapt::run(problem.as_ref(), mesh, &config, error_against, &mut |level: Level| {
         let r = level.record;
         pb.set_message(format!(

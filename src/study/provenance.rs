@@ -26,6 +26,9 @@ pub struct Provenance {
     pub ordering: String,
     /// UTC, ISO 8601.
     pub date: String,
+    /// SHA-256 of every mesh file the runs read (`gmsh:PATH` meshes), by path; absent when none.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub mesh_sha256: std::collections::BTreeMap<String, String>,
     /// Runs present in the study directory (merged by run id across shards and sessions).
     pub runs: Vec<String>,
     /// The problem files the manifest's runs name (absent for built-in problems only).
@@ -99,7 +102,7 @@ pub fn utc_now() -> String {
     format!("{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z", rem / 3600, rem / 60 % 60, rem % 60)
 }
 
-pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: bool, runs: Vec<String>) -> Provenance {
+pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: bool, runs: Vec<String>, meshes: &[&Path]) -> Provenance {
     let root = manifest_path.parent().and_then(|p| p.parent()).filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let git_commit = command("git", &["-C", &root.to_string_lossy(), "rev-parse", "HEAD"]);
     // dirty = tracked files changed outside results/ (the study's own outputs are not the code)
@@ -123,6 +126,10 @@ pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: 
             _ => "auto".into(),
         },
         date: utc_now(),
+        mesh_sha256: meshes
+            .iter()
+            .map(|m| (m.display().to_string(), std::fs::read(m).map(|b| sha256_hex(&b)).unwrap_or_else(|e| format!("(cannot read: {e})"))))
+            .collect(),
         runs,
         problem_files: Vec::new(),
     }

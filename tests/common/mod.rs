@@ -7,7 +7,7 @@ use signorini::problems::Problem;
 use signorini::solve::{self, DiscreteSolution};
 
 pub fn mesh(problem: &dyn Problem, spec: &str) -> Mesh {
-    MeshSpec::parse(spec).unwrap().build(&|x| problem.part_of(x))
+    MeshSpec::parse(spec).unwrap().build(problem).unwrap()
 }
 
 pub fn solve_on(problem: &dyn Problem, mesh: &Mesh) -> DiscreteSolution {

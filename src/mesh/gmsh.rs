@@ -1,0 +1,379 @@
+//! Gmsh meshes (`--mesh gmsh:PATH.msh`): MSH 4.1 files, ASCII or binary, read with the
+//! [`mshio`] crate.
+//!
+//! * The mesh is made of the file's linear triangles (element type 2); the harness makes the P2
+//!   nodes itself ([`P2Nodes`](super::P2Nodes)). Triangles are turned counter-clockwise where the
+//!   file lists them clockwise, and each is listed with its longest edge opposite its first vertex
+//!   (the refinement edge of newest-vertex bisection, [`refine`](super::refine)).
+//! * Boundary parts come from the physical groups of the file's 1D elements (type 2-node lines):
+//!   each group's name (from `$PhysicalNames`; a group without a name is called by its number) is
+//!   mapped to a [`Part`] by [`Problem::part_of_group`] and to an optional curve by
+//!   [`Problem::curve_of_group`]. A group the problem does not name, a boundary edge of the
+//!   triangulation in no group, a line element that is not a boundary edge, and an element
+//!   naming a node the file does not have are errors naming the file and the line.
+//! * Points (type 15) are ignored, and so is every physical group of dimension 0 or 2; any other
+//!   element type (quadrangles, second-order triangles or lines, 3D elements) is an error.
+//! * Nodes must lie in the plane z = 0. Nodes not used by any triangle are dropped; the others
+//!   become the mesh's vertices in the file's order.
+//!
+//! `mshio` parses the `$MeshFormat`, `$Entities`, `$Nodes` and `$Elements` sections but not
+//! `$PhysicalNames`, so that small section (`dim tag "name"` per line, ASCII in binary files too)
+//! is read here. `mshio` also drops the node tags of a node section whose tags are contiguous;
+//! they are then `min_node_tag, min_node_tag + 1, ...` in block order (as Gmsh writes them). Its
+//! errors carry the position in the file, turned into a line number here.
+
+use super::{BoundaryEdge, Mesh, MeshError, Part, key};
+use crate::problems::Problem;
+use mshio::ElementType;
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+/// A 1D element of a physical group: an edge `v` (vertex indices), its group (index into
+/// [`GmshFile::groups`]) and its line in the file.
+#[derive(Clone, Debug)]
+struct GroupEdge {
+    v: [usize; 2],
+    group: usize,
+    line: Option<usize>,
+}
+
+/// The contents of a Gmsh file the harness uses, before the problem tags its boundary.
+#[derive(Clone, Debug)]
+pub struct GmshFile {
+    pub path: PathBuf,
+    pub vertices: Vec<[f64; 2]>,
+    /// Counter-clockwise, longest edge opposite the first vertex.
+    pub triangles: Vec<[usize; 3]>,
+    /// The file line of every triangle (None in a binary file).
+    triangle_lines: Vec<Option<usize>>,
+    edges: Vec<GroupEdge>,
+    /// Names of the physical groups of the 1D elements, in order of first use in the file, with
+    /// the line of their `$PhysicalNames` entry.
+    pub groups: Vec<(String, Option<usize>)>,
+}
+
+fn error(path: &Path, line: Option<usize>, message: impl Into<String>) -> MeshError {
+    MeshError::Gmsh { file: path.to_path_buf(), line, message: message.into() }
+}
+
+/// 1-based line of byte `offset` of `bytes`.
+fn line_at(bytes: &[u8], offset: usize) -> usize {
+    1 + bytes[..offset.min(bytes.len())].iter().filter(|&&b| b == b'\n').count()
+}
+
+/// `$PhysicalNames`: (dimension, tag) -> (name, line).
+type PhysicalNames = HashMap<(i32, i32), (String, usize)>;
+
+fn physical_names(path: &Path, bytes: &[u8]) -> Result<PhysicalNames, MeshError> {
+    let mut names = HashMap::new();
+    let text = String::from_utf8_lossy(bytes);
+    let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l.trim()));
+    let Some((start, _)) = lines.find(|(_, l)| *l == "$PhysicalNames") else { return Ok(names) };
+    let (n_line, n) = lines.next().ok_or_else(|| error(path, Some(start), "$PhysicalNames: the file ends before the number of names"))?;
+    let n: usize = n.parse().map_err(|_| error(path, Some(n_line), format!("$PhysicalNames: expected the number of names, got {n:?}")))?;
+    for _ in 0..n {
+        let (i, l) =
+            lines.next().ok_or_else(|| error(path, Some(n_line), format!("$PhysicalNames: the file ends before its {n} names")))?;
+        let bad = || error(path, Some(i), format!("$PhysicalNames: expected `dimension tag \"name\"`, got {l:?}"));
+        let mut parts = l.splitn(3, char::is_whitespace);
+        let dim: i32 = parts.next().and_then(|s| s.parse().ok()).ok_or_else(bad)?;
+        let tag: i32 = parts.next().and_then(|s| s.parse().ok()).ok_or_else(bad)?;
+        let name = parts.next().map(str::trim).and_then(|s| s.strip_prefix('"')).and_then(|s| s.strip_suffix('"')).ok_or_else(bad)?;
+        names.insert((dim, tag), (name.to_string(), i));
+    }
+    match lines.next() {
+        Some((_, "$EndPhysicalNames")) => Ok(names),
+        Some((i, l)) => Err(error(path, Some(i), format!("$PhysicalNames: expected $EndPhysicalNames after {n} names, got {l:?}"))),
+        None => Err(error(path, None, "$PhysicalNames: the file ends before $EndPhysicalNames")),
+    }
+}
+
+/// Element tag -> line, for an ASCII file's `$Elements` section (walked block by block: a block
+/// header `dim entity type count`, then one element per line, its tag first).
+fn element_lines(bytes: &[u8]) -> HashMap<u64, usize> {
+    let mut out = HashMap::new();
+    let text = String::from_utf8_lossy(bytes);
+    let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l.trim()));
+    if lines.find(|(_, l)| *l == "$Elements").is_none() {
+        return out;
+    }
+    let n_blocks = lines.next().and_then(|(_, l)| l.split_whitespace().next()?.parse::<usize>().ok()).unwrap_or(0);
+    for _ in 0..n_blocks {
+        let Some(count) = lines.next().and_then(|(_, l)| l.split_whitespace().nth(3)?.parse::<usize>().ok()) else { break };
+        for _ in 0..count {
+            let Some((i, l)) = lines.next() else { return out };
+            if let Some(tag) = l.split_whitespace().next().and_then(|t| t.parse().ok()) {
+                out.insert(tag, i);
+            }
+        }
+    }
+    out
+}
+
+/// Read and check a Gmsh file (everything that does not depend on the problem).
+pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
+    let bytes = std::fs::read(path).map_err(|e| error(path, None, format!("cannot read the mesh file: {e}")))?;
+    let names = physical_names(path, &bytes)?;
+    // mshio has a few `expect`s left on malformed input: a panic there is a malformed file too
+    let parsed = std::panic::catch_unwind(|| {
+        mshio::parse_msh_bytes(&bytes).map_err(|e| {
+            let first = e.begin_msh_errors().next().or(e.backtrace.first());
+            let (rest, kind) = first
+                .map(|(r, k)| (r.len(), k.context().map_or_else(|| k.to_string(), |c| format!("cannot read the {c}"))))
+                .unwrap_or((0, String::new()));
+            let header = first.is_some_and(|(_, k)| {
+                matches!(k, mshio::error::MshParserErrorKind::UnsupportedMshVersion | mshio::error::MshParserErrorKind::InvalidFileHeader)
+            });
+            // mshio places header errors past the header: they are on the line after $MeshFormat
+            let offset = match header {
+                true => bytes.windows(12).position(|w| w == b"$MeshFormat\n").map_or(0, |p| p + 12),
+                false => bytes.len() - rest,
+            };
+            let within: Vec<String> = e.filter_msh_errors().skip(1).filter_map(|(_, k)| k.context().map(str::to_string)).collect();
+            let end = if rest == 0 { " (the file ends here: truncated?)" } else { "" };
+            let within = if within.is_empty() { String::new() } else { format!(" (in the {})", within.join(" of the ")) };
+            (offset, format!("not a valid MSH 4.1 file: {kind}{within}{end}"))
+        })
+    });
+    let msh = match parsed {
+        Ok(Ok(m)) => m,
+        Ok(Err((offset, message))) => return Err(error(path, Some(line_at(&bytes, offset)), message)),
+        Err(_) => return Err(error(path, None, "not a valid MSH 4.1 file (the MSH parser gave up)")),
+    };
+    let binary = msh.header.file_type != 0;
+    let lines = if binary { HashMap::new() } else { element_lines(&bytes) };
+    let line_of = |tag: u64| lines.get(&tag).copied();
+    let nodes = msh.data.nodes.as_ref().ok_or_else(|| error(path, None, "the file has no $Nodes section"))?;
+    let elements = msh.data.elements.as_ref().ok_or_else(|| error(path, None, "the file has no $Elements section"))?;
+    // nodes by tag
+    let mut node_at: HashMap<u64, [f64; 3]> = HashMap::new();
+    let mut node_order: Vec<u64> = Vec::new();
+    let mut next_tag = nodes.min_node_tag;
+    for block in &nodes.node_blocks {
+        let mut tags: Vec<u64> = vec![0; block.nodes.len()];
+        match &block.node_tags {
+            Some(map) => map.iter().for_each(|(&tag, &i)| tags[i] = tag),
+            None => {
+                for t in tags.iter_mut() {
+                    *t = next_tag;
+                    next_tag += 1;
+                }
+            }
+        }
+        for (tag, n) in tags.into_iter().zip(&block.nodes) {
+            node_at.insert(tag, [n.x, n.y, n.z]);
+            node_order.push(tag);
+        }
+    }
+    // the physical groups of every curve entity
+    let curve_groups: HashMap<i32, Vec<i32>> = msh
+        .data
+        .entities
+        .as_ref()
+        .map(|e| e.curves.iter().map(|c| (c.tag, c.physical_tags.iter().map(|t| t.abs()).collect())).collect())
+        .unwrap_or_default();
+    let mut tri_nodes: Vec<([u64; 3], u64)> = Vec::new();
+    let mut line_elems: Vec<([u64; 2], i32, u64)> = Vec::new();
+    for block in &elements.element_blocks {
+        let first = block.elements.first().map(|e| e.element_tag);
+        match (block.entity_dim, block.element_type) {
+            (2, ElementType::Tri3) => {
+                tri_nodes.extend(block.elements.iter().map(|e| ([e.nodes[0], e.nodes[1], e.nodes[2]], e.element_tag)))
+            }
+            (1, ElementType::Lin2) => {
+                let groups = curve_groups.get(&block.entity_tag).cloned().unwrap_or_default();
+                if groups.len() > 1 {
+                    return Err(error(
+                        path,
+                        first.and_then(line_of),
+                        format!("curve {} is in {} physical groups: one boundary part per edge is needed", block.entity_tag, groups.len()),
+                    ));
+                }
+                if let Some(&g) = groups.first() {
+                    line_elems.extend(block.elements.iter().map(|e| ([e.nodes[0], e.nodes[1]], g, e.element_tag)));
+                }
+            }
+            (0, ElementType::Pnt) => {}
+            (dim, ty) => {
+                return Err(error(
+                    path,
+                    first.and_then(line_of),
+                    format!(
+                        "elements of type {ty:?} (dimension {dim}): only linear triangles (type 2), 2-node lines (type 1) and points (type 15) are read (set Mesh.ElementOrder = 1 and Mesh.RecombineAll = 0)"
+                    ),
+                ));
+            }
+        }
+    }
+    if tri_nodes.is_empty() {
+        return Err(error(path, None, "the file has no linear triangles (element type 2): a 2D mesh is expected"));
+    }
+    // vertices: the nodes of the triangles, in the file's node order
+    let mut used: HashMap<u64, usize> = HashMap::new();
+    for (tri, tag) in &tri_nodes {
+        for n in tri {
+            if !node_at.contains_key(n) {
+                return Err(error(path, line_of(*tag), format!("triangle {tag} names node {n}, which the $Nodes section does not have")));
+            }
+            used.insert(*n, usize::MAX);
+        }
+    }
+    let mut vertices = Vec::with_capacity(used.len());
+    for tag in &node_order {
+        if let Some(index) = used.get_mut(tag)
+            && *index == usize::MAX
+        {
+            let [x, y, z] = node_at[tag];
+            if z != 0.0 {
+                return Err(error(path, None, format!("node {tag} has z = {z}: a planar mesh in z = 0 is expected")));
+            }
+            *index = vertices.len();
+            vertices.push([x, y]);
+        }
+    }
+    let mut triangles = Vec::with_capacity(tri_nodes.len());
+    let mut triangle_lines = Vec::with_capacity(tri_nodes.len());
+    for (tri, tag) in &tri_nodes {
+        let [a, b, c] = tri.map(|n| used[&n]);
+        let (pa, pb, pc) = (vertices[a], vertices[b], vertices[c]);
+        let area = 0.5 * ((pb[0] - pa[0]) * (pc[1] - pa[1]) - (pb[1] - pa[1]) * (pc[0] - pa[0]));
+        if !(area.abs() > 0.0) {
+            return Err(error(path, line_of(*tag), format!("triangle {tag} has zero area")));
+        }
+        let t = if area > 0.0 { [a, b, c] } else { [a, c, b] };
+        // longest edge opposite the first vertex (first of equal lengths)
+        let len = |i: usize| super::dist(vertices[t[(i + 1) % 3]], vertices[t[(i + 2) % 3]]);
+        let first = (0..3).fold(0, |best, i| if len(i) > len(best) { i } else { best });
+        triangles.push([t[first], t[(first + 1) % 3], t[(first + 2) % 3]]);
+        triangle_lines.push(line_of(*tag));
+    }
+    // line elements of physical groups
+    let mut groups: Vec<(String, Option<usize>)> = Vec::new();
+    let mut group_index: BTreeMap<i32, usize> = BTreeMap::new();
+    let mut edges = Vec::with_capacity(line_elems.len());
+    for ([a, b], g, tag) in line_elems {
+        let v = [a, b].map(|n| used.get(&n).copied());
+        let [Some(va), Some(vb)] = v else {
+            let n = if v[0].is_none() { a } else { b };
+            let why = if node_at.contains_key(&n) { "a node of no triangle" } else { "a node the $Nodes section does not have" };
+            return Err(error(path, line_of(tag), format!("line element {tag} names node {n}, {why}")));
+        };
+        let group = *group_index.entry(g).or_insert_with(|| {
+            let (name, line) = names.get(&(1, g)).map(|(n, l)| (n.clone(), Some(*l))).unwrap_or((g.to_string(), None));
+            groups.push((name, line));
+            groups.len() - 1
+        });
+        edges.push(GroupEdge { v: [va, vb], group, line: line_of(tag) });
+    }
+    Ok(GmshFile { path: path.to_path_buf(), vertices, triangles, triangle_lines, edges, groups })
+}
+
+impl GmshFile {
+    /// Number of P2 unknowns: 2 (V + E), E counted from the triangles.
+    pub fn ndof(&self) -> f64 {
+        let mut count: HashMap<(usize, usize), u8> = HashMap::new();
+        for t in &self.triangles {
+            for [i, j] in crate::element::EDGE_VERTICES {
+                *count.entry(key(t[i], t[j])).or_default() += 1;
+            }
+        }
+        2.0 * (self.vertices.len() + count.len()) as f64
+    }
+
+    /// The mesh with its boundary tagged by `problem`'s names for the physical groups.
+    pub fn mesh(&self, problem: &dyn Problem) -> Result<Mesh, MeshError> {
+        let path = &self.path;
+        // every group's part and curve, or the list of what the file has and the problem names
+        let mut parts = Vec::with_capacity(self.groups.len());
+        for (name, line) in &self.groups {
+            match problem.part_of_group(name) {
+                Some(p) => parts.push((p, problem.curve_of_group(name))),
+                None => {
+                    let listed: Vec<String> = self
+                        .groups
+                        .iter()
+                        .map(|(g, _)| match problem.part_of_group(g) {
+                            Some(p) => format!("\"{g}\" ({p:?})"),
+                            None => format!("\"{g}\" (not named by {})", problem.name()),
+                        })
+                        .collect();
+                    return Err(MeshError::Gmsh {
+                        file: path.clone(),
+                        line: *line,
+                        message: format!(
+                            "physical group \"{name}\" is not a boundary part of problem {}: every physical group of boundary lines must be named by the problem; the file's groups: {}",
+                            problem.name(),
+                            listed.join(", ")
+                        ),
+                    });
+                }
+            }
+        }
+        // edges: owners (triangle, local edge)
+        let mut owners: HashMap<(usize, usize), Vec<(usize, usize)>> = HashMap::new();
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for (le, [i, j]) in crate::element::EDGE_VERTICES.iter().enumerate() {
+                let o = owners.entry(key(tri[*i], tri[*j])).or_default();
+                o.push((t, le));
+                if o.len() > 2 {
+                    return Err(MeshError::Gmsh {
+                        file: path.clone(),
+                        line: self.triangle_lines[t],
+                        message: format!(
+                            "the mesh is not conforming: this triangle's edge ({}, {}) is in three triangles",
+                            tri[*i], tri[*j]
+                        ),
+                    });
+                }
+            }
+        }
+        let mut tag: HashMap<(usize, usize), &GroupEdge> = HashMap::new();
+        for e in &self.edges {
+            let k = key(e.v[0], e.v[1]);
+            if owners.get(&k).is_none_or(|o| o.len() != 1) {
+                return Err(MeshError::Gmsh {
+                    file: path.clone(),
+                    line: e.line,
+                    message: format!("this line element of group \"{}\" is not a boundary edge of the triangles", self.groups[e.group].0),
+                });
+            }
+            if let Some(prev) = tag.insert(k, e)
+                && parts[prev.group].0 != parts[e.group].0
+            {
+                return Err(MeshError::Gmsh {
+                    file: path.clone(),
+                    line: e.line,
+                    message: format!(
+                        "this edge is in groups \"{}\" and \"{}\", which the problem makes different boundary parts",
+                        self.groups[prev.group].0, self.groups[e.group].0
+                    ),
+                });
+            }
+        }
+        let mut boundary = Vec::new();
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for [i, j] in crate::element::EDGE_VERTICES {
+                let k = key(tri[i], tri[j]);
+                if owners[&k].len() != 1 {
+                    continue;
+                }
+                let Some(e) = tag.get(&k) else {
+                    let (p, q) = (self.vertices[tri[i]], self.vertices[tri[j]]);
+                    return Err(MeshError::Gmsh {
+                        file: path.clone(),
+                        line: self.triangle_lines[t],
+                        message: format!(
+                            "this triangle's edge from ({}, {}) to ({}, {}) is on the boundary but in no physical group of lines: every boundary edge needs a part",
+                            p[0], p[1], q[0], q[1]
+                        ),
+                    });
+                };
+                let (part, curve): (Part, _) = parts[e.group];
+                boundary.push(BoundaryEdge { v: [tri[i], tri[j]], part, curve });
+            }
+        }
+        let mesh = Mesh { vertices: self.vertices.clone(), triangles: self.triangles.clone(), boundary };
+        mesh.check()?;
+        Ok(mesh)
+    }
+}

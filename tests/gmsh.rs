@@ -1,0 +1,544 @@
+//! Gmsh meshes (`gmsh:PATH.msh`): parsing, tagging by physical group, curved boundaries under
+//! refinement, errors naming the line; the contact zone as arc-length intervals.
+
+mod common;
+use common::*;
+use signorini::mesh::{Curve, Mesh, MeshError, MeshSpec, Part};
+use signorini::problems::{Material, Problem};
+use std::path::{Path, PathBuf};
+
+/// A problem that names physical groups: `groups` maps a name to its part and curve. The body is
+/// pushed down (f = (0, -1)) onto a flat foundation under y = 0 (n = (0, -1), chi = 0).
+struct Named {
+    groups: Vec<(&'static str, Part, Option<Curve>)>,
+}
+
+impl Problem for Named {
+    fn name(&self) -> &str {
+        "named"
+    }
+    fn description(&self) -> &str {
+        "a test problem naming physical groups"
+    }
+    fn material(&self) -> Material {
+        Material::from_young(100.0, 0.3)
+    }
+    fn part_of(&self, _x: [f64; 2]) -> Part {
+        Part::Neumann
+    }
+    fn part_of_group(&self, group: &str) -> Option<Part> {
+        self.groups.iter().find(|g| g.0 == group).map(|g| g.1)
+    }
+    fn curve_of_group(&self, group: &str) -> Option<Curve> {
+        self.groups.iter().find(|g| g.0 == group).and_then(|g| g.2)
+    }
+    fn body_force(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, -1.0]
+    }
+    fn traction(&self, _x: [f64; 2], _n: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn dirichlet(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, -1.0]
+    }
+    fn gap(&self, _x: [f64; 2]) -> f64 {
+        0.0
+    }
+}
+
+const UNIT_CIRCLE: Curve = Curve::Circle { centre: [0.0, 0.0], radius: 1.0 };
+
+fn quarter_disc_problem() -> Named {
+    Named { groups: vec![("bottom", Part::Contact, None), ("arc", Part::Neumann, Some(UNIT_CIRCLE)), ("left", Part::Dirichlet, None)] }
+}
+
+fn meshes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/meshes")
+}
+
+fn area(m: &Mesh) -> f64 {
+    (0..m.n_triangles()).map(|t| m.area(t)).sum()
+}
+
+/// The unit square as two triangles (the second listed clockwise), "bottom" on y = 0 and
+/// "sides" on the other three sides: a hand-written MSH 4.1 ASCII file.
+const SQUARE: &str = r#"$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+3
+1 1 "bottom"
+1 2 "sides"
+2 3 "body"
+$EndPhysicalNames
+$Entities
+0 2 1 0
+1 0 0 0 1 0 0 1 1 0
+2 0 0 0 1 1 0 1 2 0
+1 0 0 0 1 1 0 1 3 2 1 2
+$EndEntities
+$Nodes
+1 4 1 4
+2 1 0 4
+1
+2
+3
+4
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+$EndNodes
+$Elements
+3 6 1 6
+1 1 1 1
+1 1 2
+1 2 1 3
+2 2 3
+3 3 4
+4 4 1
+2 1 2 2
+5 1 2 3
+6 1 4 3
+$EndElements
+"#;
+
+fn square_problem() -> Named {
+    Named { groups: vec![("bottom", Part::Contact, None), ("sides", Part::Dirichlet, None)] }
+}
+
+/// Write `text` to a fresh file under target/ and return its path.
+fn write(name: &str, text: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-gmsh");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// 1-based line of the first line of `text` equal to `line`.
+fn line_of(text: &str, line: &str) -> usize {
+    1 + text.lines().position(|l| l == line).unwrap()
+}
+
+fn build_err(path: &Path, problem: &dyn Problem) -> String {
+    let err = MeshSpec::Gmsh(path.to_path_buf()).build(problem).expect_err("an error");
+    assert!(matches!(err, MeshError::Gmsh { .. }), "{err:?}");
+    err.to_string()
+}
+
+#[test]
+fn hand_written_square_is_read_tagged_and_oriented() {
+    let path = write("square.msh", SQUARE);
+    let spec = MeshSpec::parse(&format!("gmsh:{}", path.display())).unwrap();
+    assert_eq!(spec, MeshSpec::Gmsh(path.clone()));
+    assert_eq!(spec.ndof().unwrap(), 2.0 * (4.0 + 5.0));
+    let m = spec.build(&square_problem()).unwrap();
+    assert_eq!((m.n_vertices(), m.n_triangles(), m.boundary.len()), (4, 2, 4));
+    assert_eq!(m.vertices, vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]);
+    // both counter-clockwise (the second was listed clockwise), the diagonal opposite the first vertex
+    for t in 0..2 {
+        assert!((m.area(t) - 0.5).abs() < 1e-15);
+        let [a, b, c] = m.triangles[t];
+        assert!([b, c] == [0, 2] || [b, c] == [2, 0], "refinement edge of {:?} is not the diagonal", m.triangles[t]);
+        assert!(a == 1 || a == 3);
+    }
+    let bottom: Vec<_> = m.boundary.iter().filter(|e| e.part == Part::Contact).map(|e| e.v).collect();
+    assert_eq!(bottom, vec![[0, 1]], "the bottom, counter-clockwise");
+    assert_eq!(m.boundary.iter().filter(|e| e.part == Part::Dirichlet).count(), 3);
+}
+
+#[test]
+fn truncated_file_is_an_error_naming_file_and_line() {
+    let cut = &SQUARE[..SQUARE.find("5 1 2 3").unwrap() + 4];
+    let path = write("truncated.msh", cut);
+    let err = build_err(&path, &square_problem());
+    let last = cut.lines().count();
+    assert!(err.contains("truncated.msh") && err.contains(&format!("line {last}")) && err.contains("truncated"), "{err}");
+    // another version of the format: the line after $MeshFormat
+    let path = write("version.msh", &SQUARE.replace("4.1 0 8", "2.2 0 8"));
+    let err = build_err(&path, &square_problem());
+    assert!(err.contains("version.msh, line 2") && err.contains("4.1"), "{err}");
+    // a missing section
+    let path = write("no_elements.msh", &SQUARE[..SQUARE.find("$Elements").unwrap()]);
+    let err = build_err(&path, &square_problem());
+    assert!(err.contains("no_elements.msh") && err.contains("no $Elements section"), "{err}");
+    // a broken $PhysicalNames entry
+    let text = SQUARE.replace("1 2 \"sides\"", "1 2 sides");
+    let path = write("bad_names.msh", &text);
+    let err = build_err(&path, &square_problem());
+    assert!(err.contains(&format!("line {}", line_of(&text, "1 2 sides"))) && err.contains("$PhysicalNames"), "{err}");
+    // an unreadable file
+    let err = build_err(Path::new("no/such/mesh.msh"), &square_problem());
+    assert!(err.contains("no/such/mesh.msh") && err.contains("cannot read"), "{err}");
+}
+
+#[test]
+fn group_the_problem_does_not_name_is_an_error_listing_the_groups() {
+    let path = write("square_unknown.msh", SQUARE);
+    let problem = Named { groups: vec![("bottom", Part::Contact, None), ("walls", Part::Dirichlet, None)] };
+    let err = build_err(&path, &problem);
+    assert!(err.contains("square_unknown.msh") && err.contains(&format!("line {}", line_of(SQUARE, "1 2 \"sides\""))), "{err}");
+    assert!(err.contains("\"sides\" (not named by named)") && err.contains("\"bottom\" (Contact)"), "{err}");
+}
+
+#[test]
+fn untagged_boundary_edge_and_missing_node_are_errors_naming_the_line() {
+    // drop the line element 4 -> 1: the edge x = 0 is then in no group
+    let text = SQUARE.replace("1 2 1 3\n", "1 2 1 2\n").replace("4 4 1\n", "").replace("3 6 1 6\n", "3 5 1 6\n");
+    let path = write("untagged.msh", &text);
+    let err = build_err(&path, &square_problem());
+    // the triangle holding that edge is element 6
+    assert!(err.contains("untagged.msh") && err.contains(&format!("line {}", line_of(&text, "6 1 4 3"))), "{err}");
+    assert!(err.contains("from (0, 1) to (0, 0)") && err.contains("no physical group"), "{err}");
+    // a triangle naming a node the file does not have
+    let text = SQUARE.replace("6 1 4 3", "6 1 9 3");
+    let path = write("missing_node.msh", &text);
+    let err = build_err(&path, &square_problem());
+    assert!(err.contains(&format!("line {}", line_of(&text, "6 1 9 3"))) && err.contains("node 9"), "{err}");
+    // a line element that is no boundary edge (the diagonal)
+    let text = SQUARE.replace("1 1 2\n", "1 1 3\n");
+    let path = write("interior_line.msh", &text);
+    let err = build_err(&path, &square_problem());
+    assert!(err.contains(&format!("line {}", line_of(&text, "1 1 3"))) && err.contains("not a boundary edge"), "{err}");
+}
+
+#[test]
+fn quarter_disc_counts_area_and_tags() {
+    let spec = MeshSpec::Gmsh(meshes_dir().join("quarter_disc.msh"));
+    let p = quarter_disc_problem();
+    let m = spec.build(&p).unwrap();
+    m.check().unwrap();
+    assert!(m.n_triangles() > 20 && m.n_triangles() < 200, "{} triangles", m.n_triangles());
+    assert_eq!(spec.ndof().unwrap(), 2.0 * signorini::mesh::P2Nodes::new(&m).len() as f64);
+    // the polygon inscribed in the quarter circle: area below pi/4 and close to it
+    let arc: Vec<_> = m.boundary.iter().filter(|e| e.part == Part::Neumann).collect();
+    let n = arc.len() as f64;
+    let polygon = 0.5 * n * (std::f64::consts::FRAC_PI_2 / n).sin();
+    assert!((area(&m) - polygon).abs() < 1e-3 * polygon && area(&m) < std::f64::consts::FRAC_PI_4, "area {} vs {polygon}", area(&m));
+    for e in &m.boundary {
+        let (a, b) = (m.vertices[e.v[0]], m.vertices[e.v[1]]);
+        match e.part {
+            Part::Contact => assert!(a[1] == 0.0 && b[1] == 0.0 && e.curve.is_none() && b[0] > a[0]),
+            Part::Dirichlet => assert!(a[0] == 0.0 && b[0] == 0.0 && e.curve.is_none() && b[1] < a[1]),
+            Part::Neumann => {
+                assert_eq!(e.curve, Some(UNIT_CIRCLE));
+                for x in [a, b] {
+                    assert!((x[0].hypot(x[1]) - 1.0).abs() < 1e-12, "{x:?} off the circle");
+                }
+            }
+        }
+    }
+    let len = |part| {
+        m.boundary.iter().filter(|e| e.part == part).map(|e| signorini::mesh::dist(m.vertices[e.v[0]], m.vertices[e.v[1]])).sum::<f64>()
+    };
+    assert!((len(Part::Contact) - 1.0).abs() < 1e-14 && (len(Part::Dirichlet) - 1.0).abs() < 1e-14);
+}
+
+/// Uniform refinement of the quarter disc: new arc vertices on the circle, no triangle inverted,
+/// the area tending to pi/4 like h^2 (the error falls by about 4 per bisection of the arc edges).
+#[test]
+fn quarter_disc_refined_onto_the_arc() {
+    let p = quarter_disc_problem();
+    let mut m = MeshSpec::Gmsh(meshes_dir().join("quarter_disc.msh")).build(&p).unwrap();
+    let mut errors = Vec::new();
+    for _ in 0..8 {
+        m = signorini::mesh::refine::refine(&m, &vec![true; m.n_triangles()]).mesh;
+        m.check().unwrap();
+        for e in m.boundary.iter().filter(|e| e.curve.is_some()) {
+            for v in e.v {
+                let x = m.vertices[v];
+                assert!((x[0].hypot(x[1]) - 1.0).abs() <= 1e-14, "{x:?} off the circle");
+            }
+        }
+        let arc_edges = m.boundary.iter().filter(|e| e.curve.is_some()).count() as f64;
+        errors.push((arc_edges, std::f64::consts::FRAC_PI_4 - area(&m)));
+    }
+    let (a, b) = (errors[errors.len() - 3], errors[errors.len() - 1]);
+    let slope = (b.1 / a.1).ln() / (b.0 / a.0).ln();
+    assert!((slope + 2.0).abs() < 0.1, "area error ~ N^{slope}: {errors:?}");
+    // a solve on the refined mesh: the body rests on the foundation
+    let sol = solve_on(&p, &m);
+    assert!(sol.active_count() > 0 && sol.kkt().max_penetration <= 1e-12);
+    // VTU as for the built-in meshes: one quadratic triangle per triangle, one line per boundary edge
+    let doc = signorini::mesh::io::vtu(&m, &sol.nodes, &[("u", signorini::mesh::io::Field::Vector(&sol.u))], &[]);
+    assert!(doc.contains(&format!("NumberOfPoints=\"{}\" NumberOfCells=\"{}\"", sol.nodes.len(), m.n_triangles() + m.boundary.len())));
+    write("quarter_disc_refined.vtu", &doc);
+}
+
+#[test]
+fn hertz_mesh_is_graded_towards_the_lowest_point() {
+    let p = Named {
+        groups: vec![
+            ("top", Part::Dirichlet, None),
+            ("contact", Part::Contact, Some(Curve::Circle { centre: [0.0, 1.0], radius: 1.0 })),
+            ("free", Part::Neumann, Some(Curve::Circle { centre: [0.0, 1.0], radius: 1.0 })),
+        ],
+    };
+    let path = meshes_dir().join("hertz.msh");
+    assert!(std::fs::metadata(&path).unwrap().len() < 1 << 20, "hertz.msh stays under 1 MB");
+    let m = MeshSpec::Gmsh(path).build(&p).unwrap();
+    // the half disc less the circular segments cut off by the straight arc edges
+    let segments: f64 = m
+        .boundary
+        .iter()
+        .filter(|e| e.curve.is_some())
+        .map(|e| {
+            let theta = 2.0 * (0.5 * signorini::mesh::dist(m.vertices[e.v[0]], m.vertices[e.v[1]])).asin();
+            0.5 * (theta - theta.sin())
+        })
+        .sum();
+    let expected = 0.5 * std::f64::consts::PI - segments;
+    assert!((area(&m) - expected).abs() < 1e-12 && segments < 3e-3, "area {} against {expected}", area(&m));
+    let near = |t: usize| signorini::mesh::dist(m.corners(t)[0], [0.0, 0.0]);
+    let h_near = (0..m.n_triangles()).filter(|&t| near(t) < 0.01).map(|t| m.diameter(t)).fold(0.0, f64::max);
+    let h_far = (0..m.n_triangles()).filter(|&t| near(t) > 0.8).map(|t| m.diameter(t)).fold(0.0, f64::max);
+    assert!(h_near < 0.01 && h_far > 0.08, "h near (0, 0) {h_near}, far {h_far}");
+    let contact = m.boundary.iter().filter(|e| e.part == Part::Contact);
+    assert!(contact.clone().all(|e| e.v.iter().all(|&v| m.vertices[v][0].abs() <= 0.3 + 1e-12)));
+    assert!(contact.count() > 20);
+}
+
+/// A body pushed down onto a foundation with two humps' valleys: contact in two separate parts of
+/// the bottom, reported as two arc-length intervals (x on the bottom), each around its valley.
+struct TwoValleys;
+
+impl Problem for TwoValleys {
+    fn name(&self) -> &str {
+        "two_valleys"
+    }
+    fn description(&self) -> &str {
+        "a block pressed onto a foundation touching it near x = 0.25 and x = 0.75"
+    }
+    fn material(&self) -> Material {
+        Material::from_young(100.0, 0.3)
+    }
+    fn part_of(&self, x: [f64; 2]) -> Part {
+        signorini::problems::contact_bottom_dirichlet_top(x)
+    }
+    fn body_force(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn traction(&self, _x: [f64; 2], _n: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn dirichlet(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, -0.01]
+    }
+    fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, -1.0]
+    }
+    /// chi = 16 (x - 1/4)^2 (x - 3/4)^2: touching at x = 1/4 and 3/4, 0.0625 apart at x = 1/2.
+    fn gap(&self, x: [f64; 2]) -> f64 {
+        16.0 * (x[0] - 0.25).powi(2) * (x[0] - 0.75).powi(2)
+    }
+}
+
+#[test]
+fn contact_zone_intervals_on_two_separate_active_parts() {
+    let p = TwoValleys;
+    let m = mesh(&p, "structured:32");
+    let sol = solve_on(&p, &m);
+    let zones = sol.contact_zones();
+    assert_eq!(zones.len(), 2, "{zones:?}");
+    for (z, centre) in zones.iter().zip([0.25, 0.75]) {
+        assert_eq!(z.component, 0);
+        assert!(z.s[0] < centre && centre < z.s[1] && z.s[1] - z.s[0] < 0.3, "{z:?} around {centre}");
+        // arc length along the bottom from (0, 0) is x
+        assert_eq!([z.from[0], z.to[0]], z.s);
+        assert!(z.from[1] == 0.0 && z.to[1] == 0.0);
+    }
+    // mirror symmetry of the problem: the intervals mirror each other
+    assert!((zones[0].s[0] - (1.0 - zones[1].s[1])).abs() < 1e-12 && (zones[0].s[1] - (1.0 - zones[1].s[0])).abs() < 1e-12, "{zones:?}");
+    // every active node is in an interval, every node inside an interval is active
+    for (k, c) in sol.dofs.contact.iter().enumerate() {
+        let x = sol.nodes.coords[c.node][0];
+        let inside = zones.iter().any(|z| z.s[0] <= x && x <= z.s[1]);
+        assert_eq!(inside, sol.active[k], "node at x = {x}");
+    }
+    assert_eq!(sol.contact_zone(), Some([zones[0].s[0], zones[1].s[1]]));
+}
+
+/// Arc length along a curved Gamma_C: the quarter disc, clamped on x = 0, its arc squeezed by a
+/// rigid ring 0.01 inside it (n the radial direction): one interval along the whole arc,
+/// counter-clockwise from (1, 0) to the midpoint of the last arc edge (the corner (0, 1) is on
+/// the closure of Gamma_D, so no contact node).
+#[test]
+fn contact_zone_arc_length_along_a_curve() {
+    struct Ring;
+    impl Problem for Ring {
+        fn name(&self) -> &str {
+            "ring"
+        }
+        fn description(&self) -> &str {
+            "a quarter disc squeezed into a ring"
+        }
+        fn material(&self) -> Material {
+            Material::from_young(100.0, 0.3)
+        }
+        fn part_of(&self, _x: [f64; 2]) -> Part {
+            Part::Neumann
+        }
+        fn part_of_group(&self, g: &str) -> Option<Part> {
+            match g {
+                "arc" => Some(Part::Contact),
+                "bottom" => Some(Part::Neumann),
+                "left" => Some(Part::Dirichlet),
+                _ => None,
+            }
+        }
+        fn curve_of_group(&self, g: &str) -> Option<Curve> {
+            (g == "arc").then_some(UNIT_CIRCLE)
+        }
+        fn body_force(&self, _x: [f64; 2]) -> [f64; 2] {
+            [0.0, 0.0]
+        }
+        fn traction(&self, _x: [f64; 2], _n: [f64; 2]) -> [f64; 2] {
+            [0.0, 0.0]
+        }
+        fn dirichlet(&self, _x: [f64; 2]) -> [f64; 2] {
+            [0.0, 0.0]
+        }
+        fn contact_normal(&self, x: [f64; 2]) -> [f64; 2] {
+            let r = x[0].hypot(x[1]);
+            [x[0] / r, x[1] / r]
+        }
+        fn gap(&self, _x: [f64; 2]) -> f64 {
+            -0.01
+        }
+    }
+    let m = MeshSpec::Gmsh(meshes_dir().join("quarter_disc.msh")).build(&Ring).unwrap();
+    let sol = solve_on(&Ring, &m);
+    let zones = sol.contact_zones();
+    let arc: Vec<[f64; 2]> =
+        m.boundary.iter().filter(|e| e.part == Part::Contact).flat_map(|e| [m.vertices[e.v[0]], m.vertices[e.v[1]]]).collect();
+    let lengths: Vec<f64> = arc.chunks(2).map(|e| signorini::mesh::dist(e[0], e[1])).collect();
+    let arc_len: f64 = lengths.iter().sum();
+    assert_eq!(zones.len(), 1, "{zones:?}");
+    assert_eq!(zones[0].s[0], 0.0);
+    let last = lengths.iter().zip(arc.chunks(2)).find(|(_, e)| e[1] == [0.0, 1.0]).map(|(l, _)| *l).unwrap();
+    assert!((zones[0].s[1] - (arc_len - 0.5 * last)).abs() < 1e-14, "{zones:?} vs {arc_len} - {last} / 2");
+    assert_eq!(zones[0].from, [1.0, 0.0]);
+    assert!(
+        zones[0].to[0] > 0.0 && (zones[0].to[0].hypot(zones[0].to[1]) - 1.0).abs() < 0.01,
+        "counter-clockwise from (1, 0) to near (0, 1): {zones:?}"
+    );
+}
+
+/// A manifest's relative mesh path is relative to the manifest's folder (the run's spec keeps it as
+/// written, like the problem, and `resolve_mesh` resolves it); an absolute one and the built-in
+/// meshes stay as they are.
+#[test]
+fn manifest_mesh_paths_are_relative_to_the_manifest() {
+    use signorini::study::manifest::{Manifest, resolve_mesh};
+    let text = |mesh: &str| format!("[defaults]\nproblem = \"ex71\"\nlevels = 2\nmesh = \"{mesh}\"\n[[run]]\nid = \"a\"\n");
+    let file = Path::new("studies/own/hertz.toml");
+    let m = Manifest::parse(file, &text("gmsh:meshes/hertz.msh")).unwrap();
+    assert_eq!(m.runs[0].spec.mesh, "gmsh:meshes/hertz.msh");
+    assert_eq!(resolve_mesh(file, &m.runs[0].spec.mesh), "gmsh:studies/own/meshes/hertz.msh");
+    assert_eq!(m.mesh_files(), vec![Path::new("studies/own/meshes/hertz.msh").to_path_buf()]);
+    assert_eq!(resolve_mesh(Path::new("hertz.toml"), "gmsh:meshes/hertz.msh"), "gmsh:meshes/hertz.msh");
+    assert_eq!(resolve_mesh(Path::new("studies/hertz.toml"), "gmsh:/abs/hertz.msh"), "gmsh:/abs/hertz.msh");
+    assert_eq!(resolve_mesh(Path::new("studies/hertz.toml"), "structured:4"), "structured:4");
+    let e = Manifest::parse(Path::new("studies/hertz.toml"), &text("gmsh:")).unwrap_err().to_string();
+    assert!(e.contains("run[0].mesh") && e.contains("gmsh:PATH.msh"), "{e}");
+}
+
+/// On the command line: a Gmsh mesh whose groups the problem does not name is a clear error, and
+/// a probe outside the mesh too.
+#[test]
+fn command_line_names_the_mesh_file_and_its_groups() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["solve", "--problem", "ex71", "--mesh", &format!("gmsh:{}", meshes_dir().join("quarter_disc.msh").display())])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("quarter_disc.msh") && err.contains("\"bottom\" (not named by ex71)") && !err.contains("panicked"), "{err}");
+}
+
+/// The binary encoding of the quarter disc gives the same mesh as the ASCII one (vertices to the
+/// ASCII file's 16 digits).
+#[test]
+fn binary_and_ascii_files_give_the_same_mesh() {
+    let p = quarter_disc_problem();
+    let ascii = MeshSpec::Gmsh(meshes_dir().join("quarter_disc.msh")).build(&p).unwrap();
+    let binary = MeshSpec::Gmsh(meshes_dir().join("quarter_disc_binary.msh")).build(&p).unwrap();
+    assert!(std::fs::read(meshes_dir().join("quarter_disc_binary.msh")).unwrap().contains(&0u8), "the file is binary");
+    // ASCII files hold 16 significant digits, binary ones the doubles themselves
+    assert_eq!(ascii.n_vertices(), binary.n_vertices());
+    for (a, b) in ascii.vertices.iter().zip(&binary.vertices) {
+        assert!((a[0] - b[0]).abs() <= 1e-15 && (a[1] - b[1]).abs() <= 1e-15, "{a:?} vs {b:?}");
+    }
+    assert_eq!(ascii.triangles, binary.triangles);
+    assert_eq!(ascii.boundary, binary.boundary);
+}
+
+/// A cylinder pressed onto a flat foundation on the Hertz mesh: the top moved down by 0.002, the
+/// constraint the vertical gap to y = 0 (n = (0, -1), chi = y). One contact interval around the
+/// lowest point, inside the contact group, refined adaptively with new arc vertices on the circle.
+#[test]
+fn hertz_mesh_gives_one_contact_interval_around_the_lowest_point() {
+    struct Pressed;
+    const ROLLER: Curve = Curve::Circle { centre: [0.0, 1.0], radius: 1.0 };
+    impl Problem for Pressed {
+        fn name(&self) -> &str {
+            "pressed"
+        }
+        fn description(&self) -> &str {
+            "a half cylinder pressed onto a flat foundation"
+        }
+        fn material(&self) -> Material {
+            Material::from_young(1.0, 0.3)
+        }
+        fn part_of(&self, _x: [f64; 2]) -> Part {
+            Part::Neumann
+        }
+        fn part_of_group(&self, g: &str) -> Option<Part> {
+            match g {
+                "top" => Some(Part::Dirichlet),
+                "contact" => Some(Part::Contact),
+                "free" => Some(Part::Neumann),
+                _ => None,
+            }
+        }
+        fn curve_of_group(&self, g: &str) -> Option<Curve> {
+            (g != "top").then_some(ROLLER)
+        }
+        fn body_force(&self, _x: [f64; 2]) -> [f64; 2] {
+            [0.0, 0.0]
+        }
+        fn traction(&self, _x: [f64; 2], _n: [f64; 2]) -> [f64; 2] {
+            [0.0, 0.0]
+        }
+        fn dirichlet(&self, _x: [f64; 2]) -> [f64; 2] {
+            [0.0, -0.002]
+        }
+        fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+            [0.0, -1.0]
+        }
+        fn gap(&self, x: [f64; 2]) -> f64 {
+            x[1]
+        }
+    }
+    let m = MeshSpec::Gmsh(meshes_dir().join("hertz.msh")).build(&Pressed).unwrap();
+    let config = signorini::adapt::AdaptConfig { levels: 4, ..Default::default() };
+    let out = signorini::adapt::run(&Pressed, m, &config, None, &mut |_| std::ops::ControlFlow::Continue(())).unwrap();
+    let (m, sol) = (&out.mesh, &out.solution);
+    for e in m.boundary.iter().filter(|e| e.curve.is_some()) {
+        for v in e.v {
+            let x = m.vertices[v];
+            assert!((x[0].hypot(x[1] - 1.0) - 1.0).abs() <= 1e-14, "{x:?} off the circle");
+        }
+    }
+    let zones = sol.contact_zones();
+    assert_eq!(zones.len(), 1, "{zones:?}");
+    let z = zones[0];
+    // the arc length of (0, 0) from (-0.3, 1 - sqrt(0.91)) along the polygon: about asin(0.3)
+    assert!(z.from[0] < 0.0 && z.to[0] > 0.0 && z.s[1] - z.s[0] < 0.3, "{z:?}");
+    assert!(z.s[0] < 0.3f64.asin() && 0.3f64.asin() - 1e-3 < z.s[1], "{z:?}");
+    assert!(sol.kkt().max_penetration <= 1e-12);
+}
