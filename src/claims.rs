@@ -738,7 +738,7 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let mut judged = None;
     for r in &runs {
         let Some(snap) = latest_mesh(ctx.results, "hertz", &r.run.id) else { continue };
-        let problem = crate::problems::by_name(&r.run.problem).map_err(std::io::Error::other)?;
+        let problem = crate::study::stored_problem(ctx.results, "hertz", &r.run).map_err(|e| std::io::Error::other(format!("{e:#}")))?;
         let Some(h) = crate::hertz::for_problem(problem.as_ref()) else {
             rows.push(format!("{}: problem {} has no circular contact group", r.run.id, r.run.problem));
             continue;

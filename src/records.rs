@@ -153,6 +153,10 @@ pub struct RunSpec {
     pub reference: Option<ReferenceSpec>,
     /// Levels whose mesh and fields are written as VTU (and as JSON for the mesh figure).
     pub save_levels: Vec<usize>,
+    /// Values for some of a problem file's `[constants]` (the same problem at another load);
+    /// empty for the file's own values and for built-in problems.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub constants: std::collections::BTreeMap<String, f64>,
 }
 
 /// How a reference solution is computed: adaptive refinement (maximum strategy with `theta`,
@@ -332,6 +336,7 @@ mod tests {
                 estimator: EstimatorConfig::default(),
                 reference: None,
                 save_levels: vec![],
+                constants: Default::default(),
             },
             levels: vec![level.clone(), LevelRecord { level: 1, ..level }],
             reference_ndof: None,

@@ -90,6 +90,7 @@ impl Run<'_> {
                 estimator: self.estimator,
                 reference: None,
                 save_levels: vec![20],
+                constants: Default::default(),
             },
             levels: lv,
             reference_ndof: (self.problem == "ex72").then_some(2_000_000),

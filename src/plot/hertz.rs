@@ -21,7 +21,7 @@ fn finest(results: &Path, r: &RunRecord) -> anyhow::Result<Option<(Hertz, MeshSn
     let Some(level) = saved_levels(&dir, &r.run.id).into_iter().max() else {
         return Ok(None);
     };
-    let problem = crate::problems::by_name(&r.run.problem)?;
+    let problem = crate::study::stored_problem(results, STUDY, &r.run)?;
     let h = hertz::for_problem(problem.as_ref())
         .with_context(|| format!("problem {} has no circular contact group '{}'", r.run.problem, hertz::CONTACT_GROUP))?;
     let snap = dir.read_mesh(&r.run.id, level).with_context(|| format!("reading the mesh snapshot of {} level {level}", r.run.id))?;
