@@ -208,8 +208,16 @@ fn nested_dissection(graph: &Graph, coords: &[[f64; 2]]) -> Vec<usize> {
     // side[i]: which half of the current split unknown i is in; the halves being split at the
     // same time are disjoint and not coupled, so one array serves the whole parallel recursion
     let side: Vec<AtomicU8> = (0..n).map(|_| AtomicU8::new(0)).collect();
+    // reach[i][axis]: how far node i's neighbours lie from it along the axis; a node farther than
+    // that from the other half of a split cannot be coupled to it, and is not searched
+    let reach: Vec<[f64; 2]> = (0..n)
+        .map(|i| {
+            let d = |axis: usize| graph.neighbours(i).map(|j| (coords[j][axis] - coords[i][axis]).abs()).fold(0.0, f64::max);
+            [d(0), d(1)]
+        })
+        .collect();
     let mut set: Vec<usize> = (0..n).collect();
-    dissect(graph, coords, &side, &mut set)
+    dissect(graph, coords, &reach, &side, &mut set)
 }
 
 /// Flops of the Cholesky factorisation of the matrix of the unknowns with the nodes in the given
@@ -249,7 +257,7 @@ fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
 }
 
 /// Order `set`: both halves of a coordinate split first, then the separator.
-fn dissect(graph: &Graph, coords: &[[f64; 2]], side: &[AtomicU8], set: &mut [usize]) -> Vec<usize> {
+fn dissect(graph: &Graph, coords: &[[f64; 2]], reach: &[[f64; 2]], side: &[AtomicU8], set: &mut [usize]) -> Vec<usize> {
     if set.len() <= LEAF {
         return set.to_vec();
     }
@@ -258,7 +266,7 @@ fn dissect(graph: &Graph, coords: &[[f64; 2]], side: &[AtomicU8], set: &mut [usi
     // most unknowns can sit on that line, and a split along it is all separator)
     let mut best: Option<(Vec<usize>, Vec<usize>, Vec<usize>)> = None;
     for axis in 0..2 {
-        let Some(split) = split_along(graph, coords, side, set, axis) else { continue };
+        let Some(split) = split_along(graph, coords, reach, side, set, axis) else { continue };
         if best.as_ref().is_none_or(|b| split.2.len() < b.2.len()) {
             best = Some(split);
         }
@@ -270,9 +278,9 @@ fn dissect(graph: &Graph, coords: &[[f64; 2]], side: &[AtomicU8], set: &mut [usi
         side[i].store(0, Relaxed); // for good: the splits below must not see it as a half
     }
     let (mut oa, ob) = if set.len() >= PAR_MIN {
-        rayon::join(|| dissect(graph, coords, side, &mut a), || dissect(graph, coords, side, &mut b))
+        rayon::join(|| dissect(graph, coords, reach, side, &mut a), || dissect(graph, coords, reach, side, &mut b))
     } else {
-        (dissect(graph, coords, side, &mut a), dissect(graph, coords, side, &mut b))
+        (dissect(graph, coords, reach, side, &mut a), dissect(graph, coords, reach, side, &mut b))
     };
     oa.extend(ob);
     oa.extend(separator);
@@ -287,6 +295,7 @@ fn dissect(graph: &Graph, coords: &[[f64; 2]], side: &[AtomicU8], set: &mut [usi
 fn split_along(
     graph: &Graph,
     coords: &[[f64; 2]],
+    reach: &[[f64; 2]],
     side: &[AtomicU8],
     set: &mut [usize],
     axis: usize,
@@ -308,10 +317,15 @@ fn split_along(
     for &i in right {
         side[i].store(2, Relaxed);
     }
-    let coupled = |half: &[usize], other: u8| -> Vec<bool> {
-        half.iter().map(|&i| graph.neighbours(i).any(|j| side[j].load(Relaxed) == other)).collect()
+    // every coordinate of the left half is below every one of the right half
+    let left_max = left.iter().map(|&i| coords[i][axis]).fold(f64::NEG_INFINITY, f64::max);
+    let right_min = coords[right[0]][axis]; // the selected element: the smallest of its half
+    let coupled = |half: &[usize], other: u8, line: f64| -> Vec<bool> {
+        half.iter()
+            .map(|&i| (coords[i][axis] - line).abs() <= reach[i][axis] && graph.neighbours(i).any(|j| side[j].load(Relaxed) == other))
+            .collect()
     };
-    let (in_left, in_right) = (coupled(left, 2), coupled(right, 1));
+    let (in_left, in_right) = (coupled(left, 2, right_min), coupled(right, 1, left_max));
     let count = |flags: &[bool]| flags.iter().filter(|&&b| b).count();
     let pick = |half: &[usize], flags: &[bool], keep: bool| -> Vec<usize> {
         half.iter().zip(flags).filter(|p| *p.1 == keep).map(|p| *p.0).collect()
