@@ -147,8 +147,7 @@ fn cold_comparison(sizes: &[usize], repeats: usize, python: &std::path::Path) ->
     let have_ngsolve = python.exists();
     let mut out = Vec::new();
     if !sizes.is_empty() {
-        println!("
-whole solves in fresh processes (ours: contact solve; NGSolve: linear solve), interleaved:");
+        println!("\nwhole solves in fresh processes (ours: contact solve; NGSolve: linear solve), interleaved:");
     }
     for &n in sizes {
         let mut size = ColdSize {
@@ -198,8 +197,7 @@ whole solves in fresh processes (ours: contact solve; NGSolve: linear solve), in
 fn scale_point(n: usize, cold: &[ColdSize], python: &std::path::Path) -> Result<ColdSize> {
     let spec = MeshSpec::Structured(n);
     solve::check_memory(&spec.to_string(), spec.ndof())?;
-    println!("
-scale point structured:{n} ({:.0} unknowns), load {}:", spec.ndof(), load());
+    println!("\nscale point structured:{n} ({:.0} unknowns), load {}:", spec.ndof(), load());
     let ours = ours_cold(n)?;
     println!("  ours {:.3} s, peak {:.0} MB", ours.whole_s, ours.peak_rss_mb);
     let mut size = ColdSize { n, ours: vec![ours], ngsolve: Vec::new(), ngsolve_missing: None };
@@ -213,8 +211,10 @@ scale point structured:{n} ({:.0} unknowns), load {}:", spec.ndof(), load());
     let needed_mb = factor * median(largest.ngsolve.iter().map(|r| r.peak_rss_mb).collect());
     let available_mb = solve::available_memory().unwrap_or(0.0) / (1024.0 * 1024.0);
     if needed_mb > 0.8 * available_mb {
-        size.ngsolve_missing =
-            Some(format!("not run: about {needed_mb:.0} MB needed (its structured:{} peak x {factor:.1}), {available_mb:.0} MB available", largest.n));
+        size.ngsolve_missing = Some(format!(
+            "not run: about {needed_mb:.0} MB needed (its structured:{} peak x {factor:.1}), {available_mb:.0} MB available",
+            largest.n
+        ));
         println!("  NGSolve {}", size.ngsolve_missing.as_deref().unwrap_or_default());
     } else {
         let ng = ngsolve_cold(python, n)?;
@@ -339,8 +339,7 @@ fn targets(phases: &[SizeResult], cold: &[ColdSize], scale: Option<&ColdSize>) -
         });
     }
     let opt = |v: Option<f64>, p: usize| v.map_or("-".to_string(), |v| format!("{v:.p$}"));
-    println!("
-targets (issue 15; our cold contact solve against NGSolve's cold linear solve, fresh processes, medians):");
+    println!("\ntargets (issue 15; our cold contact solve against NGSolve's cold linear solve, fresh processes, medians):");
     println!("{:<52} {:>5} {:>10} {:>10} {:>7}  {:<15} {:<8} note", "target", "N", "ours", "reference", "value", "goal", "met");
     for r in &t {
         println!(
