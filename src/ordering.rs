@@ -4,8 +4,9 @@
 //! The sparse Cholesky factorisation costs what its fill costs, and it runs near the machine's
 //! dense flop rate (about 25 GFlop/s on one core here), so the ordering decides its time. On
 //! the quasi-uniform meshes of the benchmark, AMD is far from the best: at `structured:512`
-//! (2.1M unknowns) it leaves 2.4e11 multiply-subtract pairs and 4.1e8 entries of L, while nested
-//! dissection leaves 8.3e10 and 2.7e8 (`ordering` in `results/bench/solver.json`). A 2D finite element mesh gives separators for free through its
+//! (2.1M unknowns) it leaves 1.7e11 flops (2.4e11 on the graph of the unknowns, 4.1e8 entries
+//! of L), while nested dissection leaves 8.3e10 (2.7e8 entries of L; `ordering` in
+//! `results/bench/solver.json`). A 2D finite element mesh gives separators for free through its
 //! coordinates: split the unknowns at the median of one coordinate, take the unknowns of one
 //! half coupled to the other half as the separator (one layer of nodes when the split follows
 //! a mesh line), number both halves first, recursively, and the separator last.
