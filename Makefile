@@ -45,7 +45,10 @@ drift: build
 crosscheck: build
 	crosscheck/run.sh
 
-# NGSolve's timings first, then ours with the two side by side (medians over repeats).
+# NGSolve's phase timings first (warm, medians over repeats in one process per size), then ours
+# side by side; then whole solves in fresh processes, ours and NGSolve's interleaved (medians of
+# 3 at N = 256 and 512), the structured:1024 scale point, and the table of the targets with
+# met / not met. About 15 minutes; results/bench/{ngsolve_bench,solver}.json.
 bench: build
 	crosscheck/setup.sh && crosscheck/.venv/bin/python crosscheck/crosscheck.py --out-dir results/bench bench --sizes 32,64,128,256,512
 	$(CARGO) run --release --locked --bin bench

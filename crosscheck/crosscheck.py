@@ -3,6 +3,7 @@
     crosscheck.py compare DIR [DIR...]       same mesh, same data, our own PDAS: u and active set must match
     crosscheck.py rates DIR [DIR...]         ex71 and fb on structured:N: L-infinity errors and rates vs case.json
     crosscheck.py bench [--sizes 32,64,...]  NGSolve timings of Example 7.2's linear elasticity system
+    crosscheck.py bench-cold --n N           one whole linear solve in a fresh process (for the Rust bench)
     crosscheck.py selftest [DIR...]          shows that `compare` fails when one side's data are perturbed
 
 Results go to results/crosscheck/ (JSON + Markdown, written atomically). Exit status 1 on any failure.
@@ -231,6 +232,33 @@ def bench_size(n, repeats, threads):
             "threads": used, "l1_error_vs_translation": err}
 
 
+def bench_cold(n, threads):
+    """One whole linear solve in this fresh process (what a user of NGSolve sees, Python's start and
+    the imports excepted): NGSolve mesh, assembly, factorisation, solve; with the process's peak memory."""
+    import resource
+    ng.SetNumThreads(threads)
+    prob = problems.problem("ex72")
+    with ng.TaskManager():
+        vertices, tris = make_case.structured_triangles(n)
+        segs, parts = make_case.boundary_segments(vertices, tris, make_case.SIDES["ex72"])
+        t0 = time.perf_counter()
+        mesh = fem.build_ngmesh(vertices, tris, segs, parts)
+        mesh_s = time.perf_counter() - t0
+        (assembly, factorisation, solve), fes, err = bench_once(mesh, prob)
+        whole = time.perf_counter() - t0
+        used = ng.GetNumThreads()
+    return {"N": n, "ndof_free": sum(fes.FreeDofs()), "whole_s": whole, "mesh_s": mesh_s, "assembly_s": assembly,
+            "factorisation_s": factorisation, "solve_s": solve,
+            "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0,
+            "threads": used, "l1_error_vs_translation": err}
+
+
+def cmd_bench_cold(args):
+    row = bench_cold(args.n, args.threads or os.cpu_count())
+    print("ROW " + json.dumps(row))
+    return row["l1_error_vs_translation"] <= 1e-8
+
+
 def cmd_bench_one(args):
     print("ROW " + json.dumps(bench_size(args.n, args.repeats, args.threads or os.cpu_count())))
     return True
@@ -340,6 +368,10 @@ def main():
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--threads", type=int, default=0)
     p.set_defaults(func=cmd_bench_one)
+    p = sub.add_parser("bench-cold", help="one whole linear solve of structured:N in this fresh process (the Rust bench runs it)")
+    p.add_argument("--n", type=int, required=True)
+    p.add_argument("--threads", type=int, default=0)
+    p.set_defaults(func=cmd_bench_cold)
     p = sub.add_parser("selftest")
     p.add_argument("dirs", nargs="*", help="exported cases to perturb (default: generated structured:8 cases)")
     p.set_defaults(func=cmd_selftest)

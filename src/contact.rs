@@ -34,6 +34,7 @@ use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, supernodal,
 };
 use faer::{Conj, Mat, Par, Side, Spec};
+use std::mem::MaybeUninit;
 use std::time::Instant;
 
 /// Why the contact solve failed.
@@ -168,13 +169,21 @@ pub enum Strategy {
     Refactor,
 }
 
-/// Above this many contact nodes the dense Schur complement (O(m^3)) costs more than a few
-/// sparse refactorisations on the meshes of our studies.
+/// Up to this many contact nodes the dense Schur complement (O(m^3)) is always cheaper than a
+/// few sparse refactorisations.
 pub const SCHUR_MAX_CONTACT: usize = 1500;
 
 impl Strategy {
-    pub fn auto(n_contact: usize) -> Self {
-        if n_contact <= SCHUR_MAX_CONTACT { Strategy::Schur } else { Strategy::Refactor }
+    /// Schur for at most [`SCHUR_MAX_CONTACT`] contact nodes, and beyond while the dense work on
+    /// the Schur complement, m^3 for m contact nodes, stays below n^1.5 for n unknowns (the order
+    /// of the flops of one sparse factorisation of a 2D mesh, about 27 n^1.5 with nested
+    /// dissection on `structured:N`), which Refactor pays once per active-set iteration. On the
+    /// meshes graded towards Gamma_C (thousands of contact nodes among a few 100k unknowns) m^3
+    /// exceeds n^1.5 a thousandfold: Refactor; on `structured:1024` (2049 contact nodes, 8.4M
+    /// unknowns) m^3 is a third of n^1.5: Schur, one factorisation instead of ten.
+    pub fn auto(n_contact: usize, n_unknowns: usize) -> Self {
+        let (m, n) = (n_contact as f64, n_unknowns as f64);
+        if n_contact <= SCHUR_MAX_CONTACT || m.powi(3) <= n.powf(1.5) { Strategy::Schur } else { Strategy::Refactor }
     }
 }
 
@@ -187,7 +196,12 @@ pub struct ContactSolver {
     n_interior: usize,
     strategy: Strategy,
     symbolic: SymbolicCholesky<usize>,
+    /// The values of L, allocated once per symbolic factorisation.
     l_values: Vec<f64>,
+    /// Scratch of the numeric factorisation, allocated once and reused by every refactorisation.
+    scratch: Vec<MaybeUninit<u8>>,
+    /// Whether the pages of `l_values` and `scratch` have been populated ([`populate`]).
+    populated: bool,
     /// S = L_CC L_CC^T (m x m), Schur strategy only.
     schur: Mat<f64>,
     /// Refactor strategy: per contact node, the (column, position) of the off-diagonal entries
@@ -203,7 +217,7 @@ impl ContactSolver {
     /// chosen by the number of contact nodes.
     /// `coords` holds the position of every unknown (its node's), for the ordering.
     pub fn new(matrix: &SymCsc, n_interior: usize, coords: &[[f64; 2]]) -> Result<Self, ContactError> {
-        Self::with_strategy(matrix, n_interior, coords, Strategy::auto(matrix.n() - n_interior))
+        Self::with_strategy(matrix, n_interior, coords, Strategy::auto(matrix.n() - n_interior, matrix.n()))
     }
 
     pub fn with_strategy(matrix: &SymCsc, n_interior: usize, coords: &[[f64; 2]], strategy: Strategy) -> Result<Self, ContactError> {
@@ -226,11 +240,15 @@ impl ContactSolver {
             }
         };
         timings.symbolic = t0.elapsed().as_secs_f64();
+        let scratch_bytes = symbolic.factorize_numeric_llt_scratch::<f64>(NUMERIC_PAR, Spec::default()).unaligned_bytes_required();
         let mut solver = ContactSolver {
             n: matrix.n(),
             n_interior,
             strategy,
+            // not touched here: the first factorisation populates them (see `factor_values`)
             l_values: vec![0.0; symbolic.len_val()],
+            scratch: uninit_bytes(scratch_bytes),
+            populated: false,
             symbolic,
             schur: Mat::zeros(0, 0),
             row_entries,
@@ -262,21 +280,26 @@ impl ContactSolver {
     /// Numeric factorisation of the pattern of `matrix` with the given values.
     fn factor_values(&mut self, matrix: &SymCsc, values: &[f64]) -> Result<(), ContactError> {
         let t0 = Instant::now();
-        let par = Par::Seq; // faster than two threads for faer's sparse Cholesky (PERF-NOTES.md)
-        let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(par, Spec::default());
-        let mut mem = MemBuffer::try_new(req).map_err(|e| ContactError::Factorisation(format!("{e:?}")))?;
         let sym = matrix.as_faer().symbolic();
-        self.symbolic
-            .factorize_numeric_llt(
+        // the first factorisation populates the memory of L and of the scratch on another thread
+        // while it runs on this one (see `populate`)
+        let regions = [region(&self.scratch), region(&self.l_values)];
+        let populated = std::mem::replace(&mut self.populated, true);
+        let result = std::thread::scope(|scope| {
+            if !populated {
+                scope.spawn(move || regions.into_iter().for_each(|(start, bytes)| populate(start, bytes)));
+            }
+            self.symbolic.factorize_numeric_llt(
                 &mut self.l_values,
                 faer::sparse::SparseColMatRef::new(sym, values),
                 Side::Lower,
                 LltRegularization::default(),
-                par,
-                MemStack::new(&mut mem),
+                NUMERIC_PAR,
+                MemStack::new(&mut self.scratch),
                 Spec::default(),
             )
-            .map_err(|e| ContactError::NotPositiveDefinite(format!("{e:?}")))?;
+        });
+        result.map_err(|e| ContactError::NotPositiveDefinite(format!("{e:?}")))?;
         self.timings.numeric += t0.elapsed().as_secs_f64();
         Ok(())
     }
@@ -464,6 +487,51 @@ impl ContactSolver {
     }
 }
 
+/// Parallelism of the numeric factorisation: one thread was faster than two for faer's sparse
+/// Cholesky on our matrices (it parallelises only inside supernodes).
+const NUMERIC_PAR: Par = Par::Seq;
+
+/// `len` bytes of scratch, neither initialised nor touched.
+fn uninit_bytes(len: usize) -> Vec<MaybeUninit<u8>> {
+    let mut v = Vec::with_capacity(len);
+    // SAFETY: MaybeUninit needs no initialisation
+    unsafe { v.set_len(len) };
+    v
+}
+
+/// The address and length in bytes of a slice's memory.
+fn region<T>(v: &[T]) -> (usize, usize) {
+    (v.as_ptr() as usize, std::mem::size_of_val(v))
+}
+
+/// Populate the pages of `bytes` bytes at address `start` (`madvise(MADV_POPULATE_WRITE)`, in
+/// chunks from the start): the kernel maps them writable as a first write would, without
+/// writing; pages already mapped stay as they are, so the memory's contents never change.
+///
+/// Why: a fresh process pays for the first touch of every page, on the virtual machines we
+/// measure on about 0.5-2 s per GB, huge pages or not; at `structured:512` the first numeric
+/// factorisation took 22 s against 8.7 s for a refactorisation. The factorisation runs on one
+/// thread and fills L front to back, so a second thread populating L ahead of it takes the
+/// faults out of its way. A no-op where the call is not supported (Linux before 5.14, others).
+fn populate(start: usize, bytes: usize) {
+    #[cfg(target_os = "linux")]
+    {
+        const PAGE: usize = 4096;
+        const CHUNK: usize = 8 << 20;
+        let (first, end) = (start.next_multiple_of(PAGE), (start + bytes) / PAGE * PAGE);
+        for at in (first..end).step_by(CHUNK) {
+            let len = CHUNK.min(end - at);
+            // SAFETY: the range lies inside one live allocation, and MADV_POPULATE_WRITE changes
+            // no contents (it only maps pages that a write would map)
+            if unsafe { libc::madvise(at as *mut libc::c_void, len, libc::MADV_POPULATE_WRITE) } != 0 {
+                return; // not supported here: the factorisation faults the pages in itself
+            }
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = (start, bytes);
+}
+
 /// Symbolic Cholesky, supernodal, with the fill-reducing ordering of [`crate::ordering`].
 /// Schur: the leading block `I` is ordered and `C` kept in place at the end, so that the
 /// trailing block of L is L_CC. Refactor: all unknowns are ordered.
@@ -567,4 +635,19 @@ pub fn pdas(
     };
     let (u, lambda) = last;
     Ok(PdasOutcome { u, lambda, active: last_active, iterations, termination })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strategy_by_the_dense_work_against_a_factorisation() {
+        assert_eq!(Strategy::auto(1500, 10_000), Strategy::Schur);
+        // Example 7.1 graded towards Gamma_C: 16385 contact nodes among 305k unknowns
+        assert_eq!(Strategy::auto(16385, 305_000), Strategy::Refactor);
+        assert_eq!(Strategy::auto(2000, 100_000), Strategy::Refactor);
+        // structured:1024: 2049 contact nodes among 8.4M unknowns
+        assert_eq!(Strategy::auto(2049, 8_392_704), Strategy::Schur);
+    }
 }

@@ -4,8 +4,9 @@
 //! The sparse Cholesky factorisation costs what its fill costs, and it runs near the machine's
 //! dense flop rate (about 25 GFlop/s on one core here), so the ordering decides its time. On
 //! the quasi-uniform meshes of the benchmark, AMD is far from the best: at `structured:512`
-//! (2.1M unknowns) it leaves 2.4e11 multiply-subtract pairs and 4.1e8 entries of L, while nested
-//! dissection leaves 8.3e10 and 2.7e8 (`ordering` in `results/bench/solver.json`). A 2D finite element mesh gives separators for free through its
+//! (2.1M unknowns) it leaves 1.7e11 flops (2.4e11 on the graph of the unknowns, 4.1e8 entries
+//! of L), while nested dissection leaves 8.3e10 (2.7e8 entries of L; `ordering` in
+//! `results/bench/solver.json`). A 2D finite element mesh gives separators for free through its
 //! coordinates: split the unknowns at the median of one coordinate, take the unknowns of one
 //! half coupled to the other half as the separator (one layer of nodes when the split follows
 //! a mesh line), number both halves first, recursively, and the separator last.
@@ -14,6 +15,13 @@
 //! needs 25 times fewer flops than the dissection. So both orderings are computed and the one
 //! with fewer flops is kept ([`fill_reducing`]); its flop count comes from the column counts
 //! of L (elimination tree, row subtrees), AMD's from AMD itself.
+//!
+//! Both orderings work on the graph of the nodes, not of the unknowns: the two unknowns of a
+//! node (consecutive, at the same position) couple to the same unknowns, so the graph of the
+//! unknowns is the node graph with every node doubled, and ordering the nodes and numbering each
+//! node's unknowns together loses nothing. The node graph has half the vertices and a quarter
+//! of the edges, which makes both orderings and their flop counts 2-4 times cheaper; the flops
+//! are still those of the unknowns (each node weighted by its number of unknowns).
 //!
 //! Written by hand because no Rust crate offers a geometric nested dissection, and METIS
 //! (through C bindings) costs 6-11 s to order `structured:512` here (PERF-NOTES.md), more than
@@ -32,45 +40,87 @@ const LEAF: usize = 8;
 /// Subsets larger than this are split in parallel.
 const PAR_MIN: usize = 20_000;
 
-/// The symmetric adjacency of the unknowns `0..n` (entries of the lower triangle `matrix` with
-/// both indices below `n`), compressed by rows, without the diagonal.
+/// The symmetric adjacency of the nodes of the unknowns `0..n` (entries of the lower triangle
+/// `matrix` with both indices below `n`), compressed by rows, without the diagonal. A node is a
+/// run of consecutive unknowns at the same position (`coords`, bitwise): the two components of
+/// a P2 node, or a lone unknown (the tangential one at a contact node whose normal unknown is
+/// ordered apart). Node k holds the unknowns `first[k]..first[k + 1]`.
 struct Graph {
     ptr: Vec<u32>,
     adj: Vec<u32>,
+    first: Vec<usize>,
 }
 
 impl Graph {
-    fn new(matrix: &SymCsc, n: usize) -> Self {
-        let mut count = vec![0usize; n + 1];
-        for j in 0..n {
-            for &i in &matrix.row_idx()[matrix.col_ptr()[j]..matrix.col_ptr()[j + 1]] {
-                if i != j && i < n {
-                    count[i + 1] += 1;
-                    count[j + 1] += 1;
-                }
+    fn new(matrix: &SymCsc, n: usize, coords: &[[f64; 2]]) -> Self {
+        let same = |a: [f64; 2], b: [f64; 2]| a[0].to_bits() == b[0].to_bits() && a[1].to_bits() == b[1].to_bits();
+        let mut first = vec![0];
+        for i in 1..n {
+            if !same(coords[i], coords[i - 1]) {
+                first.push(i);
             }
         }
-        for i in 0..n {
-            count[i + 1] += count[i];
+        first.push(n);
+        let nodes = first.len() - 1;
+        let mut node_of = vec![0u32; n];
+        for k in 0..nodes {
+            node_of[first[k]..first[k + 1]].fill(k as u32);
         }
+        // couplings (k, l), k < l, each once: node numbers follow the unknowns', so an entry (i, j),
+        // i > j, of the lower triangle lies in a column of node k = node(j) <= l = node(i); `seen`
+        // drops the repeats within node k's columns
+        let mut seen = vec![u32::MAX; nodes];
+        let couplings = |k: usize, seen: &mut [u32], found: &mut dyn FnMut(usize)| {
+            for j in first[k]..first[k + 1] {
+                for &i in &matrix.row_idx()[matrix.col_ptr()[j]..matrix.col_ptr()[j + 1]] {
+                    if i < n && node_of[i] as usize != k && seen[node_of[i] as usize] != k as u32 {
+                        seen[node_of[i] as usize] = k as u32;
+                        found(node_of[i] as usize);
+                    }
+                }
+            }
+        };
+        let mut count = vec![0usize; nodes + 1];
+        for k in 0..nodes {
+            couplings(k, &mut seen, &mut |l| {
+                count[k + 1] += 1;
+                count[l + 1] += 1;
+            });
+        }
+        for k in 0..nodes {
+            count[k + 1] += count[k];
+        }
+        assert!(count[nodes] < u32::MAX as usize, "more than 2^32 couplings: widen the graph's indices");
         let mut fill = count.clone();
-        let mut adj = vec![0u32; count[n]];
-        for j in 0..n {
-            for &i in &matrix.row_idx()[matrix.col_ptr()[j]..matrix.col_ptr()[j + 1]] {
-                if i != j && i < n {
-                    adj[fill[i]] = j as u32;
-                    fill[i] += 1;
-                    adj[fill[j]] = i as u32;
-                    fill[j] += 1;
-                }
-            }
+        let mut adj = vec![0u32; count[nodes]];
+        seen.fill(u32::MAX);
+        for k in 0..nodes {
+            couplings(k, &mut seen, &mut |l| {
+                adj[fill[k]] = l as u32;
+                fill[k] += 1;
+                adj[fill[l]] = k as u32;
+                fill[l] += 1;
+            });
         }
-        assert!(count[n] < u32::MAX as usize, "more than 2^32 couplings: widen the graph's indices");
-        Graph { ptr: count.into_iter().map(|c| c as u32).collect(), adj }
+        Graph { ptr: count.into_iter().map(|c| c as u32).collect(), adj, first }
+    }
+
+    fn n_nodes(&self) -> usize {
+        self.first.len() - 1
+    }
+
+    /// Unknowns of node k.
+    fn weight(&self, k: usize) -> usize {
+        self.first[k + 1] - self.first[k]
     }
 
     fn neighbours(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
         self.adj[self.ptr[i] as usize..self.ptr[i + 1] as usize].iter().map(|&j| j as usize)
+    }
+
+    /// The order of the unknowns from an order of the nodes: each node's unknowns together.
+    fn unknowns(&self, node_order: &[usize]) -> Vec<usize> {
+        node_order.iter().flat_map(|&k| self.first[k]..self.first[k + 1]).collect()
     }
 }
 
@@ -118,46 +168,65 @@ pub fn forced() -> Result<Option<Method>, String> {
 pub fn fill_reducing(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (Vec<usize>, OrderingChoice) {
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::sparse::linalg::amd;
-    let graph = Graph::new(matrix, n_order);
-    let (nd, (amd_order, amd_flops)) = rayon::join(
-        || nested_dissection(&graph, coords),
+    let graph = Graph::new(matrix, n_order, coords);
+    let nodes = graph.n_nodes();
+    let node_coords: Vec<[f64; 2]> = graph.first[..nodes].iter().map(|&i| coords[i]).collect();
+    let ((nd, nd_flops), (amd_order, amd_flops)) = rayon::join(
         || {
-            let pattern = faer::sparse::SymbolicSparseColMatRef::new_checked(n_order, n_order, &graph.ptr, None, &graph.adj);
-            let (mut fwd, mut inv) = (vec![0u32; n_order], vec![0u32; n_order]);
-            let flops = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(n_order, graph.adj.len())).ok().and_then(|mut mem| {
+            let order = nested_dissection(&graph, &node_coords);
+            let flops = factorisation_flops(&graph, &order);
+            (order, flops)
+        },
+        || {
+            let pattern = faer::sparse::SymbolicSparseColMatRef::new_checked(nodes, nodes, &graph.ptr, None, &graph.adj);
+            let (mut fwd, mut inv) = (vec![0u32; nodes], vec![0u32; nodes]);
+            let ordered = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(nodes, graph.adj.len())).ok().and_then(|mut mem| {
                 amd::order_maybe_unsorted(&mut fwd, &mut inv, pattern, amd::Control::default(), MemStack::new(&mut mem)).ok()
             });
-            (fwd, flops.map(|f| f.n_div + f.n_mult_subs_ldl).unwrap_or(f64::INFINITY))
+            let order: Vec<usize> = fwd.into_iter().map(|i| i as usize).collect();
+            // AMD counts the flops of the node graph; ours weighs each node by its unknowns
+            let flops = if ordered.is_some() { factorisation_flops(&graph, &order) } else { f64::INFINITY };
+            (order, flops)
         },
     );
-    let nd_flops = factorisation_flops(&graph, &nd);
     let method = match forced().ok().flatten() {
         Some(m) => m,
         None if nd_flops <= amd_flops => Method::NestedDissection,
         None => Method::MinimumDegree,
     };
-    let mut order: Vec<usize> = match method {
-        Method::NestedDissection => nd,
-        Method::MinimumDegree => amd_order.into_iter().map(|i| i as usize).collect(),
-    };
+    let mut order = graph.unknowns(match method {
+        Method::NestedDissection => &nd,
+        Method::MinimumDegree => &amd_order,
+    });
     order.extend(n_order..matrix.n());
     (order, OrderingChoice { method, flops_nested_dissection: nd_flops, flops_minimum_degree: amd_flops })
 }
 
-/// Nested dissection of all vertices of `graph`, as `order[new] = old`.
+/// Nested dissection of all nodes of `graph` (at `coords`), as `order[new] = old`.
 fn nested_dissection(graph: &Graph, coords: &[[f64; 2]]) -> Vec<usize> {
-    let n = graph.ptr.len() - 1;
+    let n = graph.n_nodes();
     assert!(coords.len() >= n);
     // side[i]: which half of the current split unknown i is in; the halves being split at the
     // same time are disjoint and not coupled, so one array serves the whole parallel recursion
     let side: Vec<AtomicU8> = (0..n).map(|_| AtomicU8::new(0)).collect();
+    // reach[i][axis]: how far node i's neighbours lie from it along the axis; a node farther than
+    // that from the other half of a split cannot be coupled to it, and is not searched
+    let reach: Vec<[f64; 2]> = (0..n)
+        .map(|i| {
+            let d = |axis: usize| graph.neighbours(i).map(|j| (coords[j][axis] - coords[i][axis]).abs()).fold(0.0, f64::max);
+            [d(0), d(1)]
+        })
+        .collect();
     let mut set: Vec<usize> = (0..n).collect();
-    dissect(graph, coords, &side, &mut set)
+    dissect(graph, coords, &reach, &side, &mut set)
 }
 
-/// Flops of the Cholesky factorisation of the graph's matrix in the given order: with d_j the
-/// number of entries of column j of L below the diagonal, sum d_j + d_j (d_j + 1) / 2 (divisions
-/// and multiply-subtract pairs), as AMD counts them. Column counts by the elimination tree and row subtrees (Liu), O(|L|).
+/// Flops of the Cholesky factorisation of the matrix of the unknowns with the nodes in the given
+/// order (each node's unknowns together): with d_j the number of entries of column j of L below
+/// the diagonal, sum d_j + d_j (d_j + 1) / 2 (divisions and multiply-subtract pairs), as AMD
+/// counts them. Column counts of the node graph by the elimination tree and row subtrees (Liu),
+/// O(|L|), in unknowns: if W is the number of unknowns in later nodes coupled to node k through
+/// L, the w unknowns of node k have d = W + w - 1, W + w - 2, ..., W.
 fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
     const NONE: usize = usize::MAX;
     let n = order.len();
@@ -165,14 +234,15 @@ fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
     for (new, &old) in order.iter().enumerate() {
         position[old] = new;
     }
-    let (mut parent, mut visited, mut count) = (vec![NONE; n], vec![NONE; n], vec![1u64; n]);
+    let (mut parent, mut visited, mut below) = (vec![NONE; n], vec![NONE; n], vec![0u64; n]);
     for (k, &old) in order.iter().enumerate() {
         visited[k] = k;
+        let w = graph.weight(old) as u64;
         for mut i in graph.neighbours(old).map(|j| position[j]).filter(|&i| i < k) {
             // walk from i up the elimination tree to k: row k of L has an entry in each column
             while visited[i] != k {
                 visited[i] = k;
-                count[i] += 1;
+                below[i] += w;
                 if parent[i] == NONE {
                     parent[i] = k;
                 }
@@ -180,11 +250,15 @@ fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
             }
         }
     }
-    count.iter().map(|&c| (c - 1) as f64 + (c * (c - 1) / 2) as f64).sum()
+    order
+        .iter()
+        .zip(&below)
+        .map(|(&node, &big_w)| (0..graph.weight(node) as u64).map(|t| big_w + t).map(|d| d as f64 + (d * (d + 1) / 2) as f64).sum::<f64>())
+        .sum()
 }
 
 /// Order `set`: both halves of a coordinate split first, then the separator.
-fn dissect(graph: &Graph, coords: &[[f64; 2]], side: &[AtomicU8], set: &mut [usize]) -> Vec<usize> {
+fn dissect(graph: &Graph, coords: &[[f64; 2]], reach: &[[f64; 2]], side: &[AtomicU8], set: &mut [usize]) -> Vec<usize> {
     if set.len() <= LEAF {
         return set.to_vec();
     }
@@ -193,7 +267,7 @@ fn dissect(graph: &Graph, coords: &[[f64; 2]], side: &[AtomicU8], set: &mut [usi
     // most unknowns can sit on that line, and a split along it is all separator)
     let mut best: Option<(Vec<usize>, Vec<usize>, Vec<usize>)> = None;
     for axis in 0..2 {
-        let Some(split) = split_along(graph, coords, side, set, axis) else { continue };
+        let Some(split) = split_along(graph, coords, reach, side, set, axis) else { continue };
         if best.as_ref().is_none_or(|b| split.2.len() < b.2.len()) {
             best = Some(split);
         }
@@ -205,9 +279,9 @@ fn dissect(graph: &Graph, coords: &[[f64; 2]], side: &[AtomicU8], set: &mut [usi
         side[i].store(0, Relaxed); // for good: the splits below must not see it as a half
     }
     let (mut oa, ob) = if set.len() >= PAR_MIN {
-        rayon::join(|| dissect(graph, coords, side, &mut a), || dissect(graph, coords, side, &mut b))
+        rayon::join(|| dissect(graph, coords, reach, side, &mut a), || dissect(graph, coords, reach, side, &mut b))
     } else {
-        (dissect(graph, coords, side, &mut a), dissect(graph, coords, side, &mut b))
+        (dissect(graph, coords, reach, side, &mut a), dissect(graph, coords, reach, side, &mut b))
     };
     oa.extend(ob);
     oa.extend(separator);
@@ -222,6 +296,7 @@ fn dissect(graph: &Graph, coords: &[[f64; 2]], side: &[AtomicU8], set: &mut [usi
 fn split_along(
     graph: &Graph,
     coords: &[[f64; 2]],
+    reach: &[[f64; 2]],
     side: &[AtomicU8],
     set: &mut [usize],
     axis: usize,
@@ -243,10 +318,15 @@ fn split_along(
     for &i in right {
         side[i].store(2, Relaxed);
     }
-    let coupled = |half: &[usize], other: u8| -> Vec<bool> {
-        half.iter().map(|&i| graph.neighbours(i).any(|j| side[j].load(Relaxed) == other)).collect()
+    // every coordinate of the left half is below every one of the right half
+    let left_max = left.iter().map(|&i| coords[i][axis]).fold(f64::NEG_INFINITY, f64::max);
+    let right_min = coords[right[0]][axis]; // the selected element: the smallest of its half
+    let coupled = |half: &[usize], other: u8, line: f64| -> Vec<bool> {
+        half.iter()
+            .map(|&i| (coords[i][axis] - line).abs() <= reach[i][axis] && graph.neighbours(i).any(|j| side[j].load(Relaxed) == other))
+            .collect()
     };
-    let (in_left, in_right) = (coupled(left, 2), coupled(right, 1));
+    let (in_left, in_right) = (coupled(left, 2, right_min), coupled(right, 1, left_max));
     let count = |flags: &[bool]| flags.iter().filter(|&&b| b).count();
     let pick = |half: &[usize], flags: &[bool], keep: bool| -> Vec<usize> {
         half.iter().zip(flags).filter(|p| *p.1 == keep).map(|p| *p.0).collect()
@@ -291,10 +371,12 @@ mod tests {
 
     #[test]
     fn flop_count_matches_amd_on_its_own_ordering() {
-        // the column-count routine against AMD's own count of the same ordering
+        // the column-count routine against AMD's own count of the same ordering, on the graph of
+        // the unknowns (every unknown a node of its own: all positions distinct)
         let (matrix, _) = system(16);
-        let graph = Graph::new(&matrix, matrix.n());
         let n = matrix.n();
+        let graph = Graph::new(&matrix, n, &distinct_positions(n));
+        assert_eq!(graph.n_nodes(), n);
         let pattern = faer::sparse::SymbolicSparseColMatRef::new_checked(n, n, &graph.ptr, None, &graph.adj);
         let (mut fwd, mut inv) = (vec![0u32; n], vec![0u32; n]);
         let mut mem = faer::dyn_stack::MemBuffer::new(faer::sparse::linalg::amd::order_maybe_unsorted_scratch::<u32>(n, graph.adj.len()));
@@ -310,6 +392,31 @@ mod tests {
         let ours = factorisation_flops(&graph, &order);
         let amd = f.n_div + f.n_mult_subs_ldl;
         assert!((ours - amd).abs() <= 1e-12 * amd, "ours {ours:e}, AMD {amd:e}");
+    }
+
+    fn distinct_positions(n: usize) -> Vec<[f64; 2]> {
+        (0..n).map(|i| [i as f64, 0.0]).collect()
+    }
+
+    #[test]
+    fn node_graph_flops_are_those_of_the_unknowns() {
+        // the weighted count on the node graph against the plain count on the graph of the
+        // unknowns, for both orderings, with the contact normals ordered apart (lone tangential
+        // unknowns) and with all unknowns ordered
+        let (matrix, coords) = system(12);
+        let n = matrix.n();
+        for n_order in [n - 13, n] {
+            let nodes = Graph::new(&matrix, n_order, &coords);
+            assert!(nodes.n_nodes() < n_order * 6 / 10, "{} nodes for {n_order} unknowns", nodes.n_nodes());
+            let unknowns = Graph::new(&matrix, n_order, &distinct_positions(n_order));
+            let node_coords: Vec<[f64; 2]> = nodes.first[..nodes.n_nodes()].iter().map(|&i| coords[i]).collect();
+            let nd = nested_dissection(&nodes, &node_coords);
+            let reversed: Vec<usize> = (0..nodes.n_nodes()).rev().collect();
+            for order in [nd, reversed] {
+                let (weighted, plain) = (factorisation_flops(&nodes, &order), factorisation_flops(&unknowns, &nodes.unknowns(&order)));
+                assert_eq!(weighted, plain, "n_order {n_order}");
+            }
+        }
     }
 
     #[test]

@@ -157,7 +157,7 @@ pub fn solve(
     let dofs = DofMap::new(&nodes, problem);
     let System { matrix, rhs, dirichlet } = assembly::assemble(mesh, &nodes, &dofs, problem);
     let assembly_time = t0.elapsed().as_secs_f64();
-    let strategy = options.strategy.unwrap_or(Strategy::auto(dofs.contact.len()));
+    let strategy = options.strategy.unwrap_or(Strategy::auto(dofs.contact.len(), dofs.n_free));
     let mut solver = ContactSolver::with_strategy(&matrix, dofs.n_interior, &dofs.unknown_coords(&nodes), strategy)?;
     let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
     let out = solver.solve_contact(&matrix, &rhs, &gap, options, observe)?.converged()?;

@@ -3,7 +3,11 @@
 //!
 //! Phases: assembly, symbolic factorisation, numeric factorisation (first in the process, and
 //! warm: a refactorisation of the same pattern), Schur complement, sparse solves, each
-//! active-set iteration. Speed lives here, never in timed tests.
+//! active-set iteration. Then what a user sees: whole contact solves in fresh processes (mesh,
+//! assembly, ordering, factorisation, active set, displacement and contact force), interleaved
+//! with NGSolve's whole linear solves of the same system in fresh processes, medians of three,
+//! and one scale point; the table of the targets of issue 15 with met / not met.
+//! Speed lives here, never in timed tests.
 
 use anyhow::Result;
 use clap::Parser;
@@ -12,6 +16,7 @@ use signorini::contact::{ContactSolver, PdasOptions};
 use signorini::mesh::{MeshSpec, P2Nodes};
 use signorini::problems::Ex72;
 use signorini::records;
+use signorini::solve;
 use std::time::Instant;
 
 #[derive(Parser)]
@@ -29,10 +34,328 @@ struct Args {
     /// NGSolve's timings of the same systems (crosscheck.py bench), printed side by side.
     #[arg(long, default_value = "results/bench/ngsolve_bench.json")]
     ngsolve: std::path::PathBuf,
+    /// Sizes of the whole-process comparison with NGSolve (fresh processes, interleaved).
+    #[arg(long, value_delimiter = ',', default_values_t = [256usize, 512])]
+    cold_sizes: Vec<usize>,
+    /// Fresh processes per size and solver in that comparison (medians are reported).
+    #[arg(long, default_value_t = 3)]
+    cold_repeats: usize,
+    /// The scale point: one whole contact solve on structured:SCALE in a fresh process (0: none).
+    #[arg(long, default_value_t = 1024)]
+    scale: usize,
+    /// The Python of the NGSolve cross-check (crosscheck/setup.sh creates it).
+    #[arg(long, default_value = "crosscheck/.venv/bin/python")]
+    python: std::path::PathBuf,
     /// Run the sizes in this process and print one JSON row per size (the parent runs every size
     /// in a child of its own, so that peak memory and first-touch costs are the size's own).
     #[arg(long, hide = true)]
     child: bool,
+    /// Run one whole contact solve of the first size in this process and print its JSON row.
+    #[arg(long, hide = true)]
+    cold_child: bool,
+}
+
+/// One whole contact solve in a fresh process: Example 7.2 on structured:N from nothing to the
+/// displacement and the contact force (what `signorini solve` does before the estimator).
+#[derive(serde::Serialize, serde::Deserialize, Clone)]
+struct ColdRun {
+    n: usize,
+    unknowns: usize,
+    whole_s: f64,
+    mesh_s: f64,
+    assembly_s: f64,
+    symbolic_s: f64,
+    numeric_s: f64,
+    /// Schur complement, sparse solves, active-set iterations and the residual
+    rest_s: f64,
+    pdas_iterations: usize,
+    peak_rss_mb: f64,
+}
+
+/// NGSolve's whole linear solve of the same system in a fresh process (`crosscheck.py bench-cold`).
+#[derive(serde::Serialize, serde::Deserialize, Clone)]
+struct NgRun {
+    #[serde(rename = "N")]
+    n: usize,
+    whole_s: f64,
+    mesh_s: f64,
+    assembly_s: f64,
+    factorisation_s: f64,
+    solve_s: f64,
+    peak_rss_mb: f64,
+}
+
+/// Medians of the fresh-process runs of one size.
+#[derive(serde::Serialize, serde::Deserialize, Clone)]
+struct ColdSize {
+    n: usize,
+    ours: Vec<ColdRun>,
+    ngsolve: Vec<NgRun>,
+    /// why NGSolve has no runs, if it has none
+    ngsolve_missing: Option<String>,
+}
+
+fn cold_solve(n: usize) -> Result<ColdRun> {
+    let t0 = Instant::now();
+    let mesh = MeshSpec::Structured(n).build(&Ex72)?;
+    let mesh_s = t0.elapsed().as_secs_f64();
+    let sol = solve::solve(&mesh, &Ex72, &PdasOptions::default(), &mut |_| {})?;
+    let whole_s = t0.elapsed().as_secs_f64();
+    let t = &sol.timings;
+    let (symbolic_s, numeric_s) = (t.contact.symbolic, t.contact.numeric);
+    Ok(ColdRun {
+        n,
+        unknowns: sol.dofs.n_free,
+        whole_s,
+        mesh_s,
+        assembly_s: t.assembly,
+        symbolic_s,
+        numeric_s,
+        rest_s: whole_s - mesh_s - t.assembly - symbolic_s - numeric_s,
+        pdas_iterations: sol.pdas.len(),
+        peak_rss_mb: peak_rss_mb(),
+    })
+}
+
+/// The JSON row a child printed after `ROW `.
+fn run_child<T: serde::de::DeserializeOwned>(cmd: &mut std::process::Command, what: &str) -> Result<T> {
+    let out = cmd.stderr(std::process::Stdio::inherit()).output()?;
+    anyhow::ensure!(out.status.success(), "{what} failed ({})", out.status);
+    let text = String::from_utf8_lossy(&out.stdout);
+    let row = text.lines().find_map(|l| l.strip_prefix("ROW ")).ok_or_else(|| anyhow::anyhow!("no result from {what}"))?;
+    Ok(serde_json::from_str(row)?)
+}
+
+fn ours_cold(n: usize) -> Result<ColdRun> {
+    let exe = std::env::current_exe()?;
+    run_child(std::process::Command::new(exe).args(["--cold-child", "--sizes", &n.to_string()]), &format!("our solve of structured:{n}"))
+}
+
+fn ngsolve_cold(python: &std::path::Path, n: usize) -> Result<NgRun> {
+    run_child(
+        std::process::Command::new(python).args(["crosscheck/crosscheck.py", "--out-dir", "", "bench-cold", "--n", &n.to_string()]),
+        &format!("NGSolve's solve of structured:{n}"),
+    )
+}
+
+fn load() -> String {
+    std::fs::read_to_string("/proc/loadavg").map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" ")).unwrap_or_default()
+}
+
+/// Fresh processes, ours and NGSolve's interleaved, `repeats` of each per size.
+fn cold_comparison(sizes: &[usize], repeats: usize, python: &std::path::Path) -> Result<Vec<ColdSize>> {
+    let have_ngsolve = python.exists();
+    let mut out = Vec::new();
+    if !sizes.is_empty() {
+        println!("\nwhole solves in fresh processes (ours: contact solve; NGSolve: linear solve), interleaved:");
+    }
+    for &n in sizes {
+        let mut size = ColdSize {
+            n,
+            ours: Vec::new(),
+            ngsolve: Vec::new(),
+            ngsolve_missing: (!have_ngsolve).then(|| format!("no NGSolve: {} does not exist (crosscheck/setup.sh)", python.display())),
+        };
+        for r in 0..repeats.max(1) {
+            let ours = ours_cold(n)?;
+            println!(
+                "  structured:{n} run {}: ours {:.3} s (mesh {:.3}, assembly {:.3}, symbolic {:.3}, numeric {:.3}, rest {:.3}), peak {:.0} MB; load {}",
+                r + 1,
+                ours.whole_s,
+                ours.mesh_s,
+                ours.assembly_s,
+                ours.symbolic_s,
+                ours.numeric_s,
+                ours.rest_s,
+                ours.peak_rss_mb,
+                load()
+            );
+            size.ours.push(ours);
+            if have_ngsolve {
+                let ng = ngsolve_cold(python, n)?;
+                println!(
+                    "  structured:{n} run {}: NGSolve {:.3} s (mesh {:.3}, assembly {:.3}, factorisation {:.3}, solve {:.3}), peak {:.0} MB; load {}",
+                    r + 1,
+                    ng.whole_s,
+                    ng.mesh_s,
+                    ng.assembly_s,
+                    ng.factorisation_s,
+                    ng.solve_s,
+                    ng.peak_rss_mb,
+                    load()
+                );
+                size.ngsolve.push(ng);
+            }
+        }
+        out.push(size);
+    }
+    Ok(out)
+}
+
+/// The scale point: our whole solve on structured:N once if its memory estimate fits; NGSolve's
+/// only if its peak, extrapolated from the largest compared size, fits in 80 % of the available memory.
+fn scale_point(n: usize, cold: &[ColdSize], python: &std::path::Path) -> Result<ColdSize> {
+    let spec = MeshSpec::Structured(n);
+    let ndof = spec.ndof()?;
+    solve::check_memory(&spec.to_string(), ndof)?;
+    println!("\nscale point structured:{n} ({ndof:.0} unknowns), load {}:", load());
+    let ours = ours_cold(n)?;
+    println!("  ours {:.3} s, peak {:.0} MB", ours.whole_s, ours.peak_rss_mb);
+    let mut size = ColdSize { n, ours: vec![ours], ngsolve: Vec::new(), ngsolve_missing: None };
+    let largest = cold.iter().filter(|c| !c.ngsolve.is_empty()).max_by_key(|c| c.n);
+    let Some(largest) = largest else {
+        size.ngsolve_missing = Some("not run: no NGSolve measurement to extrapolate its memory from".into());
+        return Ok(size);
+    };
+    // the factor grows slightly faster than the unknowns: 10 % on top of their ratio
+    let factor = 1.1 * (n as f64 / largest.n as f64).powi(2);
+    let needed_mb = factor * median(largest.ngsolve.iter().map(|r| r.peak_rss_mb).collect());
+    let available_mb = solve::available_memory().unwrap_or(0.0) / (1024.0 * 1024.0);
+    if needed_mb > 0.8 * available_mb {
+        size.ngsolve_missing = Some(format!(
+            "not run: about {needed_mb:.0} MB needed (its structured:{} peak x {factor:.1}), {available_mb:.0} MB available",
+            largest.n
+        ));
+        println!("  NGSolve {}", size.ngsolve_missing.as_deref().unwrap_or_default());
+    } else {
+        let ng = ngsolve_cold(python, n)?;
+        println!("  NGSolve {:.3} s, peak {:.0} MB", ng.whole_s, ng.peak_rss_mb);
+        size.ngsolve.push(ng);
+    }
+    Ok(size)
+}
+
+/// One line of the targets' table.
+#[derive(serde::Serialize)]
+struct Target {
+    target: String,
+    n: usize,
+    ours: f64,
+    reference: Option<f64>,
+    value: Option<f64>,
+    goal: String,
+    met: Option<bool>,
+    note: String,
+}
+
+/// The targets of issue 15, each with the measured value and whether it is met.
+fn targets(phases: &[SizeResult], cold: &[ColdSize], scale: Option<&ColdSize>) -> Vec<Target> {
+    let mut t = Vec::new();
+    let med = |v: Vec<f64>| if v.is_empty() { None } else { Some(median(v)) };
+    let goal_max = [(256, 0.40), (512, 0.45)];
+    for c in cold {
+        let ours = median(c.ours.iter().map(|r| r.whole_s).collect());
+        let ng = med(c.ngsolve.iter().map(|r| r.whole_s).collect());
+        let missing = c.ngsolve_missing.clone().unwrap_or_default();
+        if let Some(&(_, g)) = goal_max.iter().find(|(n, _)| *n == c.n) {
+            let value = ng.map(|ng| ours / ng);
+            t.push(Target {
+                target: "cold whole solve / NGSolve's whole linear solve [s]".into(),
+                n: c.n,
+                ours,
+                reference: ng,
+                value,
+                goal: format!("<= {g:.2}"),
+                met: value.map(|v| v <= g),
+                note: missing.clone(),
+            });
+        }
+        if c.n == 512 {
+            let ours = median(c.ours.iter().map(|r| r.peak_rss_mb).collect());
+            let ng = med(c.ngsolve.iter().map(|r| r.peak_rss_mb).collect());
+            let value = ng.map(|ng| ours / ng);
+            t.push(Target {
+                target: "peak memory / NGSolve's [MB]".into(),
+                n: c.n,
+                ours,
+                reference: ng,
+                value,
+                goal: "<= 0.60".into(),
+                met: value.map(|v| v <= 0.6),
+                note: missing.clone(),
+            });
+            let sym = median(c.ours.iter().map(|r| r.symbolic_s / r.whole_s).collect());
+            t.push(Target {
+                target: "symbolic analysis / cold whole solve".into(),
+                n: c.n,
+                ours: median(c.ours.iter().map(|r| r.symbolic_s).collect()),
+                reference: Some(median(c.ours.iter().map(|r| r.whole_s).collect())),
+                value: Some(sym),
+                goal: "<= 0.10".into(),
+                met: Some(sym <= 0.1),
+                note: String::new(),
+            });
+        }
+        if c.n >= 256 {
+            let ours = median(c.ours.iter().map(|r| r.assembly_s).collect());
+            let ng = med(c.ngsolve.iter().map(|r| r.assembly_s).collect());
+            let value = ng.map(|ng| ng / ours);
+            t.push(Target {
+                target: "NGSolve's assembly / ours (cold) [s]".into(),
+                n: c.n,
+                ours,
+                reference: ng,
+                value,
+                goal: ">= 2.00".into(),
+                met: value.map(|v| v >= 2.0),
+                note: missing,
+            });
+        }
+    }
+    if let Some(p) = phases.iter().find(|p| p.n == 512).or_else(|| phases.iter().max_by_key(|p| p.n)) {
+        let value = p.median.numeric_first / p.median.numeric_warm;
+        t.push(Target {
+            target: "first numeric factorisation / refactorisation [s]".into(),
+            n: p.n,
+            ours: p.median.numeric_first,
+            reference: Some(p.median.numeric_warm),
+            value: Some(value),
+            goal: "<= 1.30".into(),
+            met: Some(value <= 1.3),
+            note: "one process".into(),
+        });
+    }
+    if let Some(s) = scale {
+        let ours = &s.ours[0];
+        let ng = s.ngsolve.first();
+        t.push(Target {
+            target: "scale point: whole contact solve [s]".into(),
+            n: s.n,
+            ours: ours.whole_s,
+            reference: ng.map(|r| r.whole_s),
+            value: ng.map(|r| ours.whole_s / r.whole_s),
+            goal: "runs".into(),
+            met: Some(true),
+            note: s.ngsolve_missing.clone().unwrap_or_default(),
+        });
+        t.push(Target {
+            target: "scale point: peak memory [MB]".into(),
+            n: s.n,
+            ours: ours.peak_rss_mb,
+            reference: ng.map(|r| r.peak_rss_mb),
+            value: ng.map(|r| ours.peak_rss_mb / r.peak_rss_mb),
+            goal: "fits in 24 GiB".into(),
+            met: Some(ours.peak_rss_mb < 24.0 * 1024.0),
+            note: s.ngsolve_missing.clone().unwrap_or_default(),
+        });
+    }
+    let opt = |v: Option<f64>, p: usize| v.map_or("-".to_string(), |v| format!("{v:.p$}"));
+    println!("\ntargets (issue 15; our cold contact solve against NGSolve's cold linear solve, fresh processes, medians):");
+    println!("{:<52} {:>5} {:>10} {:>10} {:>7}  {:<15} {:<8} note", "target", "N", "ours", "reference", "value", "goal", "met");
+    for r in &t {
+        println!(
+            "{:<52} {:>5} {:>10.3} {:>10} {:>7}  {:<15} {:<8} {}",
+            r.target,
+            r.n,
+            r.ours,
+            opt(r.reference, 3),
+            opt(r.value, 2),
+            r.goal,
+            r.met.map_or("-", |m| if m { "met" } else { "not met" }),
+            r.note
+        );
+    }
+    t
 }
 
 #[derive(serde::Serialize, serde::Deserialize, Default, Clone)]
@@ -99,6 +422,11 @@ const HEADER: &str = "    N  unknowns | assembly symbolic num.first  num.warm   
 
 fn main() -> Result<()> {
     let args = Args::parse();
+    if args.cold_child {
+        let n = *args.sizes.first().ok_or_else(|| anyhow::anyhow!("--cold-child needs a size"))?;
+        println!("ROW {}", serde_json::to_string(&cold_solve(n)?)?);
+        return Ok(());
+    }
     if args.child {
         for &n in &args.sizes {
             println!("ROW {}", serde_json::to_string(&bench_size(n, args.repeats)?)?);
@@ -140,6 +468,9 @@ fn main() -> Result<()> {
         breakdown(last);
     }
     let comparison = side_by_side(&results, &args.ngsolve);
+    let cold = cold_comparison(&args.cold_sizes, args.cold_repeats, &args.python)?;
+    let scale = if args.scale > 0 { Some(scale_point(args.scale, &cold, &args.python)?) } else { None };
+    let targets = targets(&results, &cold, scale.as_ref());
     let doc = serde_json::json!({
         "benchmark": "Example 7.2 contact solve on structured:N (seconds; medians over repeats; numeric_first is the first factorisation in the process; every size in a process of its own, peak_rss_mb its peak resident memory)",
         "repeats": args.repeats,
@@ -147,6 +478,9 @@ fn main() -> Result<()> {
         "ngsolve": args.ngsolve,
         "comparison": comparison,
         "sizes": results,
+        "cold": cold,
+        "scale": scale,
+        "targets": targets,
     });
     records::write_json(&args.out, &doc)?;
     println!("wrote {}", args.out.display());

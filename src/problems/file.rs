@@ -581,7 +581,11 @@ impl FileProblem {
                         return Err(r.error("material.nu", nu_span, format!("a Poisson ratio in (-1, 1) in plane stress, got {nu}")));
                     }
                     other => {
-                        return Err(r.error("material.model", model.span(), format!("\"plane_strain\" or \"plane_stress\", got {other:?}")));
+                        return Err(r.error(
+                            "material.model",
+                            model.span(),
+                            format!("\"plane_strain\" or \"plane_stress\", got {other:?}"),
+                        ));
                     }
                 }
             }
