@@ -78,7 +78,8 @@ pub struct Comparison {
     pub hertz_peak_pressure: f64,
     /// max over active nodes of |p_h - p| / p0 (Hertz's p at the measured force).
     pub profile_deviation: f64,
-    /// Where the contact is centred: the abscissa of the peak pressure's node.
+    /// Where the contact is centred: the midpoint of the discrete zone (of the two sides' midpoints
+    /// between the outermost active and the next node); the profile is compared about it.
     pub centre: f64,
 }
 
@@ -123,7 +124,7 @@ pub fn compare(hertz: &Hertz, nodes: &[ContactSample]) -> Option<Comparison> {
         hertz_half_width: hertz.half_width(force),
         hertz_peak_pressure: p0,
         profile_deviation,
-        centre: peak.x[0],
+        centre: mid,
     })
 }
 
