@@ -725,6 +725,71 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     Ok(())
 }
 
+/// The tolerance of the Hertz check: a and p0 within 2% of Hertz's on the finest adaptive mesh.
+pub const HERTZ_TOLERANCE: f64 = 0.02;
+
+/// Hertz's cylinder on a flat (study `hertz`, beyond the paper): the half-width and peak pressure
+/// of the finest adaptive mesh of each run against Hertz's at the run's computed force. The run
+/// `adaptive` is judged; the others (a smaller load) measure how far the finite body is from
+/// Hertz's half-spaces.
+fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
+    let runs = StudyDir::new(ctx.results, "hertz").read_runs()?;
+    let mut rows = Vec::new();
+    let mut judged = None;
+    for r in &runs {
+        let Some(snap) = latest_mesh(ctx.results, "hertz", &r.run.id) else { continue };
+        let problem = crate::study::stored_problem(ctx.results, "hertz", &r.run).map_err(|e| std::io::Error::other(format!("{e:#}")))?;
+        let Some(h) = crate::hertz::for_problem(problem.as_ref()) else {
+            rows.push(format!("{}: problem {} has no circular contact group", r.run.id, r.run.problem));
+            continue;
+        };
+        let Some(c) = crate::hertz::compare(&h, &snap.contact_nodes) else {
+            rows.push(format!("{}: contact zone not resolved at level {}", r.run.id, snap.level));
+            continue;
+        };
+        let res = c.half_width_resolution / c.hertz_half_width;
+        rows.push(format!(
+            "{} (level {}, NDF {}): F = {:.4}, a/R = {:.4}; a_h = {:.5} ± {:.5} vs Hertz {:.5} ({:+.2}% ± {:.2}%); p0_h = {:.3} vs {:.3} ({:+.2}%); profile max |p_h - p|/p0 = {:.3}",
+            r.run.id,
+            snap.level,
+            snap.ndof,
+            c.force,
+            c.hertz_half_width / h.radius,
+            c.half_width,
+            c.half_width_resolution,
+            c.hertz_half_width,
+            100.0 * c.half_width_deviation(),
+            100.0 * res,
+            c.peak_pressure,
+            c.hertz_peak_pressure,
+            100.0 * c.peak_deviation(),
+            c.profile_deviation
+        ));
+        if r.run.id == "adaptive" {
+            let a_dev = c.half_width_deviation();
+            let (lo, hi) = (a_dev.abs() - res, a_dev.abs() + res);
+            let p_dev = c.peak_deviation().abs();
+            judged = Some(if hi <= HERTZ_TOLERANCE && p_dev <= HERTZ_TOLERANCE {
+                Verdict::Holds
+            } else if lo > HERTZ_TOLERANCE || p_dev > HERTZ_TOLERANCE {
+                Verdict::Fails
+            } else {
+                Verdict::Inconclusive
+            });
+        }
+    }
+    out.push(Claim {
+        id: "hertz",
+        claim: format!(
+            "Hertz (beyond the paper): an elastic cylinder (plane strain) on a rigid flat, adaptive with the paper's estimator: on the finest mesh the contact half-width a (± half the node spacing at the zone's ends) and the peak pressure p0 within {:.0}% of Hertz's a = sqrt(4FR(1 - nu^2)/(pi E)), p0 = 2F/(pi a) at the computed force F; the run with the smaller load measures the finite-size deviation",
+            100.0 * HERTZ_TOLERANCE
+        ),
+        measured: if rows.is_empty() { "no data".into() } else { rows.join("; ") },
+        verdict: judged.unwrap_or(Verdict::NoData),
+    });
+    Ok(())
+}
+
 /// Every claim with errors sampled one way.
 pub fn claims_with(results: &Path, sampling: ErrorSampling) -> std::io::Result<Vec<Claim>> {
     let ctx = Ctx { sampling, results };
@@ -734,6 +799,7 @@ pub fn claims_with(results: &Path, sampling: ErrorSampling) -> std::io::Result<V
     ex72_claims(&ctx, &mut out)?;
     log_factor_claim(&ctx, &mut out)?;
     fb_claims(&ctx, &mut out)?;
+    hertz_claims(&ctx, &mut out)?;
     Ok(out)
 }
 

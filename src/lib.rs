@@ -14,6 +14,7 @@ pub mod claims;
 pub mod contact;
 pub mod element;
 pub mod estimate;
+pub mod hertz;
 pub mod mesh;
 pub mod norms;
 pub mod ordering;

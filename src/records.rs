@@ -153,6 +153,10 @@ pub struct RunSpec {
     pub reference: Option<ReferenceSpec>,
     /// Levels whose mesh and fields are written as VTU (and as JSON for the mesh figure).
     pub save_levels: Vec<usize>,
+    /// Values for some of a problem file's `[constants]` (the same problem at another load);
+    /// empty for the file's own values and for built-in problems.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub constants: std::collections::BTreeMap<String, f64>,
 }
 
 /// How a reference solution is computed: adaptive refinement (maximum strategy with `theta`,
@@ -177,7 +181,19 @@ pub struct RunRecord {
     pub reference_ndof: Option<usize>,
 }
 
-/// A mesh snapshot for the mesh figure: vertices, triangles, and the contact nodes (active or not).
+/// A contact node of a discrete solution: its position, the nodal contact force lambda_p (paper
+/// eq. 3.6, in the constraint direction), the pressure lambda_p / int_{Gamma_C} psi_p ds (psi_p the
+/// P2 basis function of the node; see `solve::contact_samples`) and whether it is active.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactSample {
+    pub x: [f64; 2],
+    pub lambda: f64,
+    pub pressure: f64,
+    pub active: bool,
+}
+
+/// A mesh snapshot for the mesh figure: vertices, triangles, and the contact nodes (active or not,
+/// with their contact forces).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MeshSnapshot {
     pub study: String,
@@ -186,8 +202,8 @@ pub struct MeshSnapshot {
     pub ndof: usize,
     pub vertices: Vec<[f64; 2]>,
     pub triangles: Vec<[usize; 3]>,
-    /// Coordinates of the contact nodes and whether each is active.
-    pub contact_nodes: Vec<([f64; 2], bool)>,
+    /// The contact nodes, in the order of the contact unknowns.
+    pub contact_nodes: Vec<ContactSample>,
     /// Points the problem requires as vertices (the obstacle's kink).
     pub kinks: Vec<[f64; 2]>,
 }
@@ -320,6 +336,7 @@ mod tests {
                 estimator: EstimatorConfig::default(),
                 reference: None,
                 save_levels: vec![],
+                constants: Default::default(),
             },
             levels: vec![level.clone(), LevelRecord { level: 1, ..level }],
             reference_ndof: None,

@@ -350,3 +350,36 @@ pub fn contact_density(mesh: &Mesh, sol: &DiscreteSolution) -> Vec<f64> {
     }
     sol.lambda.iter().zip(&weight).map(|(l, w)| l / w).collect()
 }
+
+/// The contact nodes with their nodal forces and the pressure p_h(p) = lambda_p / int psi_p ds, psi_p
+/// the node's P2 basis function on Gamma_C (a sixth of each adjacent contact edge's length for a
+/// vertex, two thirds of its edge for an edge midpoint): the weights for which a constant or
+/// linear pressure p gives nodal forces lambda_p = int p psi_p ds with p_h = p at the nodes. The
+/// paper's density (`contact_density`, eq. 4.5) divides by integrals of piecewise-linear hats
+/// instead, which for a smooth pressure alternates between 2/3 p at vertices and 4/3 p at
+/// midpoints: fine for its sign, not for a pressure profile.
+pub fn contact_samples(mesh: &Mesh, sol: &DiscreteSolution) -> Vec<crate::records::ContactSample> {
+    let mut weight = vec![0.0; sol.dofs.contact.len()];
+    for (be, bn) in mesh.boundary.iter().zip(&sol.nodes.boundary_nodes) {
+        if be.part != crate::mesh::Part::Contact {
+            continue;
+        }
+        let len = crate::mesh::dist(mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
+        for (i, &p) in bn.iter().enumerate() {
+            if let Some(k) = sol.dofs.contact_index[p] {
+                weight[k] += if i < 2 { len / 6.0 } else { 2.0 * len / 3.0 };
+            }
+        }
+    }
+    sol.dofs
+        .contact
+        .iter()
+        .enumerate()
+        .map(|(k, c)| crate::records::ContactSample {
+            x: sol.nodes.coords[c.node],
+            lambda: sol.lambda[k],
+            pressure: sol.lambda[k] / weight[k],
+            active: sol.active[k],
+        })
+        .collect()
+}

@@ -90,6 +90,7 @@ impl Run<'_> {
                 estimator: self.estimator,
                 reference: None,
                 save_levels: vec![20],
+                constants: Default::default(),
             },
             levels: lv,
             reference_ndof: (self.problem == "ex72").then_some(2_000_000),
@@ -154,7 +155,8 @@ fn mesh_snapshot() -> MeshSnapshot {
             triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
         }
     }
-    let contact_nodes = ys.iter().map(|&y| ([1.0, y], (y - 0.5).abs() < 0.22)).collect();
+    let contact_nodes =
+        ys.iter().map(|&y| signorini::records::ContactSample { x: [1.0, y], lambda: 0.0, pressure: 0.0, active: (y - 0.5).abs() < 0.22 }).collect();
     MeshSnapshot {
         study: "ex72".into(),
         run: "adaptive".into(),

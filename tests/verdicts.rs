@@ -179,6 +179,7 @@ fn record(id: &str, refine: Refine, levels: Vec<LevelRecord>) -> RunRecord {
         estimator: EstimatorConfig::default(),
         reference: None,
         save_levels: vec![],
+        constants: Default::default(),
     };
     RunRecord { study: "fb".into(), run, levels, reference_ndof: None }
 }

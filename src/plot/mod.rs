@@ -27,6 +27,7 @@
 //! | `contact_term_ablation` | `contact_term_ablation`, a panel per problem | `estimate` (solid) and `eta5` (dashed) vs NDF for each `estimator.contact_term` |
 //! | `theta_ablation` | `theta_ablation`, a panel per problem | `err_quadrature` vs NDF for each theta and uniform, with NDF^-3/2; where some run of a problem has fewer than two errors, the estimate for all runs of that problem instead (the y label says which) |
 //! | `fb_error`, `fb_mesh` | `fb` | see [`fb`]: error and estimate vs NDF of the free-boundary problem, and its late adaptive mesh with x = a marked |
+//! | `hertz_pressure`, `hertz_mesh` | `hertz` | see [`hertz`]: the contact pressure against Hertz's, and the mesh near the contact |
 //!
 //! Style: log axes labelled at the decades (`10⁻⁴`; also 2x and 5x when less than two decades
 //! show), light grid lines at 2..9 x each decade; one colour and marker shape per series; the
@@ -52,6 +53,7 @@
 
 mod axis;
 mod fb;
+mod hertz;
 mod render;
 mod rich;
 
@@ -65,7 +67,7 @@ use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// Every figure, in the order drawn.
-pub const FIGURES: [&str; 13] = [
+pub const FIGURES: [&str; 15] = [
     "fig2a",
     "fig2b",
     "fig3a",
@@ -79,6 +81,8 @@ pub const FIGURES: [&str; 13] = [
     "theta_ablation",
     "fb_error",
     "fb_mesh",
+    "hertz_pressure",
+    "hertz_mesh",
 ];
 
 /// C0 of Section 7.
@@ -197,6 +201,8 @@ fn build(name: &str, results: &Path) -> anyhow::Result<Built> {
         "theta_ablation" => theta_ablation(results),
         "fb_error" => fb::fb_error(results),
         "fb_mesh" => fb::fb_mesh(results),
+        "hertz_pressure" => hertz::hertz_pressure(results),
+        "hertz_mesh" => hertz::hertz_mesh(results),
         other => anyhow::bail!("unknown figure {other}"),
     }
 }
@@ -449,8 +455,8 @@ fn mesh_figure(s: &MeshSnapshot, note: &str) -> MeshFigure {
     MeshFigure {
         title: format!("{}: {} mesh at level {}{note}, NDF = {}", problem_title(&problem_of(s)), s.run, s.level, s.ndof),
         edges: edge_chains(&s.vertices, &s.triangles),
-        active: s.contact_nodes.iter().filter(|c| c.1).map(|c| p(c.0)).collect(),
-        inactive: s.contact_nodes.iter().filter(|c| !c.1).map(|c| p(c.0)).collect(),
+        active: s.contact_nodes.iter().filter(|c| c.active).map(|c| p(c.x)).collect(),
+        inactive: s.contact_nodes.iter().filter(|c| !c.active).map(|c| p(c.x)).collect(),
         kinks: s.kinks.iter().map(|&k| p(k)).collect(),
         vlines: Vec::new(),
         bbox,

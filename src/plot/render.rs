@@ -55,6 +55,8 @@ pub(crate) enum Marker {
     Cross,
     Plus,
     Star,
+    /// No marker: a curve drawn from many points (a closed-form solution).
+    None,
 }
 
 pub(crate) const MARKERS: [Marker; 8] =
@@ -167,6 +169,8 @@ pub(crate) struct Panel {
     pub x_desc: String,
     pub y_desc: String,
     pub y_scale: YScale,
+    /// Logarithmic x axis (NDF; the default) or linear (a coordinate, which may be negative).
+    pub x_log: bool,
     pub series: Vec<Series>,
     pub slopes: Vec<Slope>,
     pub hlines: Vec<HLine>,
@@ -181,6 +185,7 @@ impl Panel {
             x_desc: x_desc.into(),
             y_desc: y_desc.into(),
             y_scale: YScale::Log,
+            x_log: true,
             series: Vec::new(),
             slopes: Vec::new(),
             hlines: Vec::new(),
@@ -190,7 +195,7 @@ impl Panel {
 
     /// Whether any series has a point that can be drawn (on a linear axis at least).
     pub fn has_data(&self) -> bool {
-        self.series.iter().any(|s| s.points.iter().any(|&(x, y)| x > 0.0 && y.is_some_and(f64::is_finite)))
+        self.series.iter().any(|s| s.points.iter().any(|&(x, y)| (x > 0.0 || !self.x_log) && x.is_finite() && y.is_some_and(f64::is_finite)))
     }
 }
 
@@ -300,13 +305,13 @@ impl Prepared<'_> {
     }
 }
 
-fn prepare(series: &Series, y_log: bool) -> Prepared<'_> {
+fn prepare(series: &Series, x_log: bool, y_log: bool) -> Prepared<'_> {
     let mut segments = Vec::new();
     let mut current: Vec<(f64, f64)> = Vec::new();
     let (mut zeros, mut present) = (0, 0);
     for &(x, y) in &series.points {
         let ok = match y {
-            Some(v) if x > 0.0 && x.is_finite() && v.is_finite() => {
+            Some(v) if (x > 0.0 || !x_log) && x.is_finite() && v.is_finite() => {
                 present += 1;
                 if y_log && v <= 0.0 {
                     zeros += 1;
@@ -363,9 +368,11 @@ fn padded(values: &[f64], log: bool, pad: f64, min_decades: f64) -> Axis {
         }
         Axis::log(10f64.powf(a), 10f64.powf(b))
     } else {
+        // from 0 for positive data; padded on both sides where the data go below 0
         let lo = lo.min(0.0);
         let hi = if hi > lo { hi } else { lo + 1.0 };
-        Axis::linear(lo, hi + pad * (hi - lo))
+        let below = if lo < 0.0 { pad * (hi - lo) } else { 0.0 };
+        Axis::linear(lo - below, hi + pad * (hi - lo))
     }
 }
 
@@ -382,7 +389,7 @@ fn render_panel<DB: DrawingBackend>(
 
     // y scale
     let ys: Vec<f64> =
-        p.series.iter().flat_map(|s| s.points.iter().filter(|(x, _)| *x > 0.0).filter_map(|p| p.1)).filter(|v| v.is_finite()).collect();
+        p.series.iter().flat_map(|s| s.points.iter().filter(|(x, _)| *x > 0.0 || !p.x_log).filter_map(|p| p.1)).filter(|v| v.is_finite()).collect();
     let y_log = match p.y_scale {
         YScale::Log => true,
         YScale::Auto => {
@@ -391,14 +398,14 @@ fn render_panel<DB: DrawingBackend>(
             pos.len() == ys.len() && !pos.is_empty() && hi / lo > 10.0
         }
     };
-    let prepared: Vec<Prepared> = p.series.iter().map(|s| prepare(s, y_log)).collect();
+    let prepared: Vec<Prepared> = p.series.iter().map(|s| prepare(s, p.x_log, y_log)).collect();
     let xs: Vec<f64> = prepared.iter().flat_map(|s| s.points().map(|p| p.0)).collect();
     let mut yv: Vec<f64> = prepared.iter().flat_map(|s| s.points().map(|p| p.1)).collect();
     if xs.is_empty() {
         let msg = prepared.iter().map(|s| s.legend_label()).collect::<Vec<_>>().join("; ");
         return message(root, &area, &msg, m);
     }
-    let xa = padded(&xs, true, 0.06, 1.0);
+    let xa = padded(&xs, p.x_log, 0.06, 1.0);
 
     // reference slopes: (x0, y0, x1, y1)
     let lx = xs.iter().map(|x| x.log10()).fold(f64::NEG_INFINITY, f64::max);
@@ -739,6 +746,7 @@ pub(crate) fn draw_marker<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, (x,
         root.draw(&PathElement::new(closed, edge)).drawn()
     };
     match st.marker {
+        Marker::None => {}
         Marker::Circle => {
             root.draw(&Circle::new((x, y), r, fill)).drawn()?;
             root.draw(&Circle::new((x, y), r, edge)).drawn()?;
@@ -843,7 +851,8 @@ fn render_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, mesh: &MeshFig
         }
         rich::draw(root, text, FS_LEGEND, &BLACK, (HPos::Left, VPos::Center), (x + 30, cy), false, metrics)?;
     }
-    for (k, (_, text)) in m.vlines.iter().enumerate() {
+    // lines without a text share the legend entry of the one before
+    for (k, (_, text)) in m.vlines.iter().filter(|v| !v.1.is_empty()).enumerate() {
         let cy = y + row * (entries.len() + k) as i32 + row / 2;
         for (s0, s1) in [(x + 2, x + 9), (x + 14, x + 22)] {
             root.draw(&PathElement::new(vec![(s0, cy), (s1, cy)], vline)).drawn()?;

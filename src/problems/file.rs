@@ -513,17 +513,44 @@ impl Reader<'_> {
 impl FileProblem {
     /// Read and check a problem file. The problem's name is the file stem.
     pub fn load(path: &Path) -> Result<Self, ProblemFileError> {
+        Self::load_with(path, &BTreeMap::new())
+    }
+
+    /// Read a problem file with some of its `[constants]` given other values (a study's run
+    /// `constants` table: the same problem at another load). Constants defined from an
+    /// overridden one follow it; naming a constant the file does not declare is an error.
+    pub fn load_with(path: &Path, overrides: &BTreeMap<String, f64>) -> Result<Self, ProblemFileError> {
         let text = std::fs::read_to_string(path).map_err(|error| ProblemFileError::Read { file: path.to_path_buf(), error })?;
-        Self::parse(path, &text)
+        Self::parse_with(path, &text, overrides)
     }
 
     /// Parse a problem file's text; `path` names it in errors and gives the problem's name.
     pub fn parse(path: &Path, text: &str) -> Result<Self, ProblemFileError> {
-        let raw: FileToml = toml::from_str(text).map_err(|e| {
+        Self::parse_with(path, text, &BTreeMap::new())
+    }
+
+    /// [`FileProblem::parse`] with constants overridden (see [`FileProblem::load_with`]).
+    pub fn parse_with(path: &Path, text: &str, overrides: &BTreeMap<String, f64>) -> Result<Self, ProblemFileError> {
+        let mut raw: FileToml = toml::from_str(text).map_err(|e| {
             let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
             ProblemFileError::Syntax { file: path.to_path_buf(), line, column, message: e.message().trim_end().to_string() }
         })?;
         let mut r = Reader { file: path, text, constants: BTreeMap::new() };
+        for (name, value) in overrides {
+            if raw.constants.remove(name).is_none() || !value.is_finite() {
+                let declared = raw.constants.keys().filter(|k| !overrides.contains_key(*k)).cloned().collect::<Vec<_>>();
+                return Err(r.error(
+                    &format!("constants.{name}"),
+                    0..0,
+                    format!(
+                        "a study sets the constant `{name}` = {value}, but {} (the file declares: {})",
+                        if value.is_finite() { "the file does not declare it" } else { "a constant must be a finite number" },
+                        if declared.is_empty() { "none".to_string() } else { declared.join(", ") }
+                    ),
+                ));
+            }
+            r.constants.insert(name.clone(), *value);
+        }
         r.resolve_constants(&raw.constants)?;
         let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
 

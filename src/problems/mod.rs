@@ -120,6 +120,8 @@ pub enum ProblemError {
         known = KNOWN.join(", ")
     )]
     Unknown(String),
+    #[error("problem '{0}' is built in and has no constants to set; constants apply to problem files (NAME.toml)")]
+    Constants(String),
     #[error(transparent)]
     File(#[from] ProblemFileError),
 }
@@ -132,12 +134,21 @@ pub fn is_file(s: &str) -> bool {
 /// The problem `s` names: a built-in name ([`KNOWN`]) or the path of a problem file (ending in
 /// `.toml`, read and checked here; see [`file`] for the format).
 pub fn by_name(s: &str) -> Result<Box<dyn Problem>, ProblemError> {
+    load(s, &std::collections::BTreeMap::new())
+}
+
+/// [`by_name`] with some of a problem file's `[constants]` given other values (see
+/// [`FileProblem::load_with`]); a built-in problem has no constants to set.
+pub fn load(s: &str, constants: &std::collections::BTreeMap<String, f64>) -> Result<Box<dyn Problem>, ProblemError> {
+    if !constants.is_empty() && !is_file(s) {
+        return Err(ProblemError::Constants(s.to_string()));
+    }
     match s {
         "ex71" => Ok(Box::new(Ex71)),
         "ex72" => Ok(Box::new(Ex72)),
         "fb" => Ok(Box::new(Fb)),
         "patch" => Ok(Box::new(Patch::default())),
-        _ if is_file(s) => Ok(Box::new(FileProblem::load(Path::new(s))?)),
+        _ if is_file(s) => Ok(Box::new(FileProblem::load_with(Path::new(s), constants)?)),
         _ => Err(ProblemError::Unknown(s.to_string())),
     }
 }

@@ -100,6 +100,9 @@ struct RunToml {
     reference: Option<ReferenceToml>,
     /// `no_reference = true` in a run drops the defaults' reference.
     no_reference: Option<bool>,
+    /// Values for some of the problem file's `[constants]` (a run's entries override the
+    /// defaults' one by one).
+    constants: Option<std::collections::BTreeMap<String, f64>>,
 }
 
 /// A tolerance of the drift check: |fresh - stored| <= rel |stored| + floor scale, where scale is
@@ -228,13 +231,18 @@ impl Manifest {
             }
             let problem =
                 r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid(key("problem"), "a problem name", "nothing".into()))?;
-            if let Err(e) = crate::problems::by_name(&resolve_problem(path, &problem)) {
+            let mut constants = d.constants.clone().unwrap_or_default();
+            constants.extend(r.constants.clone().unwrap_or_default());
+            if let Err(e) = crate::problems::load(&resolve_problem(path, &problem), &constants) {
                 let expected = match e {
                     crate::problems::ProblemError::Unknown(_) => format!(
                         "a built-in problem ({}) or the path of a problem file (NAME.toml, relative to the manifest)",
                         crate::problems::KNOWN.join(", ")
                     ),
                     crate::problems::ProblemError::File(e) => format!("a valid problem file ({e})"),
+                    crate::problems::ProblemError::Constants(_) => {
+                        return Err(invalid(key("constants"), "no constants: the problem is built in", format!("{constants:?} for {problem:?}")));
+                    }
                 };
                 return Err(invalid(key("problem"), &expected, format!("{problem:?}")));
             }
@@ -273,6 +281,7 @@ impl Manifest {
                     contact_term: rf.contact_term.unwrap_or(ContactTerm::WithoutFullContact),
                 }),
                 save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
+                constants,
             };
             AdaptConfig::for_run(&spec).validate().map_err(|e| invalid(key(e.key), e.expected, e.got))?;
             let quick_levels = r.quick_levels.or(d.quick_levels).unwrap_or(levels.min(6));

@@ -339,10 +339,22 @@ pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<
     Ok(())
 }
 
+/// The problem a stored run of `study` solved: its spec's problem resolved against the manifest
+/// the provenance names, with the run's constants (for figures and claims that need the problem's
+/// data, such as Hertz's radius and material).
+pub fn stored_problem(results: &std::path::Path, study: &str, spec: &RunSpec) -> Result<Box<dyn problems::Problem>> {
+    let dir = StudyDir::new(results, study);
+    let file = dir.provenance_file();
+    let text = std::fs::read_to_string(&file).with_context(|| format!("reading {}", file.display()))?;
+    let prov: provenance::Provenance = serde_json::from_str(&text).with_context(|| format!("reading {}", file.display()))?;
+    let path = manifest::resolve_problem(std::path::Path::new(&prov.manifest), &spec.problem);
+    problems::load(&path, &spec.constants).with_context(|| format!("the problem of {study}/{}", spec.id))
+}
+
 /// The key of a run's reference solution in the cache: problem and mesh as resolved (two
 /// manifests may name different files by the same relative path).
 fn reference_key(spec: &RunSpec, problem: &str, mesh: &str) -> Option<String> {
-    spec.reference.as_ref().map(|r| format!("{}|{}|{}|{}|{:?}", problem, mesh, r.theta, r.min_ndof, r.contact_term))
+    spec.reference.as_ref().map(|r| format!("{}|{:?}|{}|{}|{}|{:?}", problem, spec.constants, mesh, r.theta, r.min_ndof, r.contact_term))
 }
 
 /// One run of the manifest at `manifest_file` (its problem and mesh files are relative to it): the
@@ -350,7 +362,7 @@ fn reference_key(spec: &RunSpec, problem: &str, mesh: &str) -> Option<String> {
 fn run_one(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, dir: &StudyDir, progress: bool) -> Result<Option<RunRecord>> {
     let problem_path = manifest::resolve_problem(manifest_file, &spec.problem);
     let mesh_path = manifest::resolve_mesh(manifest_file, &spec.mesh);
-    let problem = problems::by_name(&problem_path)?;
+    let problem = problems::load(&problem_path, &spec.constants)?;
     let mesh_spec = MeshSpec::parse(&mesh_path)?;
     crate::solve::check_memory(&format!("{study}/{}: the initial mesh {}", spec.id, spec.mesh), mesh_spec.ndof()?)?;
     if spec.reference.is_some() && problem.exact().is_some() {
@@ -455,12 +467,10 @@ fn save_level(study: &str, spec: &RunSpec, dir: &StudyDir, level: &Level, proble
     let (mesh, sol) = (level.mesh, level.solution);
     let n = sol.nodes.len();
     let (mut lambda, mut active, mut contact) = (vec![0.0; n], vec![0i32; n], vec![0i32; n]);
-    let mut contact_nodes = Vec::new();
     for (k, c) in sol.dofs.contact.iter().enumerate() {
         lambda[c.node] = sol.lambda[k];
         active[c.node] = sol.active[k] as i32;
         contact[c.node] = 1;
-        contact_nodes.push((sol.nodes.coords[c.node], sol.active[k]));
     }
     let doc = io::vtu(
         mesh,
@@ -482,7 +492,7 @@ fn save_level(study: &str, spec: &RunSpec, dir: &StudyDir, level: &Level, proble
         ndof: level.record.ndof,
         vertices: mesh.vertices.clone(),
         triangles: mesh.triangles.clone(),
-        contact_nodes,
+        contact_nodes: crate::solve::contact_samples(mesh, sol),
         kinks: problem.required_vertices(),
     };
     records::write_json(&dir.mesh_file(&spec.id, l, "json"), &snapshot)?;
