@@ -155,8 +155,10 @@ fn mesh_snapshot() -> MeshSnapshot {
             triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
         }
     }
-    let contact_nodes =
-        ys.iter().map(|&y| signorini::records::ContactSample { x: [1.0, y], lambda: 0.0, pressure: 0.0, active: (y - 0.5).abs() < 0.22 }).collect();
+    let contact_nodes = ys
+        .iter()
+        .map(|&y| signorini::records::ContactSample { x: [1.0, y], lambda: 0.0, pressure: 0.0, active: (y - 0.5).abs() < 0.22 })
+        .collect();
     MeshSnapshot {
         study: "ex72".into(),
         run: "adaptive".into(),

@@ -82,7 +82,11 @@ pub(super) fn hertz_pressure(results: &Path) -> anyhow::Result<Built> {
         });
         deviation.series.push(Series {
             label: format!("{} (a/R = {:.3}): max {:.3}", r.run.id, a / h.radius, c.profile_deviation),
-            points: nodes.iter().filter(|n| n.active).map(|n| (s(n), Some((n.pressure - h.pressure(c.force, n.x[0] - c.centre)) / p0))).collect(),
+            points: nodes
+                .iter()
+                .filter(|n| n.active)
+                .map(|n| (s(n), Some((n.pressure - h.pressure(c.force, n.x[0] - c.centre)) / p0)))
+                .collect(),
             style,
             roundoff: false,
         });

@@ -195,7 +195,9 @@ impl Panel {
 
     /// Whether any series has a point that can be drawn (on a linear axis at least).
     pub fn has_data(&self) -> bool {
-        self.series.iter().any(|s| s.points.iter().any(|&(x, y)| (x > 0.0 || !self.x_log) && x.is_finite() && y.is_some_and(f64::is_finite)))
+        self.series
+            .iter()
+            .any(|s| s.points.iter().any(|&(x, y)| (x > 0.0 || !self.x_log) && x.is_finite() && y.is_some_and(f64::is_finite)))
     }
 }
 
@@ -388,8 +390,12 @@ fn render_panel<DB: DrawingBackend>(
     }
 
     // y scale
-    let ys: Vec<f64> =
-        p.series.iter().flat_map(|s| s.points.iter().filter(|(x, _)| *x > 0.0 || !p.x_log).filter_map(|p| p.1)).filter(|v| v.is_finite()).collect();
+    let ys: Vec<f64> = p
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().filter(|(x, _)| *x > 0.0 || !p.x_log).filter_map(|p| p.1))
+        .filter(|v| v.is_finite())
+        .collect();
     let y_log = match p.y_scale {
         YScale::Log => true,
         YScale::Auto => {

@@ -241,7 +241,11 @@ impl Manifest {
                     ),
                     crate::problems::ProblemError::File(e) => format!("a valid problem file ({e})"),
                     crate::problems::ProblemError::Constants(_) => {
-                        return Err(invalid(key("constants"), "no constants: the problem is built in", format!("{constants:?} for {problem:?}")));
+                        return Err(invalid(
+                            key("constants"),
+                            "no constants: the problem is built in",
+                            format!("{constants:?} for {problem:?}"),
+                        ));
                     }
                 };
                 return Err(invalid(key("problem"), &expected, format!("{problem:?}")));
