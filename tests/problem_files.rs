@@ -280,6 +280,33 @@ fn constants_resolve_in_any_order_and_bad_ones_are_errors() {
     assert!(e.contains("key `constants.x`"), "{e}");
 }
 
+/// A study's run can give a constant another value: constants defined from it follow; a constant
+/// the file does not declare, or constants for a built-in problem, are errors.
+#[test]
+fn constants_can_be_overridden_from_a_run() {
+    use std::collections::BTreeMap;
+    let text = edit("chi = \"0.01*x\"", "chi = \"b*x\"") + "\n[constants]\nb = \"2*a\"\na = 1\n";
+    let set = |k: &str, v: f64| BTreeMap::from([(k.to_string(), v)]);
+    let p = FileProblem::parse_with(Path::new("c.toml"), &text, &set("a", 3.0)).unwrap();
+    assert_eq!(p.gap([0.5, 0.0]), 3.0);
+    let e = FileProblem::parse_with(Path::new("c.toml"), &text, &set("q", 3.0)).unwrap_err().to_string();
+    assert!(e.starts_with("c.toml") && e.contains("constants.q") && e.contains("declares: a, b"), "{e}");
+    let e = FileProblem::parse_with(Path::new("c.toml"), &text, &set("a", f64::NAN)).unwrap_err().to_string();
+    assert!(e.contains("finite"), "{e}");
+    let e = signorini::problems::load("ex71", &set("a", 1.0)).err().unwrap().to_string();
+    assert!(e.contains("built in") && e.contains("ex71"), "{e}");
+    let hertz = signorini::problems::load("experiments/problems/hertz.toml", &set("delta", 0.002)).unwrap();
+    assert_eq!(hertz.dirichlet([0.3, 1.0]), [0.0, -0.002]);
+}
+
+/// A problem whose parts are physical groups only, on a built-in mesh (which has none): a clear
+/// error instead of a singular system.
+#[test]
+fn groups_only_problem_on_a_built_in_mesh_is_an_error() {
+    let e = signorini::mesh::MeshSpec::parse("structured:4").unwrap().build(&file("hertz")).unwrap_err().to_string();
+    assert!(e.contains("physical group") && e.contains("structured:4") && e.contains("gmsh:"), "{e}");
+}
+
 #[test]
 fn group_errors() {
     let groups =

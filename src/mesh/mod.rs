@@ -93,6 +93,10 @@ pub enum MeshError {
     TagNotOnBoundary { a: usize, b: usize },
     #[error("triangle {t} refers to vertex {v}, but the mesh has {n} vertices")]
     BadVertex { t: usize, v: usize, n: usize },
+    #[error(
+        "the problem gives its boundary parts by Gmsh physical group ({groups}), but {mesh} is a built-in mesh without groups, and no Dirichlet edge is left: use a Gmsh mesh (gmsh:PATH.msh) or give the parts as predicates in x and y"
+    )]
+    GroupsOnBuiltIn { mesh: String, groups: String },
     #[error("required vertex ({x}, {y}) (a kink of the obstacle) is not a mesh vertex")]
     MissingVertex { x: f64, y: f64 },
     /// A Gmsh file that cannot be read, is malformed or does not fit the problem; `line` is the
@@ -152,11 +156,18 @@ impl MeshSpec {
     /// `problem.curve_of_group`).
     pub fn build(&self, problem: &dyn Problem) -> Result<Mesh, MeshError> {
         let part_of = |x: [f64; 2]| problem.part_of(x);
-        match self {
-            MeshSpec::Structured(n) => Ok(Mesh::unit_square(*n, false, &part_of)),
-            MeshSpec::Symmetric(n) => Ok(Mesh::unit_square(*n, true, &part_of)),
-            MeshSpec::Gmsh(path) => gmsh::read(path)?.mesh(problem),
+        let mesh = match self {
+            MeshSpec::Structured(n) => Mesh::unit_square(*n, false, &part_of),
+            MeshSpec::Symmetric(n) => Mesh::unit_square(*n, true, &part_of),
+            MeshSpec::Gmsh(path) => return gmsh::read(path)?.mesh(problem),
+        };
+        // a problem written for a Gmsh mesh (parts by physical group) on a built-in mesh, which has
+        // no groups: without this its predicates tag nothing Dirichlet and the system is singular
+        let groups = problem.groups();
+        if !groups.is_empty() && !mesh.boundary.iter().any(|e| e.part == Part::Dirichlet) {
+            return Err(MeshError::GroupsOnBuiltIn { mesh: self.to_string(), groups: groups.join(", ") });
         }
+        Ok(mesh)
     }
 }
 
