@@ -234,6 +234,62 @@ fn full_results(results: &Path) {
     write_study(results, "fb", &[fb("adaptive", Adaptive), without(fb("adaptive_wfc", Adaptive)), fb("uniform", Uniform)]);
     let snapshot = MeshSnapshot { study: "fb".into(), run: "adaptive_wfc".into(), level: 12, kinks: vec![], ..mesh_snapshot() };
     write_json(&StudyDir::new(results, "fb").mesh_file("adaptive_wfc", 12, "json"), &snapshot).unwrap();
+    hertz_results(results);
+}
+
+/// The hertz study: one run of the repository's Hertz problem file (found through the provenance's
+/// manifest, as for stored results), its last level with contact nodes sampling Hertz's pressure.
+fn hertz_results(results: &Path) {
+    use signorini::hertz::Hertz;
+    use signorini::problems::Material;
+    use signorini::records::ContactSample;
+    let mut r = run("adaptive", "problems/hertz.toml", Refine::Adaptive);
+    r.missing = never;
+    write_study(results, "hertz", &[r]);
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/hertz.toml");
+    let provenance = serde_json::json!({
+        "study": "hertz", "manifest": manifest.display().to_string(), "manifest_sha256": "", "quick": false,
+        "git_commit": null, "git_dirty": null, "cargo_lock_sha256": null, "rustc": null, "signorini_version": "test",
+        "machine": { "cpu": "test", "cores": 1, "memory_kb": null, "os": "test" }, "threads": 1, "date": "", "runs": ["adaptive"]
+    });
+    write_json(&StudyDir::new(results, "hertz").provenance_file(), &provenance).unwrap();
+    let h = Hertz::new(Material::from_young(1000.0, 0.3), 1.0);
+    let f = 2.35;
+    let n = 60;
+    let xs: Vec<f64> = (-n..=n).map(|k| 0.1 * k as f64 / n as f64).collect();
+    let contact_nodes = xs
+        .iter()
+        .map(|&x| {
+            let p = h.pressure(f, x);
+            ContactSample { x: [x, 1.0 - (1.0 - x * x).sqrt()], lambda: if x == 0.0 { f } else { 0.0 }, pressure: p, active: p > 0.0 }
+        })
+        .collect::<Vec<_>>();
+    let mut vertices = Vec::new();
+    let mut triangles = Vec::new();
+    for j in 0..=6 {
+        for &x in &xs {
+            vertices.push([x, 0.01 * j as f64]);
+        }
+    }
+    let w = xs.len();
+    for j in 0..6 {
+        for i in 0..w - 1 {
+            let (a, b, c, d) = (j * w + i, j * w + i + 1, (j + 1) * w + i + 1, (j + 1) * w + i);
+            triangles.push([a, b, c]);
+            triangles.push([a, c, d]);
+        }
+    }
+    let snapshot = MeshSnapshot {
+        study: "hertz".into(),
+        run: "adaptive".into(),
+        level: 19,
+        ndof: 2 * vertices.len(),
+        vertices,
+        triangles,
+        contact_nodes,
+        kinks: vec![],
+    };
+    write_json(&StudyDir::new(results, "hertz").mesh_file("adaptive", 19, "json"), &snapshot).unwrap();
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -270,11 +326,17 @@ fn every_figure_is_written_from_records() {
         std::fs::read_dir(&figures).unwrap().filter_map(|e| e.ok()).filter(|e| e.file_name().to_string_lossy().starts_with('.')).collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");
 
-    for name in FIGURES.iter().filter(|n| !["fig3b", "fig3b_variant", "fb_mesh"].contains(*n)) {
+    for name in FIGURES.iter().filter(|n| !["fig3b", "fig3b_variant", "fb_mesh", "hertz_pressure", "hertz_mesh"].contains(*n)) {
         let svg = read(&figures.join(format!("{name}.svg")));
         assert!(svg.contains("NDF (2 × P2 nodes"), "{name}: no NDF axis label");
         assert!(svg.contains("10³") || svg.contains("10⁴"), "{name}: no decade tick labels");
     }
+    // Hertz: the pressure against x / a (linear axes) with the recovered deviations, the mesh near the contact
+    let hertz = read(&figures.join("hertz_pressure.svg"));
+    for text in ["Hertz", "x / a", "(+0.00%)", "max 0.000"] {
+        assert!(hertz.contains(text), "hertz_pressure lacks {text:?}");
+    }
+    assert!(read(&figures.join("hertz_mesh.svg")).contains("Hertz&apos;s a = 0.05"));
     // labels are drawn in segments (subscripts separately): look for the pieces
     let fig2a = read(&figures.join("fig2a.svg"));
     for text in ["Example 7.1", "error ‖u − u", ", adaptive", "estimate C", ", uniform", "\nNDF\n", "−3/2"] {
