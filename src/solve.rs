@@ -336,6 +336,13 @@ pub struct ContactInterval {
 /// int psi_p ds is a quarter of the adjacent contact edge lengths for a vertex, half of its edge
 /// for an edge midpoint.
 pub fn contact_density(mesh: &Mesh, sol: &DiscreteSolution) -> Vec<f64> {
+    let weight = contact_weights(mesh, sol, |vertex, len| if vertex { 0.25 * len } else { 0.5 * len });
+    sol.lambda.iter().zip(&weight).map(|(l, w)| l / w).collect()
+}
+
+/// Per contact unknown, the sum over the contact edges at its node of `share(is_vertex, edge
+/// length)`: the integral of the node's basis function over Gamma_C, for the basis `share` describes.
+fn contact_weights(mesh: &Mesh, sol: &DiscreteSolution, share: impl Fn(bool, f64) -> f64) -> Vec<f64> {
     let mut weight = vec![0.0; sol.dofs.contact.len()];
     for (be, bn) in mesh.boundary.iter().zip(&sol.nodes.boundary_nodes) {
         if be.part != crate::mesh::Part::Contact {
@@ -344,11 +351,11 @@ pub fn contact_density(mesh: &Mesh, sol: &DiscreteSolution) -> Vec<f64> {
         let len = crate::mesh::dist(mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
         for (i, &p) in bn.iter().enumerate() {
             if let Some(k) = sol.dofs.contact_index[p] {
-                weight[k] += if i < 2 { 0.25 * len } else { 0.5 * len };
+                weight[k] += share(i < 2, len);
             }
         }
     }
-    sol.lambda.iter().zip(&weight).map(|(l, w)| l / w).collect()
+    weight
 }
 
 /// The contact nodes with their nodal forces and the pressure p_h(p) = lambda_p / int psi_p ds, psi_p
@@ -359,18 +366,7 @@ pub fn contact_density(mesh: &Mesh, sol: &DiscreteSolution) -> Vec<f64> {
 /// instead, which for a smooth pressure alternates between 2/3 p at vertices and 4/3 p at
 /// midpoints: fine for its sign, not for a pressure profile.
 pub fn contact_samples(mesh: &Mesh, sol: &DiscreteSolution) -> Vec<crate::records::ContactSample> {
-    let mut weight = vec![0.0; sol.dofs.contact.len()];
-    for (be, bn) in mesh.boundary.iter().zip(&sol.nodes.boundary_nodes) {
-        if be.part != crate::mesh::Part::Contact {
-            continue;
-        }
-        let len = crate::mesh::dist(mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
-        for (i, &p) in bn.iter().enumerate() {
-            if let Some(k) = sol.dofs.contact_index[p] {
-                weight[k] += if i < 2 { len / 6.0 } else { 2.0 * len / 3.0 };
-            }
-        }
-    }
+    let weight = contact_weights(mesh, sol, |vertex, len| if vertex { len / 6.0 } else { 2.0 * len / 3.0 });
     sol.dofs
         .contact
         .iter()
