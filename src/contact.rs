@@ -25,16 +25,15 @@
 //! refactorisation. Both strategies share one active-set driver ([`pdas`]).
 
 use crate::assembly::SymCsc;
+use crate::cholesky;
 use crate::ordering::OrderingChoice;
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, supernodal,
 };
-use faer::{Conj, Mat, Par, Side, Spec};
-use std::mem::MaybeUninit;
+use faer::{Conj, Mat, Par, Side};
 use std::time::Instant;
 
 /// Why the contact solve failed.
@@ -196,12 +195,10 @@ pub struct ContactSolver {
     n_interior: usize,
     strategy: Strategy,
     symbolic: SymbolicCholesky<usize>,
+    /// Where the matrix goes in L, and the schedule of the numeric factorisation.
+    plan: cholesky::Plan,
     /// The values of L, allocated once per symbolic factorisation.
     l_values: Vec<f64>,
-    /// Scratch of the numeric factorisation, allocated once and reused by every refactorisation.
-    scratch: Vec<MaybeUninit<u8>>,
-    /// Whether the pages of `l_values` and `scratch` have been populated ([`populate`]).
-    populated: bool,
     /// S = L_CC L_CC^T (m x m), Schur strategy only.
     schur: Mat<f64>,
     /// Refactor strategy: per contact node, the (column, position) of the off-diagonal entries
@@ -239,16 +236,19 @@ impl ContactSolver {
                 rows
             }
         };
+        let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else {
+            return Err(ContactError::Factorisation("expected a supernodal factorisation".into()));
+        };
+        let inv = symbolic.perm().expect("a custom ordering").arrays().1;
+        let plan = cholesky::Plan::new(sn, matrix, inv);
         timings.symbolic = t0.elapsed().as_secs_f64();
-        let scratch_bytes = symbolic.factorize_numeric_llt_scratch::<f64>(NUMERIC_PAR, Spec::default()).unaligned_bytes_required();
         let mut solver = ContactSolver {
             n: matrix.n(),
             n_interior,
             strategy,
-            // not touched here: the first factorisation populates them (see `factor_values`)
+            plan,
+            // not touched here: the first factorisation writes every value
             l_values: vec![0.0; symbolic.len_val()],
-            scratch: uninit_bytes(scratch_bytes),
-            populated: false,
             symbolic,
             schur: Mat::zeros(0, 0),
             row_entries,
@@ -267,7 +267,7 @@ impl ContactSolver {
     /// Schur complement).
     pub fn refactor(&mut self, matrix: &SymCsc) -> Result<(), ContactError> {
         self.timings.numeric = 0.0;
-        self.factor_values(matrix, matrix.values())?;
+        self.factor_values(matrix.values())?;
         if self.strategy == Strategy::Schur {
             let t0 = Instant::now();
             let lcc = self.trailing_factor_block()?;
@@ -277,29 +277,13 @@ impl ContactSolver {
         Ok(())
     }
 
-    /// Numeric factorisation of the pattern of `matrix` with the given values.
-    fn factor_values(&mut self, matrix: &SymCsc, values: &[f64]) -> Result<(), ContactError> {
+    /// Numeric factorisation of the pattern of `matrix` with the given values ([`cholesky`]).
+    fn factor_values(&mut self, values: &[f64]) -> Result<(), ContactError> {
         let t0 = Instant::now();
-        let sym = matrix.as_faer().symbolic();
-        // the first factorisation populates the memory of L and of the scratch on another thread
-        // while it runs on this one (see `populate`)
-        let regions = [region(&self.scratch), region(&self.l_values)];
-        let populated = std::mem::replace(&mut self.populated, true);
-        let result = std::thread::scope(|scope| {
-            if !populated {
-                scope.spawn(move || regions.into_iter().for_each(|(start, bytes)| populate(start, bytes)));
-            }
-            self.symbolic.factorize_numeric_llt(
-                &mut self.l_values,
-                faer::sparse::SparseColMatRef::new(sym, values),
-                Side::Lower,
-                LltRegularization::default(),
-                NUMERIC_PAR,
-                MemStack::new(&mut self.scratch),
-                Spec::default(),
-            )
-        });
-        result.map_err(|e| ContactError::NotPositiveDefinite(format!("{e:?}")))?;
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
+            return Err(ContactError::Factorisation("expected a supernodal factorisation".into()));
+        };
+        cholesky::factorize(sn, &self.plan, values, &mut self.l_values).map_err(|e| ContactError::NotPositiveDefinite(e.to_string()))?;
         self.timings.numeric += t0.elapsed().as_secs_f64();
         Ok(())
     }
@@ -471,7 +455,7 @@ impl ContactSolver {
             for k in (0..m).filter(|&k| active[k]) {
                 b[ni + k] = diag(k) * gap[k];
             }
-            self.factor_values(matrix, &values)?;
+            self.factor_values(&values)?;
             let u = self.solve(&b);
             let ku = matrix.mul(&u);
             let lambda: Vec<f64> = (0..m).map(|k| if active[k] { rhs[ni + k] - ku[ni + k] } else { 0.0 }).collect();
@@ -485,51 +469,6 @@ impl ContactSolver {
         }
         Ok((last_u, outcome, c))
     }
-}
-
-/// Parallelism of the numeric factorisation: one thread was faster than two for faer's sparse
-/// Cholesky on our matrices (it parallelises only inside supernodes).
-const NUMERIC_PAR: Par = Par::Seq;
-
-/// `len` bytes of scratch, neither initialised nor touched.
-fn uninit_bytes(len: usize) -> Vec<MaybeUninit<u8>> {
-    let mut v = Vec::with_capacity(len);
-    // SAFETY: MaybeUninit needs no initialisation
-    unsafe { v.set_len(len) };
-    v
-}
-
-/// The address and length in bytes of a slice's memory.
-fn region<T>(v: &[T]) -> (usize, usize) {
-    (v.as_ptr() as usize, std::mem::size_of_val(v))
-}
-
-/// Populate the pages of `bytes` bytes at address `start` (`madvise(MADV_POPULATE_WRITE)`, in
-/// chunks from the start): the kernel maps them writable as a first write would, without
-/// writing; pages already mapped stay as they are, so the memory's contents never change.
-///
-/// Why: a fresh process pays for the first touch of every page, on the virtual machines we
-/// measure on about 0.5-2 s per GB, huge pages or not; at `structured:512` the first numeric
-/// factorisation took 22 s against 8.7 s for a refactorisation. The factorisation runs on one
-/// thread and fills L front to back, so a second thread populating L ahead of it takes the
-/// faults out of its way. A no-op where the call is not supported (Linux before 5.14, others).
-fn populate(start: usize, bytes: usize) {
-    #[cfg(target_os = "linux")]
-    {
-        const PAGE: usize = 4096;
-        const CHUNK: usize = 8 << 20;
-        let (first, end) = (start.next_multiple_of(PAGE), (start + bytes) / PAGE * PAGE);
-        for at in (first..end).step_by(CHUNK) {
-            let len = CHUNK.min(end - at);
-            // SAFETY: the range lies inside one live allocation, and MADV_POPULATE_WRITE changes
-            // no contents (it only maps pages that a write would map)
-            if unsafe { libc::madvise(at as *mut libc::c_void, len, libc::MADV_POPULATE_WRITE) } != 0 {
-                return; // not supported here: the factorisation faults the pages in itself
-            }
-        }
-    }
-    #[cfg(not(target_os = "linux"))]
-    let _ = (start, bytes);
 }
 
 /// Symbolic Cholesky, supernodal, with the fill-reducing ordering of [`crate::ordering`].

@@ -1,0 +1,385 @@
+//! The numeric supernodal Cholesky factorisation P K P^T = L L^T, on every core.
+//!
+//! faer computes the symbolic factorisation (the supernodes: runs of columns of L with one row
+//! pattern, the layout of L's values) and solves with L; this module fills L's values. faer's
+//! own numeric step visits the supernodes one after another and parallelises only inside a
+//! supernode's dense kernels, which on our matrices was slower than one thread. Yet most of the
+//! work of a nested-dissection ordering lies in subtrees of the elimination tree that share
+//! nothing: the two halves of a dissection only meet in their separator. So here the supernodal
+//! elimination tree is the schedule: the subtrees of a supernode are factorised in parallel
+//! (rayon), the supernode itself once they are all done.
+//!
+//! Each supernode s is computed left-looking, as faer does, by one thread:
+//!
+//! ```text
+//!   L_s  = K_s - sum_{d in desc(s)} L_{d,rows(s)} L_{d,cols(s)}^T     (desc(s): the supernodes with rows in s's columns, ascending)
+//!   L_ss = chol(L_ss),   L_{s,below} = L_{s,below} L_ss^{-T}
+//! ```
+//!
+//! with sequential dense kernels. The descendants are visited in the same order and every update
+//! is computed the same way whichever thread runs it, so L is bitwise the same on any number of
+//! threads; only the order in which independent supernodes finish changes.
+//!
+//! Written by hand because faer 0.24 has no tree-parallel numeric factorisation (and keeps its
+//! lists of descendants private, so [`Plan`] rebuilds them from the public structure). The
+//! dense kernels (products, Cholesky, triangular solve) are faer's.
+
+use crate::assembly::SymCsc;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{LltParams, LltRegularization};
+use faer::linalg::matmul::triangular::BlockStructure;
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
+use faer::{Accum, MatMut, MatRef, Par, Spec};
+use rayon::prelude::*;
+use std::cell::RefCell;
+
+/// Subtrees with less work than this share of the whole are factorised by one thread, in one
+/// task (finer tasks cost more to schedule than they gain).
+const TASK_SHARE: f64 = 1.0 / 256.0;
+
+/// What the numeric factorisation needs beyond faer's symbolic structure, computed once per
+/// symbolic factorisation: the supernodal elimination tree, the descendants that update each
+/// supernode, and where every entry of the matrix goes in L.
+pub struct Plan {
+    /// Descendants updating supernode s: `upd[upd_ptr[s]..upd_ptr[s + 1]]`, ascending.
+    upd_ptr: Vec<usize>,
+    upd: Vec<u32>,
+    /// Children of supernode s in the supernodal elimination tree: `kids[kid_ptr[s]..kid_ptr[s + 1]]`.
+    kid_ptr: Vec<usize>,
+    kids: Vec<u32>,
+    roots: Vec<u32>,
+    /// Flops (multiply-add pairs) of the subtree of each supernode.
+    work: Vec<f64>,
+    /// Subtrees with less work are one task.
+    task_work: f64,
+    /// The matrix entries of supernode s: `entries[entry_ptr[s]..entry_ptr[s + 1]]`, each
+    /// (offset in the supernode's block of L, position in the matrix's values).
+    entry_ptr: Vec<usize>,
+    entries: Vec<(u32, u32)>,
+    /// The largest update product (rows x columns) and the widest supernode, for the scratch.
+    max_update: usize,
+    max_cols: usize,
+}
+
+/// The matrix is not positive definite: a pivot of this (permuted) column was not positive.
+#[derive(Debug, thiserror::Error)]
+#[error("non-positive pivot at column {column} of the permuted matrix")]
+pub struct NotPositiveDefinite {
+    pub column: usize,
+}
+
+/// A supernode's place in L: first column, columns, row pattern below them, offset of its values.
+struct Supernode<'a> {
+    begin: usize,
+    ncols: usize,
+    pattern: &'a [usize],
+    offset: usize,
+}
+
+impl Supernode<'_> {
+    fn nrows(&self) -> usize {
+        self.ncols + self.pattern.len()
+    }
+}
+
+fn supernode(sn: &SymbolicSupernodalCholesky<usize>, s: usize) -> Supernode<'_> {
+    let (begin, end) = (sn.supernode_begin()[s], sn.supernode_end()[s]);
+    let start = sn.col_ptr_for_row_idx()[s];
+    Supernode { begin, ncols: end - begin, pattern: &sn.row_idx()[start..start + sn.nnz_per_super()[s]], offset: sn.col_ptr_for_val()[s] }
+}
+
+impl Plan {
+    /// The plan for factorising `matrix` (lower triangle, original numbering) permuted by `inv`
+    /// (`inv[old] = new`, the symbolic factorisation's ordering) with the structure `sn`.
+    pub fn new(sn: &SymbolicSupernodalCholesky<usize>, matrix: &SymCsc, inv: &[usize]) -> Self {
+        let (n, ns) = (sn.nrows(), sn.n_supernodes());
+        assert!(matrix.values().len() < u32::MAX as usize, "more than 2^32 matrix entries: widen Plan's positions");
+        let (begin, end) = (sn.supernode_begin(), sn.supernode_end());
+        let mut super_of = vec![0u32; n];
+        for s in 0..ns {
+            super_of[begin[s]..end[s]].fill(s as u32);
+        }
+        // descendants: d updates every supernode its pattern rows fall in (each once, d ascending)
+        let super_of = &super_of;
+        let targets = |d: usize| {
+            let p = supernode(sn, d).pattern;
+            p.iter().enumerate().filter(move |&(i, &r)| i == 0 || super_of[p[i - 1]] != super_of[r]).map(|(_, &r)| super_of[r] as usize)
+        };
+        let mut upd_ptr = vec![0usize; ns + 1];
+        let mut kid_ptr = vec![0usize; ns + 1];
+        let mut roots = Vec::new();
+        for d in 0..ns {
+            targets(d).for_each(|s| upd_ptr[s + 1] += 1);
+            match targets(d).next() {
+                Some(parent) => kid_ptr[parent + 1] += 1,
+                None => roots.push(d as u32),
+            }
+        }
+        for s in 0..ns {
+            upd_ptr[s + 1] += upd_ptr[s];
+            kid_ptr[s + 1] += kid_ptr[s];
+        }
+        let (mut upd, mut kids) = (vec![0u32; upd_ptr[ns]], vec![0u32; kid_ptr[ns]]);
+        let (mut upd_fill, mut kid_fill) = (upd_ptr.clone(), kid_ptr.clone());
+        let mut max_update = 0;
+        for d in 0..ns {
+            let node = supernode(sn, d);
+            let mut first = true;
+            let mut i = 0;
+            while i < node.pattern.len() {
+                let s = super_of[node.pattern[i]] as usize;
+                let mid = node.pattern[i..].iter().take_while(|&&r| super_of[r] as usize == s).count();
+                max_update = max_update.max((node.pattern.len() - i) * mid);
+                upd[upd_fill[s]] = d as u32;
+                upd_fill[s] += 1;
+                if first {
+                    kids[kid_fill[s]] = d as u32;
+                    kid_fill[s] += 1;
+                    first = false;
+                }
+                i += mid;
+            }
+        }
+        // work: the right-looking flops of each supernode's columns, summed over subtrees
+        // (children have smaller numbers than their parent)
+        let mut work: Vec<f64> = (0..ns)
+            .map(|s| {
+                let node = supernode(sn, s);
+                (0..node.ncols).map(|c| ((node.nrows() - c) as f64).powi(2) / 2.0).sum()
+            })
+            .collect();
+        for s in 0..ns {
+            let w: f64 = kids[kid_ptr[s]..kid_ptr[s + 1]].iter().map(|&k| work[k as usize]).sum();
+            work[s] += w;
+        }
+        let total: f64 = roots.iter().map(|&r| work[r as usize]).sum();
+        // where each matrix entry (i, j), i >= j, goes: column min(inv i, inv j) of P K P^T, row max
+        let mut entry_ptr = vec![0usize; ns + 1];
+        let place = |k: usize, j_old: usize| -> (usize, u32) {
+            let (a, b) = (inv[matrix.row_idx()[k]], inv[j_old]);
+            let (r, c) = (a.max(b), a.min(b));
+            let s = super_of[c] as usize;
+            let node = supernode(sn, s);
+            let row = if r < node.begin + node.ncols {
+                r - node.begin
+            } else {
+                node.ncols + node.pattern.binary_search(&r).expect("a matrix entry outside the symbolic pattern of L")
+            };
+            let offset = (c - node.begin) * node.nrows() + row;
+            assert!(offset < u32::MAX as usize, "a supernode with more than 2^32 values: widen Plan's offsets");
+            (s, offset as u32)
+        };
+        let cols = matrix.col_ptr();
+        let placed: Vec<(u32, u32)> = (0..n)
+            .into_par_iter()
+            .flat_map_iter(|j| (cols[j]..cols[j + 1]).map(move |k| (j, k)))
+            .map(|(j, k)| {
+                let (s, off) = place(k, j);
+                (s as u32, off)
+            })
+            .collect();
+        for &(s, _) in &placed {
+            entry_ptr[s as usize + 1] += 1;
+        }
+        for s in 0..ns {
+            entry_ptr[s + 1] += entry_ptr[s];
+        }
+        let mut fill = entry_ptr.clone();
+        let mut entries = vec![(0u32, 0u32); placed.len()];
+        for (k, &(s, off)) in placed.iter().enumerate() {
+            entries[fill[s as usize]] = (off, k as u32);
+            fill[s as usize] += 1;
+        }
+        let max_cols = (0..ns).map(|s| end[s] - begin[s]).max().unwrap_or(0);
+        Plan { upd_ptr, upd, kid_ptr, kids, roots, work, task_work: total * TASK_SHARE, entry_ptr, entries, max_update, max_cols }
+    }
+
+    fn kids(&self, s: usize) -> impl Iterator<Item = usize> + '_ {
+        self.kids[self.kid_ptr[s]..self.kid_ptr[s + 1]].iter().map(|&k| k as usize)
+    }
+
+    /// The supernodes of the subtree of s, ascending (a valid order: children before parents).
+    fn subtree(&self, s: usize) -> Vec<usize> {
+        let mut nodes = vec![s];
+        let mut i = 0;
+        while i < nodes.len() {
+            let x = nodes[i];
+            nodes.extend(self.kids(x));
+            i += 1;
+        }
+        nodes.sort_unstable();
+        nodes
+    }
+}
+
+/// L's values, shared by the threads: each supernode's block is written by the one task that
+/// computes it and read by its ancestors only after that task has finished (the schedule of
+/// [`factorize`] orders them), so no value is ever accessed concurrently with a write.
+#[derive(Clone, Copy)]
+struct SharedL {
+    ptr: *mut f64,
+    len: usize,
+}
+
+// SAFETY: see the type's documentation; the schedule keeps accesses disjoint or ordered
+unsafe impl Send for SharedL {}
+unsafe impl Sync for SharedL {}
+
+/// Per-thread scratch: the position of each row of the current supernode in its block, the
+/// update product and the dense Cholesky's workspace.
+struct Scratch {
+    local: Vec<u32>,
+    update: Vec<f64>,
+    stack: MemBuffer,
+    stack_bytes: usize,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Option<Scratch>> = const { RefCell::new(None) };
+}
+
+/// Fill `l` (faer's layout of `sn`) with the Cholesky factor of the matrix whose lower triangle
+/// has the pattern the plan was made for and the given values, permuted as planned.
+pub fn factorize(sn: &SymbolicSupernodalCholesky<usize>, plan: &Plan, values: &[f64], l: &mut [f64]) -> Result<(), NotPositiveDefinite> {
+    assert_eq!(l.len(), sn.len_val());
+    let shared = SharedL { ptr: l.as_mut_ptr(), len: l.len() };
+    let ctx = Context { sn, plan, values, l: shared };
+    plan.roots.par_iter().map(|&r| ctx.run(r as usize)).collect::<Result<Vec<()>, _>>()?;
+    Ok(())
+}
+
+struct Context<'a> {
+    sn: &'a SymbolicSupernodalCholesky<usize>,
+    plan: &'a Plan,
+    values: &'a [f64],
+    l: SharedL,
+}
+
+impl Context<'_> {
+    /// Factorise the subtree of s: small subtrees in one task; otherwise the children's
+    /// subtrees in parallel, then s. A chain of supernodes with one large child each is walked
+    /// without recursion (its small side subtrees run just before their parent), so the depth
+    /// of recursion is bounded by the number of tasks, not by the height of the tree.
+    fn run(&self, s: usize) -> Result<(), NotPositiveDefinite> {
+        let plan = self.plan;
+        if plan.work[s] < plan.task_work {
+            return plan.subtree(s).into_iter().try_for_each(|x| self.supernode(x));
+        }
+        let mut chain = vec![s];
+        loop {
+            let top = *chain.last().unwrap();
+            let large: Vec<usize> = plan.kids(top).filter(|&k| plan.work[k] >= plan.task_work).collect();
+            if large.len() != 1 {
+                break;
+            }
+            chain.push(large[0]);
+        }
+        let bottom = *chain.last().unwrap();
+        plan.kids(bottom).collect::<Vec<_>>().into_par_iter().map(|k| self.run(k)).collect::<Result<Vec<()>, _>>()?;
+        self.supernode(bottom)?;
+        for w in chain.windows(2).rev() {
+            let (x, large) = (w[0], w[1]);
+            for k in plan.kids(x).filter(|&k| k != large) {
+                self.run(k)?;
+            }
+            self.supernode(x)?;
+        }
+        Ok(())
+    }
+
+    /// Compute supernode s's block of L from the matrix and its (finished) descendants.
+    fn supernode(&self, s: usize) -> Result<(), NotPositiveDefinite> {
+        let (sn, plan) = (self.sn, self.plan);
+        let node = supernode(sn, s);
+        let (ncols, nrows) = (node.ncols, node.nrows());
+        let len = nrows * ncols;
+        assert!(node.offset + len <= self.l.len);
+        // SAFETY: this block is written only here, and nothing reads it before this task ends
+        let block = unsafe { std::slice::from_raw_parts_mut(self.l.ptr.add(node.offset), len) };
+        block.fill(0.0);
+        for &(off, pos) in &plan.entries[plan.entry_ptr[s]..plan.entry_ptr[s + 1]] {
+            block[off as usize] += self.values[pos as usize];
+        }
+        SCRATCH.with_borrow_mut(|scratch| {
+            let scratch = scratch.get_or_insert_with(|| Scratch {
+                local: Vec::new(),
+                update: Vec::new(),
+                stack: MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
+                stack_bytes: 0,
+            });
+            if scratch.local.len() < sn.nrows() {
+                scratch.local.resize(sn.nrows(), 0);
+            }
+            if scratch.update.len() < plan.max_update {
+                scratch.update.resize(plan.max_update, 0.0);
+            }
+            let need = faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(
+                plan.max_cols,
+                Par::Seq,
+                Spec::<LltParams, f64>::default(),
+            );
+            if scratch.stack_bytes < need.unaligned_bytes_required() {
+                scratch.stack = MemBuffer::new(need);
+                scratch.stack_bytes = need.unaligned_bytes_required();
+            }
+            let local = &mut scratch.local;
+            for (i, &r) in node.pattern.iter().enumerate() {
+                local[r] = (ncols + i) as u32;
+            }
+            let mut ls = MatMut::from_column_major_slice_mut(block, nrows, ncols);
+            let end = node.begin + ncols;
+            for &d in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
+                let dn = supernode(sn, d as usize);
+                // SAFETY: supernode d is a descendant of s, finished before this task started
+                let dvals = unsafe { std::slice::from_raw_parts(self.l.ptr.add(dn.offset), dn.nrows() * dn.ncols) };
+                let ld = MatRef::from_column_major_slice(dvals, dn.nrows(), dn.ncols);
+                let first = dn.pattern.partition_point(|&r| r < node.begin);
+                let mid = dn.pattern[first..].partition_point(|&r| r < end);
+                let rows = dn.pattern.len() - first;
+                let below = ld.subrows(dn.ncols + first, rows);
+                let (ld_mid, ld_bot) = below.split_at_row(mid);
+                let mut upd = MatMut::from_column_major_slice_mut(&mut scratch.update[..rows * mid], rows, mid);
+                {
+                    let (top, bot) = upd.rb_mut().split_at_row_mut(mid);
+                    faer::linalg::matmul::triangular::matmul(
+                        top,
+                        BlockStructure::TriangularLower,
+                        Accum::Replace,
+                        ld_mid,
+                        BlockStructure::Rectangular,
+                        ld_mid.transpose(),
+                        BlockStructure::Rectangular,
+                        1.0,
+                        Par::Seq,
+                    );
+                    faer::linalg::matmul::matmul(bot, Accum::Replace, ld_bot, ld_mid.transpose(), 1.0, Par::Seq);
+                }
+                let rows_of = &dn.pattern[first..];
+                for jj in 0..mid {
+                    let col = rows_of[jj] - node.begin;
+                    for ii in jj..rows {
+                        let r = rows_of[ii];
+                        let at = if ii < mid { r - node.begin } else { local[r] as usize };
+                        ls[(at, col)] -= upd[(ii, jj)];
+                    }
+                }
+            }
+            let (mut top, bot) = ls.split_at_row_mut(ncols);
+            faer::linalg::cholesky::llt::factor::cholesky_in_place(
+                top.rb_mut(),
+                LltRegularization::default(),
+                Par::Seq,
+                MemStack::new(&mut scratch.stack),
+                Spec::<LltParams, f64>::default(),
+            )
+            .map_err(|e| match e {
+                faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => {
+                    NotPositiveDefinite { column: node.begin + index }
+                }
+            })?;
+            faer::linalg::triangular_solve::solve_lower_triangular_in_place(top.rb(), bot.transpose_mut(), Par::Seq);
+            Ok(())
+        })
+    }
+}

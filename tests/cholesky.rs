@@ -1,0 +1,117 @@
+//! The tree-parallel numeric Cholesky factorisation (`signorini::cholesky`): the same factor as
+//! faer's sequential one, bitwise the same on one and two threads, and a clear error for a
+//! matrix that is not positive definite.
+
+mod common;
+
+use common::*;
+use faer::Side;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::{
+    CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
+};
+use faer::{Par, Spec};
+use signorini::assembly::{self, DofMap, SymCsc};
+use signorini::cholesky::{self, Plan};
+use signorini::mesh::{Mesh, P2Nodes, refine::refine};
+use signorini::problems;
+
+/// Example 7.2's stiffness on `mesh`, and the position of every unknown.
+fn stiffness(mesh: &Mesh) -> (SymCsc, Vec<[f64; 2]>) {
+    let p = problems::Ex72;
+    let nodes = P2Nodes::new(mesh);
+    let dofs = DofMap::new(&nodes, &p);
+    let sys = assembly::assemble(mesh, &nodes, &dofs, &p);
+    (sys.matrix, dofs.unknown_coords(&nodes))
+}
+
+/// A mesh refined five times towards the bottom edge (y = 0): long, thin layers, where the
+/// minimum-degree ordering wins and the elimination tree is deep.
+fn graded() -> Mesh {
+    let mut m = mesh(&problems::Ex72, "structured:8");
+    for _ in 0..5 {
+        let marked: Vec<bool> = (0..m.n_triangles()).map(|t| m.corners(t).iter().any(|c| c[1] < 1e-12)).collect();
+        m = refine(&m, &marked).mesh;
+    }
+    m
+}
+
+/// Supernodal symbolic factorisation with the project's fill-reducing ordering.
+fn symbolic(matrix: &SymCsc, coords: &[[f64; 2]]) -> SymbolicCholesky<usize> {
+    let n = matrix.n();
+    let (fwd, _) = signorini::ordering::fill_reducing(matrix, n, coords);
+    let mut inv = vec![0; n];
+    for (new, &old) in fwd.iter().enumerate() {
+        inv[old] = new;
+    }
+    let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
+    let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
+    factorize_symbolic_cholesky(matrix.as_faer().symbolic(), Side::Lower, SymmetricOrdering::Custom(perm), params).unwrap()
+}
+
+/// Our factor of `values` (on the pattern of `matrix`) on `threads` threads.
+fn ours(
+    symbolic: &SymbolicCholesky<usize>,
+    matrix: &SymCsc,
+    values: &[f64],
+    threads: usize,
+) -> Result<Vec<f64>, cholesky::NotPositiveDefinite> {
+    let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else { panic!("supernodal") };
+    let plan = Plan::new(sn, matrix, symbolic.perm().unwrap().arrays().1);
+    let mut l = vec![f64::NAN; symbolic.len_val()];
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    pool.install(|| cholesky::factorize(sn, &plan, values, &mut l))?;
+    Ok(l)
+}
+
+fn faers(symbolic: &SymbolicCholesky<usize>, matrix: &SymCsc) -> Vec<f64> {
+    let mut l = vec![0.0; symbolic.len_val()];
+    let mut mem = MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Spec::default()));
+    symbolic
+        .factorize_numeric_llt(
+            &mut l,
+            matrix.as_faer(),
+            Side::Lower,
+            LltRegularization::default(),
+            Par::Seq,
+            MemStack::new(&mut mem),
+            Spec::default(),
+        )
+        .unwrap();
+    l
+}
+
+#[test]
+fn the_factor_is_faers_and_the_same_on_any_number_of_threads() {
+    for (name, m) in [("structured:24", mesh(&problems::Ex72, "structured:24")), ("graded", graded())] {
+        let (matrix, coords) = stiffness(&m);
+        let symbolic = symbolic(&matrix, &coords);
+        let reference = faers(&symbolic, &matrix);
+        let one = ours(&symbolic, &matrix, matrix.values(), 1).unwrap();
+        let two = ours(&symbolic, &matrix, matrix.values(), 2).unwrap();
+        assert!(one.iter().zip(&two).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}: one and two threads differ");
+        let scale = reference.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let worst = reference.iter().zip(&one).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(worst <= 1e-13 * scale, "{name}: largest difference from faer's factor {worst:.2e} (largest entry {scale:.2e})");
+        // a second factorisation on the same plan (a refactorisation) gives the same again
+        let again = ours(&symbolic, &matrix, matrix.values(), 2).unwrap();
+        assert!(again.iter().zip(&two).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}: refactorisation differs");
+    }
+}
+
+#[test]
+fn a_matrix_that_is_not_positive_definite_is_an_error_naming_its_column() {
+    let (matrix, coords) = stiffness(&mesh(&problems::Ex72, "structured:8"));
+    let symbolic = symbolic(&matrix, &coords);
+    let mut values = matrix.values().to_vec();
+    // a negative diagonal entry at unknown 5
+    let at = matrix.position(5, 5);
+    values[at] = -values[at];
+    let err = ours(&symbolic, &matrix, &values, 2).unwrap_err();
+    let inv = symbolic.perm().unwrap().arrays().1;
+    // columns before it do not see the entry; at its own column the pivot is -K_55 minus squares
+    assert_eq!(err.column, inv[5], "{err}");
+    assert!(err.to_string().contains("non-positive pivot"), "{err}");
+}
