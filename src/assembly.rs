@@ -280,7 +280,7 @@ pub fn element_stiffness(map: &Affine, material: Material, rule: &element::Rule<
 /// Runs `fill(item, slice)` for every item of a compressed layout (`offsets`, one slice of
 /// `buf` per item), in parallel over blocks of items: the slices are disjoint, so any thread
 /// count writes the same values.
-fn par_fill<T: Send>(buf: &mut [T], offsets: &[usize], fill: impl Fn(usize, &mut [T]) + Sync) {
+pub(crate) fn par_fill<T: Send>(buf: &mut [T], offsets: &[usize], fill: impl Fn(usize, &mut [T]) + Sync) {
     const BLOCK: usize = 4096;
     let n = offsets.len() - 1;
     let mut blocks = Vec::with_capacity(n.div_ceil(BLOCK));

@@ -38,6 +38,11 @@ use std::cell::RefCell;
 /// task (finer tasks cost more to schedule than they gain).
 const TASK_SHARE: f64 = 1.0 / 256.0;
 
+/// A supernode whose task has at least this many multiply-adds runs its dense kernels on every
+/// thread when nothing else runs (at the top of the tree: at `structured:256` the last supernode,
+/// the top separator with the contact unknowns, is a fifth of all the work).
+const PAR_KERNEL_WORK: f64 = 1e7;
+
 /// What the numeric factorisation needs beyond faer's symbolic structure, computed once per
 /// symbolic factorisation: the supernodal elimination tree, the descendants that update each
 /// supernode, and where every entry of the matrix goes in L.
@@ -49,12 +54,13 @@ pub struct Plan {
     kid_ptr: Vec<usize>,
     kids: Vec<u32>,
     roots: Vec<u32>,
-    /// Flops (multiply-add pairs) of the subtree of each supernode.
+    /// Multiply-add pairs of the task of each supernode (`own`) and of its subtree (`work`).
+    own: Vec<f64>,
     work: Vec<f64>,
     /// Subtrees with less work are one task.
     task_work: f64,
-    /// The matrix entries of supernode s: `entries[entry_ptr[s]..entry_ptr[s + 1]]`, each
-    /// (offset in the supernode's block of L, position in the matrix's values).
+    /// The matrix entries of column j of P K P^T: `entries[entry_ptr[j]..entry_ptr[j + 1]]`,
+    /// each (row, position in the matrix's values).
     entry_ptr: Vec<usize>,
     entries: Vec<(u32, u32)>,
     /// The largest update product (rows x columns) and the widest supernode, for the scratch.
@@ -94,7 +100,7 @@ impl Plan {
     /// (`inv[old] = new`, the symbolic factorisation's ordering) with the structure `sn`.
     pub fn new(sn: &SymbolicSupernodalCholesky<usize>, matrix: &SymCsc, inv: &[usize]) -> Self {
         let (n, ns) = (sn.nrows(), sn.n_supernodes());
-        assert!(matrix.values().len() < u32::MAX as usize, "more than 2^32 matrix entries: widen Plan's positions");
+        assert!(matrix.values().len() < u32::MAX as usize && n < u32::MAX as usize, "more than 2^32 matrix entries: widen Plan's indices");
         let (begin, end) = (sn.supernode_begin(), sn.supernode_end());
         let mut super_of = vec![0u32; n];
         for s in 0..ns {
@@ -141,58 +147,58 @@ impl Plan {
                 i += mid;
             }
         }
-        // work: the right-looking flops of each supernode's columns, summed over subtrees
+        // work: what the task of each supernode computes (left-looking: the updates it pulls from
+        // its descendants, its dense Cholesky and triangular solve), summed over subtrees
         // (children have smaller numbers than their parent)
         let mut work: Vec<f64> = (0..ns)
             .map(|s| {
                 let node = supernode(sn, s);
-                (0..node.ncols).map(|c| ((node.nrows() - c) as f64).powi(2) / 2.0).sum()
+                let (c, p) = (node.ncols as f64, node.pattern.len() as f64);
+                let pulled: f64 = upd[upd_ptr[s]..upd_ptr[s + 1]]
+                    .iter()
+                    .map(|&d| {
+                        let dn = supernode(sn, d as usize);
+                        let first = dn.pattern.partition_point(|&r| r < node.begin);
+                        let mid = dn.pattern[first..].partition_point(|&r| r < node.begin + node.ncols);
+                        let rows = (dn.pattern.len() - first) as f64;
+                        (rows - mid as f64 / 2.0) * mid as f64 * dn.ncols as f64
+                    })
+                    .sum();
+                pulled + c * c * c / 3.0 + p * c * c / 2.0
             })
             .collect();
+        let own = work.clone();
         for s in 0..ns {
             let w: f64 = kids[kid_ptr[s]..kid_ptr[s + 1]].iter().map(|&k| work[k as usize]).sum();
             work[s] += w;
         }
         let total: f64 = roots.iter().map(|&r| work[r as usize]).sum();
-        // where each matrix entry (i, j), i >= j, goes: column min(inv i, inv j) of P K P^T, row max
-        let mut entry_ptr = vec![0usize; ns + 1];
-        let place = |k: usize, j_old: usize| -> (usize, u32) {
-            let (a, b) = (inv[matrix.row_idx()[k]], inv[j_old]);
-            let (r, c) = (a.max(b), a.min(b));
-            let s = super_of[c] as usize;
-            let node = supernode(sn, s);
-            let row = if r < node.begin + node.ncols {
-                r - node.begin
-            } else {
-                node.ncols + node.pattern.binary_search(&r).expect("a matrix entry outside the symbolic pattern of L")
-            };
-            let offset = (c - node.begin) * node.nrows() + row;
-            assert!(offset < u32::MAX as usize, "a supernode with more than 2^32 values: widen Plan's offsets");
-            (s, offset as u32)
-        };
+        // where each matrix entry (i, j), i >= j, goes: column min(inv i, inv j) of P K P^T, row
+        // max (its place in the column's supernode is looked up when factorising, where the
+        // supernode's rows are mapped anyway); grouped by column
         let cols = matrix.col_ptr();
-        let placed: Vec<(u32, u32)> = (0..n)
-            .into_par_iter()
-            .flat_map_iter(|j| (cols[j]..cols[j + 1]).map(move |k| (j, k)))
-            .map(|(j, k)| {
-                let (s, off) = place(k, j);
-                (s as u32, off)
-            })
-            .collect();
-        for &(s, _) in &placed {
-            entry_ptr[s as usize + 1] += 1;
+        let mut placed = vec![(0u32, 0u32); matrix.values().len()];
+        crate::assembly::par_fill(&mut placed, cols, |j, out| {
+            for (slot, &i) in out.iter_mut().zip(&matrix.row_idx()[cols[j]..cols[j + 1]]) {
+                let (a, b) = (inv[i], inv[j]);
+                *slot = (a.min(b) as u32, a.max(b) as u32);
+            }
+        });
+        let mut entry_ptr = vec![0usize; n + 1];
+        for &(c, _) in &placed {
+            entry_ptr[c as usize + 1] += 1;
         }
-        for s in 0..ns {
-            entry_ptr[s + 1] += entry_ptr[s];
+        for j in 0..n {
+            entry_ptr[j + 1] += entry_ptr[j];
         }
         let mut fill = entry_ptr.clone();
         let mut entries = vec![(0u32, 0u32); placed.len()];
-        for (k, &(s, off)) in placed.iter().enumerate() {
-            entries[fill[s as usize]] = (off, k as u32);
-            fill[s as usize] += 1;
+        for (k, &(c, r)) in placed.iter().enumerate() {
+            entries[fill[c as usize]] = (r, k as u32);
+            fill[c as usize] += 1;
         }
         let max_cols = (0..ns).map(|s| end[s] - begin[s]).max().unwrap_or(0);
-        Plan { upd_ptr, upd, kid_ptr, kids, roots, work, task_work: total * TASK_SHARE, entry_ptr, entries, max_update, max_cols }
+        Plan { upd_ptr, upd, kid_ptr, kids, roots, own, work, task_work: total * TASK_SHARE, entry_ptr, entries, max_update, max_cols }
     }
 
     fn kids(&self, s: usize) -> impl Iterator<Item = usize> + '_ {
@@ -245,7 +251,8 @@ pub fn factorize(sn: &SymbolicSupernodalCholesky<usize>, plan: &Plan, values: &[
     assert_eq!(l.len(), sn.len_val());
     let shared = SharedL { ptr: l.as_mut_ptr(), len: l.len() };
     let ctx = Context { sn, plan, values, l: shared };
-    plan.roots.par_iter().map(|&r| ctx.run(r as usize)).collect::<Result<Vec<()>, _>>()?;
+    let alone = plan.roots.len() == 1;
+    plan.roots.par_iter().map(|&r| ctx.run(r as usize, alone)).collect::<Result<Vec<()>, _>>()?;
     Ok(())
 }
 
@@ -260,11 +267,13 @@ impl Context<'_> {
     /// Factorise the subtree of s: small subtrees in one task; otherwise the children's
     /// subtrees in parallel, then s. A chain of supernodes with one large child each is walked
     /// without recursion (its small side subtrees run just before their parent), so the depth
-    /// of recursion is bounded by the number of tasks, not by the height of the tree.
-    fn run(&self, s: usize) -> Result<(), NotPositiveDefinite> {
+    /// of recursion is bounded by the number of tasks, not by the height of the tree. `alone`:
+    /// nothing else runs meanwhile (the top of the tree), so a large supernode's dense kernels
+    /// may use every thread.
+    fn run(&self, s: usize, alone: bool) -> Result<(), NotPositiveDefinite> {
         let plan = self.plan;
         if plan.work[s] < plan.task_work {
-            return plan.subtree(s).into_iter().try_for_each(|x| self.supernode(x));
+            return plan.subtree(s).into_iter().try_for_each(|x| self.supernode(x, alone));
         }
         let mut chain = vec![s];
         loop {
@@ -276,21 +285,26 @@ impl Context<'_> {
             chain.push(large[0]);
         }
         let bottom = *chain.last().unwrap();
-        plan.kids(bottom).collect::<Vec<_>>().into_par_iter().map(|k| self.run(k)).collect::<Result<Vec<()>, _>>()?;
-        self.supernode(bottom)?;
+        let kids: Vec<usize> = plan.kids(bottom).collect();
+        let kids_alone = alone && kids.len() == 1;
+        kids.into_par_iter().map(|k| self.run(k, kids_alone)).collect::<Result<Vec<()>, _>>()?;
+        self.supernode(bottom, alone)?;
         for w in chain.windows(2).rev() {
             let (x, large) = (w[0], w[1]);
             for k in plan.kids(x).filter(|&k| k != large) {
-                self.run(k)?;
+                self.run(k, alone)?;
             }
-            self.supernode(x)?;
+            self.supernode(x, alone)?;
         }
         Ok(())
     }
 
     /// Compute supernode s's block of L from the matrix and its (finished) descendants.
-    fn supernode(&self, s: usize) -> Result<(), NotPositiveDefinite> {
+    fn supernode(&self, s: usize, alone: bool) -> Result<(), NotPositiveDefinite> {
         let (sn, plan) = (self.sn, self.plan);
+        // faer's parallel dense kernels give the same bits as its sequential ones (tested: one and
+        // two threads agree bitwise), so this choice changes only the time
+        let par = if alone && plan.own[s] >= PAR_KERNEL_WORK { Par::rayon(0) } else { Par::Seq };
         let node = supernode(sn, s);
         let (ncols, nrows) = (node.ncols, node.nrows());
         let len = nrows * ncols;
@@ -298,9 +312,6 @@ impl Context<'_> {
         // SAFETY: this block is written only here, and nothing reads it before this task ends
         let block = unsafe { std::slice::from_raw_parts_mut(self.l.ptr.add(node.offset), len) };
         block.fill(0.0);
-        for &(off, pos) in &plan.entries[plan.entry_ptr[s]..plan.entry_ptr[s + 1]] {
-            block[off as usize] += self.values[pos as usize];
-        }
         SCRATCH.with_borrow_mut(|scratch| {
             let scratch = scratch.get_or_insert_with(|| Scratch {
                 local: Vec::new(),
@@ -316,7 +327,7 @@ impl Context<'_> {
             }
             let need = faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(
                 plan.max_cols,
-                Par::Seq,
+                Par::rayon(0),
                 Spec::<LltParams, f64>::default(),
             );
             if scratch.stack_bytes < need.unaligned_bytes_required() {
@@ -327,8 +338,15 @@ impl Context<'_> {
             for (i, &r) in node.pattern.iter().enumerate() {
                 local[r] = (ncols + i) as u32;
             }
-            let mut ls = MatMut::from_column_major_slice_mut(block, nrows, ncols);
             let end = node.begin + ncols;
+            for j in node.begin..end {
+                let column = &mut block[(j - node.begin) * nrows..][..nrows];
+                for &(r, pos) in &plan.entries[plan.entry_ptr[j]..plan.entry_ptr[j + 1]] {
+                    let r = r as usize;
+                    column[if r < end { r - node.begin } else { local[r] as usize }] += self.values[pos as usize];
+                }
+            }
+            let mut ls = MatMut::from_column_major_slice_mut(block, nrows, ncols);
             for &d in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
                 let dn = supernode(sn, d as usize);
                 // SAFETY: supernode d is a descendant of s, finished before this task started
@@ -351,9 +369,9 @@ impl Context<'_> {
                         ld_mid.transpose(),
                         BlockStructure::Rectangular,
                         1.0,
-                        Par::Seq,
+                        par,
                     );
-                    faer::linalg::matmul::matmul(bot, Accum::Replace, ld_bot, ld_mid.transpose(), 1.0, Par::Seq);
+                    faer::linalg::matmul::matmul(bot, Accum::Replace, ld_bot, ld_mid.transpose(), 1.0, par);
                 }
                 let rows_of = &dn.pattern[first..];
                 for jj in 0..mid {
@@ -369,7 +387,7 @@ impl Context<'_> {
             faer::linalg::cholesky::llt::factor::cholesky_in_place(
                 top.rb_mut(),
                 LltRegularization::default(),
-                Par::Seq,
+                par,
                 MemStack::new(&mut scratch.stack),
                 Spec::<LltParams, f64>::default(),
             )
@@ -378,7 +396,7 @@ impl Context<'_> {
                     NotPositiveDefinite { column: node.begin + index }
                 }
             })?;
-            faer::linalg::triangular_solve::solve_lower_triangular_in_place(top.rb(), bot.transpose_mut(), Par::Seq);
+            faer::linalg::triangular_solve::solve_lower_triangular_in_place(top.rb(), bot.transpose_mut(), par);
             Ok(())
         })
     }
