@@ -66,6 +66,7 @@ pub struct Plan {
     /// The largest update product (rows x columns) and the widest supernode, for the scratch.
     max_update: usize,
     max_cols: usize,
+    max_pattern: usize,
 }
 
 /// The matrix is not positive definite: a pivot of this (permuted) column was not positive.
@@ -198,7 +199,89 @@ impl Plan {
             fill[c as usize] += 1;
         }
         let max_cols = (0..ns).map(|s| end[s] - begin[s]).max().unwrap_or(0);
-        Plan { upd_ptr, upd, kid_ptr, kids, roots, own, work, task_work: total * TASK_SHARE, entry_ptr, entries, max_update, max_cols }
+        let max_pattern = sn.nnz_per_super().iter().copied().max().unwrap_or(0);
+        Plan {
+            upd_ptr,
+            upd,
+            kid_ptr,
+            kids,
+            roots,
+            own,
+            work,
+            task_work: total * TASK_SHARE,
+            entry_ptr,
+            entries,
+            max_update,
+            max_cols,
+            max_pattern,
+        }
+    }
+
+    /// Run `kernel(s, alone)` for every supernode, each after all its descendants (for the
+    /// factorisation and the forward substitution): the children's subtrees in parallel, then
+    /// the supernode; subtrees with less work than [`TASK_SHARE`] of the whole in one task. A
+    /// chain of supernodes with one large child each is walked without recursion (its small side
+    /// subtrees run just before their parent), so the depth of recursion is bounded by the number
+    /// of tasks, not by the height of the tree. `alone`: nothing else runs meanwhile (the top of
+    /// the tree), so the kernel may use every thread.
+    fn upward<E: Send>(&self, kernel: &(dyn Fn(usize, bool) -> Result<(), E> + Sync)) -> Result<(), E> {
+        let alone = self.roots.len() == 1;
+        self.roots.par_iter().try_for_each(|&r| self.up(r as usize, alone, kernel))
+    }
+
+    fn up<E: Send>(&self, s: usize, alone: bool, kernel: &(dyn Fn(usize, bool) -> Result<(), E> + Sync)) -> Result<(), E> {
+        if self.work[s] < self.task_work {
+            return self.subtree(s).into_iter().try_for_each(|x| kernel(x, alone));
+        }
+        let mut chain = vec![s];
+        loop {
+            let top = *chain.last().unwrap();
+            let large: Vec<usize> = self.kids(top).filter(|&k| self.work[k] >= self.task_work).collect();
+            if large.len() != 1 {
+                break;
+            }
+            chain.push(large[0]);
+        }
+        let bottom = *chain.last().unwrap();
+        let kids: Vec<usize> = self.kids(bottom).collect();
+        let kids_alone = alone && kids.len() == 1;
+        kids.into_par_iter().try_for_each(|k| self.up(k, kids_alone, kernel))?;
+        kernel(bottom, alone)?;
+        for w in chain.windows(2).rev() {
+            let (x, large) = (w[0], w[1]);
+            for k in self.kids(x).filter(|&k| k != large) {
+                self.up(k, alone, kernel)?;
+            }
+            kernel(x, alone)?;
+        }
+        Ok(())
+    }
+
+    /// Run `kernel(s)` for every supernode, each after all its ancestors (for the backward
+    /// substitution): the supernode, then its children's subtrees in parallel; small subtrees
+    /// in one task, chains walked without recursion as in [`Plan::upward`].
+    fn downward(&self, kernel: &(dyn Fn(usize) + Sync)) {
+        self.roots.par_iter().for_each(|&r| self.down(r as usize, kernel));
+    }
+
+    fn down(&self, s: usize, kernel: &(dyn Fn(usize) + Sync)) {
+        let mut s = s;
+        loop {
+            if self.work[s] < self.task_work {
+                self.subtree(s).into_iter().rev().for_each(kernel);
+                return;
+            }
+            kernel(s);
+            let large: Vec<usize> = self.kids(s).filter(|&k| self.work[k] >= self.task_work).collect();
+            if large.len() != 1 {
+                self.kids(s).collect::<Vec<_>>().into_par_iter().for_each(|k| self.down(k, kernel));
+                return;
+            }
+            for k in self.kids(s).filter(|&k| k != large[0]) {
+                self.down(k, kernel);
+            }
+            s = large[0];
+        }
     }
 
     fn kids(&self, s: usize) -> impl Iterator<Item = usize> + '_ {
@@ -219,18 +302,31 @@ impl Plan {
     }
 }
 
-/// L's values, shared by the threads: each supernode's block is written by the one task that
-/// computes it and read by its ancestors only after that task has finished (the schedule of
-/// [`factorize`] orders them), so no value is ever accessed concurrently with a write.
+/// L's values (or a solution vector), shared by the threads: each supernode's block (its
+/// columns of L, its rows of the vector) is written by the one task that computes it and read
+/// by others only after that task has finished (the schedules [`Plan::upward`] and
+/// [`Plan::downward`] order them), so no value is ever accessed concurrently with a write.
 #[derive(Clone, Copy)]
-struct SharedL {
+struct Shared {
     ptr: *mut f64,
     len: usize,
 }
 
 // SAFETY: see the type's documentation; the schedule keeps accesses disjoint or ordered
-unsafe impl Send for SharedL {}
-unsafe impl Sync for SharedL {}
+unsafe impl Send for Shared {}
+unsafe impl Sync for Shared {}
+
+impl Shared {
+    /// `len` values from `begin`.
+    /// # Safety
+    /// No other live reference to them may be used while the slice is (see [`Shared`]).
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn slice(&self, begin: usize, len: usize) -> &mut [f64] {
+        assert!(begin + len <= self.len);
+        // SAFETY: inside the allocation (checked); exclusivity is the caller's
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(begin), len) }
+    }
+}
 
 /// Per-thread scratch: the position of each row of the current supernode in its block, the
 /// update product and the dense Cholesky's workspace.
@@ -249,56 +345,19 @@ thread_local! {
 /// has the pattern the plan was made for and the given values, permuted as planned.
 pub fn factorize(sn: &SymbolicSupernodalCholesky<usize>, plan: &Plan, values: &[f64], l: &mut [f64]) -> Result<(), NotPositiveDefinite> {
     assert_eq!(l.len(), sn.len_val());
-    let shared = SharedL { ptr: l.as_mut_ptr(), len: l.len() };
+    let shared = Shared { ptr: l.as_mut_ptr(), len: l.len() };
     let ctx = Context { sn, plan, values, l: shared };
-    let alone = plan.roots.len() == 1;
-    plan.roots.par_iter().map(|&r| ctx.run(r as usize, alone)).collect::<Result<Vec<()>, _>>()?;
-    Ok(())
+    plan.upward(&|s, alone| ctx.supernode(s, alone))
 }
 
 struct Context<'a> {
     sn: &'a SymbolicSupernodalCholesky<usize>,
     plan: &'a Plan,
     values: &'a [f64],
-    l: SharedL,
+    l: Shared,
 }
 
 impl Context<'_> {
-    /// Factorise the subtree of s: small subtrees in one task; otherwise the children's
-    /// subtrees in parallel, then s. A chain of supernodes with one large child each is walked
-    /// without recursion (its small side subtrees run just before their parent), so the depth
-    /// of recursion is bounded by the number of tasks, not by the height of the tree. `alone`:
-    /// nothing else runs meanwhile (the top of the tree), so a large supernode's dense kernels
-    /// may use every thread.
-    fn run(&self, s: usize, alone: bool) -> Result<(), NotPositiveDefinite> {
-        let plan = self.plan;
-        if plan.work[s] < plan.task_work {
-            return plan.subtree(s).into_iter().try_for_each(|x| self.supernode(x, alone));
-        }
-        let mut chain = vec![s];
-        loop {
-            let top = *chain.last().unwrap();
-            let large: Vec<usize> = plan.kids(top).filter(|&k| plan.work[k] >= plan.task_work).collect();
-            if large.len() != 1 {
-                break;
-            }
-            chain.push(large[0]);
-        }
-        let bottom = *chain.last().unwrap();
-        let kids: Vec<usize> = plan.kids(bottom).collect();
-        let kids_alone = alone && kids.len() == 1;
-        kids.into_par_iter().map(|k| self.run(k, kids_alone)).collect::<Result<Vec<()>, _>>()?;
-        self.supernode(bottom, alone)?;
-        for w in chain.windows(2).rev() {
-            let (x, large) = (w[0], w[1]);
-            for k in plan.kids(x).filter(|&k| k != large) {
-                self.run(k, alone)?;
-            }
-            self.supernode(x, alone)?;
-        }
-        Ok(())
-    }
-
     /// Compute supernode s's block of L from the matrix and its (finished) descendants.
     fn supernode(&self, s: usize, alone: bool) -> Result<(), NotPositiveDefinite> {
         let (sn, plan) = (self.sn, self.plan);
@@ -400,4 +459,77 @@ impl Context<'_> {
             Ok(())
         })
     }
+}
+
+thread_local! {
+    static SOLVE_SCRATCH: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Solve L L^T x = b in place for the factor `l` of [`factorize`], with b and x in the permuted
+/// numbering (row `inv[i]` holds unknown i). Forward substitution up the tree (each supernode
+/// pulls the products of its descendants, in the order faer pushes them), backward substitution
+/// down it, independent subtrees in parallel; the same bits on any number of threads.
+pub fn solve_in_place(sn: &SymbolicSupernodalCholesky<usize>, plan: &Plan, l: &[f64], x: &mut [f64]) {
+    assert_eq!((l.len(), x.len()), (sn.len_val(), sn.nrows()));
+    let x = Shared { ptr: x.as_mut_ptr(), len: x.len() };
+    let block = |node: &Supernode| -> MatRef<'_, f64> {
+        MatRef::from_column_major_slice(&l[node.offset..node.offset + node.nrows() * node.ncols], node.nrows(), node.ncols)
+    };
+    // SAFETY (both kernels): a task writes only its supernode's rows of x, and reads rows of
+    // descendants (forward) or ancestors (backward), which the schedule has finished
+    let rows = |begin: usize, len: usize| unsafe { x.slice(begin, len) };
+    let forward = |s: usize, _: bool| -> Result<(), std::convert::Infallible> {
+        let node = supernode(sn, s);
+        let end = node.begin + node.ncols;
+        let xs = rows(node.begin, node.ncols);
+        SOLVE_SCRATCH.with_borrow_mut(|tmp| {
+            tmp.resize(plan.max_pattern.max(plan.max_cols), 0.0);
+            for &d in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
+                let dn = supernode(sn, d as usize);
+                let first = dn.pattern.partition_point(|&r| r < node.begin);
+                let mid = dn.pattern[first..].partition_point(|&r| r < end);
+                let xd = MatRef::from_column_major_slice(rows(dn.begin, dn.ncols), dn.ncols, 1);
+                let mut t = MatMut::from_column_major_slice_mut(&mut tmp[..mid], mid, 1);
+                faer::linalg::matmul::matmul(t.rb_mut(), Accum::Replace, block(&dn).subrows(dn.ncols + first, mid), xd, 1.0, Par::Seq);
+                for (jj, &r) in dn.pattern[first..first + mid].iter().enumerate() {
+                    xs[r - node.begin] -= t[(jj, 0)];
+                }
+            }
+        });
+        let ls = block(&node);
+        faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+            ls.subrows(0, node.ncols),
+            MatMut::from_column_major_slice_mut(xs, node.ncols, 1),
+            Par::Seq,
+        );
+        Ok(())
+    };
+    let backward = |s: usize| {
+        let node = supernode(sn, s);
+        let xs = rows(node.begin, node.ncols);
+        let ls = block(&node);
+        SOLVE_SCRATCH.with_borrow_mut(|tmp| {
+            tmp.resize(plan.max_pattern.max(plan.max_cols), 0.0);
+            let p = node.pattern.len();
+            for (t, &r) in tmp[..p].iter_mut().zip(node.pattern) {
+                *t = rows(r, 1)[0];
+            }
+            let t = MatRef::from_column_major_slice(&tmp[..p], p, 1);
+            faer::linalg::matmul::matmul(
+                MatMut::from_column_major_slice_mut(&mut *xs, node.ncols, 1),
+                Accum::Add,
+                ls.subrows(node.ncols, p).transpose(),
+                t,
+                -1.0,
+                Par::Seq,
+            );
+        });
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+            ls.subrows(0, node.ncols).transpose(),
+            MatMut::from_column_major_slice_mut(xs, node.ncols, 1),
+            Par::Seq,
+        );
+    };
+    let _ = plan.upward(&forward);
+    plan.downward(&backward);
 }

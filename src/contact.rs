@@ -27,13 +27,11 @@
 use crate::assembly::SymCsc;
 use crate::cholesky;
 use crate::ordering::OrderingChoice;
-use faer::dyn_stack::{MemBuffer, MemStack};
+
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, supernodal,
-};
-use faer::{Conj, Mat, Par, Side};
+use faer::sparse::linalg::cholesky::{CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, supernodal};
+use faer::{Mat, Side};
 use std::time::Instant;
 
 /// Why the contact solve failed.
@@ -327,15 +325,19 @@ impl ContactSolver {
         Ok(lcc)
     }
 
-    /// Solve with the current factorisation.
+    /// Solve with the current factorisation ([`cholesky::solve_in_place`]).
     pub fn solve(&mut self, b: &[f64]) -> Vec<f64> {
         let t0 = Instant::now();
-        let mut x = Mat::<f64>::from_fn(self.n, 1, |i, _| b[i]);
-        let par = Par::Seq;
-        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, par));
-        LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(Conj::No, x.as_mut(), par, MemStack::new(&mut mem));
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else { unreachable!("checked in `with_strategy`") };
+        let inv = self.symbolic.perm().expect("a custom ordering").arrays().1;
+        let mut x = vec![0.0; self.n];
+        for (i, &v) in b.iter().enumerate() {
+            x[inv[i]] = v;
+        }
+        cholesky::solve_in_place(sn, &self.plan, &self.l_values, &mut x);
+        let u = inv.iter().map(|&k| x[k]).collect();
         self.timings.solves += t0.elapsed().as_secs_f64();
-        (0..self.n).map(|i| x[(i, 0)]).collect()
+        u
     }
 
     /// Solve the discrete Signorini problem K u = F - E lambda with u_C <= gap, lambda >= 0,

@@ -121,3 +121,45 @@ fn a_matrix_that_is_not_positive_definite_is_an_error_naming_its_column() {
     assert_eq!(err.column, inv[5], "{err}");
     assert!(err.to_string().contains("non-positive pivot"), "{err}");
 }
+
+#[test]
+fn solves_agree_with_faers_and_on_any_number_of_threads() {
+    use faer::sparse::linalg::cholesky::LltRef;
+    use faer::{Conj, Mat};
+    for (name, m) in [("structured:96", mesh(&problems::Ex72, "structured:96")), ("graded", graded())] {
+        let (matrix, coords) = stiffness(&m);
+        let symbolic = symbolic(&matrix, &coords);
+        let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else { panic!("supernodal") };
+        let plan = Plan::new(sn, &matrix, symbolic.perm().unwrap().arrays().1);
+        let l = ours(&symbolic, &matrix, matrix.values(), 2).unwrap();
+        let n = matrix.n();
+        let b: Vec<f64> = (0..n).map(|i| ((i * 37 % 101) as f64 - 50.0) / 7.0).collect();
+        // faer's solve (it permutes itself)
+        let mut reference = Mat::<f64>::from_fn(n, 1, |i, _| b[i]);
+        let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+        LltRef::new(&symbolic, &l).solve_in_place_with_conj(Conj::No, reference.as_mut(), Par::Seq, MemStack::new(&mut mem));
+        let inv = symbolic.perm().unwrap().arrays().1;
+        let solve = |threads: usize| -> Vec<f64> {
+            let mut x = vec![0.0; n];
+            for i in 0..n {
+                x[inv[i]] = b[i];
+            }
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| cholesky::solve_in_place(sn, &plan, &l, &mut x));
+            (0..n).map(|i| x[inv[i]]).collect()
+        };
+        let (one, two) = (solve(1), solve(2));
+        assert!(one.iter().zip(&two).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}: one and two threads differ");
+        let scale = (0..n).fold(0.0f64, |a, i| a.max(reference[(i, 0)].abs()));
+        let worst = (0..n).map(|i| (reference[(i, 0)] - one[i]).abs()).fold(0.0, f64::max);
+        assert!(worst <= 1e-12 * scale, "{name}: largest difference from faer's solve {worst:.2e} (largest value {scale:.2e})");
+        // and it solves K x = b: the residual is at round-off
+        let kx = matrix.mul(&one);
+        let res = kx.iter().zip(&b).map(|(a, c)| (a - c).abs()).fold(0.0, f64::max);
+        let bmax = b.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        assert!(res <= 1e-8 * bmax, "{name}: residual {res:.2e}");
+    }
+}
