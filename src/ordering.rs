@@ -176,10 +176,11 @@ pub fn forced() -> Result<Option<Method>, String> {
 /// refined meshes of this size).
 pub const BOTH_MAX_NODES: usize = 100_000;
 
-/// A mesh whose [`grading`] exceeds this is graded: both orderings are computed. Quasi-uniform
-/// meshes stay at 2 (`structured:N`, uniform refinements of it); adaptive ones reach 10^2-10^4
-/// within a few levels.
-pub const GRADED: f64 = 8.0;
+/// A mesh whose [`grading`] exceeds this is graded: both orderings are computed. A uniform
+/// mesh of P2 triangles is at 2 (`structured:N` and its uniform refinements), one round of
+/// local bisection takes it to 4; the adaptive meshes of the studies are at 32 to 131072 from
+/// 2.3k nodes up, the Hertz study's Gmsh meshes at 35 to 4900. So any local refinement counts.
+pub const GRADED: f64 = 3.0;
 
 /// A fill-reducing ordering of the unknowns `0..n_order` of `matrix` (the others keep their
 /// places at the end, after them), from the coordinates of every unknown. Returns the
@@ -187,15 +188,16 @@ pub const GRADED: f64 = 8.0;
 ///
 /// Nested dissection is always computed. AMD is computed too, and the one with fewer flops
 /// kept, only where it can win: on meshes of at most [`BOTH_MAX_NODES`] nodes, and on graded
-/// meshes ([`grading`] above [`GRADED`]). Measured over every level of the studies (flops,
-/// nested dissection / AMD): on quasi-uniform meshes nested dissection wins (0.46-0.63 on
-/// uniform refinements of Example 7.1's and 7.2's meshes above 16k unknowns, 0.50 on
-/// `structured:256` and `structured:512`) or loses by little (1.25-1.5 on the other uniform
-/// levels, all below 200k unknowns, where both are computed anyway); on adaptively refined
-/// meshes AMD wins by a lot (Example 7.1 graded towards Gamma_C: 10-67 from 16k unknowns up;
-/// Example 7.2's adaptive meshes: 6-27, 25 at 1.1M unknowns), and there the flops of nested
-/// dissection per n^1.5 overlap those of `structured:N` (27 on `structured:N`, 35-65 on
-/// `ex72_large`), so the flop count of nested dissection alone cannot tell them apart: the
+/// meshes ([`grading`] above [`GRADED`]). Measured over every level of the studies `ex71`,
+/// `ex72`, `ex72_large`, `hertz` (flops, nested dissection / AMD): on uniform meshes nested
+/// dissection wins (0.46-0.63 on half of the uniform refinements of Example 7.1's and 7.2's
+/// meshes above 8k nodes, 0.50 on `structured:256` and `structured:512`) or loses by little
+/// (1.25-1.5 on the other half, all below 66k nodes, where both are computed anyway); on every
+/// graded mesh above 2.3k nodes AMD wins, by a lot on most (Example 7.1 graded towards
+/// Gamma_C: 10-67 from 18k nodes up; Example 7.2's adaptive meshes: 1.7-27, 25 at 1.1M
+/// unknowns; Hertz: 2-7). There the flops of nested dissection per n^1.5 for n unknowns
+/// overlap those of `structured:N` (27 on `structured:N`, 35-65 on `ex72_large`), so the flop
+/// count of nested dissection alone cannot tell the two kinds of mesh apart: the
 /// grading does. The rule is a function of the mesh only (never of timing or threads).
 /// [`FORCE_ENV`] overrides it: a forced AMD is computed whatever the mesh.
 pub fn fill_reducing(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (Vec<usize>, OrderingChoice) {
