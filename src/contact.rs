@@ -473,7 +473,9 @@ impl ContactSolver {
     }
 }
 
-/// Symbolic Cholesky, supernodal, with the fill-reducing ordering of [`crate::ordering`].
+/// Symbolic Cholesky, supernodal, with the fill-reducing ordering of [`crate::ordering`]
+/// (faer's symbolic step runs while the ordering's flop count is computed on another thread,
+/// when nested dissection is the only candidate).
 /// Schur: the leading block `I` is ordered and `C` kept in place at the end, so that the
 /// trailing block of L is L_CC. Refactor: all unknowns are ordered.
 fn symbolic_factorisation(
@@ -484,20 +486,21 @@ fn symbolic_factorisation(
 ) -> Result<(SymbolicCholesky<usize>, OrderingChoice), ContactError> {
     let n = matrix.n();
     let n_order = if strategy == Strategy::Schur { ni } else { n };
-    let (fwd, choice) = crate::ordering::fill_reducing(matrix, n_order, coords);
-    let mut inv = vec![0usize; n];
-    for (new, &old) in fwd.iter().enumerate() {
-        inv[old] = new;
-    }
-    let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
     let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
-    let symbolic = faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
-        matrix.as_faer().symbolic(),
-        Side::Lower,
-        SymmetricOrdering::Custom(perm),
-        params,
-    )
-    .map_err(|e| ContactError::Factorisation(format!("{e:?}")))?;
+    let (symbolic, choice) = crate::ordering::fill_reducing_then(matrix, n_order, coords, |fwd| {
+        let mut inv = vec![0usize; n];
+        for (new, &old) in fwd.iter().enumerate() {
+            inv[old] = new;
+        }
+        let perm = faer::perm::PermRef::new_checked(fwd, &inv, n);
+        faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
+            matrix.as_faer().symbolic(),
+            Side::Lower,
+            SymmetricOrdering::Custom(perm),
+            params,
+        )
+    });
+    let symbolic = symbolic.map_err(|e| ContactError::Factorisation(format!("{e:?}")))?;
     Ok((symbolic, choice))
 }
 

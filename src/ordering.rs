@@ -12,9 +12,14 @@
 //! a mesh line), number both halves first, recursively, and the separator last.
 //! On meshes graded towards a boundary line (Example 7.1 refines Gamma_C to thousands of
 //! contact nodes) it is the other way round: AMD orders the thin layers almost as a band and
-//! needs 25 times fewer flops than the dissection. So both orderings are computed and the one
-//! with fewer flops is kept ([`fill_reducing`]); its flop count comes from the column counts
-//! of L (elimination tree, row subtrees), AMD's from AMD itself.
+//! needs 25 times fewer flops than the dissection, and so it does on Example 7.2's adaptive
+//! meshes (graded towards the singularities). So AMD is computed as well, and the ordering
+//! with fewer flops kept, where it can win: on small meshes (at most [`BOTH_MAX_NODES`] nodes,
+//! where both cost under 0.1 s) and on graded ones (the ratio of the largest to the smallest
+//! local mesh size, [`grading`], above [`GRADED`]); a large quasi-uniform mesh gets nested
+//! dissection alone, which saves AMD and its flop count (about 1.5 s of one core at
+//! `structured:512`). The numbers behind the rule are in [`fill_reducing`]. The flops of both
+//! come from the column counts of L (elimination tree, row subtrees).
 //!
 //! Both orderings work on the graph of the nodes, not of the unknowns: the two unknowns of a
 //! node (consecutive, at the same position) couple to the same unknowns, so the graph of the
@@ -124,13 +129,17 @@ impl Graph {
     }
 }
 
-/// Which ordering [`fill_reducing`] kept, and the flops (multiply-subtract pairs and divisions
-/// of the factorisation of the ordered block) of both.
+/// Which ordering [`fill_reducing`] kept, the flops (multiply-subtract pairs and divisions of
+/// the factorisation of the ordered block) of the candidates it computed, and the mesh grading
+/// that decided whether AMD was a candidate.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct OrderingChoice {
     pub method: Method,
     pub flops_nested_dissection: f64,
-    pub flops_minimum_degree: f64,
+    /// None (`null`) if AMD was not computed: a large quasi-uniform mesh, see [`fill_reducing`].
+    pub flops_minimum_degree: Option<f64>,
+    /// The largest over the smallest local mesh size of the ordered nodes (see [`grading`]).
+    pub grading: f64,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -162,63 +171,139 @@ pub fn forced() -> Result<Option<Method>, String> {
         .clone()
 }
 
+/// Up to this many nodes both orderings are computed and the one with fewer flops kept, whatever
+/// the mesh: together they cost under 0.1 s there (and AMD wins by up to 1.5x on some uniformly
+/// refined meshes of this size).
+pub const BOTH_MAX_NODES: usize = 100_000;
+
+/// A mesh whose [`grading`] exceeds this is graded: both orderings are computed. A uniform
+/// mesh of P2 triangles is at 2 (`structured:N` and its uniform refinements), one round of
+/// local bisection takes it to 4; the adaptive meshes of the studies are at 32 to 131072 from
+/// 2.3k nodes up, the Hertz study's Gmsh meshes at 35 to 4900. So any local refinement counts.
+pub const GRADED: f64 = 3.0;
+
 /// A fill-reducing ordering of the unknowns `0..n_order` of `matrix` (the others keep their
-/// places at the end, after them), from the coordinates of every unknown: nested dissection or
-/// AMD, whichever needs fewer flops. Returns the permutation as `order[new] = old`.
+/// places at the end, after them), from the coordinates of every unknown. Returns the
+/// permutation as `order[new] = old`.
+///
+/// Nested dissection is always computed. AMD is computed too, and the one with fewer flops
+/// kept, only where it can win: on meshes of at most [`BOTH_MAX_NODES`] nodes, and on graded
+/// meshes ([`grading`] above [`GRADED`]). Measured over every level of the studies `ex71`,
+/// `ex72`, `ex72_large`, `hertz` (flops, nested dissection / AMD): on uniform meshes nested
+/// dissection wins (0.46-0.63 on half of the uniform refinements of Example 7.1's and 7.2's
+/// meshes above 8k nodes, 0.50 on `structured:256` and `structured:512`) or loses by little
+/// (1.25-1.5 on the other half, all below 66k nodes, where both are computed anyway); on every
+/// graded mesh above 2.3k nodes AMD wins, by a lot on most (Example 7.1 graded towards
+/// Gamma_C: 10-67 from 18k nodes up; Example 7.2's adaptive meshes: 1.7-27, 25 at 1.1M
+/// unknowns; Hertz: 2-7). There the flops of nested dissection per n^1.5 for n unknowns
+/// overlap those of `structured:N` (27 on `structured:N`, 35-65 on `ex72_large`), so the flop
+/// count of nested dissection alone cannot tell the two kinds of mesh apart: the
+/// grading does. The rule is a function of the mesh only (never of timing or threads).
+/// [`FORCE_ENV`] overrides it: a forced AMD is computed whatever the mesh.
 pub fn fill_reducing(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (Vec<usize>, OrderingChoice) {
+    fill_reducing_then(matrix, n_order, coords, |order| order.to_vec())
+}
+
+/// [`fill_reducing`], handing the permutation to `then` (the symbolic factorisation) and
+/// returning what it returns: when nested dissection is the only candidate, its flop count is
+/// not needed for the choice and runs on another thread while `then` runs.
+pub fn fill_reducing_then<T: Send>(
+    matrix: &SymCsc,
+    n_order: usize,
+    coords: &[[f64; 2]],
+    then: impl FnOnce(&[usize]) -> T + Send,
+) -> (T, OrderingChoice) {
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::sparse::linalg::amd;
     let graph = Graph::new(matrix, n_order, coords);
     let nodes = graph.n_nodes();
     let node_coords: Vec<[f64; 2]> = graph.first[..nodes].iter().map(|&i| coords[i]).collect();
-    let ((nd, nd_flops), (amd_order, amd_flops)) = rayon::join(
-        || {
-            let order = nested_dissection(&graph, &node_coords);
-            let flops = factorisation_flops(&graph, &order);
-            (order, flops)
-        },
-        || {
-            let pattern = faer::sparse::SymbolicSparseColMatRef::new_checked(nodes, nodes, &graph.ptr, None, &graph.adj);
-            let (mut fwd, mut inv) = (vec![0u32; nodes], vec![0u32; nodes]);
-            let ordered = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(nodes, graph.adj.len())).ok().and_then(|mut mem| {
-                amd::order_maybe_unsorted(&mut fwd, &mut inv, pattern, amd::Control::default(), MemStack::new(&mut mem)).ok()
-            });
-            let order: Vec<usize> = fwd.into_iter().map(|i| i as usize).collect();
-            // AMD counts the flops of the node graph; ours weighs each node by its unknowns
-            let flops = if ordered.is_some() { factorisation_flops(&graph, &order) } else { f64::INFINITY };
-            (order, flops)
-        },
-    );
-    let method = match forced().ok().flatten() {
-        Some(m) => m,
-        None if nd_flops <= amd_flops => Method::NestedDissection,
-        None => Method::MinimumDegree,
+    let reach = reach(&graph, &node_coords);
+    let grading = grading(&reach);
+    let forced = forced().ok().flatten();
+    let with_amd = amd_is_candidate(nodes, grading, forced);
+    let minimum_degree = || {
+        let pattern = faer::sparse::SymbolicSparseColMatRef::new_checked(nodes, nodes, &graph.ptr, None, &graph.adj);
+        let (mut fwd, mut inv) = (vec![0u32; nodes], vec![0u32; nodes]);
+        let ordered = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(nodes, graph.adj.len())).ok().and_then(|mut mem| {
+            amd::order_maybe_unsorted(&mut fwd, &mut inv, pattern, amd::Control::default(), MemStack::new(&mut mem)).ok()
+        });
+        let order: Vec<usize> = fwd.into_iter().map(|i| i as usize).collect();
+        // AMD counts the flops of the node graph; ours weighs each node by its unknowns
+        let flops = if ordered.is_some() { factorisation_flops(&graph, &order) } else { f64::INFINITY };
+        (order, flops)
     };
-    let mut order = graph.unknowns(match method {
-        Method::NestedDissection => &nd,
-        Method::MinimumDegree => &amd_order,
-    });
-    order.extend(n_order..matrix.n());
-    (order, OrderingChoice { method, flops_nested_dissection: nd_flops, flops_minimum_degree: amd_flops })
+    let nested = || nested_dissection(&graph, &node_coords, &reach);
+    let with_unknowns = |node_order: &[usize]| {
+        let mut order = graph.unknowns(node_order);
+        order.extend(n_order..matrix.n());
+        order
+    };
+    let (method, out, nd_flops, amd_flops) = if with_amd {
+        let ((nd, nd_flops), (amd, amd_flops)) = rayon::join(
+            || {
+                let order = nested();
+                let flops = factorisation_flops(&graph, &order);
+                (order, flops)
+            },
+            minimum_degree,
+        );
+        let method = match forced {
+            Some(m) => m,
+            None if amd_flops < nd_flops => Method::MinimumDegree,
+            None => Method::NestedDissection,
+        };
+        let kept = if method == Method::MinimumDegree { &amd } else { &nd };
+        (method, then(&with_unknowns(kept)), nd_flops, Some(amd_flops))
+    } else {
+        let nd = nested();
+        let (nd_flops, out) = rayon::join(|| factorisation_flops(&graph, &nd), || then(&with_unknowns(&nd)));
+        (Method::NestedDissection, out, nd_flops, None)
+    };
+    (out, OrderingChoice { method, flops_nested_dissection: nd_flops, flops_minimum_degree: amd_flops, grading })
 }
 
-/// Nested dissection of all nodes of `graph` (at `coords`), as `order[new] = old`.
-fn nested_dissection(graph: &Graph, coords: &[[f64; 2]]) -> Vec<usize> {
-    let n = graph.n_nodes();
-    assert!(coords.len() >= n);
-    // side[i]: which half of the current split unknown i is in; the halves being split at the
-    // same time are disjoint and not coupled, so one array serves the whole parallel recursion
-    let side: Vec<AtomicU8> = (0..n).map(|_| AtomicU8::new(0)).collect();
-    // reach[i][axis]: how far node i's neighbours lie from it along the axis; a node farther than
-    // that from the other half of a split cannot be coupled to it, and is not searched
-    let reach: Vec<[f64; 2]> = (0..n)
+/// Whether [`fill_reducing`] computes AMD: when forced, on small meshes and on graded ones.
+fn amd_is_candidate(nodes: usize, grading: f64, forced: Option<Method>) -> bool {
+    match forced {
+        Some(Method::MinimumDegree) => true,
+        Some(Method::NestedDissection) => false,
+        None => nodes <= BOTH_MAX_NODES || grading > GRADED,
+    }
+}
+
+/// The grading of a mesh: the largest over the smallest local mesh size, with the local mesh
+/// size of a node the farthest its neighbours lie from it along an axis (`reach`; nodes without
+/// neighbours left out). About 2 on a quasi-uniform mesh of P2 triangles (a vertex reaches h,
+/// an edge midpoint h/2); each bisection towards a point or a line doubles it at most.
+pub fn grading(reach: &[[f64; 2]]) -> f64 {
+    let sizes = reach.iter().map(|r| r[0].max(r[1])).filter(|&h| h > 0.0);
+    let (lo, hi) = sizes.fold((f64::INFINITY, 0.0f64), |(lo, hi), h| (lo.min(h), hi.max(h)));
+    if hi > 0.0 { hi / lo } else { 1.0 }
+}
+
+/// How far the neighbours of every node of `graph` (at `coords`) lie from it along each axis.
+fn reach(graph: &Graph, coords: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    use rayon::prelude::*;
+    (0..graph.n_nodes())
+        .into_par_iter()
         .map(|i| {
             let d = |axis: usize| graph.neighbours(i).map(|j| (coords[j][axis] - coords[i][axis]).abs()).fold(0.0, f64::max);
             [d(0), d(1)]
         })
-        .collect();
+        .collect()
+}
+
+/// Nested dissection of all nodes of `graph` (at `coords`, with their `reach`), as
+/// `order[new] = old`.
+fn nested_dissection(graph: &Graph, coords: &[[f64; 2]], reach: &[[f64; 2]]) -> Vec<usize> {
+    let n = graph.n_nodes();
+    assert!(coords.len() >= n && reach.len() >= n);
+    // side[i]: which half of the current split node i is in; the halves being split at the
+    // same time are disjoint and not coupled, so one array serves the whole parallel recursion
+    let side: Vec<AtomicU8> = (0..n).map(|_| AtomicU8::new(0)).collect();
     let mut set: Vec<usize> = (0..n).collect();
-    dissect(graph, coords, &reach, &side, &mut set)
+    dissect(graph, coords, reach, &side, &mut set)
 }
 
 /// Flops of the Cholesky factorisation of the matrix of the unknowns with the nodes in the given
@@ -366,7 +451,41 @@ mod tests {
         }
         assert!(seen.iter().all(|&s| s));
         assert_eq!(choice.method, Method::NestedDissection, "{choice:?}");
-        assert!(choice.flops_nested_dissection < 0.8 * choice.flops_minimum_degree, "{choice:?}");
+        assert!(choice.flops_nested_dissection < 0.8 * choice.flops_minimum_degree.expect("both computed on a small mesh"), "{choice:?}");
+    }
+
+    #[test]
+    fn amd_only_where_it_can_win_or_when_forced() {
+        assert!(amd_is_candidate(BOTH_MAX_NODES, 2.0, None), "small: both");
+        assert!(!amd_is_candidate(BOTH_MAX_NODES + 1, 2.0, None), "large and quasi-uniform: nested dissection alone");
+        assert!(amd_is_candidate(BOTH_MAX_NODES + 1, 2.0 * GRADED, None), "large and graded: both");
+        assert!(amd_is_candidate(10 * BOTH_MAX_NODES, 2.0, Some(Method::MinimumDegree)), "forced AMD is computed");
+        assert!(!amd_is_candidate(10, 1e3, Some(Method::NestedDissection)));
+    }
+
+    #[test]
+    fn grading_tells_a_uniform_mesh_from_one_graded_towards_gamma_c() {
+        // structured and uniformly refined: 2 (vertices reach h, edge midpoints h/2)
+        let (matrix, coords) = system(24);
+        let (_, choice) = fill_reducing(&matrix, matrix.n(), &coords);
+        assert!((choice.grading - 2.0).abs() < 1e-9, "{choice:?}");
+        // graded towards the contact boundary y = 0 as Example 7.1's adaptive meshes: AMD is
+        // computed and needs several times fewer flops than nested dissection
+        let p = crate::problems::Ex71;
+        let mut mesh = MeshSpec::Structured(8).build(&p).expect("the unit square");
+        for _ in 0..12 {
+            let marked: Vec<bool> = (0..mesh.n_triangles()).map(|t| mesh.corners(t).iter().any(|c| c[1] == 0.0)).collect();
+            mesh = crate::mesh::refine::refine(&mesh, &marked).mesh;
+        }
+        let nodes = P2Nodes::new(&mesh);
+        let dofs = DofMap::new(&nodes, &p);
+        let sys = assembly::assemble(&mesh, &nodes, &dofs, &p);
+        let (_, choice) = fill_reducing(&sys.matrix, sys.matrix.n(), &dofs.unknown_coords(&nodes));
+        assert!(choice.grading > GRADED, "{choice:?}");
+        assert_eq!(choice.method, Method::MinimumDegree, "{choice:?}");
+        let amd = choice.flops_minimum_degree.expect("computed on a graded mesh");
+        assert!(amd < 0.5 * choice.flops_nested_dissection, "{choice:?}");
+        eprintln!("graded: {} unknowns, {choice:?}", sys.matrix.n());
     }
 
     #[test]
@@ -410,7 +529,7 @@ mod tests {
             assert!(nodes.n_nodes() < n_order * 6 / 10, "{} nodes for {n_order} unknowns", nodes.n_nodes());
             let unknowns = Graph::new(&matrix, n_order, &distinct_positions(n_order));
             let node_coords: Vec<[f64; 2]> = nodes.first[..nodes.n_nodes()].iter().map(|&i| coords[i]).collect();
-            let nd = nested_dissection(&nodes, &node_coords);
+            let nd = nested_dissection(&nodes, &node_coords, &reach(&nodes, &node_coords));
             let reversed: Vec<usize> = (0..nodes.n_nodes()).rev().collect();
             for order in [nd, reversed] {
                 let (weighted, plain) = (factorisation_flops(&nodes, &order), factorisation_flops(&unknowns, &nodes.unknowns(&order)));
