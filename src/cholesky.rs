@@ -49,7 +49,7 @@ const PAR_KERNEL_WORK: f64 = 1e7;
 pub struct Plan {
     /// Descendants updating supernode s: `upd[upd_ptr[s]..upd_ptr[s + 1]]`, ascending.
     upd_ptr: Vec<usize>,
-    upd: Vec<u32>,
+    upd: Vec<Update>,
     /// Children of supernode s in the supernodal elimination tree: `kids[kid_ptr[s]..kid_ptr[s + 1]]`.
     kid_ptr: Vec<usize>,
     kids: Vec<u32>,
@@ -67,6 +67,15 @@ pub struct Plan {
     max_update: usize,
     max_cols: usize,
     max_pattern: usize,
+}
+
+/// Supernode `d` updates a later supernode s through its pattern rows `first..first + mid`,
+/// the ones among s's columns.
+#[derive(Clone, Copy, Default)]
+struct Update {
+    d: u32,
+    first: u32,
+    mid: u32,
 }
 
 /// The matrix is not positive definite: a pivot of this (permuted) column was not positive.
@@ -127,7 +136,7 @@ impl Plan {
             upd_ptr[s + 1] += upd_ptr[s];
             kid_ptr[s + 1] += kid_ptr[s];
         }
-        let (mut upd, mut kids) = (vec![0u32; upd_ptr[ns]], vec![0u32; kid_ptr[ns]]);
+        let (mut upd, mut kids) = (vec![Update::default(); upd_ptr[ns]], vec![0u32; kid_ptr[ns]]);
         let (mut upd_fill, mut kid_fill) = (upd_ptr.clone(), kid_ptr.clone());
         let mut max_update = 0;
         for d in 0..ns {
@@ -138,7 +147,7 @@ impl Plan {
                 let s = super_of[node.pattern[i]] as usize;
                 let mid = node.pattern[i..].iter().take_while(|&&r| super_of[r] as usize == s).count();
                 max_update = max_update.max((node.pattern.len() - i) * mid);
-                upd[upd_fill[s]] = d as u32;
+                upd[upd_fill[s]] = Update { d: d as u32, first: i as u32, mid: mid as u32 };
                 upd_fill[s] += 1;
                 if first {
                     kids[kid_fill[s]] = d as u32;
@@ -157,12 +166,10 @@ impl Plan {
                 let (c, p) = (node.ncols as f64, node.pattern.len() as f64);
                 let pulled: f64 = upd[upd_ptr[s]..upd_ptr[s + 1]]
                     .iter()
-                    .map(|&d| {
-                        let dn = supernode(sn, d as usize);
-                        let first = dn.pattern.partition_point(|&r| r < node.begin);
-                        let mid = dn.pattern[first..].partition_point(|&r| r < node.begin + node.ncols);
-                        let rows = (dn.pattern.len() - first) as f64;
-                        (rows - mid as f64 / 2.0) * mid as f64 * dn.ncols as f64
+                    .map(|u| {
+                        let dn = supernode(sn, u.d as usize);
+                        let (rows, mid) = ((dn.pattern.len() - u.first as usize) as f64, u.mid as f64);
+                        (rows - mid / 2.0) * mid * dn.ncols as f64
                     })
                     .sum();
                 pulled + c * c * c / 3.0 + p * c * c / 2.0
@@ -406,13 +413,12 @@ impl Context<'_> {
                 }
             }
             let mut ls = MatMut::from_column_major_slice_mut(block, nrows, ncols);
-            for &d in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
-                let dn = supernode(sn, d as usize);
+            for u in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
+                let dn = supernode(sn, u.d as usize);
                 // SAFETY: supernode d is a descendant of s, finished before this task started
                 let dvals = unsafe { std::slice::from_raw_parts(self.l.ptr.add(dn.offset), dn.nrows() * dn.ncols) };
                 let ld = MatRef::from_column_major_slice(dvals, dn.nrows(), dn.ncols);
-                let first = dn.pattern.partition_point(|&r| r < node.begin);
-                let mid = dn.pattern[first..].partition_point(|&r| r < end);
+                let (first, mid) = (u.first as usize, u.mid as usize);
                 let rows = dn.pattern.len() - first;
                 let below = ld.subrows(dn.ncols + first, rows);
                 let (ld_mid, ld_bot) = below.split_at_row(mid);
@@ -480,19 +486,26 @@ pub fn solve_in_place(sn: &SymbolicSupernodalCholesky<usize>, plan: &Plan, l: &[
     let rows = |begin: usize, len: usize| unsafe { x.slice(begin, len) };
     let forward = |s: usize, _: bool| -> Result<(), std::convert::Infallible> {
         let node = supernode(sn, s);
-        let end = node.begin + node.ncols;
         let xs = rows(node.begin, node.ncols);
         SOLVE_SCRATCH.with_borrow_mut(|tmp| {
             tmp.resize(plan.max_pattern.max(plan.max_cols), 0.0);
-            for &d in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
-                let dn = supernode(sn, d as usize);
-                let first = dn.pattern.partition_point(|&r| r < node.begin);
-                let mid = dn.pattern[first..].partition_point(|&r| r < end);
+            for u in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
+                let dn = supernode(sn, u.d as usize);
+                let (first, mid) = (u.first as usize, u.mid as usize);
+                // t = L_{d, rows in s} x_d: the rows of faer's product L_{d, below} x_d that fall
+                // in s, computed by the same kernel (a loop of our own here would round differently)
                 let xd = MatRef::from_column_major_slice(rows(dn.begin, dn.ncols), dn.ncols, 1);
-                let mut t = MatMut::from_column_major_slice_mut(&mut tmp[..mid], mid, 1);
-                faer::linalg::matmul::matmul(t.rb_mut(), Accum::Replace, block(&dn).subrows(dn.ncols + first, mid), xd, 1.0, Par::Seq);
-                for (jj, &r) in dn.pattern[first..first + mid].iter().enumerate() {
-                    xs[r - node.begin] -= t[(jj, 0)];
+                let t = &mut tmp[..mid];
+                faer::linalg::matmul::matmul(
+                    MatMut::from_column_major_slice_mut(&mut *t, mid, 1),
+                    Accum::Replace,
+                    block(&dn).subrows(dn.ncols + first, mid),
+                    xd,
+                    1.0,
+                    Par::Seq,
+                );
+                for (&tj, &r) in t.iter().zip(&dn.pattern[first..first + mid]) {
+                    xs[r - node.begin] -= tj;
                 }
             }
         });
