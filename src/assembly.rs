@@ -277,10 +277,16 @@ pub fn element_stiffness(map: &Affine, material: Material, rule: &element::Rule<
     k
 }
 
-/// Runs `fill(item, slice)` for every item of a compressed layout (`offsets`, one slice of
-/// `buf` per item), in parallel over blocks of items: the slices are disjoint, so any thread
-/// count writes the same values.
-fn par_fill<T: Send>(buf: &mut [T], offsets: &[usize], fill: impl Fn(usize, &mut [T]) + Sync) {
+/// Runs `fill(item, scratch, slice)` for every item of a compressed layout (`offsets`, one slice
+/// of `buf` per item), in parallel over blocks of items, and returns what each call returns, in
+/// item order. Every block makes its own `scratch` with `init`. The slices are disjoint, so any
+/// thread count writes the same values.
+fn par_fill<T: Send, S, R: Send>(
+    buf: &mut [T],
+    offsets: &[usize],
+    init: impl Fn() -> S + Sync,
+    fill: impl Fn(usize, &mut S, &mut [T]) -> R + Sync,
+) -> Vec<R> {
     const BLOCK: usize = 4096;
     let n = offsets.len() - 1;
     let mut blocks = Vec::with_capacity(n.div_ceil(BLOCK));
@@ -291,13 +297,20 @@ fn par_fill<T: Send>(buf: &mut [T], offsets: &[usize], fill: impl Fn(usize, &mut
         blocks.push((start, end, head));
         rest = tail;
     }
-    blocks.into_par_iter().for_each(|(start, end, mut block)| {
-        for item in start..end {
-            let (head, tail) = std::mem::take(&mut block).split_at_mut(offsets[item + 1] - offsets[item]);
-            fill(item, head);
-            block = tail;
-        }
-    });
+    let results: Vec<Vec<R>> = blocks
+        .into_par_iter()
+        .map(|(start, end, mut block)| {
+            let mut scratch = init();
+            let mut out = Vec::with_capacity(end - start);
+            for item in start..end {
+                let (head, tail) = std::mem::take(&mut block).split_at_mut(offsets[item + 1] - offsets[item]);
+                out.push(fill(item, &mut scratch, head));
+                block = tail;
+            }
+            out
+        })
+        .collect();
+    results.into_iter().flatten().collect()
 }
 
 /// Prefix sums of counts: the offsets of a compressed layout.
@@ -310,10 +323,13 @@ fn offsets(counts: impl Iterator<Item = usize>) -> Vec<usize> {
 }
 
 /// The sparsity pattern of the lower triangle on the unknowns: (row, col) is present when the
-/// two nodes share an element.
+/// two nodes share an element. Built on the nodes: every node's neighbours once, sorted; the
+/// column of an unknown holds the unknowns >= it of its node's neighbours.
 fn pattern(nodes: &P2Nodes, dofs: &DofMap) -> SymCsc {
     let n_nodes = nodes.len();
-    // node adjacency: every node of every element containing the node, then sorted and unique
+    let node_index = |p: usize| u32::try_from(p).expect("more than 2^32 nodes");
+    // node adjacency: every node of every element containing the node (u32: half the memory
+    // traffic of usize), then sorted, the unique ones moved to the front of each node's slice
     let mut count = vec![0usize; n_nodes];
     for el in &nodes.elements {
         for &p in el {
@@ -321,40 +337,59 @@ fn pattern(nodes: &P2Nodes, dofs: &DofMap) -> SymCsc {
         }
     }
     let adj_ptr = offsets(count.into_iter());
-    let mut adj = vec![0usize; adj_ptr[n_nodes]];
+    let mut adj = vec![0u32; adj_ptr[n_nodes]];
     let mut fill = adj_ptr.clone();
     for el in &nodes.elements {
+        let el32 = el.map(node_index);
         for &p in el {
-            adj[fill[p]..fill[p] + N_NODES].copy_from_slice(el);
+            adj[fill[p]..fill[p] + N_NODES].copy_from_slice(&el32);
             fill[p] += N_NODES;
         }
     }
-    par_fill(&mut adj, &adj_ptr, |_, list| {
+    drop(fill);
+    let n_unique = par_fill(&mut adj, &adj_ptr, || (), |_, _, list| {
         list.sort_unstable();
+        let mut k = 0;
+        for i in 0..list.len() {
+            if i == 0 || list[i] != list[k - 1] {
+                list[k] = list[i];
+                k += 1;
+            }
+        }
+        k
     });
-    let neighbours = |p: usize| {
-        let list = &adj[adj_ptr[p]..adj_ptr[p + 1]];
-        list.iter().enumerate().filter(move |&(i, q)| i == 0 || list[i - 1] != *q).map(|(_, &q)| q)
-    };
-    // each unknown's owner node; column j holds the unknowns >= j of the owner's neighbours
+    let neighbours = |p: usize| adj[adj_ptr[p]..adj_ptr[p] + n_unique[p]].iter().map(|&q| q as usize);
+    // each unknown's owner node
     let n = dofs.n_free;
-    let mut owner = vec![0usize; n];
+    let mut owner = vec![0u32; n];
     for p in 0..n_nodes {
         for &d in &dofs.dof[p] {
             if d != FIXED {
-                owner[d] = p;
+                owner[d] = node_index(p);
             }
         }
     }
-    let rows_of = |j: usize| neighbours(owner[j]).flat_map(|q| dofs.dof[q]).filter(move |&d| d != FIXED && d >= j);
+    // The rows of column j: the unknowns >= j of the owner's neighbours. DofMap numbers the
+    // unknowns in node order, the contact normals last (also in node order): the neighbours'
+    // other unknowns, then their contact normals, are increasing without a sort (checked; sorted
+    // if a numbering ever breaks that).
+    let (owner, n_interior) = (&owner, dofs.n_interior);
+    let rows_of = move |j: usize| {
+        let nb = move || neighbours(owner[j] as usize).map(|q| dofs.dof[q]);
+        let interior = nb().flat_map(|d| d).filter(move |&d| d != FIXED && d < n_interior && d >= j);
+        let normal = nb().map(|d| d[0]).filter(move |&d| d != FIXED && d >= n_interior && d >= j);
+        interior.chain(normal)
+    };
     let counts: Vec<usize> = (0..n).into_par_iter().map(|j| rows_of(j).count()).collect();
     let col_ptr = offsets(counts.into_iter());
     let mut row_idx = vec![0usize; col_ptr[n]];
-    par_fill(&mut row_idx, &col_ptr, |j, col| {
+    par_fill(&mut row_idx, &col_ptr, || (), |j, _, col| {
         for (slot, d) in col.iter_mut().zip(rows_of(j)) {
             *slot = d;
         }
-        col.sort_unstable();
+        if !col.is_sorted() {
+            col.sort_unstable();
+        }
     });
     let nnz = row_idx.len();
     SymCsc::new(n, col_ptr, row_idx, vec![0.0; nnz])
@@ -626,5 +661,55 @@ mod tests {
         assert!(err(vec![0, 2, 4, 5], vec![0, 2, 0, 2, 2]).contains("diagonal"));
         assert!(err(vec![0, 2, 4, 5], vec![0, 0, 1, 2, 2]).contains("strictly increasing"));
         assert!(err(vec![0, 2, 4, 5], vec![0, 3, 1, 2, 2]).contains("out of range"));
+    }
+
+    /// The matrix summed the plain way: every element's rotated stiffness added entry by entry,
+    /// in element order, into a map keyed by (row, col).
+    fn plain_assembly(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem) -> std::collections::BTreeMap<(usize, usize), f64> {
+        let rule = element::triangle_rule(2);
+        let mut entries = std::collections::BTreeMap::new();
+        for (t, el) in nodes.elements.iter().enumerate() {
+            let mut k = element_stiffness(&Affine::new(mesh.corners(t)), problem.material(), &rule);
+            rotate(&mut k, &mut [0.0; 12], el, dofs);
+            let global: [usize; 12] = std::array::from_fn(|l| dofs.dof[el[l / 2]][l % 2]);
+            for (r, &gr) in global.iter().enumerate() {
+                for (c, &gc) in global.iter().enumerate() {
+                    if gr != FIXED && gc != FIXED && gr >= gc {
+                        *entries.entry((gr, gc)).or_insert(0.0) += k[r][c];
+                    }
+                }
+            }
+        }
+        entries
+    }
+
+    /// The pattern holds exactly the couplings of the elements, and every entry is the plain sum
+    /// in element order, to the bit, on one thread and on two (with oblique contact normals, so
+    /// that the local frames are exercised, and several element chunks).
+    #[test]
+    fn assembled_matrix_is_the_plain_sum_in_element_order_on_any_thread_count() {
+        let problem = crate::problems::Patch { normal: [0.8, -0.6], ..Default::default() };
+        let mesh = crate::mesh::MeshSpec::parse("structured:100").unwrap().build(&problem).unwrap();
+        let nodes = P2Nodes::new(&mesh);
+        let dofs = DofMap::new(&nodes, &problem);
+        assert!(!dofs.contact.is_empty() && dofs.n_interior < dofs.n_free && mesh.n_triangles() > 16384);
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| assemble(&mesh, &nodes, &dofs, &problem))
+        };
+        let (one, two) = (on(1), on(2));
+        let plain = plain_assembly(&mesh, &nodes, &dofs, &problem);
+        let m = &one.matrix;
+        assert_eq!(m.values().len(), plain.len(), "the pattern has exactly the elements' couplings");
+        for j in 0..m.n() {
+            for k in m.col_ptr()[j]..m.col_ptr()[j + 1] {
+                let i = m.row_idx()[k];
+                assert_eq!(m.values()[k].to_bits(), plain[&(i, j)].to_bits(), "entry ({i}, {j})");
+            }
+        }
+        assert_eq!((m.col_ptr(), m.row_idx()), (two.matrix.col_ptr(), two.matrix.row_idx()));
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(m.values()), bits(two.matrix.values()), "matrix on 1 and 2 threads");
+        assert_eq!(bits(&one.rhs), bits(&two.rhs), "load on 1 and 2 threads");
     }
 }
