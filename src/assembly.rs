@@ -251,30 +251,68 @@ pub struct System {
 
 /// The 12 x 12 element stiffness of P2 plane elasticity on one triangle, local unknown order
 /// `2 a + i` (node a, Cartesian component i):
-/// K[(a,i),(b,j)] = int mu (delta_ij grad phi_a . grad phi_b + d_j phi_a d_i phi_b) + zeta d_i phi_a d_j phi_b.
+/// K[(a,i),(b,j)] = int mu (delta_ij grad phi_a . grad phi_b + d_j phi_a d_i phi_b) + zeta d_i phi_a d_j phi_b,
+/// integrated with `rule` (see [`ReferenceProducts`]).
 pub fn element_stiffness(map: &Affine, material: Material, rule: &element::Rule<2>) -> [[f64; 12]; 12] {
-    let mut k = [[0.0; 12]; 12];
-    let area = map.det.abs();
-    for (q, w) in rule.points.iter().zip(&rule.weights) {
-        let rg = element::p2_gradients(q[0], q[1]);
-        let g: [[f64; 2]; N_NODES] = std::array::from_fn(|a| map.grad(rg[a]));
-        let w = w * area;
-        for a in 0..N_NODES {
-            for b in 0..N_NODES {
-                let dot = g[a][0] * g[b][0] + g[a][1] * g[b][1];
-                for i in 0..2 {
-                    for j in 0..2 {
-                        let mut v = material.mu * g[a][j] * g[b][i] + material.zeta * g[a][i] * g[b][j];
-                        if i == j {
-                            v += material.mu * dot;
+    ReferenceProducts::new(rule).stiffness(map, material)
+}
+
+/// The integrals R_kl[a][b] = int_ref d_k phi_a d_l phi_b of products of reference gradients
+/// (k, l in {x, y}), by a quadrature rule. On an affine element the physical gradient is
+/// `inv_t` times the reference one, so int_T d_i phi_a d_j phi_b = |det| sum_kl inv_t[i][k]
+/// inv_t[j][l] R_kl[a][b]: the element stiffness is a combination of these four 6 x 6 tables,
+/// computed once for all elements.
+pub struct ReferenceProducts {
+    r: [[[[f64; N_NODES]; N_NODES]; 2]; 2],
+}
+
+impl ReferenceProducts {
+    pub fn new(rule: &element::Rule<2>) -> Self {
+        let mut r = [[[[0.0; N_NODES]; N_NODES]; 2]; 2];
+        for (q, w) in rule.points.iter().zip(&rule.weights) {
+            let g = element::p2_gradients(q[0], q[1]);
+            for (k, rk) in r.iter_mut().enumerate() {
+                for (l, rkl) in rk.iter_mut().enumerate() {
+                    for a in 0..N_NODES {
+                        for b in 0..N_NODES {
+                            rkl[a][b] += w * g[a][k] * g[b][l];
                         }
-                        k[2 * a + i][2 * b + j] += w * v;
                     }
                 }
             }
         }
+        ReferenceProducts { r }
     }
-    k
+
+    /// The element stiffness of [`element_stiffness`] on the triangle of `map`.
+    pub fn stiffness(&self, map: &Affine, material: Material) -> [[f64; 12]; 12] {
+        let (b, area) = (map.inv_t, map.det.abs());
+        // gij[a][b] = int_T d_i phi_a d_j phi_b; g10 is g01 transposed
+        let product = |i: usize, j: usize| {
+            let c = [[area * b[i][0] * b[j][0], area * b[i][0] * b[j][1]], [area * b[i][1] * b[j][0], area * b[i][1] * b[j][1]]];
+            let mut g = [[0.0; N_NODES]; N_NODES];
+            for (x, row) in g.iter_mut().enumerate() {
+                for (y, v) in row.iter_mut().enumerate() {
+                    *v = c[0][0] * self.r[0][0][x][y] + c[0][1] * self.r[0][1][x][y] + c[1][0] * self.r[1][0][x][y] + c[1][1] * self.r[1][1][x][y];
+                }
+            }
+            g
+        };
+        let (g00, g01, g11) = (product(0, 0), product(0, 1), product(1, 1));
+        let (mu, zeta) = (material.mu, material.zeta);
+        let mut k = [[0.0; 12]; 12];
+        for a in 0..N_NODES {
+            for c in 0..N_NODES {
+                let lap = mu * (g00[a][c] + g11[a][c]);
+                // (i, j) = (0, 0), (0, 1), (1, 0), (1, 1): mu g_ji + zeta g_ij (+ mu laplacian)
+                k[2 * a][2 * c] = lap + (mu + zeta) * g00[a][c];
+                k[2 * a][2 * c + 1] = mu * g01[c][a] + zeta * g01[a][c];
+                k[2 * a + 1][2 * c] = mu * g01[a][c] + zeta * g01[c][a];
+                k[2 * a + 1][2 * c + 1] = lap + (mu + zeta) * g11[a][c];
+            }
+        }
+        k
+    }
 }
 
 /// Runs `fill(item, scratch, slice)` for every item of a compressed layout (`offsets`, one slice
@@ -369,27 +407,39 @@ fn pattern(nodes: &P2Nodes, dofs: &DofMap) -> SymCsc {
             }
         }
     }
-    // The rows of column j: the unknowns >= j of the owner's neighbours. DofMap numbers the
-    // unknowns in node order, the contact normals last (also in node order): the neighbours'
-    // other unknowns, then their contact normals, are increasing without a sort (checked; sorted
-    // if a numbering ever breaks that).
+    // The unknowns of node p's neighbours, increasing. DofMap numbers the unknowns in node
+    // order, the contact normals last (also in node order): the neighbours' other unknowns, then
+    // their contact normals, are increasing without a sort (checked; sorted if a numbering ever
+    // breaks that).
     let (owner, n_interior) = (&owner, dofs.n_interior);
-    let rows_of = move |j: usize| {
-        let nb = move || neighbours(owner[j] as usize).map(|q| dofs.dof[q]);
-        let interior = nb().flat_map(|d| d).filter(move |&d| d != FIXED && d < n_interior && d >= j);
-        let normal = nb().map(|d| d[0]).filter(move |&d| d != FIXED && d >= n_interior && d >= j);
-        interior.chain(normal)
+    let node_rows = |p: usize, list: &mut Vec<usize>| {
+        list.clear();
+        list.extend(neighbours(p).flat_map(|q| dofs.dof[q]).filter(|&d| d != FIXED && d < n_interior));
+        list.extend(neighbours(p).map(|q| dofs.dof[q][0]).filter(|&d| d != FIXED && d >= n_interior));
+        if !list.is_sorted() {
+            list.sort_unstable();
+        }
     };
-    let counts: Vec<usize> = (0..n).into_par_iter().map(|j| rows_of(j).count()).collect();
+    // The rows of column j are the suffix >= j of its owner's list: where it starts. The list is
+    // kept in `scratch` with its node, so the columns of one node build it once.
+    let column = |j: usize, scratch: &mut (usize, Vec<usize>)| {
+        let p = owner[j] as usize;
+        if scratch.0 != p {
+            node_rows(p, &mut scratch.1);
+            scratch.0 = p;
+        }
+        scratch.1.partition_point(|&d| d < j)
+    };
+    let scratch = || (usize::MAX, Vec::with_capacity(64));
+    let counts: Vec<usize> = (0..n).into_par_iter().map_init(scratch, |s, j| {
+        let start = column(j, s);
+        s.1.len() - start
+    }).collect();
     let col_ptr = offsets(counts.into_iter());
     let mut row_idx = vec![0usize; col_ptr[n]];
-    par_fill(&mut row_idx, &col_ptr, || (), |j, _, col| {
-        for (slot, d) in col.iter_mut().zip(rows_of(j)) {
-            *slot = d;
-        }
-        if !col.is_sorted() {
-            col.sort_unstable();
-        }
+    par_fill(&mut row_idx, &col_ptr, scratch, |j, s, col| {
+        let start = column(j, s);
+        col.copy_from_slice(&s.1[start..]);
     });
     let nnz = row_idx.len();
     SymCsc::new(n, col_ptr, row_idx, vec![0.0; nnz])
@@ -404,45 +454,81 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
     let dirichlet: Vec<[f64; 2]> = (0..nodes.len())
         .map(|p| if nodes.part[p] == Some(Part::Dirichlet) { problem.dirichlet(nodes.coords[p]) } else { [0.0, 0.0] })
         .collect();
-    let stiff_rule = element::triangle_rule(2);
+    let products = ReferenceProducts::new(&element::triangle_rule(2));
     let load_rule = element::triangle_rule(LOAD_DEGREE);
     let load_basis: Vec<[f64; N_NODES]> = load_rule.points.iter().map(|q| element::p2_values(q[0], q[1])).collect();
     let breaks = problem.load_breaks();
+    let contribution = |t: usize, e: &mut Contribution| {
+        let corners = mesh.corners(t);
+        let map = Affine::new(corners);
+        e.k = products.stiffness(&map, material);
+        e.f = [0.0; 12];
+        let area = map.det.abs();
+        let crossing = breaks.iter().find(|&&c| corners.iter().any(|v| v[0] < c) && corners.iter().any(|v| v[0] > c));
+        if let Some(&c) = crossing {
+            e.f = split_load(&map, corners, c, &|x| problem.body_force(x));
+        } else {
+            for ((q, w), phi) in load_rule.points.iter().zip(&load_rule.weights).zip(&load_basis) {
+                let fx = problem.body_force(map.map(*q));
+                let (f0, f1) = (w * area * fx[0], w * area * fx[1]);
+                for a in 0..N_NODES {
+                    e.f[2 * a] += f0 * phi[a];
+                    e.f[2 * a + 1] += f1 * phi[a];
+                }
+            }
+        }
+        let el = &nodes.elements[t];
+        rotate(&mut e.k, &mut e.f, el, dofs);
+        e.locate(el, dofs, &dirichlet);
+    };
 
-    // Element matrices and loads in parallel (in chunks, to bound memory); scattered in element
-    // order so the sums are the same on any number of threads.
+    // Element contributions in parallel, a chunk at a time into one buffer (to bound memory),
+    // scattered in element order so the sums are the same on any number of threads.
     const CHUNK: usize = 16384;
     let n_el = mesh.n_triangles();
+    let mut local = vec![Contribution::ZERO; CHUNK.min(n_el)];
     for start in (0..n_el).step_by(CHUNK) {
-        let end = (start + CHUNK).min(n_el);
-        let local: Vec<([[f64; 12]; 12], [f64; 12])> = (start..end)
-            .into_par_iter()
-            .map(|t| {
-                let map = Affine::new(mesh.corners(t));
-                let mut k = element_stiffness(&map, material, &stiff_rule);
-                let mut f = [0.0; 12];
-                let area = map.det.abs();
-                let corners = mesh.corners(t);
-                let crossing = breaks.iter().find(|&&c| corners.iter().any(|v| v[0] < c) && corners.iter().any(|v| v[0] > c));
-                if let Some(&c) = crossing {
-                    f = split_load(&map, corners, c, &|x| problem.body_force(x));
-                } else {
-                    for ((q, w), phi) in load_rule.points.iter().zip(&load_rule.weights).zip(&load_basis) {
-                        let fx = problem.body_force(map.map(*q));
-                        for a in 0..N_NODES {
-                            f[2 * a] += w * area * fx[0] * phi[a];
-                            f[2 * a + 1] += w * area * fx[1] * phi[a];
-                        }
-                    }
-                }
-                rotate(&mut k, &mut f, &nodes.elements[t], dofs);
-                (k, f)
-            })
-            .collect();
-        scatter(&mut matrix, &mut rhs, &local, &nodes.elements[start..end], dofs, &dirichlet);
+        let chunk = &mut local[..CHUNK.min(n_el - start)];
+        chunk.par_iter_mut().enumerate().for_each(|(i, e)| contribution(start + i, e));
+        scatter(&mut matrix, &mut rhs, chunk);
     }
+    drop(local);
     neumann_load(mesh, nodes, dofs, problem, &mut rhs);
     System { matrix, rhs, dirichlet }
+}
+
+/// One element's share of the system, ready to scatter: its stiffness and load in the local
+/// frames, the load with the Dirichlet values eliminated (f - K_(., fixed) g), and where its
+/// local unknowns go.
+#[derive(Clone, Copy)]
+struct Contribution {
+    k: [[f64; 12]; 12],
+    f: [f64; 12],
+    global: [usize; 12],
+    /// The local unknowns by increasing global index, the `n_free` free ones first.
+    order: [u8; 12],
+    n_free: u8,
+}
+
+impl Contribution {
+    const ZERO: Contribution = Contribution { k: [[0.0; 12]; 12], f: [0.0; 12], global: [FIXED; 12], order: [0; 12], n_free: 0 };
+
+    /// With `k` and `f` in the local frames: where the local unknowns go, and the Dirichlet
+    /// values eliminated from `f`.
+    fn locate(&mut self, el: &[usize; 6], dofs: &DofMap, dirichlet: &[[f64; 2]]) {
+        self.global = std::array::from_fn(|l| dofs.dof[el[l / 2]][l % 2]);
+        for c in (0..12).filter(|&c| self.global[c] == FIXED) {
+            // Dirichlet nodes are never rotated: their local components are Cartesian
+            let g = dirichlet[el[c / 2]][c % 2];
+            for (fr, kr) in self.f.iter_mut().zip(&self.k) {
+                *fr -= kr[c] * g;
+            }
+        }
+        let global = &self.global;
+        self.order = std::array::from_fn(|l| l as u8);
+        self.order.sort_unstable_by_key(|&l| global[l as usize]);
+        self.n_free = global.iter().filter(|&&g| g != FIXED).count() as u8;
+    }
 }
 
 /// Gauss points per direction of [`split_load`].
@@ -530,18 +616,11 @@ fn rotate(k: &mut [[f64; 12]; 12], f: &mut [f64; 12], el: &[usize; 6], dofs: &Do
     }
 }
 
-/// Add element matrices and loads, in element order, into the matrix and the right-hand side.
+/// Add element contributions, in element order, into the matrix and the right-hand side.
 /// The unknowns are split into ranges of about equal nonzeros, one per thread: a range takes the
 /// matrix entries of its columns and the loads of its rows. Every entry still receives its
 /// contributions in element order, so the sums are the same on any number of threads.
-fn scatter(
-    matrix: &mut SymCsc,
-    rhs: &mut [f64],
-    local: &[([[f64; 12]; 12], [f64; 12])],
-    elements: &[[usize; 6]],
-    dofs: &DofMap,
-    dirichlet: &[[f64; 2]],
-) {
+fn scatter(matrix: &mut SymCsc, rhs: &mut [f64], local: &[Contribution]) {
     let n = matrix.n;
     let parts = rayon::current_num_threads().max(1);
     let nnz = matrix.values.len();
@@ -562,35 +641,25 @@ fn scatter(
     }
     jobs.into_par_iter().for_each(|(c0, c1, values, rhs)| {
         let base = col_ptr[c0];
-        let mine = |d: usize| d != FIXED && (c0..c1).contains(&d);
-        for ((k, f), el) in local.iter().zip(elements) {
-            let global: [usize; 12] = std::array::from_fn(|l| dofs.dof[el[l / 2]][l % 2]);
-            for r in (0..12).filter(|&r| mine(global[r])) {
-                let gr = global[r];
-                rhs[gr - c0] += f[r];
-                for c in 0..12 {
-                    if global[c] == FIXED {
-                        // Dirichlet nodes are never rotated: their local components are Cartesian
-                        rhs[gr - c0] -= k[r][c] * dirichlet[el[c / 2]][c % 2];
-                    }
+        for e in local {
+            let free = &e.order[..e.n_free as usize];
+            // the free unknowns are by increasing global index: those of this range are a run
+            let first = free.partition_point(|&l| e.global[l as usize] < c0);
+            for (i, &c) in free.iter().enumerate().skip(first) {
+                let gc = e.global[c as usize];
+                if gc >= c1 {
+                    break;
                 }
-            }
-            // local unknowns by increasing global index (FIXED last): the rows of a column are
-            // then found by one forward scan of its sorted row indices
-            let mut order: [usize; 12] = std::array::from_fn(|l| l);
-            order.sort_unstable_by_key(|&l| global[l]);
-            for (i, &c) in order.iter().enumerate() {
-                let gc = global[c];
-                if !mine(gc) {
-                    continue;
-                }
+                rhs[gc - c0] += e.f[c as usize];
+                // the rows below: one forward scan of the column's sorted row indices
                 let (mut pos, hi) = (col_ptr[gc], col_ptr[gc + 1]);
-                for &r in order[i..].iter().take_while(|&&r| global[r] != FIXED) {
-                    while row_idx[pos] != global[r] {
+                for &r in &free[i..] {
+                    let gr = e.global[r as usize];
+                    while row_idx[pos] != gr {
                         pos += 1;
                         assert!(pos < hi, "entry outside the sparsity pattern");
                     }
-                    values[pos - base] += k[r][c];
+                    values[pos - base] += e.k[r as usize][c as usize];
                 }
             }
         }
@@ -661,6 +730,38 @@ mod tests {
         assert!(err(vec![0, 2, 4, 5], vec![0, 2, 0, 2, 2]).contains("diagonal"));
         assert!(err(vec![0, 2, 4, 5], vec![0, 0, 1, 2, 2]).contains("strictly increasing"));
         assert!(err(vec![0, 2, 4, 5], vec![0, 3, 1, 2, 2]).contains("out of range"));
+    }
+
+    /// The stiffness from the reference products is the direct quadrature of the bilinear form
+    /// (physical gradients at every point of the rule), to round-off, on a skewed triangle.
+    #[test]
+    fn reference_products_give_the_quadrature_stiffness() {
+        let map = Affine::new([[0.1, 0.2], [0.9, 0.3], [0.4, 0.8]]);
+        let material = Material::from_young(500.0, 0.3);
+        let rule = element::triangle_rule(2);
+        let mut direct = [[0.0; 12]; 12];
+        for (q, w) in rule.points.iter().zip(&rule.weights) {
+            let rg = element::p2_gradients(q[0], q[1]);
+            let g: [[f64; 2]; N_NODES] = std::array::from_fn(|a| map.grad(rg[a]));
+            for a in 0..N_NODES {
+                for b in 0..N_NODES {
+                    let dot = g[a][0] * g[b][0] + g[a][1] * g[b][1];
+                    for i in 0..2 {
+                        for j in 0..2 {
+                            let delta = if i == j { material.mu * dot } else { 0.0 };
+                            direct[2 * a + i][2 * b + j] += w * map.det.abs() * (material.mu * g[a][j] * g[b][i] + material.zeta * g[a][i] * g[b][j] + delta);
+                        }
+                    }
+                }
+            }
+        }
+        let k = ReferenceProducts::new(&rule).stiffness(&map, material);
+        let scale = direct.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (r, (kr, dr)) in k.iter().zip(&direct).enumerate() {
+            for (c, (x, y)) in kr.iter().zip(dr).enumerate() {
+                assert!((x - y).abs() <= 1e-14 * scale, "entry ({r}, {c}): {x} vs {y}");
+            }
+        }
     }
 
     /// The matrix summed the plain way: every element's rotated stiffness added entry by entry,
