@@ -645,22 +645,36 @@ fn scatter(matrix: &mut SymCsc, rhs: &mut [f64], local: &[Contribution]) {
             let free = &e.order[..e.n_free as usize];
             // the free unknowns are by increasing global index: those of this range are a run
             let first = free.partition_point(|&l| e.global[l as usize] < c0);
-            for (i, &c) in free.iter().enumerate().skip(first) {
-                let gc = e.global[c as usize];
+            let mut i = first;
+            while i < free.len() {
+                let c = free[i] as usize;
+                let gc = e.global[c];
                 if gc >= c1 {
                     break;
                 }
-                rhs[gc - c0] += e.f[c as usize];
+                // A node's two unknowns gc, gc + 1 (both in this range): column gc + 1 holds the
+                // rows of column gc but gc itself, in the same order (both are the suffixes of
+                // the node's sorted list), so one scan of column gc places both columns' entries.
+                let pair = free.get(i + 1).map(|&l| l as usize).filter(|&c2| c2 / 2 == c / 2 && e.global[c2] == gc + 1 && gc + 1 < c1);
+                rhs[gc - c0] += e.f[c];
+                if let Some(c2) = pair {
+                    rhs[gc + 1 - c0] += e.f[c2];
+                }
                 // the rows below: one forward scan of the column's sorted row indices
-                let (mut pos, hi) = (col_ptr[gc], col_ptr[gc + 1]);
+                let (lo, hi) = (col_ptr[gc], col_ptr[gc + 1]);
+                let mut pos = lo;
                 for &r in &free[i..] {
                     let gr = e.global[r as usize];
                     while row_idx[pos] != gr {
                         pos += 1;
                         assert!(pos < hi, "entry outside the sparsity pattern");
                     }
-                    values[pos - base] += e.k[r as usize][c as usize];
+                    values[pos - base] += e.k[r as usize][c];
+                    if let Some(c2) = pair.filter(|_| gr != gc) {
+                        values[hi + (pos - lo - 1) - base] += e.k[r as usize][c2];
+                    }
                 }
+                i += if pair.is_some() { 2 } else { 1 };
             }
         }
     });
