@@ -482,9 +482,11 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
         e.locate(el, dofs, &dirichlet);
     };
 
-    // Element contributions in parallel, a chunk at a time into one buffer (to bound memory),
-    // scattered in element order so the sums are the same on any number of threads.
-    const CHUNK: usize = 16384;
+    // Element contributions in parallel, a chunk at a time into one buffer, scattered in element
+    // order so the sums are the same on any number of threads. A chunk (about 1.4 kB an element)
+    // stays in the last-level cache between the two passes: 2048 elements take 8% less time on
+    // one thread than 16384 at structured:256.
+    const CHUNK: usize = 2048;
     let n_el = mesh.n_triangles();
     let mut local = vec![Contribution::ZERO; CHUNK.min(n_el)];
     for start in (0..n_el).step_by(CHUNK) {
