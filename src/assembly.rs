@@ -251,68 +251,30 @@ pub struct System {
 
 /// The 12 x 12 element stiffness of P2 plane elasticity on one triangle, local unknown order
 /// `2 a + i` (node a, Cartesian component i):
-/// K[(a,i),(b,j)] = int mu (delta_ij grad phi_a . grad phi_b + d_j phi_a d_i phi_b) + zeta d_i phi_a d_j phi_b,
-/// integrated with `rule` (see [`ReferenceProducts`]).
+/// K[(a,i),(b,j)] = int mu (delta_ij grad phi_a . grad phi_b + d_j phi_a d_i phi_b) + zeta d_i phi_a d_j phi_b.
 pub fn element_stiffness(map: &Affine, material: Material, rule: &element::Rule<2>) -> [[f64; 12]; 12] {
-    ReferenceProducts::new(rule).stiffness(map, material)
-}
-
-/// The integrals R_kl[a][b] = int_ref d_k phi_a d_l phi_b of products of reference gradients
-/// (k, l in {x, y}), by a quadrature rule. On an affine element the physical gradient is
-/// `inv_t` times the reference one, so int_T d_i phi_a d_j phi_b = |det| sum_kl inv_t[i][k]
-/// inv_t[j][l] R_kl[a][b]: the element stiffness is a combination of these four 6 x 6 tables,
-/// computed once for all elements.
-pub struct ReferenceProducts {
-    r: [[[[f64; N_NODES]; N_NODES]; 2]; 2],
-}
-
-impl ReferenceProducts {
-    pub fn new(rule: &element::Rule<2>) -> Self {
-        let mut r = [[[[0.0; N_NODES]; N_NODES]; 2]; 2];
-        for (q, w) in rule.points.iter().zip(&rule.weights) {
-            let g = element::p2_gradients(q[0], q[1]);
-            for (k, rk) in r.iter_mut().enumerate() {
-                for (l, rkl) in rk.iter_mut().enumerate() {
-                    for a in 0..N_NODES {
-                        for b in 0..N_NODES {
-                            rkl[a][b] += w * g[a][k] * g[b][l];
+    let mut k = [[0.0; 12]; 12];
+    let area = map.det.abs();
+    for (q, w) in rule.points.iter().zip(&rule.weights) {
+        let rg = element::p2_gradients(q[0], q[1]);
+        let g: [[f64; 2]; N_NODES] = std::array::from_fn(|a| map.grad(rg[a]));
+        let w = w * area;
+        for a in 0..N_NODES {
+            for b in 0..N_NODES {
+                let dot = g[a][0] * g[b][0] + g[a][1] * g[b][1];
+                for i in 0..2 {
+                    for j in 0..2 {
+                        let mut v = material.mu * g[a][j] * g[b][i] + material.zeta * g[a][i] * g[b][j];
+                        if i == j {
+                            v += material.mu * dot;
                         }
+                        k[2 * a + i][2 * b + j] += w * v;
                     }
                 }
             }
         }
-        ReferenceProducts { r }
     }
-
-    /// The element stiffness of [`element_stiffness`] on the triangle of `map`.
-    pub fn stiffness(&self, map: &Affine, material: Material) -> [[f64; 12]; 12] {
-        let (b, area) = (map.inv_t, map.det.abs());
-        // gij[a][b] = int_T d_i phi_a d_j phi_b; g10 is g01 transposed
-        let product = |i: usize, j: usize| {
-            let c = [[area * b[i][0] * b[j][0], area * b[i][0] * b[j][1]], [area * b[i][1] * b[j][0], area * b[i][1] * b[j][1]]];
-            let mut g = [[0.0; N_NODES]; N_NODES];
-            for (x, row) in g.iter_mut().enumerate() {
-                for (y, v) in row.iter_mut().enumerate() {
-                    *v = c[0][0] * self.r[0][0][x][y] + c[0][1] * self.r[0][1][x][y] + c[1][0] * self.r[1][0][x][y] + c[1][1] * self.r[1][1][x][y];
-                }
-            }
-            g
-        };
-        let (g00, g01, g11) = (product(0, 0), product(0, 1), product(1, 1));
-        let (mu, zeta) = (material.mu, material.zeta);
-        let mut k = [[0.0; 12]; 12];
-        for a in 0..N_NODES {
-            for c in 0..N_NODES {
-                let lap = mu * (g00[a][c] + g11[a][c]);
-                // (i, j) = (0, 0), (0, 1), (1, 0), (1, 1): mu g_ji + zeta g_ij (+ mu laplacian)
-                k[2 * a][2 * c] = lap + (mu + zeta) * g00[a][c];
-                k[2 * a][2 * c + 1] = mu * g01[c][a] + zeta * g01[a][c];
-                k[2 * a + 1][2 * c] = mu * g01[a][c] + zeta * g01[c][a];
-                k[2 * a + 1][2 * c + 1] = lap + (mu + zeta) * g11[a][c];
-            }
-        }
-        k
-    }
+    k
 }
 
 /// Runs `fill(item, scratch, slice)` for every item of a compressed layout (`offsets`, one slice
@@ -454,14 +416,14 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
     let dirichlet: Vec<[f64; 2]> = (0..nodes.len())
         .map(|p| if nodes.part[p] == Some(Part::Dirichlet) { problem.dirichlet(nodes.coords[p]) } else { [0.0, 0.0] })
         .collect();
-    let products = ReferenceProducts::new(&element::triangle_rule(2));
+    let stiff_rule = element::triangle_rule(2);
     let load_rule = element::triangle_rule(LOAD_DEGREE);
     let load_basis: Vec<[f64; N_NODES]> = load_rule.points.iter().map(|q| element::p2_values(q[0], q[1])).collect();
     let breaks = problem.load_breaks();
     let contribution = |t: usize, e: &mut Contribution| {
         let corners = mesh.corners(t);
         let map = Affine::new(corners);
-        e.k = products.stiffness(&map, material);
+        e.k = element_stiffness(&map, material, &stiff_rule);
         e.f = [0.0; 12];
         let area = map.det.abs();
         let crossing = breaks.iter().find(|&&c| corners.iter().any(|v| v[0] < c) && corners.iter().any(|v| v[0] > c));
@@ -500,36 +462,42 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
 }
 
 /// One element's share of the system, ready to scatter: its stiffness and load in the local
-/// frames, the load with the Dirichlet values eliminated (f - K_(., fixed) g), and where its
-/// local unknowns go.
+/// frames, the Dirichlet values of its fixed unknowns, and where its local unknowns go.
 #[derive(Clone, Copy)]
 struct Contribution {
     k: [[f64; 12]; 12],
     f: [f64; 12],
     global: [usize; 12],
+    /// The Dirichlet value of every fixed local unknown (0 at the free ones).
+    g: [f64; 12],
     /// The local unknowns by increasing global index, the `n_free` free ones first.
     order: [u8; 12],
     n_free: u8,
 }
 
 impl Contribution {
-    const ZERO: Contribution = Contribution { k: [[0.0; 12]; 12], f: [0.0; 12], global: [FIXED; 12], order: [0; 12], n_free: 0 };
+    const ZERO: Contribution = Contribution { k: [[0.0; 12]; 12], f: [0.0; 12], global: [FIXED; 12], g: [0.0; 12], order: [0; 12], n_free: 0 };
 
     /// With `k` and `f` in the local frames: where the local unknowns go, and the Dirichlet
-    /// values eliminated from `f`.
+    /// values of the fixed ones.
     fn locate(&mut self, el: &[usize; 6], dofs: &DofMap, dirichlet: &[[f64; 2]]) {
         self.global = std::array::from_fn(|l| dofs.dof[el[l / 2]][l % 2]);
-        for c in (0..12).filter(|&c| self.global[c] == FIXED) {
-            // Dirichlet nodes are never rotated: their local components are Cartesian
-            let g = dirichlet[el[c / 2]][c % 2];
-            for (fr, kr) in self.f.iter_mut().zip(&self.k) {
-                *fr -= kr[c] * g;
-            }
-        }
+        // Dirichlet nodes are never rotated: their local components are Cartesian
+        self.g = std::array::from_fn(|l| if self.global[l] == FIXED { dirichlet[el[l / 2]][l % 2] } else { 0.0 });
         let global = &self.global;
         self.order = std::array::from_fn(|l| l as u8);
         self.order.sort_unstable_by_key(|&l| global[l as usize]);
         self.n_free = global.iter().filter(|&&g| g != FIXED).count() as u8;
+    }
+
+    /// Adds the load of local unknown r with the Dirichlet values eliminated,
+    /// f_r - sum_fixed K_rl g_l, term by term into `rhs`.
+    #[inline]
+    fn load(&self, rhs: &mut f64, r: usize) {
+        *rhs += self.f[r];
+        for l in (0..12).filter(|&l| self.global[l] == FIXED) {
+            *rhs -= self.k[r][l] * self.g[l];
+        }
     }
 }
 
@@ -658,9 +626,9 @@ fn scatter(matrix: &mut SymCsc, rhs: &mut [f64], local: &[Contribution]) {
                 // rows of column gc but gc itself, in the same order (both are the suffixes of
                 // the node's sorted list), so one scan of column gc places both columns' entries.
                 let pair = free.get(i + 1).map(|&l| l as usize).filter(|&c2| c2 / 2 == c / 2 && e.global[c2] == gc + 1 && gc + 1 < c1);
-                rhs[gc - c0] += e.f[c];
+                e.load(&mut rhs[gc - c0], c);
                 if let Some(c2) = pair {
-                    rhs[gc + 1 - c0] += e.f[c2];
+                    e.load(&mut rhs[gc + 1 - c0], c2);
                 }
                 // the rows below: one forward scan of the column's sorted row indices
                 let (lo, hi) = (col_ptr[gc], col_ptr[gc + 1]);
@@ -746,38 +714,6 @@ mod tests {
         assert!(err(vec![0, 2, 4, 5], vec![0, 2, 0, 2, 2]).contains("diagonal"));
         assert!(err(vec![0, 2, 4, 5], vec![0, 0, 1, 2, 2]).contains("strictly increasing"));
         assert!(err(vec![0, 2, 4, 5], vec![0, 3, 1, 2, 2]).contains("out of range"));
-    }
-
-    /// The stiffness from the reference products is the direct quadrature of the bilinear form
-    /// (physical gradients at every point of the rule), to round-off, on a skewed triangle.
-    #[test]
-    fn reference_products_give_the_quadrature_stiffness() {
-        let map = Affine::new([[0.1, 0.2], [0.9, 0.3], [0.4, 0.8]]);
-        let material = Material::from_young(500.0, 0.3);
-        let rule = element::triangle_rule(2);
-        let mut direct = [[0.0; 12]; 12];
-        for (q, w) in rule.points.iter().zip(&rule.weights) {
-            let rg = element::p2_gradients(q[0], q[1]);
-            let g: [[f64; 2]; N_NODES] = std::array::from_fn(|a| map.grad(rg[a]));
-            for a in 0..N_NODES {
-                for b in 0..N_NODES {
-                    let dot = g[a][0] * g[b][0] + g[a][1] * g[b][1];
-                    for i in 0..2 {
-                        for j in 0..2 {
-                            let delta = if i == j { material.mu * dot } else { 0.0 };
-                            direct[2 * a + i][2 * b + j] += w * map.det.abs() * (material.mu * g[a][j] * g[b][i] + material.zeta * g[a][i] * g[b][j] + delta);
-                        }
-                    }
-                }
-            }
-        }
-        let k = ReferenceProducts::new(&rule).stiffness(&map, material);
-        let scale = direct.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-        for (r, (kr, dr)) in k.iter().zip(&direct).enumerate() {
-            for (c, (x, y)) in kr.iter().zip(dr).enumerate() {
-                assert!((x - y).abs() <= 1e-14 * scale, "entry ({r}, {c}): {x} vs {y}");
-            }
-        }
     }
 
     /// The matrix summed the plain way: every element's rotated stiffness added entry by entry,
