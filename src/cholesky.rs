@@ -186,12 +186,17 @@ impl Plan {
         // supernode's rows are mapped anyway); grouped by column
         let cols = matrix.col_ptr();
         let mut placed = vec![(0u32, 0u32); matrix.values().len()];
-        crate::assembly::par_fill(&mut placed, cols, |j, out| {
-            for (slot, &i) in out.iter_mut().zip(&matrix.row_idx()[cols[j]..cols[j + 1]]) {
-                let (a, b) = (inv[i], inv[j]);
-                *slot = (a.min(b) as u32, a.max(b) as u32);
-            }
-        });
+        crate::assembly::par_fill(
+            &mut placed,
+            cols,
+            || (),
+            |j, _, out| {
+                for (slot, &i) in out.iter_mut().zip(&matrix.row_idx()[cols[j]..cols[j + 1]]) {
+                    let (a, b) = (inv[i], inv[j]);
+                    *slot = (a.min(b) as u32, a.max(b) as u32);
+                }
+            },
+        );
         let mut entry_ptr = vec![0usize; n + 1];
         for &(c, _) in &placed {
             entry_ptr[c as usize + 1] += 1;
