@@ -1,7 +1,8 @@
 //! The numeric supernodal Cholesky factorisation P K P^T = L L^T, on every core.
 //!
 //! faer computes the symbolic factorisation (the supernodes: runs of columns of L with one row
-//! pattern, the layout of L's values) and solves with L; this module fills L's values. faer's
+//! pattern, the layout of L's values); this module fills L's values ([`factorize`]) and solves
+//! with L ([`solve_in_place`]). faer's
 //! own numeric step visits the supernodes one after another and parallelises only inside a
 //! supernode's dense kernels, which on our matrices was slower than one thread. Yet most of the
 //! work of a nested-dissection ordering lies in subtrees of the elimination tree that share
@@ -379,9 +380,8 @@ impl Context<'_> {
         let node = supernode(sn, s);
         let (ncols, nrows) = (node.ncols, node.nrows());
         let len = nrows * ncols;
-        assert!(node.offset + len <= self.l.len);
         // SAFETY: this block is written only here, and nothing reads it before this task ends
-        let block = unsafe { std::slice::from_raw_parts_mut(self.l.ptr.add(node.offset), len) };
+        let block = unsafe { self.l.slice(node.offset, len) };
         block.fill(0.0);
         SCRATCH.with_borrow_mut(|scratch| {
             let scratch = scratch.get_or_insert_with(|| Scratch {
@@ -421,7 +421,7 @@ impl Context<'_> {
             for u in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
                 let dn = supernode(sn, u.d as usize);
                 // SAFETY: supernode d is a descendant of s, finished before this task started
-                let dvals = unsafe { std::slice::from_raw_parts(self.l.ptr.add(dn.offset), dn.nrows() * dn.ncols) };
+                let dvals: &[f64] = unsafe { self.l.slice(dn.offset, dn.nrows() * dn.ncols) };
                 let ld = MatRef::from_column_major_slice(dvals, dn.nrows(), dn.ncols);
                 let (first, mid) = (u.first as usize, u.mid as usize);
                 let rows = dn.pattern.len() - first;

@@ -246,7 +246,7 @@ impl Problem for Fb {
 /// Neumann top and bottom.
 pub struct Patch {
     pub material: Material,
-    /// u_i = sum_k c[i][k] m_k(x, y) with monomials m = (1, x, y, x^2, xy, y^2).
+    /// `u_i = sum_k c[i][k] m_k(x, y)` with monomials m = (1, x, y, x^2, xy, y^2).
     pub c: [[f64; 6]; 2],
     pub gap: f64,
     /// The contact normal used for the constraint (the boundary is x = 1 whatever it says):
