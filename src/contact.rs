@@ -27,10 +27,10 @@
 use crate::assembly::SymCsc;
 use crate::cholesky;
 use crate::ordering::OrderingChoice;
-
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::linalg::cholesky::{CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, supernodal};
+use faer::sparse::linalg::cholesky::supernodal::{self, SymbolicSupernodalCholesky};
+use faer::sparse::linalg::cholesky::{CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering};
 use faer::{Mat, Side};
 use std::time::Instant;
 
@@ -278,10 +278,8 @@ impl ContactSolver {
     /// Numeric factorisation of the pattern of `matrix` with the given values ([`cholesky`]).
     fn factor_values(&mut self, values: &[f64]) -> Result<(), ContactError> {
         let t0 = Instant::now();
-        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
-            return Err(ContactError::Factorisation("expected a supernodal factorisation".into()));
-        };
-        cholesky::factorize(sn, &self.plan, values, &mut self.l_values).map_err(|e| ContactError::NotPositiveDefinite(e.to_string()))?;
+        cholesky::factorize(supernodal(&self.symbolic), &self.plan, values, &mut self.l_values)
+            .map_err(|e| ContactError::NotPositiveDefinite(e.to_string()))?;
         self.timings.numeric += t0.elapsed().as_secs_f64();
         Ok(())
     }
@@ -301,9 +299,7 @@ impl ContactSolver {
         let (n, ni) = (self.n, self.n_interior);
         let m = n - ni;
         let mut lcc = Mat::<f64>::zeros(m, m);
-        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else {
-            return Err(ContactError::Factorisation("expected a supernodal factorisation".into()));
-        };
+        let sn = supernodal(&self.symbolic);
         let l = supernodal::SupernodalLltRef::new(sn, &self.l_values);
         for s in 0..sn.n_supernodes() {
             let node = l.supernode(s);
@@ -328,7 +324,7 @@ impl ContactSolver {
     /// Solve with the current factorisation ([`cholesky::solve_in_place`]).
     pub fn solve(&mut self, b: &[f64]) -> Vec<f64> {
         let t0 = Instant::now();
-        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.raw() else { unreachable!("checked in `with_strategy`") };
+        let sn = supernodal(&self.symbolic);
         let inv = self.symbolic.perm().expect("a custom ordering").arrays().1;
         let mut x = vec![0.0; self.n];
         for (i, &v) in b.iter().enumerate() {
@@ -502,6 +498,15 @@ fn symbolic_factorisation(
     });
     let symbolic = symbolic.map_err(|e| ContactError::Factorisation(format!("{e:?}")))?;
     Ok((symbolic, choice))
+}
+
+/// The supernodal structure of a symbolic factorisation that [`ContactSolver::with_strategy`]
+/// has checked to be supernodal (it asks faer for one).
+fn supernodal(symbolic: &SymbolicCholesky<usize>) -> &SymbolicSupernodalCholesky<usize> {
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Supernodal(sn) => sn,
+        SymbolicCholeskyRaw::Simplicial(_) => unreachable!("checked supernodal when the solver was built"),
+    }
 }
 
 /// All unknowns, the active-set outcome and the complementarity constant c.

@@ -238,6 +238,24 @@ struct Target {
     note: String,
 }
 
+/// The bound a target's value must keep.
+enum Bound {
+    AtMost(f64),
+    AtLeast(f64),
+}
+
+impl Target {
+    /// A target whose value is held against a bound: the goal's text and whether it is met
+    /// follow from the bound (not met is `None` when there is no value).
+    fn bounded(target: &str, n: usize, ours: f64, reference: Option<f64>, value: Option<f64>, bound: Bound, note: String) -> Self {
+        let (goal, met) = match bound {
+            Bound::AtMost(g) => (format!("<= {g:.2}"), value.map(|v| v <= g)),
+            Bound::AtLeast(g) => (format!(">= {g:.2}"), value.map(|v| v >= g)),
+        };
+        Target { target: target.into(), n, ours, reference, value, goal, met, note }
+    }
+}
+
 /// The targets of issue 15, each with the measured value and whether it is met.
 fn targets(phases: &[SizeResult], cold: &[ColdSize], scale: Option<&ColdSize>) -> Vec<Target> {
     let mut t = Vec::new();
@@ -249,95 +267,75 @@ fn targets(phases: &[SizeResult], cold: &[ColdSize], scale: Option<&ColdSize>) -
         let missing = c.ngsolve_missing.clone().unwrap_or_default();
         if let Some(&(_, g)) = goal_max.iter().find(|(n, _)| *n == c.n) {
             let value = ng.map(|ng| ours / ng);
-            t.push(Target {
-                target: "cold whole solve / NGSolve's whole linear solve [s]".into(),
-                n: c.n,
+            t.push(Target::bounded(
+                "cold whole solve / NGSolve's whole linear solve [s]",
+                c.n,
                 ours,
-                reference: ng,
+                ng,
                 value,
-                goal: format!("<= {g:.2}"),
-                met: value.map(|v| v <= g),
-                note: missing.clone(),
-            });
+                Bound::AtMost(g),
+                missing.clone(),
+            ));
         }
         if c.n == 512 {
             let ours = median(c.ours.iter().map(|r| r.peak_rss_mb).collect());
             let ng = med(c.ngsolve.iter().map(|r| r.peak_rss_mb).collect());
             let value = ng.map(|ng| ours / ng);
-            t.push(Target {
-                target: "peak memory / NGSolve's [MB]".into(),
-                n: c.n,
-                ours,
-                reference: ng,
-                value,
-                goal: "<= 0.60".into(),
-                met: value.map(|v| v <= 0.6),
-                note: missing.clone(),
-            });
+            t.push(Target::bounded("peak memory / NGSolve's [MB]", c.n, ours, ng, value, Bound::AtMost(0.6), missing.clone()));
             let sym = median(c.ours.iter().map(|r| r.symbolic_s / r.whole_s).collect());
-            t.push(Target {
-                target: "symbolic analysis / cold whole solve".into(),
-                n: c.n,
-                ours: median(c.ours.iter().map(|r| r.symbolic_s).collect()),
-                reference: Some(median(c.ours.iter().map(|r| r.whole_s).collect())),
-                value: Some(sym),
-                goal: "<= 0.10".into(),
-                met: Some(sym <= 0.1),
-                note: String::new(),
-            });
+            let (symbolic, whole) =
+                (median(c.ours.iter().map(|r| r.symbolic_s).collect()), median(c.ours.iter().map(|r| r.whole_s).collect()));
+            t.push(Target::bounded(
+                "symbolic analysis / cold whole solve",
+                c.n,
+                symbolic,
+                Some(whole),
+                Some(sym),
+                Bound::AtMost(0.1),
+                String::new(),
+            ));
         }
         if c.n >= 256 {
             let ours = median(c.ours.iter().map(|r| r.assembly_s).collect());
             let ng = med(c.ngsolve.iter().map(|r| r.assembly_s).collect());
             let value = ng.map(|ng| ng / ours);
-            t.push(Target {
-                target: "NGSolve's assembly / ours (cold) [s]".into(),
-                n: c.n,
-                ours,
-                reference: ng,
-                value,
-                goal: ">= 2.00".into(),
-                met: value.map(|v| v >= 2.0),
-                note: missing,
-            });
+            t.push(Target::bounded("NGSolve's assembly / ours (cold) [s]", c.n, ours, ng, value, Bound::AtLeast(2.0), missing));
         }
     }
     if let Some(p) = phases.iter().find(|p| p.n == 512).or_else(|| phases.iter().max_by_key(|p| p.n)) {
-        let value = p.median.numeric_first / p.median.numeric_warm;
-        t.push(Target {
-            target: "first numeric factorisation / refactorisation [s]".into(),
-            n: p.n,
-            ours: p.median.numeric_first,
-            reference: Some(p.median.numeric_warm),
-            value: Some(value),
-            goal: "<= 1.30".into(),
-            met: Some(value <= 1.3),
-            note: "one process".into(),
-        });
+        let (first, warm) = (p.median.numeric_first, p.median.numeric_warm);
+        t.push(Target::bounded(
+            "first numeric factorisation / refactorisation [s]",
+            p.n,
+            first,
+            Some(warm),
+            Some(first / warm),
+            Bound::AtMost(1.3),
+            "one process".into(),
+        ));
     }
     if let Some(s) = scale {
         let ours = &s.ours[0];
         let ng = s.ngsolve.first();
-        t.push(Target {
-            target: "scale point: whole contact solve [s]".into(),
+        // ours beside NGSolve's (if it ran), as a ratio
+        let row = |target: &str, mine: f64, theirs: Option<f64>, goal: &str, met: bool| Target {
+            target: target.into(),
             n: s.n,
-            ours: ours.whole_s,
-            reference: ng.map(|r| r.whole_s),
-            value: ng.map(|r| ours.whole_s / r.whole_s),
-            goal: "runs".into(),
-            met: Some(true),
+            ours: mine,
+            reference: theirs,
+            value: theirs.map(|r| mine / r),
+            goal: goal.into(),
+            met: Some(met),
             note: s.ngsolve_missing.clone().unwrap_or_default(),
-        });
-        t.push(Target {
-            target: "scale point: peak memory [MB]".into(),
-            n: s.n,
-            ours: ours.peak_rss_mb,
-            reference: ng.map(|r| r.peak_rss_mb),
-            value: ng.map(|r| ours.peak_rss_mb / r.peak_rss_mb),
-            goal: "fits in 24 GiB".into(),
-            met: Some(ours.peak_rss_mb < 24.0 * 1024.0),
-            note: s.ngsolve_missing.clone().unwrap_or_default(),
-        });
+        };
+        t.push(row("scale point: whole contact solve [s]", ours.whole_s, ng.map(|r| r.whole_s), "runs", true));
+        t.push(row(
+            "scale point: peak memory [MB]",
+            ours.peak_rss_mb,
+            ng.map(|r| r.peak_rss_mb),
+            "fits in 24 GiB",
+            ours.peak_rss_mb < 24.0 * 1024.0,
+        ));
     }
     let opt = |v: Option<f64>, p: usize| v.map_or("-".to_string(), |v| format!("{v:.p$}"));
     println!("\ntargets (issue 15; our cold contact solve against NGSolve's cold linear solve, fresh processes, medians):");
