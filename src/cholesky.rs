@@ -25,12 +25,11 @@
 //! lists of descendants private, so [`Plan`] rebuilds them from the public structure). The
 //! dense kernels (products, Cholesky, triangular solve) are faer's.
 
-use crate::assembly::SymCsc;
+use crate::symbolic::Symbolic;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{LltParams, LltRegularization};
 use faer::linalg::matmul::triangular::BlockStructure;
 use faer::reborrow::{Reborrow, ReborrowMut};
-use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::{Accum, MatMut, MatRef, Par, Spec};
 use rayon::prelude::*;
 use std::cell::RefCell;
@@ -60,10 +59,6 @@ pub struct Plan {
     work: Vec<f64>,
     /// Subtrees with less work are one task.
     task_work: f64,
-    /// The matrix entries of column j of P K P^T: `entries[entry_ptr[j]..entry_ptr[j + 1]]`,
-    /// each (row, position in the matrix's values).
-    entry_ptr: Vec<usize>,
-    entries: Vec<(u32, u32)>,
     /// The largest update product (rows x columns) and the widest supernode, for the scratch.
     max_update: usize,
     max_cols: usize,
@@ -90,7 +85,7 @@ pub struct NotPositiveDefinite {
 struct Supernode<'a> {
     begin: usize,
     ncols: usize,
-    pattern: &'a [usize],
+    pattern: &'a [u32],
     offset: usize,
 }
 
@@ -100,28 +95,28 @@ impl Supernode<'_> {
     }
 }
 
-fn supernode(sn: &SymbolicSupernodalCholesky<usize>, s: usize) -> Supernode<'_> {
-    let (begin, end) = (sn.supernode_begin()[s], sn.supernode_end()[s]);
-    let start = sn.col_ptr_for_row_idx()[s];
-    Supernode { begin, ncols: end - begin, pattern: &sn.row_idx()[start..start + sn.nnz_per_super()[s]], offset: sn.col_ptr_for_val()[s] }
+fn supernode(sn: &Symbolic, s: usize) -> Supernode<'_> {
+    let begin = sn.supernode_begin();
+    Supernode { begin: begin[s], ncols: begin[s + 1] - begin[s], pattern: sn.pattern(s), offset: sn.val_ptr()[s] }
 }
 
 impl Plan {
-    /// The plan for factorising `matrix` (lower triangle, original numbering) permuted by `inv`
-    /// (`inv[old] = new`, the symbolic factorisation's ordering) with the structure `sn`.
-    pub fn new(sn: &SymbolicSupernodalCholesky<usize>, matrix: &SymCsc, inv: &[usize]) -> Self {
-        let (n, ns) = (sn.nrows(), sn.n_supernodes());
-        assert!(matrix.values().len() < u32::MAX as usize && n < u32::MAX as usize, "more than 2^32 matrix entries: widen Plan's indices");
-        let (begin, end) = (sn.supernode_begin(), sn.supernode_end());
+    /// The plan for factorising with the structure `sn`.
+    pub fn new(sn: &Symbolic) -> Self {
+        let (n, ns) = (sn.n(), sn.n_supernodes());
+        let begin = sn.supernode_begin();
         let mut super_of = vec![0u32; n];
         for s in 0..ns {
-            super_of[begin[s]..end[s]].fill(s as u32);
+            super_of[begin[s]..begin[s + 1]].fill(s as u32);
         }
         // descendants: d updates every supernode its pattern rows fall in (each once, d ascending)
         let super_of = &super_of;
         let targets = |d: usize| {
             let p = supernode(sn, d).pattern;
-            p.iter().enumerate().filter(move |&(i, &r)| i == 0 || super_of[p[i - 1]] != super_of[r]).map(|(_, &r)| super_of[r] as usize)
+            p.iter()
+                .enumerate()
+                .filter(move |&(i, &r)| i == 0 || super_of[p[i - 1] as usize] != super_of[r as usize])
+                .map(|(_, &r)| super_of[r as usize] as usize)
         };
         let mut upd_ptr = vec![0usize; ns + 1];
         let mut kid_ptr = vec![0usize; ns + 1];
@@ -145,8 +140,8 @@ impl Plan {
             let mut first = true;
             let mut i = 0;
             while i < node.pattern.len() {
-                let s = super_of[node.pattern[i]] as usize;
-                let mid = node.pattern[i..].iter().take_while(|&&r| super_of[r] as usize == s).count();
+                let s = super_of[node.pattern[i] as usize] as usize;
+                let mid = node.pattern[i..].iter().take_while(|&&r| super_of[r as usize] as usize == s).count();
                 max_update = max_update.max((node.pattern.len() - i) * mid);
                 upd[upd_fill[s]] = Update { d: d as u32, first: i as u32, mid: mid as u32 };
                 upd_fill[s] += 1;
@@ -182,52 +177,9 @@ impl Plan {
             work[s] += w;
         }
         let total: f64 = roots.iter().map(|&r| work[r as usize]).sum();
-        // where each matrix entry (i, j), i >= j, goes: column min(inv i, inv j) of P K P^T, row
-        // max (its place in the column's supernode is looked up when factorising, where the
-        // supernode's rows are mapped anyway); grouped by column
-        let cols = matrix.col_ptr();
-        let mut placed = vec![(0u32, 0u32); matrix.values().len()];
-        crate::assembly::par_fill(
-            &mut placed,
-            cols,
-            || (),
-            |j, _, out| {
-                for (slot, &i) in out.iter_mut().zip(&matrix.row_idx()[cols[j]..cols[j + 1]]) {
-                    let (a, b) = (inv[i], inv[j]);
-                    *slot = (a.min(b) as u32, a.max(b) as u32);
-                }
-            },
-        );
-        let mut entry_ptr = vec![0usize; n + 1];
-        for &(c, _) in &placed {
-            entry_ptr[c as usize + 1] += 1;
-        }
-        for j in 0..n {
-            entry_ptr[j + 1] += entry_ptr[j];
-        }
-        let mut fill = entry_ptr.clone();
-        let mut entries = vec![(0u32, 0u32); placed.len()];
-        for (k, &(c, r)) in placed.iter().enumerate() {
-            entries[fill[c as usize]] = (r, k as u32);
-            fill[c as usize] += 1;
-        }
-        let max_cols = (0..ns).map(|s| end[s] - begin[s]).max().unwrap_or(0);
-        let max_pattern = sn.nnz_per_super().iter().copied().max().unwrap_or(0);
-        Plan {
-            upd_ptr,
-            upd,
-            kid_ptr,
-            kids,
-            roots,
-            own,
-            work,
-            task_work: total * TASK_SHARE,
-            entry_ptr,
-            entries,
-            max_update,
-            max_cols,
-            max_pattern,
-        }
+        let max_cols = (0..ns).map(|s| begin[s + 1] - begin[s]).max().unwrap_or(0);
+        let max_pattern = (0..ns).map(|s| sn.pattern(s).len()).max().unwrap_or(0);
+        Plan { upd_ptr, upd, kid_ptr, kids, roots, own, work, task_work: total * TASK_SHARE, max_update, max_cols, max_pattern }
     }
 
     /// Run `kernel(s, alone)` for every supernode, each after all its descendants (for the
@@ -356,7 +308,7 @@ thread_local! {
 
 /// Fill `l` (faer's layout of `sn`) with the Cholesky factor of the matrix whose lower triangle
 /// has the pattern the plan was made for and the given values, permuted as planned.
-pub fn factorize(sn: &SymbolicSupernodalCholesky<usize>, plan: &Plan, values: &[f64], l: &mut [f64]) -> Result<(), NotPositiveDefinite> {
+pub fn factorize(sn: &Symbolic, plan: &Plan, values: &[f64], l: &mut [f64]) -> Result<(), NotPositiveDefinite> {
     assert_eq!(l.len(), sn.len_val());
     let shared = Shared { ptr: l.as_mut_ptr(), len: l.len() };
     let ctx = Context { sn, plan, values, l: shared };
@@ -364,7 +316,7 @@ pub fn factorize(sn: &SymbolicSupernodalCholesky<usize>, plan: &Plan, values: &[
 }
 
 struct Context<'a> {
-    sn: &'a SymbolicSupernodalCholesky<usize>,
+    sn: &'a Symbolic,
     plan: &'a Plan,
     values: &'a [f64],
     l: Shared,
@@ -390,8 +342,8 @@ impl Context<'_> {
                 stack: MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
                 stack_bytes: 0,
             });
-            if scratch.local.len() < sn.nrows() {
-                scratch.local.resize(sn.nrows(), 0);
+            if scratch.local.len() < sn.n() {
+                scratch.local.resize(sn.n(), 0);
             }
             if scratch.update.len() < plan.max_update {
                 scratch.update.resize(plan.max_update, 0.0);
@@ -407,12 +359,12 @@ impl Context<'_> {
             }
             let local = &mut scratch.local;
             for (i, &r) in node.pattern.iter().enumerate() {
-                local[r] = (ncols + i) as u32;
+                local[r as usize] = (ncols + i) as u32;
             }
             let end = node.begin + ncols;
             for j in node.begin..end {
                 let column = &mut block[(j - node.begin) * nrows..][..nrows];
-                for &(r, pos) in &plan.entries[plan.entry_ptr[j]..plan.entry_ptr[j + 1]] {
+                for &(r, pos) in sn.entries(j) {
                     let r = r as usize;
                     column[if r < end { r - node.begin } else { local[r] as usize }] += self.values[pos as usize];
                 }
@@ -445,9 +397,9 @@ impl Context<'_> {
                 }
                 let rows_of = &dn.pattern[first..];
                 for jj in 0..mid {
-                    let col = rows_of[jj] - node.begin;
+                    let col = rows_of[jj] as usize - node.begin;
                     for ii in jj..rows {
-                        let r = rows_of[ii];
+                        let r = rows_of[ii] as usize;
                         let at = if ii < mid { r - node.begin } else { local[r] as usize };
                         ls[(at, col)] -= upd[(ii, jj)];
                     }
@@ -480,8 +432,8 @@ thread_local! {
 /// numbering (row `inv[i]` holds unknown i). Forward substitution up the tree (each supernode
 /// pulls the products of its descendants, in the order faer pushes them), backward substitution
 /// down it, independent subtrees in parallel; the same bits on any number of threads.
-pub fn solve_in_place(sn: &SymbolicSupernodalCholesky<usize>, plan: &Plan, l: &[f64], x: &mut [f64]) {
-    assert_eq!((l.len(), x.len()), (sn.len_val(), sn.nrows()));
+pub fn solve_in_place(sn: &Symbolic, plan: &Plan, l: &[f64], x: &mut [f64]) {
+    assert_eq!((l.len(), x.len()), (sn.len_val(), sn.n()));
     let x = Shared { ptr: x.as_mut_ptr(), len: x.len() };
     let block = |node: &Supernode| -> MatRef<'_, f64> {
         MatRef::from_column_major_slice(&l[node.offset..node.offset + node.nrows() * node.ncols], node.nrows(), node.ncols)
@@ -510,7 +462,7 @@ pub fn solve_in_place(sn: &SymbolicSupernodalCholesky<usize>, plan: &Plan, l: &[
                     Par::Seq,
                 );
                 for (&tj, &r) in t.iter().zip(&dn.pattern[first..first + mid]) {
-                    xs[r - node.begin] -= tj;
+                    xs[r as usize - node.begin] -= tj;
                 }
             }
         });
@@ -530,7 +482,7 @@ pub fn solve_in_place(sn: &SymbolicSupernodalCholesky<usize>, plan: &Plan, l: &[
             tmp.resize(plan.max_pattern.max(plan.max_cols), 0.0);
             let p = node.pattern.len();
             for (t, &r) in tmp[..p].iter_mut().zip(node.pattern) {
-                *t = rows(r, 1)[0];
+                *t = rows(r as usize, 1)[0];
             }
             let t = MatRef::from_column_major_slice(&tmp[..p], p, 1);
             faer::linalg::matmul::matmul(

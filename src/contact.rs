@@ -27,10 +27,8 @@
 use crate::assembly::SymCsc;
 use crate::cholesky;
 use crate::ordering::OrderingChoice;
+use crate::symbolic::{self, Symbolic};
 use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::linalg::cholesky::supernodal::{self, SymbolicSupernodalCholesky};
-use faer::sparse::linalg::cholesky::{CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering};
 use faer::{Mat, Side};
 use std::time::Instant;
 
@@ -192,7 +190,7 @@ pub struct ContactSolver {
     n: usize,
     n_interior: usize,
     strategy: Strategy,
-    symbolic: SymbolicCholesky<usize>,
+    symbolic: Symbolic,
     /// Where the matrix goes in L, and the schedule of the numeric factorisation.
     plan: cholesky::Plan,
     /// The values of L, allocated once per symbolic factorisation.
@@ -218,7 +216,10 @@ impl ContactSolver {
     pub fn with_strategy(matrix: &SymCsc, n_interior: usize, coords: &[[f64; 2]], strategy: Strategy) -> Result<Self, ContactError> {
         let mut timings = Timings::default();
         let t0 = Instant::now();
-        let (symbolic, ordering) = symbolic_factorisation(matrix, n_interior, coords, strategy)?;
+        // Schur: the leading block `I` is ordered and `C` kept in place at the end, so that the
+        // trailing block of L is L_CC; Refactor: all unknowns are ordered
+        let n_order = if strategy == Strategy::Schur { n_interior } else { matrix.n() };
+        let (symbolic, ordering) = symbolic::analyse(matrix, n_order, coords);
         let row_entries = match strategy {
             Strategy::Schur => Vec::new(),
             Strategy::Refactor => {
@@ -234,11 +235,7 @@ impl ContactSolver {
                 rows
             }
         };
-        let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else {
-            return Err(ContactError::Factorisation("expected a supernodal factorisation".into()));
-        };
-        let inv = symbolic.perm().expect("a custom ordering").arrays().1;
-        let plan = cholesky::Plan::new(sn, matrix, inv);
+        let plan = cholesky::Plan::new(&symbolic);
         timings.symbolic = t0.elapsed().as_secs_f64();
         let mut solver = ContactSolver {
             n: matrix.n(),
@@ -278,7 +275,7 @@ impl ContactSolver {
     /// Numeric factorisation of the pattern of `matrix` with the given values ([`cholesky`]).
     fn factor_values(&mut self, values: &[f64]) -> Result<(), ContactError> {
         let t0 = Instant::now();
-        cholesky::factorize(supernodal(&self.symbolic), &self.plan, values, &mut self.l_values)
+        cholesky::factorize(&self.symbolic, &self.plan, values, &mut self.l_values)
             .map_err(|e| ContactError::NotPositiveDefinite(e.to_string()))?;
         self.timings.numeric += t0.elapsed().as_secs_f64();
         Ok(())
@@ -299,12 +296,12 @@ impl ContactSolver {
         let (n, ni) = (self.n, self.n_interior);
         let m = n - ni;
         let mut lcc = Mat::<f64>::zeros(m, m);
-        let sn = supernodal(&self.symbolic);
-        let l = supernodal::SupernodalLltRef::new(sn, &self.l_values);
+        let sn = &self.symbolic;
+        let (begin, val_ptr) = (sn.supernode_begin(), sn.val_ptr());
         for s in 0..sn.n_supernodes() {
-            let node = l.supernode(s);
-            let (start, val, pattern) = (node.start(), node.val(), node.pattern());
-            let ncols = val.ncols();
+            let (start, ncols, pattern) = (begin[s], begin[s + 1] - begin[s], sn.pattern(s));
+            let nrows = ncols + pattern.len();
+            let val = faer::MatRef::from_column_major_slice(&self.l_values[val_ptr[s]..val_ptr[s + 1]], nrows, ncols);
             for jc in 0..ncols {
                 let j = start + jc;
                 if j < ni {
@@ -314,7 +311,7 @@ impl ContactSolver {
                     lcc[(start + rc - ni, j - ni)] = val[(rc, jc)];
                 }
                 for (k, &row) in pattern.iter().enumerate() {
-                    lcc[(row - ni, j - ni)] = val[(ncols + k, jc)];
+                    lcc[(row as usize - ni, j - ni)] = val[(ncols + k, jc)];
                 }
             }
         }
@@ -324,13 +321,12 @@ impl ContactSolver {
     /// Solve with the current factorisation ([`cholesky::solve_in_place`]).
     pub fn solve(&mut self, b: &[f64]) -> Vec<f64> {
         let t0 = Instant::now();
-        let sn = supernodal(&self.symbolic);
-        let inv = self.symbolic.perm().expect("a custom ordering").arrays().1;
+        let inv = self.symbolic.inv();
         let mut x = vec![0.0; self.n];
         for (i, &v) in b.iter().enumerate() {
             x[inv[i]] = v;
         }
-        cholesky::solve_in_place(sn, &self.plan, &self.l_values, &mut x);
+        cholesky::solve_in_place(&self.symbolic, &self.plan, &self.l_values, &mut x);
         let u = inv.iter().map(|&k| x[k]).collect();
         self.timings.solves += t0.elapsed().as_secs_f64();
         u
@@ -466,46 +462,6 @@ impl ContactSolver {
             last_u = self.solve(rhs); // no iteration: the unconstrained solution
         }
         Ok((last_u, outcome, c))
-    }
-}
-
-/// Symbolic Cholesky, supernodal, with the fill-reducing ordering of [`crate::ordering`]
-/// (faer's symbolic step runs while the ordering's flop count is computed on another thread,
-/// when nested dissection is the only candidate).
-/// Schur: the leading block `I` is ordered and `C` kept in place at the end, so that the
-/// trailing block of L is L_CC. Refactor: all unknowns are ordered.
-fn symbolic_factorisation(
-    matrix: &SymCsc,
-    ni: usize,
-    coords: &[[f64; 2]],
-    strategy: Strategy,
-) -> Result<(SymbolicCholesky<usize>, OrderingChoice), ContactError> {
-    let n = matrix.n();
-    let n_order = if strategy == Strategy::Schur { ni } else { n };
-    let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
-    let (symbolic, choice) = crate::ordering::fill_reducing_then(matrix, n_order, coords, |fwd| {
-        let mut inv = vec![0usize; n];
-        for (new, &old) in fwd.iter().enumerate() {
-            inv[old] = new;
-        }
-        let perm = faer::perm::PermRef::new_checked(fwd, &inv, n);
-        faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
-            matrix.as_faer().symbolic(),
-            Side::Lower,
-            SymmetricOrdering::Custom(perm),
-            params,
-        )
-    });
-    let symbolic = symbolic.map_err(|e| ContactError::Factorisation(format!("{e:?}")))?;
-    Ok((symbolic, choice))
-}
-
-/// The supernodal structure of a symbolic factorisation that [`ContactSolver::with_strategy`]
-/// has checked to be supernodal (it asks faer for one).
-fn supernodal(symbolic: &SymbolicCholesky<usize>) -> &SymbolicSupernodalCholesky<usize> {
-    match symbolic.raw() {
-        SymbolicCholeskyRaw::Supernodal(sn) => sn,
-        SymbolicCholeskyRaw::Simplicial(_) => unreachable!("checked supernodal when the solver was built"),
     }
 }
 

@@ -25,4 +25,5 @@ pub mod records;
 pub mod report;
 pub mod solve;
 pub mod study;
+pub mod symbolic;
 pub mod verdict;

@@ -50,7 +50,7 @@ const PAR_MIN: usize = 20_000;
 /// run of consecutive unknowns at the same position (`coords`, bitwise): the two components of
 /// a P2 node, or a lone unknown (the tangential one at a contact node whose normal unknown is
 /// ordered apart). Node k holds the unknowns `first[k]..first[k + 1]`.
-struct Graph {
+pub(crate) struct Graph {
     ptr: Vec<u32>,
     adj: Vec<u32>,
     first: Vec<usize>,
@@ -110,21 +110,26 @@ impl Graph {
         Graph { ptr: count.into_iter().map(|c| c as u32).collect(), adj, first }
     }
 
-    fn n_nodes(&self) -> usize {
+    pub(crate) fn n_nodes(&self) -> usize {
         self.first.len() - 1
     }
 
-    /// Unknowns of node k.
-    fn weight(&self, k: usize) -> usize {
+    /// The unknowns of node k.
+    pub(crate) fn unknowns_of(&self, k: usize) -> std::ops::Range<usize> {
+        self.first[k]..self.first[k + 1]
+    }
+
+    /// The number of unknowns of node k.
+    pub(crate) fn weight(&self, k: usize) -> usize {
         self.first[k + 1] - self.first[k]
     }
 
-    fn neighbours(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
+    pub(crate) fn neighbours(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
         self.adj[self.ptr[i] as usize..self.ptr[i + 1] as usize].iter().map(|&j| j as usize)
     }
 
     /// The order of the unknowns from an order of the nodes: each node's unknowns together.
-    fn unknowns(&self, node_order: &[usize]) -> Vec<usize> {
+    pub(crate) fn unknowns(&self, node_order: &[usize]) -> Vec<usize> {
         node_order.iter().flat_map(|&k| self.first[k]..self.first[k + 1]).collect()
     }
 }
@@ -201,17 +206,23 @@ pub const GRADED: f64 = 3.0;
 /// grading does. The rule is a function of the mesh only (never of timing or threads).
 /// [`FORCE_ENV`] overrides it: a forced AMD is computed whatever the mesh.
 pub fn fill_reducing(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (Vec<usize>, OrderingChoice) {
-    fill_reducing_then(matrix, n_order, coords, |order| order.to_vec())
+    fill_reducing_then(matrix, n_order, coords, |graph, node_order| {
+        let mut order = graph.unknowns(node_order);
+        order.extend(n_order..matrix.n());
+        (order, factorisation_flops(graph, node_order))
+    })
 }
 
-/// [`fill_reducing`], handing the permutation to `then` (the symbolic factorisation) and
-/// returning what it returns: when nested dissection is the only candidate, its flop count is
-/// not needed for the choice and runs on another thread while `then` runs.
-pub fn fill_reducing_then<T: Send>(
+/// [`fill_reducing`], handing the node graph and the order of its nodes (`node_order[new] =
+/// old`) to `then` (the symbolic factorisation) and returning what it returns. `then` returns
+/// the flops of factorising the ordered block too (the symbolic factorisation has the column
+/// counts anyway): when nested dissection is the only candidate they are not needed for the
+/// choice and are not computed twice.
+pub(crate) fn fill_reducing_then<T: Send>(
     matrix: &SymCsc,
     n_order: usize,
     coords: &[[f64; 2]],
-    then: impl FnOnce(&[usize]) -> T + Send,
+    then: impl FnOnce(&Graph, &[usize]) -> (T, f64) + Send,
 ) -> (T, OrderingChoice) {
     use faer::dyn_stack::{MemBuffer, MemStack};
     use faer::sparse::linalg::amd;
@@ -234,11 +245,6 @@ pub fn fill_reducing_then<T: Send>(
         (order, flops)
     };
     let nested = || nested_dissection(&graph, &node_coords, &reach);
-    let with_unknowns = |node_order: &[usize]| {
-        let mut order = graph.unknowns(node_order);
-        order.extend(n_order..matrix.n());
-        order
-    };
     let (method, out, nd_flops, amd_flops) = if with_amd {
         let ((nd, nd_flops), (amd, amd_flops)) = rayon::join(
             || {
@@ -253,11 +259,16 @@ pub fn fill_reducing_then<T: Send>(
             None if amd_flops < nd_flops => Method::MinimumDegree,
             None => Method::NestedDissection,
         };
-        let kept = if method == Method::MinimumDegree { &amd } else { &nd };
-        (method, then(&with_unknowns(kept)), nd_flops, Some(amd_flops))
+        let (kept, kept_flops) = if method == Method::MinimumDegree { (&amd, amd_flops) } else { (&nd, nd_flops) };
+        let (out, flops) = then(&graph, kept);
+        assert!(
+            !kept_flops.is_finite() || flops.to_bits() == kept_flops.to_bits(),
+            "two flop counts of one ordering disagree: {flops} and {kept_flops}"
+        );
+        (method, out, nd_flops, Some(amd_flops))
     } else {
         let nd = nested();
-        let (nd_flops, out) = rayon::join(|| factorisation_flops(&graph, &nd), || then(&with_unknowns(&nd)));
+        let (out, nd_flops) = then(&graph, &nd);
         (Method::NestedDissection, out, nd_flops, None)
     };
     (out, OrderingChoice { method, flops_nested_dissection: nd_flops, flops_minimum_degree: amd_flops, grading })
@@ -307,39 +318,16 @@ fn nested_dissection(graph: &Graph, coords: &[[f64; 2]], reach: &[[f64; 2]]) -> 
 }
 
 /// Flops of the Cholesky factorisation of the matrix of the unknowns with the nodes in the given
-/// order (each node's unknowns together): with d_j the number of entries of column j of L below
-/// the diagonal, sum d_j + d_j (d_j + 1) / 2 (divisions and multiply-subtract pairs), as AMD
-/// counts them. Column counts of the node graph by the elimination tree and row subtrees (Liu),
-/// O(|L|), in unknowns: if W is the number of unknowns in later nodes coupled to node k through
-/// L, the w unknowns of node k have d = W + w - 1, W + w - 2, ..., W.
+/// order (each node's unknowns together), from the column counts of the node graph
+/// ([`crate::symbolic::tree_and_counts`], [`crate::symbolic::Counts::flops`]).
 fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
-    const NONE: usize = usize::MAX;
-    let n = order.len();
-    let mut position = vec![0usize; n];
+    let mut position = vec![0u32; order.len()];
     for (new, &old) in order.iter().enumerate() {
-        position[old] = new;
+        position[old] = new as u32;
     }
-    let (mut parent, mut visited, mut below) = (vec![NONE; n], vec![NONE; n], vec![0u64; n]);
-    for (k, &old) in order.iter().enumerate() {
-        visited[k] = k;
-        let w = graph.weight(old) as u64;
-        for mut i in graph.neighbours(old).map(|j| position[j]).filter(|&i| i < k) {
-            // walk from i up the elimination tree to k: row k of L has an entry in each column
-            while visited[i] != k {
-                visited[i] = k;
-                below[i] += w;
-                if parent[i] == NONE {
-                    parent[i] = k;
-                }
-                i = parent[i];
-            }
-        }
-    }
-    order
-        .iter()
-        .zip(&below)
-        .map(|(&node, &big_w)| (0..graph.weight(node) as u64).map(|t| big_w + t).map(|d| d as f64 + (d * (d + 1) / 2) as f64).sum::<f64>())
-        .sum()
+    let weight = |p: usize| graph.weight(order[p]);
+    let neighbours = |p: usize, f: &mut dyn FnMut(usize)| graph.neighbours(order[p]).for_each(|q| f(position[q] as usize));
+    crate::symbolic::tree_and_counts(order.len(), order.len(), &weight, &neighbours).flops(order.len(), &weight)
 }
 
 /// Order `set`: both halves of a coordinate split first, then the separator.

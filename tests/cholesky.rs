@@ -1,6 +1,7 @@
-//! The tree-parallel numeric Cholesky factorisation (`signorini::cholesky`): the same factor as
-//! faer's sequential one, bitwise the same on one and two threads, and a clear error for a
-//! matrix that is not positive definite.
+//! The Cholesky factorisation of our own (`signorini::symbolic`, `signorini::cholesky`): the
+//! symbolic structure is faer's for the same ordering, array for array; the factor is faer's
+//! sequential one's, bitwise the same on one and two threads; a matrix that is not positive
+//! definite is a clear error.
 
 mod common;
 
@@ -17,14 +18,21 @@ use signorini::assembly::{self, DofMap, SymCsc};
 use signorini::cholesky::{self, Plan};
 use signorini::mesh::{Mesh, P2Nodes, refine::refine};
 use signorini::problems;
+use signorini::symbolic::Symbolic;
 
-/// Example 7.2's stiffness on `mesh`, and the position of every unknown.
-fn stiffness(mesh: &Mesh) -> (SymCsc, Vec<[f64; 2]>) {
+/// Example 7.2's stiffness on `mesh`, the position of every unknown, and the number of unknowns
+/// that are not contact normals.
+fn stiffness_and_contact(mesh: &Mesh) -> (SymCsc, Vec<[f64; 2]>, usize) {
     let p = problems::Ex72;
     let nodes = P2Nodes::new(mesh);
     let dofs = DofMap::new(&nodes, &p);
     let sys = assembly::assemble(mesh, &nodes, &dofs, &p);
-    (sys.matrix, dofs.unknown_coords(&nodes))
+    (sys.matrix, dofs.unknown_coords(&nodes), dofs.n_interior)
+}
+
+fn stiffness(mesh: &Mesh) -> (SymCsc, Vec<[f64; 2]>) {
+    let (matrix, coords, _) = stiffness_and_contact(mesh);
+    (matrix, coords)
 }
 
 /// A mesh refined five times towards the bottom edge (y = 0): long, thin layers, where the
@@ -38,32 +46,55 @@ fn graded() -> Mesh {
     m
 }
 
-/// Supernodal symbolic factorisation with the project's fill-reducing ordering.
-fn symbolic(matrix: &SymCsc, coords: &[[f64; 2]]) -> SymbolicCholesky<usize> {
-    let n = matrix.n();
-    let (fwd, _) = signorini::ordering::fill_reducing(matrix, n, coords);
-    let mut inv = vec![0; n];
-    for (new, &old) in fwd.iter().enumerate() {
-        inv[old] = new;
-    }
-    let perm = faer::perm::PermRef::new_checked(&fwd, &inv, n);
+/// Our symbolic factorisation with the project's fill-reducing ordering of `0..n_order`.
+fn symbolic(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> Symbolic {
+    signorini::symbolic::analyse(matrix, n_order, coords).0
+}
+
+/// faer's supernodal symbolic factorisation with the ordering of `ours`.
+fn faers_symbolic(matrix: &SymCsc, ours: &Symbolic) -> SymbolicCholesky<usize> {
+    let perm = faer::perm::PermRef::new_checked(ours.perm(), ours.inv(), matrix.n());
     let params = CholeskySymbolicParams { supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL, ..Default::default() };
     factorize_symbolic_cholesky(matrix.as_faer().symbolic(), Side::Lower, SymmetricOrdering::Custom(perm), params).unwrap()
 }
 
 /// Our factor of `values` (on the pattern of `matrix`) on `threads` threads.
-fn ours(
-    symbolic: &SymbolicCholesky<usize>,
-    matrix: &SymCsc,
-    values: &[f64],
-    threads: usize,
-) -> Result<Vec<f64>, cholesky::NotPositiveDefinite> {
-    let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else { panic!("supernodal") };
-    let plan = Plan::new(sn, matrix, symbolic.perm().unwrap().arrays().1);
+fn ours(symbolic: &Symbolic, values: &[f64], threads: usize) -> Result<Vec<f64>, cholesky::NotPositiveDefinite> {
+    let plan = Plan::new(symbolic);
     let mut l = vec![f64::NAN; symbolic.len_val()];
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    pool.install(|| cholesky::factorize(sn, &plan, values, &mut l))?;
+    pool.install(|| cholesky::factorize(symbolic, &plan, values, &mut l))?;
     Ok(l)
+}
+
+#[test]
+fn the_symbolic_structure_is_faers_for_the_same_ordering() {
+    // uniform and graded meshes (nested dissection and minimum degree), all unknowns ordered
+    // (the Refactor strategy) or the contact normals last, each its own node (Schur)
+    for (name, m) in [
+        ("structured:24", mesh(&problems::Ex72, "structured:24")),
+        ("structured:96", mesh(&problems::Ex72, "structured:96")),
+        ("graded", graded()),
+    ] {
+        let (matrix, coords, n_interior) = stiffness_and_contact(&m);
+        assert!(n_interior < matrix.n(), "{name}: a mesh with contact unknowns");
+        for n_order in [matrix.n(), n_interior] {
+            let ours = symbolic(&matrix, n_order, &coords);
+            let faers = faers_symbolic(&matrix, &ours);
+            let SymbolicCholeskyRaw::Supernodal(theirs) = faers.raw() else { panic!("supernodal") };
+            let ns = ours.n_supernodes();
+            assert_eq!(ours.supernode_begin()[..ns], theirs.supernode_begin()[..], "{name}, {n_order} ordered: supernodes");
+            assert_eq!(ours.supernode_begin()[1..], theirs.supernode_end()[..], "{name}, {n_order} ordered: supernodes");
+            for s in 0..ns {
+                let start = theirs.col_ptr_for_row_idx()[s];
+                let pattern: Vec<u32> = theirs.row_idx()[start..start + theirs.nnz_per_super()[s]].iter().map(|&r| r as u32).collect();
+                assert_eq!(ours.pattern(s), &pattern[..], "{name}, {n_order} ordered: pattern of supernode {s}");
+            }
+            assert_eq!(ours.val_ptr(), theirs.col_ptr_for_val(), "{name}, {n_order} ordered: layout of the values");
+            // and the contact normals stayed in place at the end
+            assert!((n_order..matrix.n()).all(|i| ours.inv()[i] == i), "{name}: contact normals moved");
+        }
+    }
 }
 
 fn faers(symbolic: &SymbolicCholesky<usize>, matrix: &SymCsc) -> Vec<f64> {
@@ -93,16 +124,16 @@ fn the_factor_is_faers_and_the_same_on_any_number_of_threads() {
         ("graded", graded()),
     ] {
         let (matrix, coords) = stiffness(&m);
-        let symbolic = symbolic(&matrix, &coords);
-        let reference = faers(&symbolic, &matrix);
-        let one = ours(&symbolic, &matrix, matrix.values(), 1).unwrap();
-        let two = ours(&symbolic, &matrix, matrix.values(), 2).unwrap();
+        let symbolic = symbolic(&matrix, matrix.n(), &coords);
+        let reference = faers(&faers_symbolic(&matrix, &symbolic), &matrix);
+        let one = ours(&symbolic, matrix.values(), 1).unwrap();
+        let two = ours(&symbolic, matrix.values(), 2).unwrap();
         assert!(one.iter().zip(&two).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}: one and two threads differ");
         let scale = reference.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let worst = reference.iter().zip(&one).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         assert!(worst <= 1e-13 * scale, "{name}: largest difference from faer's factor {worst:.2e} (largest entry {scale:.2e})");
         // a second factorisation on the same plan (a refactorisation) gives the same again
-        let again = ours(&symbolic, &matrix, matrix.values(), 2).unwrap();
+        let again = ours(&symbolic, matrix.values(), 2).unwrap();
         assert!(again.iter().zip(&two).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}: refactorisation differs");
     }
 }
@@ -110,13 +141,13 @@ fn the_factor_is_faers_and_the_same_on_any_number_of_threads() {
 #[test]
 fn a_matrix_that_is_not_positive_definite_is_an_error_naming_its_column() {
     let (matrix, coords) = stiffness(&mesh(&problems::Ex72, "structured:8"));
-    let symbolic = symbolic(&matrix, &coords);
+    let symbolic = symbolic(&matrix, matrix.n(), &coords);
     let mut values = matrix.values().to_vec();
     // a negative diagonal entry at unknown 5
     let at = matrix.position(5, 5);
     values[at] = -values[at];
-    let err = ours(&symbolic, &matrix, &values, 2).unwrap_err();
-    let inv = symbolic.perm().unwrap().arrays().1;
+    let err = ours(&symbolic, &values, 2).unwrap_err();
+    let inv = symbolic.inv();
     // columns before it do not see the entry; at its own column the pivot is -K_55 minus squares
     assert_eq!(err.column, inv[5], "{err}");
     assert!(err.to_string().contains("non-positive pivot"), "{err}");
@@ -128,17 +159,17 @@ fn solves_agree_with_faers_and_on_any_number_of_threads() {
     use faer::{Conj, Mat};
     for (name, m) in [("structured:96", mesh(&problems::Ex72, "structured:96")), ("graded", graded())] {
         let (matrix, coords) = stiffness(&m);
-        let symbolic = symbolic(&matrix, &coords);
-        let SymbolicCholeskyRaw::Supernodal(sn) = symbolic.raw() else { panic!("supernodal") };
-        let plan = Plan::new(sn, &matrix, symbolic.perm().unwrap().arrays().1);
-        let l = ours(&symbolic, &matrix, matrix.values(), 2).unwrap();
+        let symbolic = symbolic(&matrix, matrix.n(), &coords);
+        let plan = Plan::new(&symbolic);
+        let l = ours(&symbolic, matrix.values(), 2).unwrap();
+        let faers_symbolic = faers_symbolic(&matrix, &symbolic);
         let n = matrix.n();
         let b: Vec<f64> = (0..n).map(|i| ((i * 37 % 101) as f64 - 50.0) / 7.0).collect();
         // faer's solve (it permutes itself)
         let mut reference = Mat::<f64>::from_fn(n, 1, |i, _| b[i]);
-        let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
-        LltRef::new(&symbolic, &l).solve_in_place_with_conj(Conj::No, reference.as_mut(), Par::Seq, MemStack::new(&mut mem));
-        let inv = symbolic.perm().unwrap().arrays().1;
+        let mut mem = MemBuffer::new(faers_symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+        LltRef::new(&faers_symbolic, &l).solve_in_place_with_conj(Conj::No, reference.as_mut(), Par::Seq, MemStack::new(&mut mem));
+        let inv = symbolic.inv();
         let solve = |threads: usize| -> Vec<f64> {
             let mut x = vec![0.0; n];
             for i in 0..n {
@@ -148,7 +179,7 @@ fn solves_agree_with_faers_and_on_any_number_of_threads() {
                 .num_threads(threads)
                 .build()
                 .unwrap()
-                .install(|| cholesky::solve_in_place(sn, &plan, &l, &mut x));
+                .install(|| cholesky::solve_in_place(&symbolic, &plan, &l, &mut x));
             (0..n).map(|i| x[inv[i]]).collect()
         };
         let (one, two) = (solve(1), solve(2));

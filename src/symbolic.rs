@@ -1,0 +1,484 @@
+//! The symbolic Cholesky factorisation: which entries of L = chol(P K P^T) can be nonzero, and
+//! how the columns of L group into supernodes (runs of columns with one row pattern below them,
+//! stored as dense blocks), computed on the graph of the mesh nodes.
+//!
+//! The structure is exactly the one faer's supernodal symbolic factorisation computes for the
+//! same permutation (the test in `tests/cholesky.rs` compares every array): the elimination tree
+//! and the column counts of L, fundamental supernodes (column j joins column j - 1 when j is the
+//! only parent of j - 1 and its column count is one less), faer's default relaxation (a supernode
+//! absorbs the one just before it, its child, while the share of explicit zeros this adds stays
+//! under 100% / 80% / 10% / 5% for up to 4 / 16 / 48 / more columns), and the sorted row pattern
+//! of every supernode. So the numeric factorisation and every number computed from it are the
+//! same as with faer's symbolic step.
+//!
+//! Written by hand because faer's symbolic step works on the graph of the unknowns and finds the
+//! column counts by walking the elimination tree once per entry of L (O(|L|): 2.8e8 steps at
+//! `structured:512`, 1.65 s of one core), and it has no way to take a structure computed
+//! elsewhere. Here the same walk runs on the graph of the nodes, which has half the vertices and
+//! a quarter of the entries of L: the two unknowns of a node couple to the same unknowns, so in
+//! the ordered matrix they are consecutive columns with nested patterns. The first is the only
+//! child of the second in the elimination tree and has one more entry, so they always fall in the
+//! same fundamental supernode, every supernode is a run of whole nodes, and the structure of the
+//! unknowns follows from that of the nodes with each node weighted by its number of unknowns:
+//! with W the unknowns of later nodes in the column of node k of L, the w unknowns of node k have
+//! column counts W + w, W + w - 1, ..., W + 1.
+
+use crate::assembly::SymCsc;
+use crate::ordering::{Graph, OrderingChoice};
+
+/// faer's default supernode relaxation (`SymbolicSupernodalParams::default`): two adjacent
+/// supernodes of together at most `.0` columns merge while the share of explicit zeros in the
+/// merged one stays at most `.1`.
+const RELAX: [(usize, f64); 4] = [(4, 1.0), (16, 0.8), (48, 0.1), (usize::MAX, 0.05)];
+
+const NONE: u32 = u32::MAX;
+
+/// The ordering and supernodal structure of L for P K P^T = L L^T.
+pub struct Symbolic {
+    /// `perm[new] = old`, `inv[old] = new`.
+    perm: Vec<usize>,
+    inv: Vec<usize>,
+    /// Supernode s holds the columns `begin[s]..begin[s + 1]` of L ...
+    begin: Vec<usize>,
+    /// ... the rows `rows[row_ptr[s]..row_ptr[s + 1]]` below them (ascending) ...
+    row_ptr: Vec<usize>,
+    rows: Vec<u32>,
+    /// ... and its values, column-major (rows: its columns, then its pattern), at
+    /// `val_ptr[s]..val_ptr[s + 1]` of L's values.
+    val_ptr: Vec<usize>,
+    /// The matrix entries of column j of P K P^T: `entries[entry_ptr[j]..entry_ptr[j + 1]]`,
+    /// each (row, position in the matrix's values).
+    entry_ptr: Vec<usize>,
+    entries: Vec<(u32, u32)>,
+}
+
+/// The structure of L alone: [`Symbolic`]'s `begin`, `row_ptr`, `rows`, `val_ptr`.
+type Structure = (Vec<usize>, Vec<usize>, Vec<u32>, Vec<usize>);
+
+/// Order the unknowns `0..n_order` of `matrix` ([`crate::ordering::fill_reducing_then`]; the
+/// others stay at the end in place) and compute the symbolic factorisation with that order.
+pub fn analyse(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (Symbolic, OrderingChoice) {
+    crate::ordering::fill_reducing_then(matrix, n_order, coords, |graph, node_order| Symbolic::new(matrix, n_order, graph, node_order))
+}
+
+impl Symbolic {
+    /// The structure of L for `matrix` with the nodes of `graph` (the unknowns `0..n_order`) in
+    /// `node_order` (`node_order[new] = old`), each node's unknowns together, followed by the
+    /// unknowns `n_order..n` in place, each a node of its own; with the flops of factorising the
+    /// ordered block (the leading block of L).
+    pub(crate) fn new(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize]) -> (Self, f64) {
+        let n = matrix.n();
+        assert!(matrix.values().len() < u32::MAX as usize, "more than 2^32 matrix entries: widen the symbolic factorisation's indices");
+        let mut perm = graph.unknowns(node_order);
+        perm.extend(n_order..n);
+        let mut inv = vec![0usize; n];
+        for (new, &old) in perm.iter().enumerate() {
+            inv[old] = new;
+        }
+        // where the matrix entries go needs only the ordering: on the other core meanwhile
+        let (((begin, row_ptr, rows, val_ptr), flops), (entry_ptr, entries)) =
+            rayon::join(|| structure(matrix, n_order, graph, node_order), || place_entries(matrix, &inv));
+        (Symbolic { perm, inv, begin, row_ptr, rows, val_ptr, entry_ptr, entries }, flops)
+    }
+
+    /// Unknowns (rows and columns of L).
+    pub fn n(&self) -> usize {
+        self.perm.len()
+    }
+
+    /// The ordering, `perm[new] = old`.
+    pub fn perm(&self) -> &[usize] {
+        &self.perm
+    }
+
+    /// Its inverse, `inv[old] = new`.
+    pub fn inv(&self) -> &[usize] {
+        &self.inv
+    }
+
+    pub fn n_supernodes(&self) -> usize {
+        self.begin.len() - 1
+    }
+
+    /// Supernode s holds the columns `begin[s]..begin[s + 1]`.
+    pub fn supernode_begin(&self) -> &[usize] {
+        &self.begin
+    }
+
+    /// The rows of supernode s below its columns, ascending.
+    pub fn pattern(&self, s: usize) -> &[u32] {
+        &self.rows[self.row_ptr[s]..self.row_ptr[s + 1]]
+    }
+
+    /// Supernode s's values lie at `val_ptr[s]..val_ptr[s + 1]` of L's values.
+    pub fn val_ptr(&self) -> &[usize] {
+        &self.val_ptr
+    }
+
+    /// The matrix entries of column j of P K P^T below the diagonal and on it, each as (row of
+    /// P K P^T, position in the matrix's values).
+    pub fn entries(&self, j: usize) -> &[(u32, u32)] {
+        &self.entries[self.entry_ptr[j]..self.entry_ptr[j + 1]]
+    }
+
+    /// The number of values of L.
+    pub fn len_val(&self) -> usize {
+        *self.val_ptr.last().unwrap()
+    }
+}
+
+/// The structure of L (see [`Symbolic::new`]).
+fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize]) -> (Structure, f64) {
+    let n = matrix.n();
+    let nodes_i = node_order.len();
+    assert_eq!(nodes_i, graph.n_nodes());
+    assert!(n < NONE as usize, "more than 2^32 unknowns: widen the symbolic factorisation's indices");
+    let nodes = nodes_i + (n - n_order);
+    // node p (new numbering) holds the unknowns first[p]..first[p + 1] (new numbering)
+    let mut first = Vec::with_capacity(nodes + 1);
+    first.push(0usize);
+    for p in 0..nodes {
+        let w = if p < nodes_i { graph.weight(node_order[p]) } else { 1 };
+        first.push(first[p] + w);
+    }
+    assert_eq!(first[nodes], n);
+    let mut position = vec![0u32; nodes_i];
+    for (p, &old) in node_order.iter().enumerate() {
+        position[old] = p as u32;
+    }
+    // the unknowns n_order..n are not in the graph: their couplings from the matrix (entries
+    // with rows >= n_order; rows are sorted within a column), as an extra adjacency
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    let (cols, row_idx) = (matrix.col_ptr(), matrix.row_idx());
+    if n > n_order {
+        let position = &position;
+        let columns = (0..nodes_i)
+            .flat_map(|k| graph.unknowns_of(k).map(move |j| (j, position[k])))
+            .chain((n_order..n).map(|j| (j, (nodes_i + j - n_order) as u32)));
+        for (j, p) in columns {
+            let rows = &row_idx[cols[j]..cols[j + 1]];
+            pairs.extend(rows[rows.partition_point(|&i| i < n_order.max(j + 1))..].iter().map(|&i| (p, (nodes_i + i - n_order) as u32)));
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+    }
+    let mut extra_ptr = vec![0usize; nodes + 1];
+    for &(a, b) in &pairs {
+        extra_ptr[a as usize + 1] += 1;
+        extra_ptr[b as usize + 1] += 1;
+    }
+    for p in 0..nodes {
+        extra_ptr[p + 1] += extra_ptr[p];
+    }
+    let mut extra = vec![0u32; extra_ptr[nodes]];
+    let mut fill = extra_ptr.clone();
+    for &(a, b) in &pairs {
+        extra[fill[a as usize]] = b;
+        fill[a as usize] += 1;
+        extra[fill[b as usize]] = a;
+        fill[b as usize] += 1;
+    }
+    // every neighbour of node p (new numbering)
+    let neighbours = |p: usize, f: &mut dyn FnMut(usize)| {
+        if p < nodes_i {
+            graph.neighbours(node_order[p]).for_each(|q| f(position[q] as usize));
+        }
+        extra[extra_ptr[p]..extra_ptr[p + 1]].iter().for_each(|&q| f(q as usize));
+    };
+    let weight = |p: usize| first[p + 1] - first[p];
+    let counts = tree_and_counts(nodes, nodes_i, &weight, &neighbours);
+    let flops = counts.flops(nodes_i, &weight);
+    let Counts { parent, below_w, below_n, .. } = counts;
+    let mut children = vec![0u32; nodes];
+    for &q in parent.iter().filter(|&&q| q != NONE) {
+        children[q as usize] += 1;
+    }
+
+    // fundamental supernodes (runs of nodes): node p continues the run of p - 1 when, in
+    // unknowns, its first column is the only parent of the last column of p - 1 and has one
+    // entry less
+    let mut fund = vec![0usize]; // first node of each, then `nodes`
+    for p in 1..nodes {
+        let joins = parent[p - 1] as usize == p && children[p] == 1 && below_w[p - 1] == below_w[p] + weight(p);
+        if !joins {
+            fund.push(p);
+        }
+    }
+    fund.push(nodes);
+    let nf = fund.len() - 1;
+    let mut super_of = vec![0u32; nodes];
+    for s in 0..nf {
+        super_of[fund[s]..fund[s + 1]].fill(s as u32);
+    }
+    let top = |s: usize, bounds: &[usize]| bounds[s + 1] - 1; // the last node of supernode s
+
+    // relaxation, as faer does it: in ascending order, a supernode absorbs the one just before
+    // it if that is its child and the explicit zeros stay under the thresholds (sizes and
+    // zeros accumulate along a chain of merges; `size` 0 marks an absorbed supernode)
+    let mut size: Vec<usize> = (0..nf).map(|s| first[fund[s + 1]] - first[fund[s]]).collect();
+    let degree: Vec<usize> = (0..nf).map(|s| below_w[top(s, &fund)]).collect();
+    let mut zeros = vec![0usize; nf];
+    for s in 1..nf {
+        let c = s - 1;
+        let parent_of_c = parent[top(c, &fund)];
+        if parent_of_c == NONE || super_of[parent_of_c as usize] as usize != s {
+            continue;
+        }
+        let (ps, cs, pd, cd) = (size[s], size[c], degree[s], degree[c]);
+        let new_zeros = (ps + pd - cd) * cs;
+        let merged = if new_zeros == 0 {
+            Some(zeros[s] + zeros[c])
+        } else {
+            let z = new_zeros + zeros[c] + zeros[s];
+            let cols = cs + ps;
+            let entries = cols * (cols + 1) / 2 + pd * cols;
+            RELAX.iter().any(|&(max_cols, share)| max_cols >= cols && entries as f64 * share >= z as f64).then_some(z)
+        };
+        if let Some(z) = merged {
+            size[s] += cs;
+            size[c] = 0;
+            zeros[s] = z;
+        }
+    }
+    // the relaxed supernodes, as runs of nodes
+    let mut bounds = vec![0usize];
+    for s in 0..nf {
+        if size[s] > 0 {
+            bounds.push(fund[s + 1]);
+        }
+    }
+    let ns = bounds.len() - 1;
+    for s in 0..ns {
+        super_of[bounds[s]..bounds[s + 1]].fill(s as u32);
+    }
+    let super_parent: Vec<u32> = (0..ns)
+        .map(|s| match parent[top(s, &bounds)] {
+            NONE => NONE,
+            q => super_of[q as usize],
+        })
+        .collect();
+
+    // row patterns in nodes: node p is in the pattern of every supernode on the tree paths
+    // from its lower neighbours' supernodes up to its own (faer's `ereach_super`), so each
+    // pattern fills in ascending order
+    let mut node_ptr = vec![0usize; ns + 1];
+    for s in 0..ns {
+        node_ptr[s + 1] = node_ptr[s] + below_n[top(s, &bounds)] as usize;
+    }
+    let mut node_rows = vec![0u32; node_ptr[ns]];
+    let mut next = node_ptr.clone();
+    let mut seen = vec![NONE; ns];
+    for p in 0..nodes {
+        seen[super_of[p] as usize] = p as u32;
+        neighbours(p, &mut |q| {
+            if q >= p {
+                return;
+            }
+            let mut t = super_of[q] as usize;
+            while seen[t] != p as u32 {
+                node_rows[next[t]] = p as u32;
+                next[t] += 1;
+                seen[t] = p as u32;
+                t = super_parent[t] as usize;
+            }
+        });
+    }
+    assert_eq!(next[..ns], node_ptr[1..], "row patterns disagree with the column counts");
+
+    // in unknowns
+    let begin: Vec<usize> = bounds.iter().map(|&b| first[b]).collect();
+    let mut row_ptr = vec![0usize; ns + 1];
+    let mut val_ptr = vec![0usize; ns + 1];
+    for s in 0..ns {
+        let (ncols, deg) = (begin[s + 1] - begin[s], below_w[top(s, &bounds)]);
+        row_ptr[s + 1] = row_ptr[s] + deg;
+        val_ptr[s + 1] = val_ptr[s] + (ncols + deg) * ncols;
+    }
+    let mut rows = Vec::with_capacity(row_ptr[ns]);
+    for &q in &node_rows {
+        rows.extend(first[q as usize] as u32..first[q as usize + 1] as u32);
+    }
+    assert_eq!(rows.len(), row_ptr[ns]);
+
+    ((begin, row_ptr, rows, val_ptr), flops)
+}
+
+/// Where each matrix entry (i, j), i >= j, goes: column min(inv i, inv j) of P K P^T, row max
+/// (its place in the column's supernode is looked up when factorising, where the supernode's
+/// rows are mapped anyway); grouped by column, counted and then filled.
+fn place_entries(matrix: &SymCsc, inv: &[usize]) -> (Vec<usize>, Vec<(u32, u32)>) {
+    let (n, cols, row_idx) = (matrix.n(), matrix.col_ptr(), matrix.row_idx());
+    let mut entry_ptr = vec![0usize; n + 1];
+    for j in 0..n {
+        for &i in &row_idx[cols[j]..cols[j + 1]] {
+            entry_ptr[inv[i].min(inv[j]) + 1] += 1;
+        }
+    }
+    for c in 0..n {
+        entry_ptr[c + 1] += entry_ptr[c];
+    }
+    let mut fill = entry_ptr.clone();
+    let mut entries = vec![(0u32, 0u32); entry_ptr[n]];
+    for j in 0..n {
+        for (k, &i) in (cols[j]..cols[j + 1]).zip(&row_idx[cols[j]..cols[j + 1]]) {
+            let (a, b) = (inv[i], inv[j]);
+            let c = a.min(b);
+            entries[fill[c]] = (a.max(b) as u32, k as u32);
+            fill[c] += 1;
+        }
+    }
+    (entry_ptr, entries)
+}
+
+/// The elimination tree of a graph in its numbering and the column counts of L, per node:
+/// `parent[p]` ([`NONE`] at a root), and strictly below node p's columns the number of later
+/// nodes (`below_n`) and their total weight (`below_w`) in the structure of column p.
+pub(crate) struct Counts {
+    pub parent: Vec<u32>,
+    pub below_w: Vec<usize>,
+    pub below_n: Vec<u32>,
+    /// `below_w` counting only the nodes before `lead`.
+    pub below_lead: Vec<usize>,
+}
+
+impl Counts {
+    /// Flops of the factorisation of the leading block (the nodes before `lead`, which are the
+    /// leading block of L too): with d_j the entries of column j of L below the diagonal,
+    /// sum d_j + d_j (d_j + 1) / 2 (divisions and multiply-subtract pairs, as AMD counts them);
+    /// the w unknowns of node p have d = W + w - 1, ..., W with W = `below_lead[p]`.
+    pub fn flops(&self, lead: usize, weight: &dyn Fn(usize) -> usize) -> f64 {
+        (0..lead)
+            .map(|p| (0..weight(p) as u64).map(|t| self.below_lead[p] as u64 + t).map(|d| d as f64 + (d * (d + 1) / 2) as f64).sum::<f64>())
+            .sum()
+    }
+}
+
+/// `neighbours(p, f)` calls f for every neighbour of node p.
+pub(crate) type Neighbours<'a> = dyn Fn(usize, &mut dyn FnMut(usize)) + 'a;
+
+/// [`Counts`] for the graph of `nodes` nodes with the given `weight`s whose `neighbours(p, f)`
+/// calls f for every neighbour of p (`below_lead` counting the nodes before `lead`), in O(|edges| alpha) (Gilbert, Ng and Peyton's skeleton
+/// algorithm, as in Davis' `cs_etree`, `cs_post`, `cs_counts`): row q of L has an entry in column
+/// p exactly when p lies in the row subtree of q (the union of the tree paths from q's earlier
+/// neighbours up to q); each row subtree adds its weight at its leaves and takes it off again at
+/// the least common ancestor of consecutive leaves (in postorder) and above its root, and a
+/// column's count is the sum over its subtree.
+pub(crate) fn tree_and_counts(
+    nodes: usize,
+    lead: usize,
+    weight: &dyn Fn(usize) -> usize,
+    neighbours: &Neighbours,
+) -> Counts {
+    assert!(nodes < NONE as usize);
+    // elimination tree, with path compression through `ancestor`
+    let (mut parent, mut ancestor) = (vec![NONE; nodes], vec![NONE; nodes]);
+    for k in 0..nodes {
+        neighbours(k, &mut |mut i| {
+            while i < k {
+                let next = ancestor[i];
+                ancestor[i] = k as u32;
+                if next == NONE {
+                    parent[i] = k as u32;
+                    break;
+                }
+                i = next as usize;
+            }
+        });
+    }
+    // postorder: children in ascending order, roots in ascending order
+    let (mut head, mut next) = (vec![NONE; nodes], vec![NONE; nodes]);
+    for j in (0..nodes).rev() {
+        if parent[j] != NONE {
+            next[j] = head[parent[j] as usize];
+            head[parent[j] as usize] = j as u32;
+        }
+    }
+    let mut post = Vec::with_capacity(nodes);
+    let mut stack = Vec::new();
+    for root in (0..nodes).filter(|&j| parent[j] == NONE) {
+        stack.push(root as u32);
+        while let Some(&p) = stack.last() {
+            let child = head[p as usize];
+            if child == NONE {
+                stack.pop();
+                post.push(p);
+            } else {
+                head[p as usize] = next[child as usize];
+                stack.push(child);
+            }
+        }
+    }
+    // first[j]: the first postorder position in j's subtree; a leaf of the tree is the only leaf
+    // of its own row subtree
+    let mut first = vec![NONE; nodes];
+    let (mut delta_w, mut delta_n, mut delta_l) = (vec![0i64; nodes], vec![0i64; nodes], vec![0i64; nodes]);
+    let weight_lead = |p: usize| if p < lead { weight(p) as i64 } else { 0 };
+    for (k, &j) in post.iter().enumerate() {
+        let mut j = j as usize;
+        if first[j] == NONE {
+            delta_w[j] = weight(j) as i64;
+            delta_n[j] = 1;
+            delta_l[j] = weight_lead(j);
+        }
+        while j != NONE as usize && first[j] == NONE {
+            first[j] = k as u32;
+            j = if parent[j] == NONE { NONE as usize } else { parent[j] as usize };
+        }
+    }
+    // `max_first[i]`: 1 + the largest `first` among the leaves of row subtree i seen so far
+    let (mut max_first, mut prev_leaf) = (vec![0u32; nodes], vec![NONE; nodes]);
+    for (i, a) in ancestor.iter_mut().enumerate() {
+        *a = i as u32;
+    }
+    for &j in &post {
+        let j = j as usize;
+        if parent[j] != NONE {
+            delta_w[parent[j] as usize] -= weight(j) as i64;
+            delta_n[parent[j] as usize] -= 1;
+            delta_l[parent[j] as usize] -= weight_lead(j);
+        }
+        neighbours(j, &mut |i| {
+            // is j a new leaf of row subtree i (j not below an earlier leaf)?
+            if i <= j || first[j] < max_first[i] {
+                return;
+            }
+            max_first[i] = first[j] + 1;
+            let (wi, li) = (weight(i) as i64, weight_lead(i));
+            delta_w[j] += wi;
+            delta_n[j] += 1;
+            delta_l[j] += li;
+            let prev = std::mem::replace(&mut prev_leaf[i], j as u32);
+            if prev != NONE {
+                // the least common ancestor of the previous leaf and j, compressing the path
+                let mut q = prev as usize;
+                while ancestor[q] as usize != q {
+                    q = ancestor[q] as usize;
+                }
+                let mut s = prev as usize;
+                while s != q {
+                    let up = ancestor[s] as usize;
+                    ancestor[s] = q as u32;
+                    s = up;
+                }
+                delta_w[q] -= wi;
+                delta_n[q] -= 1;
+                delta_l[q] -= li;
+            }
+        });
+        if parent[j] != NONE {
+            ancestor[j] = parent[j];
+        }
+    }
+    for j in 0..nodes {
+        if parent[j] != NONE {
+            let p = parent[j] as usize;
+            delta_w[p] += delta_w[j];
+            delta_n[p] += delta_n[j];
+            delta_l[p] += delta_l[j];
+        }
+    }
+    let below_w = (0..nodes).map(|j| (delta_w[j] - weight(j) as i64) as usize).collect();
+    let below_n = delta_n.iter().map(|&c| (c - 1) as u32).collect();
+    let below_lead = (0..nodes).map(|j| (delta_l[j] - weight_lead(j)) as usize).collect();
+    Counts { parent, below_w, below_n, below_lead }
+}
