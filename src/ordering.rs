@@ -35,6 +35,7 @@
 //! so the ordering does not depend on the number of threads.
 
 use crate::assembly::SymCsc;
+use crate::symbolic::Adjacency;
 use std::sync::atomic::AtomicU8;
 use std::sync::atomic::Ordering::Relaxed;
 
@@ -122,6 +123,11 @@ impl Graph {
     /// The number of unknowns of node k.
     pub(crate) fn weight(&self, k: usize) -> usize {
         self.first[k + 1] - self.first[k]
+    }
+
+    /// The number of neighbours of node i.
+    pub(crate) fn degree(&self, i: usize) -> usize {
+        (self.ptr[i + 1] - self.ptr[i]) as usize
     }
 
     pub(crate) fn neighbours(&self, i: usize) -> impl Iterator<Item = usize> + '_ {
@@ -326,8 +332,9 @@ fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
         position[old] = new as u32;
     }
     let weight = |p: usize| graph.weight(order[p]);
-    let neighbours = |p: usize, f: &mut dyn FnMut(usize)| graph.neighbours(order[p]).for_each(|q| f(position[q] as usize));
-    crate::symbolic::tree_and_counts(order.len(), order.len(), &weight, &neighbours).flops(order.len(), &weight)
+    let adjacency =
+        Adjacency::gather(order.len(), &|p| graph.degree(order[p]), &|p, f| graph.neighbours(order[p]).for_each(|q| f(position[q])));
+    crate::symbolic::tree_and_counts(&adjacency, order.len(), &weight).flops(order.len(), &weight)
 }
 
 /// Order `set`: both halves of a coordinate split first, then the separator.

@@ -178,15 +178,16 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
         extra[fill[b as usize]] = a;
         fill[b as usize] += 1;
     }
-    // every neighbour of node p (new numbering)
-    let neighbours = |p: usize, f: &mut dyn FnMut(usize)| {
+    // the neighbours of every node, in the new numbering
+    let degree = |p: usize| if p < nodes_i { graph.degree(node_order[p]) } else { 0 } + extra_ptr[p + 1] - extra_ptr[p];
+    let adjacency = Adjacency::gather(nodes, &degree, &|p, f| {
         if p < nodes_i {
-            graph.neighbours(node_order[p]).for_each(|q| f(position[q] as usize));
+            graph.neighbours(node_order[p]).for_each(|q| f(position[q]));
         }
-        extra[extra_ptr[p]..extra_ptr[p + 1]].iter().for_each(|&q| f(q as usize));
-    };
+        extra[extra_ptr[p]..extra_ptr[p + 1]].iter().for_each(|&q| f(q));
+    });
     let weight = |p: usize| first[p + 1] - first[p];
-    let counts = tree_and_counts(nodes, nodes_i, &weight, &neighbours);
+    let counts = tree_and_counts(&adjacency, nodes_i, &weight);
     let flops = counts.flops(nodes_i, &weight);
     let Counts { parent, below_w, below_n, .. } = counts;
     let mut children = vec![0u32; nodes];
@@ -270,18 +271,15 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
     let mut seen = vec![NONE; ns];
     for p in 0..nodes {
         seen[super_of[p] as usize] = p as u32;
-        neighbours(p, &mut |q| {
-            if q >= p {
-                return;
-            }
-            let mut t = super_of[q] as usize;
+        for &q in adjacency.row(p).iter().filter(|&&q| (q as usize) < p) {
+            let mut t = super_of[q as usize] as usize;
             while seen[t] != p as u32 {
                 node_rows[next[t]] = p as u32;
                 next[t] += 1;
                 seen[t] = p as u32;
                 t = super_parent[t] as usize;
             }
-        });
+        }
     }
     assert_eq!(next[..ns], node_ptr[1..], "row patterns disagree with the column counts");
 
@@ -353,27 +351,67 @@ impl Counts {
     }
 }
 
-/// `neighbours(p, f)` calls f for every neighbour of node p.
-pub(crate) type Neighbours<'a> = dyn Fn(usize, &mut dyn FnMut(usize)) + 'a;
+/// A graph in the numbering of an ordering, compressed by rows: the neighbours of node p are
+/// `adj[ptr[p]..ptr[p + 1]]`. Gathered once (in parallel), it turns the sequential passes over
+/// the nodes in the new order (elimination tree, column counts, row patterns) into reads of
+/// neighbouring memory.
+pub(crate) struct Adjacency {
+    ptr: Vec<usize>,
+    adj: Vec<u32>,
+}
 
-/// [`Counts`] for the graph of `nodes` nodes with the given `weight`s whose `neighbours(p, f)`
-/// calls f for every neighbour of p (`below_lead` counting the nodes before `lead`), in O(|edges| alpha) (Gilbert, Ng and Peyton's skeleton
+impl Adjacency {
+    /// Node p has `degree(p)` neighbours, which `neighbours(p, f)` hands to f one by one.
+    pub(crate) fn gather(
+        nodes: usize,
+        degree: &(dyn Fn(usize) -> usize + Sync),
+        neighbours: &(dyn Fn(usize, &mut dyn FnMut(u32)) + Sync),
+    ) -> Self {
+        let mut ptr = vec![0usize; nodes + 1];
+        for p in 0..nodes {
+            ptr[p + 1] = ptr[p] + degree(p);
+        }
+        let mut adj = vec![0u32; ptr[nodes]];
+        crate::assembly::par_fill(
+            &mut adj,
+            &ptr,
+            || (),
+            |p, _, row| {
+                let mut k = 0;
+                neighbours(p, &mut |q| {
+                    row[k] = q;
+                    k += 1;
+                });
+                assert_eq!(k, row.len(), "node {p}: as many neighbours as its degree");
+            },
+        );
+        Adjacency { ptr, adj }
+    }
+
+    fn nodes(&self) -> usize {
+        self.ptr.len() - 1
+    }
+
+    fn row(&self, p: usize) -> &[u32] {
+        &self.adj[self.ptr[p]..self.ptr[p + 1]]
+    }
+}
+
+/// [`Counts`] for the graph `adjacency` with the given `weight`s (`below_lead` counting the
+/// nodes before `lead`), in O(|edges| alpha) (Gilbert, Ng and Peyton's skeleton
 /// algorithm, as in Davis' `cs_etree`, `cs_post`, `cs_counts`): row q of L has an entry in column
 /// p exactly when p lies in the row subtree of q (the union of the tree paths from q's earlier
 /// neighbours up to q); each row subtree adds its weight at its leaves and takes it off again at
 /// the least common ancestor of consecutive leaves (in postorder) and above its root, and a
 /// column's count is the sum over its subtree.
-pub(crate) fn tree_and_counts(
-    nodes: usize,
-    lead: usize,
-    weight: &dyn Fn(usize) -> usize,
-    neighbours: &Neighbours,
-) -> Counts {
+pub(crate) fn tree_and_counts(adjacency: &Adjacency, lead: usize, weight: &dyn Fn(usize) -> usize) -> Counts {
+    let nodes = adjacency.nodes();
     assert!(nodes < NONE as usize);
     // elimination tree, with path compression through `ancestor`
     let (mut parent, mut ancestor) = (vec![NONE; nodes], vec![NONE; nodes]);
     for k in 0..nodes {
-        neighbours(k, &mut |mut i| {
+        for &i in adjacency.row(k) {
+            let mut i = i as usize;
             while i < k {
                 let next = ancestor[i];
                 ancestor[i] = k as u32;
@@ -383,7 +421,7 @@ pub(crate) fn tree_and_counts(
                 }
                 i = next as usize;
             }
-        });
+        }
     }
     // postorder: children in ascending order, roots in ascending order
     let (mut head, mut next) = (vec![NONE; nodes], vec![NONE; nodes]);
@@ -437,10 +475,11 @@ pub(crate) fn tree_and_counts(
             delta_n[parent[j] as usize] -= 1;
             delta_l[parent[j] as usize] -= weight_lead(j);
         }
-        neighbours(j, &mut |i| {
+        for &i in adjacency.row(j) {
+            let i = i as usize;
             // is j a new leaf of row subtree i (j not below an earlier leaf)?
             if i <= j || first[j] < max_first[i] {
-                return;
+                continue;
             }
             max_first[i] = first[j] + 1;
             let (wi, li) = (weight(i) as i64, weight_lead(i));
@@ -464,7 +503,7 @@ pub(crate) fn tree_and_counts(
                 delta_n[q] -= 1;
                 delta_l[q] -= li;
             }
-        });
+        }
         if parent[j] != NONE {
             ancestor[j] = parent[j];
         }
