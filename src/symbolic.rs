@@ -351,6 +351,9 @@ impl Counts {
     }
 }
 
+/// `neighbours(p, f)` calls f for every neighbour of node p.
+pub(crate) type Neighbours<'a> = dyn Fn(usize, &mut dyn FnMut(u32)) + Sync + 'a;
+
 /// A graph in the numbering of an ordering, compressed by rows: the neighbours of node p are
 /// `adj[ptr[p]..ptr[p + 1]]`. Gathered once (in parallel), it turns the sequential passes over
 /// the nodes in the new order (elimination tree, column counts, row patterns) into reads of
@@ -362,11 +365,7 @@ pub(crate) struct Adjacency {
 
 impl Adjacency {
     /// Node p has `degree(p)` neighbours, which `neighbours(p, f)` hands to f one by one.
-    pub(crate) fn gather(
-        nodes: usize,
-        degree: &(dyn Fn(usize) -> usize + Sync),
-        neighbours: &(dyn Fn(usize, &mut dyn FnMut(u32)) + Sync),
-    ) -> Self {
+    pub(crate) fn gather(nodes: usize, degree: &(dyn Fn(usize) -> usize + Sync), neighbours: &Neighbours) -> Self {
         let mut ptr = vec![0usize; nodes + 1];
         for p in 0..nodes {
             ptr[p + 1] = ptr[p] + degree(p);
