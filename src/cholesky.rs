@@ -1,8 +1,8 @@
 //! The numeric supernodal Cholesky factorisation P K P^T = L L^T, on every core.
 //!
-//! faer computes the symbolic factorisation (the supernodes: runs of columns of L with one row
-//! pattern, the layout of L's values); this module fills L's values ([`factorize`]) and solves
-//! with L ([`solve_in_place`]). faer's
+//! [`crate::symbolic`] computes the structure (the supernodes: runs of columns of L with one row
+//! pattern, the layout of L's values, where the matrix's entries go); this module fills L's
+//! values ([`factorize`]) and solves with L ([`solve_in_place`]). faer's
 //! own numeric step visits the supernodes one after another and parallelises only inside a
 //! supernode's dense kernels, which on our matrices was slower than one thread. Yet most of the
 //! work of a nested-dissection ordering lies in subtrees of the elimination tree that share
@@ -21,9 +21,9 @@
 //! is computed the same way whichever thread runs it, so L is bitwise the same on any number of
 //! threads; only the order in which independent supernodes finish changes.
 //!
-//! Written by hand because faer 0.24 has no tree-parallel numeric factorisation (and keeps its
-//! lists of descendants private, so [`Plan`] rebuilds them from the public structure). The
-//! dense kernels (products, Cholesky, triangular solve) are faer's.
+//! Written by hand because faer 0.24 has no tree-parallel numeric factorisation (and takes no
+//! structure computed elsewhere). The dense kernels (products, Cholesky, triangular solve) are
+//! faer's.
 
 use crate::symbolic::Symbolic;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -43,9 +43,9 @@ const TASK_SHARE: f64 = 1.0 / 256.0;
 /// the top separator with the contact unknowns, is a fifth of all the work).
 const PAR_KERNEL_WORK: f64 = 1e7;
 
-/// What the numeric factorisation needs beyond faer's symbolic structure, computed once per
+/// What the numeric factorisation needs beyond the symbolic structure, computed once per
 /// symbolic factorisation: the supernodal elimination tree, the descendants that update each
-/// supernode, and where every entry of the matrix goes in L.
+/// supernode, and the work of every subtree (for the schedule).
 pub struct Plan {
     /// Descendants updating supernode s: `upd[upd_ptr[s]..upd_ptr[s + 1]]`, ascending.
     upd_ptr: Vec<usize>,
@@ -272,21 +272,25 @@ impl Plan {
 /// by others only after that task has finished (the schedules [`Plan::upward`] and
 /// [`Plan::downward`] order them), so no value is ever accessed concurrently with a write.
 #[derive(Clone, Copy)]
-struct Shared {
-    ptr: *mut f64,
+pub(crate) struct Shared<T = f64> {
+    ptr: *mut T,
     len: usize,
 }
 
 // SAFETY: see the type's documentation; the schedule keeps accesses disjoint or ordered
-unsafe impl Send for Shared {}
-unsafe impl Sync for Shared {}
+unsafe impl<T: Send> Send for Shared<T> {}
+unsafe impl<T: Send> Sync for Shared<T> {}
 
-impl Shared {
+impl<T> Shared<T> {
+    pub(crate) fn new(values: &mut [T]) -> Self {
+        Shared { ptr: values.as_mut_ptr(), len: values.len() }
+    }
+
     /// `len` values from `begin`.
     /// # Safety
     /// No other live reference to them may be used while the slice is (see [`Shared`]).
     #[allow(clippy::mut_from_ref)]
-    unsafe fn slice(&self, begin: usize, len: usize) -> &mut [f64] {
+    pub(crate) unsafe fn slice(&self, begin: usize, len: usize) -> &mut [T] {
         assert!(begin + len <= self.len);
         // SAFETY: inside the allocation (checked); exclusivity is the caller's
         unsafe { std::slice::from_raw_parts_mut(self.ptr.add(begin), len) }
@@ -306,11 +310,11 @@ thread_local! {
     static SCRATCH: RefCell<Option<Scratch>> = const { RefCell::new(None) };
 }
 
-/// Fill `l` (faer's layout of `sn`) with the Cholesky factor of the matrix whose lower triangle
+/// Fill `l` (the layout of `sn`) with the Cholesky factor of the matrix whose lower triangle
 /// has the pattern the plan was made for and the given values, permuted as planned.
 pub fn factorize(sn: &Symbolic, plan: &Plan, values: &[f64], l: &mut [f64]) -> Result<(), NotPositiveDefinite> {
     assert_eq!(l.len(), sn.len_val());
-    let shared = Shared { ptr: l.as_mut_ptr(), len: l.len() };
+    let shared = Shared::new(l);
     let ctx = Context { sn, plan, values, l: shared };
     plan.upward(&|s, alone| ctx.supernode(s, alone))
 }
@@ -434,7 +438,7 @@ thread_local! {
 /// down it, independent subtrees in parallel; the same bits on any number of threads.
 pub fn solve_in_place(sn: &Symbolic, plan: &Plan, l: &[f64], x: &mut [f64]) {
     assert_eq!((l.len(), x.len()), (sn.len_val(), sn.n()));
-    let x = Shared { ptr: x.as_mut_ptr(), len: x.len() };
+    let x = Shared::new(x);
     let block = |node: &Supernode| -> MatRef<'_, f64> {
         MatRef::from_column_major_slice(&l[node.offset..node.offset + node.nrows() * node.ncols], node.nrows(), node.ncols)
     };

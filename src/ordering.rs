@@ -29,19 +29,27 @@
 //! are still those of the unknowns (each node weighted by its number of unknowns).
 //!
 //! Written by hand because no Rust crate offers a geometric nested dissection, and METIS
-//! (through C bindings) costs 6-11 s to order `structured:512` here (PERF-NOTES.md), more than
-//! it saves. Deterministic: the recursion splits by a total order on (coordinate, index) and
-//! the two halves are ordered independently (in parallel) and concatenated in a fixed order,
-//! so the ordering does not depend on the number of threads.
+//! (through C bindings) took 6-11 s to order `structured:512` on this machine, more than it
+//! saves. The nodes are sorted along both axes once; every subset keeps both orders, so a
+//! median is an index and a split two stable partitions (no selection per split: at
+//! `structured:512` this took the dissection from 0.8 to 0.5 s). Deterministic: the recursion
+//! splits by a total order on (coordinate, index) and the two halves are ordered independently
+//! (in parallel) and concatenated in a fixed order, so the ordering does not depend on the
+//! number of threads.
 
 use crate::assembly::SymCsc;
 use crate::symbolic::Adjacency;
+use rayon::prelude::*;
 use std::sync::atomic::AtomicU8;
 use std::sync::atomic::Ordering::Relaxed;
 
-/// Subsets at most this large are not split further; they are numbered in the order the last
-/// split left them (sorted along a coordinate).
+/// Subsets at most this large are not split further; they are numbered along the axis of the
+/// split that made them.
 const LEAF: usize = 8;
+
+/// The graph of the nodes is built in this many runs of nodes (a constant, so that the work does
+/// not depend on the number of threads; enough for two cores to share).
+const GRAPH_CHUNKS: usize = 4;
 
 /// Subsets larger than this are split in parallel.
 const PAR_MIN: usize = 20_000;
@@ -75,7 +83,6 @@ impl Graph {
         // couplings (k, l), k < l, each once: node numbers follow the unknowns', so an entry (i, j),
         // i > j, of the lower triangle lies in a column of node k = node(j) <= l = node(i); `seen`
         // drops the repeats within node k's columns
-        let mut seen = vec![u32::MAX; nodes];
         let couplings = |k: usize, seen: &mut [u32], found: &mut dyn FnMut(usize)| {
             for j in first[k]..first[k + 1] {
                 for &i in &matrix.row_idx()[matrix.col_ptr()[j]..matrix.col_ptr()[j + 1]] {
@@ -86,29 +93,54 @@ impl Graph {
                 }
             }
         };
-        let mut count = vec![0usize; nodes + 1];
+        // in GRAPH_CHUNKS runs of nodes at once, each counted and then filled at offsets that
+        // put the runs in order: the same adjacency as one sequential pass over the nodes (each
+        // node's neighbours in the order they are found), whatever the number of threads
+        let nnz = matrix.col_ptr()[n];
+        let mut bounds: Vec<usize> =
+            (0..GRAPH_CHUNKS).map(|b| first[..nodes].partition_point(|&f| matrix.col_ptr()[f] < nnz * b / GRAPH_CHUNKS)).collect();
+        bounds.push(nodes);
+        let mut counts: Vec<Vec<u32>> = (0..GRAPH_CHUNKS)
+            .into_par_iter()
+            .map(|b| {
+                let (mut count, mut seen) = (vec![0u32; nodes], vec![u32::MAX; nodes]);
+                for k in bounds[b]..bounds[b + 1] {
+                    couplings(k, &mut seen, &mut |l| {
+                        count[k] += 1;
+                        count[l] += 1;
+                    });
+                }
+                count
+            })
+            .collect();
+        let mut ptr = vec![0u32; nodes + 1];
+        let mut at = 0usize;
         for k in 0..nodes {
-            couplings(k, &mut seen, &mut |l| {
-                count[k + 1] += 1;
-                count[l + 1] += 1;
-            });
+            for count in counts.iter_mut() {
+                let c = count[k] as usize;
+                count[k] = at as u32;
+                at += c;
+            }
+            assert!(at < u32::MAX as usize, "more than 2^32 couplings: widen the graph's indices");
+            ptr[k + 1] = at as u32;
         }
-        for k in 0..nodes {
-            count[k + 1] += count[k];
-        }
-        assert!(count[nodes] < u32::MAX as usize, "more than 2^32 couplings: widen the graph's indices");
-        let mut fill = count.clone();
-        let mut adj = vec![0u32; count[nodes]];
-        seen.fill(u32::MAX);
-        for k in 0..nodes {
-            couplings(k, &mut seen, &mut |l| {
-                adj[fill[k]] = l as u32;
-                fill[k] += 1;
-                adj[fill[l]] = k as u32;
-                fill[l] += 1;
-            });
-        }
-        Graph { ptr: count.into_iter().map(|c| c as u32).collect(), adj, first }
+        let mut adj = vec![0u32; at];
+        let out = crate::cholesky::Shared::new(&mut adj);
+        counts.into_par_iter().enumerate().for_each(|(b, mut next)| {
+            let mut seen = vec![u32::MAX; nodes];
+            for k in bounds[b]..bounds[b + 1] {
+                couplings(k, &mut seen, &mut |l| {
+                    // SAFETY: each slot is written by one run only (the offsets above)
+                    unsafe {
+                        out.slice(next[k] as usize, 1)[0] = l as u32;
+                        out.slice(next[l] as usize, 1)[0] = k as u32;
+                    }
+                    next[k] += 1;
+                    next[l] += 1;
+                });
+            }
+        });
+        Graph { ptr, adj, first }
     }
 
     pub(crate) fn n_nodes(&self) -> usize {
@@ -301,7 +333,6 @@ pub fn grading(reach: &[[f64; 2]]) -> f64 {
 
 /// How far the neighbours of every node of `graph` (at `coords`) lie from it along each axis.
 fn reach(graph: &Graph, coords: &[[f64; 2]]) -> Vec<[f64; 2]> {
-    use rayon::prelude::*;
     (0..graph.n_nodes())
         .into_par_iter()
         .map(|i| {
@@ -315,12 +346,134 @@ fn reach(graph: &Graph, coords: &[[f64; 2]]) -> Vec<[f64; 2]> {
 /// `order[new] = old`.
 fn nested_dissection(graph: &Graph, coords: &[[f64; 2]], reach: &[[f64; 2]]) -> Vec<usize> {
     let n = graph.n_nodes();
-    assert!(coords.len() >= n && reach.len() >= n);
+    assert!(coords.len() >= n && reach.len() >= n && n < u32::MAX as usize);
     // side[i]: which half of the current split node i is in; the halves being split at the
     // same time are disjoint and not coupled, so one array serves the whole parallel recursion
     let side: Vec<AtomicU8> = (0..n).map(|_| AtomicU8::new(0)).collect();
-    let mut set: Vec<usize> = (0..n).collect();
-    dissect(graph, coords, reach, &side, &mut set)
+    // the nodes sorted along each axis by (coordinate, index), once: every subset keeps both
+    // orders, so a median is an index and a split two stable partitions
+    let sorted = |axis: usize| {
+        let mut list: Vec<u32> = (0..n as u32).collect();
+        list.par_sort_unstable_by(|&a, &b| coords[a as usize][axis].total_cmp(&coords[b as usize][axis]).then(a.cmp(&b)));
+        list
+    };
+    let (xs, ys) = rayon::join(|| sorted(0), || sorted(1));
+    let ctx = Dissection { graph, coords, reach, side: &side };
+    ctx.dissect([xs, ys], 0)
+}
+
+/// What every split of [`nested_dissection`] reads.
+struct Dissection<'a> {
+    graph: &'a Graph,
+    coords: &'a [[f64; 2]],
+    reach: &'a [[f64; 2]],
+    side: &'a [AtomicU8],
+}
+
+/// A split of a subset along `axis`: the first `mid` nodes in that axis's order form one half,
+/// the rest the other; `separator` lists the nodes of one half coupled to the other.
+struct Split {
+    axis: usize,
+    mid: usize,
+    separator: Vec<u32>,
+}
+
+impl Dissection<'_> {
+    /// Order the subset whose nodes are `by[axis]`, sorted along each axis: both halves of a
+    /// coordinate split first, then the separator. A subset of at most [`LEAF`] nodes keeps the
+    /// order along `last_axis` (the axis of the split that made it).
+    fn dissect(&self, by: [Vec<u32>; 2], last_axis: usize) -> Vec<usize> {
+        let as_usize = |list: &[u32]| list.iter().map(|&i| i as usize).collect::<Vec<_>>();
+        if by[0].len() <= LEAF {
+            return as_usize(&by[last_axis]);
+        }
+        // split at the median along either axis, keeping the one with the smaller separator (the
+        // longer side of the bounding box is not enough: on meshes graded towards a boundary line
+        // most unknowns can sit on that line, and a split along it is all separator)
+        let mut best: Option<Split> = None;
+        for (axis, list) in by.iter().enumerate() {
+            let Some(split) = self.split_along(list, axis) else { continue };
+            if best.as_ref().is_none_or(|b| split.separator.len() < b.separator.len()) {
+                best = Some(split);
+            }
+        }
+        let Some(best) = best else {
+            return as_usize(&by[last_axis]); // all unknowns at one point
+        };
+        // the halves of the kept split (the other axis's trial overwrote them), the separator
+        // out of both for good: the splits below must not see it as a half
+        for (k, &i) in by[best.axis].iter().enumerate() {
+            self.side[i as usize].store(if k < best.mid { 1 } else { 2 }, Relaxed);
+        }
+        for &i in &best.separator {
+            self.side[i as usize].store(0, Relaxed);
+        }
+        let halves = |list: &[u32]| {
+            let (mut a, mut b) = (Vec::with_capacity(best.mid), Vec::with_capacity(list.len() - best.mid));
+            for &i in list {
+                match self.side[i as usize].load(Relaxed) {
+                    1 => a.push(i),
+                    2 => b.push(i),
+                    _ => {}
+                }
+            }
+            (a, b)
+        };
+        let ((ax, bx), (ay, by_)) = (halves(&by[0]), halves(&by[1]));
+        // the separator lies on a line across the split axis: numbered along it
+        let other = 1 - best.axis;
+        let separator: Vec<usize> = by[other].iter().filter(|&&i| self.side[i as usize].load(Relaxed) == 0).map(|&i| i as usize).collect();
+        debug_assert_eq!(separator.len(), best.separator.len());
+        let len = by[0].len();
+        drop(by);
+        let (mut oa, ob) = if len >= PAR_MIN {
+            rayon::join(|| self.dissect([ax, ay], best.axis), || self.dissect([bx, by_], best.axis))
+        } else {
+            (self.dissect([ax, ay], best.axis), self.dissect([bx, by_], best.axis))
+        };
+        oa.extend(ob);
+        oa.extend(separator);
+        oa
+    }
+
+    /// Split the subset `list` (sorted along `axis`) at its median along `axis` (unknowns on the
+    /// median line all on one side, so that a split along a line of nodes leaves a separator one
+    /// node thick) and take as the separator the unknowns of one half coupled to the other, of
+    /// the half where they are fewer. None if all unknowns have the same coordinate.
+    fn split_along(&self, list: &[u32], axis: usize) -> Option<Split> {
+        let (coords, reach, side) = (self.coords, self.reach, self.side);
+        let at = |i: u32| coords[i as usize][axis];
+        let v = at(list[list.len() / 2]);
+        let below = list.partition_point(|&i| at(i) < v);
+        let mid = if below > 0 { below } else { list.partition_point(|&i| at(i) <= v) };
+        if mid == list.len() {
+            return None;
+        }
+        let (left, right) = list.split_at(mid);
+        for &i in left {
+            side[i as usize].store(1, Relaxed);
+        }
+        for &i in right {
+            side[i as usize].store(2, Relaxed);
+        }
+        // every coordinate of the left half is below every one of the right half
+        let (left_max, right_min) = (at(left[left.len() - 1]), at(right[0]));
+        let coupled = |half: &[u32], other: u8, line: f64| -> Vec<u32> {
+            half.iter()
+                .copied()
+                .filter(|&i| {
+                    (at(i) - line).abs() <= reach[i as usize][axis]
+                        && self.graph.neighbours(i as usize).any(|j| side[j].load(Relaxed) == other)
+                })
+                .collect()
+        };
+        let (in_left, in_right) = (coupled(left, 2, right_min), coupled(right, 1, left_max));
+        Some(if in_right.len() <= in_left.len() {
+            Split { axis, mid, separator: in_right }
+        } else {
+            Split { axis, mid, separator: in_left }
+        })
+    }
 }
 
 /// Flops of the Cholesky factorisation of the matrix of the unknowns with the nodes in the given
@@ -335,88 +488,6 @@ fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
     let adjacency =
         Adjacency::gather(order.len(), &|p| graph.degree(order[p]), &|p, f| graph.neighbours(order[p]).for_each(|q| f(position[q])));
     crate::symbolic::tree_and_counts(&adjacency, order.len(), &weight).flops(order.len(), &weight)
-}
-
-/// Order `set`: both halves of a coordinate split first, then the separator.
-fn dissect(graph: &Graph, coords: &[[f64; 2]], reach: &[[f64; 2]], side: &[AtomicU8], set: &mut [usize]) -> Vec<usize> {
-    if set.len() <= LEAF {
-        return set.to_vec();
-    }
-    // split at the median along either axis, keeping the one with the smaller separator (the
-    // longer side of the bounding box is not enough: on meshes graded towards a boundary line
-    // most unknowns can sit on that line, and a split along it is all separator)
-    let mut best: Option<(Vec<usize>, Vec<usize>, Vec<usize>)> = None;
-    for axis in 0..2 {
-        let Some(split) = split_along(graph, coords, reach, side, set, axis) else { continue };
-        if best.as_ref().is_none_or(|b| split.2.len() < b.2.len()) {
-            best = Some(split);
-        }
-    }
-    let Some((mut a, mut b, separator)) = best else {
-        return set.to_vec(); // all unknowns at one point
-    };
-    for &i in &separator {
-        side[i].store(0, Relaxed); // for good: the splits below must not see it as a half
-    }
-    let (mut oa, ob) = if set.len() >= PAR_MIN {
-        rayon::join(|| dissect(graph, coords, reach, side, &mut a), || dissect(graph, coords, reach, side, &mut b))
-    } else {
-        (dissect(graph, coords, reach, side, &mut a), dissect(graph, coords, reach, side, &mut b))
-    };
-    oa.extend(ob);
-    oa.extend(separator);
-    oa
-}
-
-/// Split `set` at the median of coordinate `axis` (unknowns on the median line all on one side,
-/// so that a split along a line of nodes leaves a separator one node thick) and take as the
-/// separator the unknowns of one half coupled to the other, of the half where they are fewer.
-/// Returns (first half, second half, separator) without the separator in the halves, or None
-/// if all unknowns have the same coordinate.
-fn split_along(
-    graph: &Graph,
-    coords: &[[f64; 2]],
-    reach: &[[f64; 2]],
-    side: &[AtomicU8],
-    set: &mut [usize],
-    axis: usize,
-) -> Option<(Vec<usize>, Vec<usize>, Vec<usize>)> {
-    let cmp = |a: &usize, b: &usize| coords[*a][axis].total_cmp(&coords[*b][axis]).then(a.cmp(b));
-    let mid = set.len() / 2;
-    set.select_nth_unstable_by(mid, cmp);
-    let v = coords[set[mid]][axis];
-    let below = set.iter().filter(|&&i| coords[i][axis] < v).count();
-    let mid = if below > 0 { below } else { set.iter().filter(|&&i| coords[i][axis] <= v).count() };
-    if mid == set.len() {
-        return None;
-    }
-    set.select_nth_unstable_by(mid, cmp);
-    let (left, right) = set.split_at(mid);
-    for &i in left {
-        side[i].store(1, Relaxed);
-    }
-    for &i in right {
-        side[i].store(2, Relaxed);
-    }
-    // every coordinate of the left half is below every one of the right half
-    let left_max = left.iter().map(|&i| coords[i][axis]).fold(f64::NEG_INFINITY, f64::max);
-    let right_min = coords[right[0]][axis]; // the selected element: the smallest of its half
-    let coupled = |half: &[usize], other: u8, line: f64| -> Vec<bool> {
-        half.iter()
-            .map(|&i| (coords[i][axis] - line).abs() <= reach[i][axis] && graph.neighbours(i).any(|j| side[j].load(Relaxed) == other))
-            .collect()
-    };
-    let (in_left, in_right) = (coupled(left, 2, right_min), coupled(right, 1, left_max));
-    let count = |flags: &[bool]| flags.iter().filter(|&&b| b).count();
-    let pick = |half: &[usize], flags: &[bool], keep: bool| -> Vec<usize> {
-        half.iter().zip(flags).filter(|p| *p.1 == keep).map(|p| *p.0).collect()
-    };
-    let out = if count(&in_right) <= count(&in_left) {
-        (left.to_vec(), pick(right, &in_right, false), pick(right, &in_right, true))
-    } else {
-        (pick(left, &in_left, false), right.to_vec(), pick(left, &in_left, true))
-    };
-    Some(out)
 }
 
 #[cfg(test)]

@@ -303,30 +303,61 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
 
 /// Where each matrix entry (i, j), i >= j, goes: column min(inv i, inv j) of P K P^T, row max
 /// (its place in the column's supernode is looked up when factorising, where the supernode's
-/// rows are mapped anyway); grouped by column, counted and then filled.
+/// rows are mapped anyway); grouped by column in the order of the matrix's entries. A counting
+/// sort in [`PLACE_CHUNKS`] chunks of the matrix's columns, each counted and then filled in
+/// parallel at offsets that put the chunks in order: the same array as one sequential pass,
+/// whatever the number of threads.
 fn place_entries(matrix: &SymCsc, inv: &[usize]) -> (Vec<usize>, Vec<(u32, u32)>) {
+    use rayon::prelude::*;
     let (n, cols, row_idx) = (matrix.n(), matrix.col_ptr(), matrix.row_idx());
+    let nnz = cols[n];
+    // chunk b holds the columns bounds[b]..bounds[b + 1], about nnz / PLACE_CHUNKS entries each
+    let bounds: Vec<usize> = (0..=PLACE_CHUNKS).map(|b| cols.partition_point(|&c| c < nnz * b / PLACE_CHUNKS).min(n)).collect();
+    let target = |i: usize, j: usize| {
+        let (a, b) = (inv[i], inv[j]);
+        (a.min(b), a.max(b))
+    };
+    let mut counts: Vec<Vec<u32>> = (0..PLACE_CHUNKS)
+        .into_par_iter()
+        .map(|b| {
+            let mut count = vec![0u32; n];
+            for j in bounds[b]..bounds[b + 1] {
+                for &i in &row_idx[cols[j]..cols[j + 1]] {
+                    count[target(i, j).0] += 1;
+                }
+            }
+            count
+        })
+        .collect();
+    // column c starts at entry_ptr[c]; chunk b's entries of it after those of the chunks before
     let mut entry_ptr = vec![0usize; n + 1];
-    for j in 0..n {
-        for &i in &row_idx[cols[j]..cols[j + 1]] {
-            entry_ptr[inv[i].min(inv[j]) + 1] += 1;
-        }
-    }
     for c in 0..n {
-        entry_ptr[c + 1] += entry_ptr[c];
-    }
-    let mut fill = entry_ptr.clone();
-    let mut entries = vec![(0u32, 0u32); entry_ptr[n]];
-    for j in 0..n {
-        for (k, &i) in (cols[j]..cols[j + 1]).zip(&row_idx[cols[j]..cols[j + 1]]) {
-            let (a, b) = (inv[i], inv[j]);
-            let c = a.min(b);
-            entries[fill[c]] = (a.max(b) as u32, k as u32);
-            fill[c] += 1;
+        let mut at = entry_ptr[c];
+        for count in counts.iter_mut() {
+            let k = count[c] as usize;
+            count[c] = at as u32;
+            at += k;
         }
+        entry_ptr[c + 1] = at;
     }
+    let mut entries = vec![(0u32, 0u32); nnz];
+    let out = crate::cholesky::Shared::new(&mut entries);
+    counts.into_par_iter().enumerate().for_each(|(b, mut next)| {
+        for j in bounds[b]..bounds[b + 1] {
+            for (k, &i) in (cols[j]..cols[j + 1]).zip(&row_idx[cols[j]..cols[j + 1]]) {
+                let (c, r) = target(i, j);
+                // SAFETY: each slot is written by one chunk only (the offsets above)
+                unsafe { out.slice(next[c] as usize, 1)[0] = (r as u32, k as u32) };
+                next[c] += 1;
+            }
+        }
+    });
     (entry_ptr, entries)
 }
+
+/// The matrix's columns are placed in this many chunks (a constant, so that the work does not
+/// depend on the number of threads; enough for two cores to share).
+const PLACE_CHUNKS: usize = 4;
 
 /// The elimination tree of a graph in its numbering and the column counts of L, per node:
 /// `parent[p]` ([`NONE`] at a root), and strictly below node p's columns the number of later
