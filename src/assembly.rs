@@ -277,6 +277,58 @@ pub fn element_stiffness(map: &Affine, material: Material, rule: &element::Rule<
     k
 }
 
+/// The group of every item when group g holds the items `bounds[g]..bounds[g + 1]` (runs of
+/// consecutive items: the unknowns of a node, the columns of a supernode).
+pub(crate) fn group_of(bounds: &[usize]) -> Vec<u32> {
+    let mut group = vec![0u32; *bounds.last().unwrap_or(&0)];
+    for g in 0..bounds.len().saturating_sub(1) {
+        group[bounds[g]..bounds[g + 1]].fill(g as u32);
+    }
+    group
+}
+
+/// `emit(chunk, sink)` of [`group_by_target`]: calls `sink(target, item)` for every item of the chunk.
+pub(crate) type Emit<'a, T> = dyn Fn(usize, &mut dyn FnMut(usize, T)) + Sync + 'a;
+
+/// A counting sort on every core, deterministic: `emit(chunk, sink)` calls `sink(target, item)`
+/// for the items of chunk `chunk` (of `0..chunks`), the same ones in the same order each time
+/// (it is called twice: to count, then to place). Returns the items grouped by target
+/// (`0..targets`) as offsets and items, within a target in chunk order and then in the order
+/// emitted: the array one sequential pass over the chunks would give, whatever the number of
+/// threads. `chunks` should be a constant (the work then does not depend on the number of
+/// threads) with enough chunks for every core.
+pub(crate) fn group_by_target<T: Copy + Default + Send + Sync>(targets: usize, chunks: usize, emit: &Emit<T>) -> (Vec<usize>, Vec<T>) {
+    let mut counts: Vec<Vec<u32>> = (0..chunks)
+        .into_par_iter()
+        .map(|b| {
+            let mut count = vec![0u32; targets];
+            emit(b, &mut |t, _| count[t] += 1);
+            count
+        })
+        .collect();
+    // target t starts at ptr[t]; chunk b's items of it after those of the chunks before
+    let mut ptr = vec![0usize; targets + 1];
+    for t in 0..targets {
+        let mut at = ptr[t];
+        for count in counts.iter_mut() {
+            let k = count[t] as usize;
+            count[t] = u32::try_from(at).expect("more than 2^32 items: widen group_by_target's counts");
+            at += k;
+        }
+        ptr[t + 1] = at;
+    }
+    let mut items = vec![T::default(); ptr[targets]];
+    let out = crate::cholesky::Shared::new(&mut items);
+    counts.into_par_iter().enumerate().for_each(|(b, mut next)| {
+        emit(b, &mut |t, item| {
+            // SAFETY: each slot belongs to one chunk (the offsets above) and is written once
+            unsafe { out.slice(next[t] as usize, 1)[0] = item };
+            next[t] += 1;
+        });
+    });
+    (ptr, items)
+}
+
 /// Runs `fill(item, scratch, slice)` for every item of a compressed layout (`offsets`, one slice
 /// of `buf` per item), in parallel over blocks of items, and returns what each call returns, in
 /// item order. Every block makes its own `scratch` with `init`. The slices are disjoint, so any

@@ -103,12 +103,9 @@ fn supernode(sn: &Symbolic, s: usize) -> Supernode<'_> {
 impl Plan {
     /// The plan for factorising with the structure `sn`.
     pub fn new(sn: &Symbolic) -> Self {
-        let (n, ns) = (sn.n(), sn.n_supernodes());
+        let ns = sn.n_supernodes();
         let begin = sn.supernode_begin();
-        let mut super_of = vec![0u32; n];
-        for s in 0..ns {
-            super_of[begin[s]..begin[s + 1]].fill(s as u32);
-        }
+        let super_of = crate::assembly::group_of(begin);
         // descendants: d updates every supernode its pattern rows fall in (each once, d ascending)
         let super_of = &super_of;
         let targets = |d: usize| {

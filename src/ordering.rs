@@ -76,10 +76,7 @@ impl Graph {
         }
         first.push(n);
         let nodes = first.len() - 1;
-        let mut node_of = vec![0u32; n];
-        for k in 0..nodes {
-            node_of[first[k]..first[k + 1]].fill(k as u32);
-        }
+        let node_of = crate::assembly::group_of(&first);
         // couplings (k, l), k < l, each once: node numbers follow the unknowns', so an entry (i, j),
         // i > j, of the lower triangle lies in a column of node k = node(j) <= l = node(i); `seen`
         // drops the repeats within node k's columns
@@ -93,53 +90,24 @@ impl Graph {
                 }
             }
         };
-        // in GRAPH_CHUNKS runs of nodes at once, each counted and then filled at offsets that
-        // put the runs in order: the same adjacency as one sequential pass over the nodes (each
-        // node's neighbours in the order they are found), whatever the number of threads
+        // in GRAPH_CHUNKS runs of nodes at once, each coupling placed with both its nodes: the
+        // same adjacency as one sequential pass over the nodes (each node's neighbours in the
+        // order they are found), whatever the number of threads
         let nnz = matrix.col_ptr()[n];
         let mut bounds: Vec<usize> =
             (0..GRAPH_CHUNKS).map(|b| first[..nodes].partition_point(|&f| matrix.col_ptr()[f] < nnz * b / GRAPH_CHUNKS)).collect();
         bounds.push(nodes);
-        let mut counts: Vec<Vec<u32>> = (0..GRAPH_CHUNKS)
-            .into_par_iter()
-            .map(|b| {
-                let (mut count, mut seen) = (vec![0u32; nodes], vec![u32::MAX; nodes]);
-                for k in bounds[b]..bounds[b + 1] {
-                    couplings(k, &mut seen, &mut |l| {
-                        count[k] += 1;
-                        count[l] += 1;
-                    });
-                }
-                count
-            })
-            .collect();
-        let mut ptr = vec![0u32; nodes + 1];
-        let mut at = 0usize;
-        for k in 0..nodes {
-            for count in counts.iter_mut() {
-                let c = count[k] as usize;
-                count[k] = at as u32;
-                at += c;
-            }
-            assert!(at < u32::MAX as usize, "more than 2^32 couplings: widen the graph's indices");
-            ptr[k + 1] = at as u32;
-        }
-        let mut adj = vec![0u32; at];
-        let out = crate::cholesky::Shared::new(&mut adj);
-        counts.into_par_iter().enumerate().for_each(|(b, mut next)| {
+        let (ptr, adj) = crate::assembly::group_by_target(nodes, GRAPH_CHUNKS, &|b, sink| {
             let mut seen = vec![u32::MAX; nodes];
             for k in bounds[b]..bounds[b + 1] {
                 couplings(k, &mut seen, &mut |l| {
-                    // SAFETY: each slot is written by one run only (the offsets above)
-                    unsafe {
-                        out.slice(next[k] as usize, 1)[0] = l as u32;
-                        out.slice(next[l] as usize, 1)[0] = k as u32;
-                    }
-                    next[k] += 1;
-                    next[l] += 1;
+                    sink(k, l as u32);
+                    sink(l, k as u32);
                 });
             }
         });
+        assert!(adj.len() < u32::MAX as usize, "more than 2^32 couplings: widen the graph's indices");
+        let ptr = ptr.into_iter().map(|p| p as u32).collect();
         Graph { ptr, adj, first }
     }
 

@@ -23,7 +23,7 @@
 //! with W the unknowns of later nodes in the column of node k of L, the w unknowns of node k have
 //! column counts W + w, W + w - 1, ..., W + 1.
 
-use crate::assembly::SymCsc;
+use crate::assembly::{SymCsc, group_of};
 use crate::ordering::{Graph, OrderingChoice};
 
 /// faer's default supernode relaxation (`SymbolicSupernodalParams::default`): two adjacent
@@ -207,10 +207,7 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
     }
     fund.push(nodes);
     let nf = fund.len() - 1;
-    let mut super_of = vec![0u32; nodes];
-    for s in 0..nf {
-        super_of[fund[s]..fund[s + 1]].fill(s as u32);
-    }
+    let super_of = group_of(&fund);
     let top = |s: usize, bounds: &[usize]| bounds[s + 1] - 1; // the last node of supernode s
 
     // relaxation, as faer does it: in ascending order, a supernode absorbs the one just before
@@ -249,9 +246,7 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
         }
     }
     let ns = bounds.len() - 1;
-    for s in 0..ns {
-        super_of[bounds[s]..bounds[s + 1]].fill(s as u32);
-    }
+    let super_of = group_of(&bounds);
     let super_parent: Vec<u32> = (0..ns)
         .map(|s| match parent[top(s, &bounds)] {
             NONE => NONE,
@@ -303,56 +298,21 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
 
 /// Where each matrix entry (i, j), i >= j, goes: column min(inv i, inv j) of P K P^T, row max
 /// (its place in the column's supernode is looked up when factorising, where the supernode's
-/// rows are mapped anyway); grouped by column in the order of the matrix's entries. A counting
-/// sort in [`PLACE_CHUNKS`] chunks of the matrix's columns, each counted and then filled in
-/// parallel at offsets that put the chunks in order: the same array as one sequential pass,
-/// whatever the number of threads.
+/// rows are mapped anyway); grouped by column in the order of the matrix's entries
+/// ([`crate::assembly::group_by_target`] over [`PLACE_CHUNKS`] runs of the matrix's columns).
 fn place_entries(matrix: &SymCsc, inv: &[usize]) -> (Vec<usize>, Vec<(u32, u32)>) {
-    use rayon::prelude::*;
     let (n, cols, row_idx) = (matrix.n(), matrix.col_ptr(), matrix.row_idx());
     let nnz = cols[n];
     // chunk b holds the columns bounds[b]..bounds[b + 1], about nnz / PLACE_CHUNKS entries each
     let bounds: Vec<usize> = (0..=PLACE_CHUNKS).map(|b| cols.partition_point(|&c| c < nnz * b / PLACE_CHUNKS).min(n)).collect();
-    let target = |i: usize, j: usize| {
-        let (a, b) = (inv[i], inv[j]);
-        (a.min(b), a.max(b))
-    };
-    let mut counts: Vec<Vec<u32>> = (0..PLACE_CHUNKS)
-        .into_par_iter()
-        .map(|b| {
-            let mut count = vec![0u32; n];
-            for j in bounds[b]..bounds[b + 1] {
-                for &i in &row_idx[cols[j]..cols[j + 1]] {
-                    count[target(i, j).0] += 1;
-                }
-            }
-            count
-        })
-        .collect();
-    // column c starts at entry_ptr[c]; chunk b's entries of it after those of the chunks before
-    let mut entry_ptr = vec![0usize; n + 1];
-    for c in 0..n {
-        let mut at = entry_ptr[c];
-        for count in counts.iter_mut() {
-            let k = count[c] as usize;
-            count[c] = at as u32;
-            at += k;
-        }
-        entry_ptr[c + 1] = at;
-    }
-    let mut entries = vec![(0u32, 0u32); nnz];
-    let out = crate::cholesky::Shared::new(&mut entries);
-    counts.into_par_iter().enumerate().for_each(|(b, mut next)| {
+    crate::assembly::group_by_target(n, PLACE_CHUNKS, &|b, sink| {
         for j in bounds[b]..bounds[b + 1] {
             for (k, &i) in (cols[j]..cols[j + 1]).zip(&row_idx[cols[j]..cols[j + 1]]) {
-                let (c, r) = target(i, j);
-                // SAFETY: each slot is written by one chunk only (the offsets above)
-                unsafe { out.slice(next[c] as usize, 1)[0] = (r as u32, k as u32) };
-                next[c] += 1;
+                let (a, c) = (inv[i], inv[j]);
+                sink(a.min(c), (a.max(c) as u32, k as u32));
             }
         }
-    });
-    (entry_ptr, entries)
+    })
 }
 
 /// The matrix's columns are placed in this many chunks (a constant, so that the work does not
