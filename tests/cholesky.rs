@@ -194,3 +194,24 @@ fn solves_agree_with_faers_and_on_any_number_of_threads() {
         assert!(res <= 1e-8 * bmax, "{name}: residual {res:.2e}");
     }
 }
+
+#[test]
+fn the_symbolic_analysis_is_the_same_on_any_number_of_threads() {
+    // the node graph, the dissection, the gathered graph and the placement of the matrix entries
+    // all run in parallel; each must give the same arrays on one and two threads
+    for (name, m) in [("structured:96", mesh(&problems::Ex72, "structured:96")), ("graded", graded())] {
+        let (matrix, coords, n_interior) = stiffness_and_contact(&m);
+        for n_order in [matrix.n(), n_interior] {
+            let on = |threads: usize| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                pool.install(|| signorini::symbolic::analyse(&matrix, n_order, &coords))
+            };
+            let ((one, choice_one), (two, choice_two)) = (on(1), on(2));
+            assert_eq!(choice_one, choice_two, "{name}: ordering choice");
+            assert_eq!(one.perm(), two.perm(), "{name}: ordering");
+            assert_eq!(one.supernode_begin(), two.supernode_begin(), "{name}: supernodes");
+            assert!((0..one.n_supernodes()).all(|s| one.pattern(s) == two.pattern(s)), "{name}: row patterns");
+            assert!((0..matrix.n()).all(|j| one.entries(j) == two.entries(j)), "{name}: placement of the matrix entries");
+        }
+    }
+}
