@@ -55,7 +55,7 @@ pub struct Symbolic {
 /// The structure of L alone: [`Symbolic`]'s `begin`, `row_ptr`, `rows`, `val_ptr`.
 type Structure = (Vec<usize>, Vec<usize>, Vec<u32>, Vec<usize>);
 
-/// Order the unknowns `0..n_order` of `matrix` ([`crate::ordering::fill_reducing_then`]; the
+/// Order the unknowns `0..n_order` of `matrix` (as [`crate::ordering::fill_reducing`] does; the
 /// others stay at the end in place) and compute the symbolic factorisation with that order.
 pub fn analyse(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (Symbolic, OrderingChoice) {
     crate::ordering::fill_reducing_then(matrix, n_order, coords, |graph, node_order| Symbolic::new(matrix, n_order, graph, node_order))

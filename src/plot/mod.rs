@@ -26,8 +26,8 @@
 //! | `log_ablation` | `log_ablation`, a panel per problem | efficiency per level (vs NDF) for each `estimator.log_factor`; line at 1 |
 //! | `contact_term_ablation` | `contact_term_ablation`, a panel per problem | `estimate` (solid) and `eta5` (dashed) vs NDF for each `estimator.contact_term` |
 //! | `theta_ablation` | `theta_ablation`, a panel per problem | `err_quadrature` vs NDF for each theta and uniform, with NDF^-3/2; where some run of a problem has fewer than two errors, the estimate for all runs of that problem instead (the y label says which) |
-//! | `fb_error`, `fb_mesh` | `fb` | see [`fb`]: error and estimate vs NDF of the free-boundary problem, and its late adaptive mesh with x = a marked |
-//! | `hertz_pressure`, `hertz_mesh` | `hertz` | see [`hertz`]: the contact pressure against Hertz's, and the mesh near the contact |
+//! | `fb_error`, `fb_mesh` | `fb` | see `plot/fb.rs`: error and estimate vs NDF of the free-boundary problem, and its late adaptive mesh with x = a marked |
+//! | `hertz_pressure`, `hertz_mesh` | `hertz` | see `plot/hertz.rs`: the contact pressure against Hertz's, and the mesh near the contact |
 //!
 //! Style: log axes labelled at the decades (`10⁻⁴`; also 2x and 5x when less than two decades
 //! show), light grid lines at 2..9 x each decade; one colour and marker shape per series; the

@@ -3,7 +3,7 @@
 //! A problem is data, not branches in the solver: every problem implements [`Problem`] and the
 //! solver, estimator and studies only ever call the trait. The built-in problems ([`KNOWN`],
 //! module [`builtin`]) are written in Rust; a problem file (`experiments/problems/NAME.toml`,
-//! module [`file`]) states one as data, with its loads, obstacle and exact solution as
+//! module [`file`](mod@file)) states one as data, with its loads, obstacle and exact solution as
 //! expressions in x and y. [`by_name`] takes either.
 
 pub mod builtin;
@@ -132,7 +132,7 @@ pub fn is_file(s: &str) -> bool {
 }
 
 /// The problem `s` names: a built-in name ([`KNOWN`]) or the path of a problem file (ending in
-/// `.toml`, read and checked here; see [`file`] for the format).
+/// `.toml`, read and checked here; see [`file`](mod@file) for the format).
 pub fn by_name(s: &str) -> Result<Box<dyn Problem>, ProblemError> {
     load(s, &std::collections::BTreeMap::new())
 }
