@@ -198,6 +198,9 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
     // fundamental supernodes (runs of nodes): node p continues the run of p - 1 when, in
     // unknowns, its first column is the only parent of the last column of p - 1 and has one
     // entry less
+    if nodes == 0 {
+        return ((vec![0], vec![0], Vec::new(), vec![0]), 0.0);
+    }
     let mut fund = vec![0usize]; // first node of each, then `nodes`
     for p in 1..nodes {
         let joins = parent[p - 1] as usize == p && children[p] == 1 && below_w[p - 1] == below_w[p] + weight(p);
@@ -510,4 +513,22 @@ pub(crate) fn tree_and_counts(adjacency: &Adjacency, lead: usize, weight: &dyn F
     let below_n = delta_n.iter().map(|&c| (c - 1) as u32).collect();
     let below_lead = (0..nodes).map(|j| (delta_l[j] - weight_lead(j)) as usize).collect();
     Counts { parent, below_w, below_n, below_lead }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn systems_without_unknowns_or_with_one() {
+        let empty = SymCsc::new(0, vec![0], Vec::new(), Vec::new()).unwrap();
+        let (sym, _) = analyse(&empty, 0, &[]);
+        assert_eq!((sym.n(), sym.n_supernodes(), sym.len_val()), (0, 0, 0));
+        // one unknown, ordered or kept in place at the end (a contact normal)
+        let one = SymCsc::new(1, vec![0, 1], vec![0], vec![2.0]).unwrap();
+        for n_order in [0, 1] {
+            let (sym, _) = analyse(&one, n_order, &[[0.0, 0.0]]);
+            assert_eq!((sym.n(), sym.n_supernodes(), sym.len_val(), sym.entries(0)), (1, 1, 1, &[(0, 0)][..]));
+        }
+    }
 }
