@@ -14,7 +14,7 @@
 //! Written by hand because faer's symbolic step works on the graph of the unknowns and finds the
 //! column counts by walking the elimination tree once per entry of L (O(|L|): 2.8e8 steps at
 //! `structured:512`, 1.65 s of one core), and it has no way to take a structure computed
-//! elsewhere. Here the counts come from Gilbert, Ng and Peyton's algorithm ([`tree_and_counts`],
+//! elsewhere. Here the counts come from Gilbert, Ng and Peyton's algorithm (`tree_and_counts`,
 //! near-linear in the edges) on the graph of the nodes, which has half the vertices and a
 //! quarter of the edges of the graph of the unknowns: the two unknowns of a node couple to the
 //! same unknowns, so in
