@@ -46,6 +46,17 @@ fn graded() -> Mesh {
     m
 }
 
+/// The meshes of the tests: uniform ones (nested dissection; at structured:96 the top supernode,
+/// separator and contact unknowns, is large enough for the dense kernels to run on both threads)
+/// and a graded one (minimum degree).
+fn meshes() -> [(&'static str, Mesh); 3] {
+    [
+        ("structured:24", mesh(&problems::Ex72, "structured:24")),
+        ("structured:96", mesh(&problems::Ex72, "structured:96")),
+        ("graded", graded()),
+    ]
+}
+
 /// Our symbolic factorisation with the project's fill-reducing ordering of `0..n_order`.
 fn symbolic(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> Symbolic {
     signorini::symbolic::analyse(matrix, n_order, coords).0
@@ -71,11 +82,7 @@ fn ours(symbolic: &Symbolic, values: &[f64], threads: usize) -> Result<Vec<f64>,
 fn the_symbolic_structure_is_faers_for_the_same_ordering() {
     // uniform and graded meshes (nested dissection and minimum degree), all unknowns ordered
     // (the Refactor strategy) or the contact normals last, each its own node (Schur)
-    for (name, m) in [
-        ("structured:24", mesh(&problems::Ex72, "structured:24")),
-        ("structured:96", mesh(&problems::Ex72, "structured:96")),
-        ("graded", graded()),
-    ] {
+    for (name, m) in meshes() {
         let (matrix, coords, n_interior) = stiffness_and_contact(&m);
         assert!(n_interior < matrix.n(), "{name}: a mesh with contact unknowns");
         for n_order in [matrix.n(), n_interior] {
@@ -118,11 +125,7 @@ fn faers(symbolic: &SymbolicCholesky<usize>, matrix: &SymCsc) -> Vec<f64> {
 fn the_factor_is_faers_and_the_same_on_any_number_of_threads() {
     // structured:96: the top supernode (separator and contact unknowns) is large enough for the
     // dense kernels to run on both threads
-    for (name, m) in [
-        ("structured:24", mesh(&problems::Ex72, "structured:24")),
-        ("structured:96", mesh(&problems::Ex72, "structured:96")),
-        ("graded", graded()),
-    ] {
+    for (name, m) in meshes() {
         let (matrix, coords) = stiffness(&m);
         let symbolic = symbolic(&matrix, matrix.n(), &coords);
         let reference = faers(&faers_symbolic(&matrix, &symbolic), &matrix);
