@@ -500,7 +500,7 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
             }
         }
         let el = &nodes.elements[t];
-        rotate(&mut e.k, &mut e.f, el, dofs);
+        rotate(&mut e.k, Some(&mut e.f), el, dofs);
         e.locate(el, dofs, &dirichlet);
     };
 
@@ -519,6 +519,42 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
     drop(local);
     neumann_load(mesh, nodes, dofs, problem, &mut rhs);
     System { matrix, rhs, dirichlet }
+}
+
+/// K u on the unknowns, element by element: for every triangle its stiffness in the local frames
+/// (as [`assemble`] computes it) times u at its unknowns, added into K u in element order (so the
+/// same bits on any number of threads). This is a(u_h, phi) for every basis function phi of an
+/// unknown without the assembled matrix, which the contact solver releases before factorising
+/// (see [`crate::contact`]); it equals `matrix.mul(u)` up to round-off (a test checks it).
+pub fn stiffness_times(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, material: Material, u: &[f64]) -> Vec<f64> {
+    assert_eq!(u.len(), dofs.n_free);
+    let rule = element::triangle_rule(2);
+    let product = |t: usize, out: &mut ([f64; 12], [usize; 12])| {
+        let el = &nodes.elements[t];
+        let mut k = element_stiffness(&Affine::new(mesh.corners(t)), material, &rule);
+        rotate(&mut k, None, el, dofs);
+        let global: [usize; 12] = std::array::from_fn(|l| dofs.dof[el[l / 2]][l % 2]);
+        let free = || (0..12).filter(|&l| global[l] != FIXED);
+        out.0 = std::array::from_fn(|r| if global[r] == FIXED { 0.0 } else { free().map(|l| k[r][l] * u[global[l]]).sum() });
+        out.1 = global;
+    };
+    // a chunk of elements in parallel, then its products added in element order
+    const CHUNK: usize = 4096;
+    let n_el = mesh.n_triangles();
+    let mut ku = vec![0.0; dofs.n_free];
+    let mut local = vec![([0.0; 12], [FIXED; 12]); CHUNK.min(n_el)];
+    for start in (0..n_el).step_by(CHUNK) {
+        let chunk = &mut local[..CHUNK.min(n_el - start)];
+        chunk.par_iter_mut().enumerate().for_each(|(i, out)| product(start + i, out));
+        for (y, global) in chunk.iter() {
+            for (v, &g) in y.iter().zip(global) {
+                if g != FIXED {
+                    ku[g] += v;
+                }
+            }
+        }
+    }
+    ku
 }
 
 /// One element's share of the system, ready to scatter: its stiffness and load in the local
@@ -622,10 +658,10 @@ pub fn split_load(map: &Affine, corners: [[f64; 2]; 3], c: f64, f: &dyn Fn([f64;
     load
 }
 
-/// Take the element matrix and load to the local frames of its contact nodes:
+/// Take the element matrix (and load, if given) to the local frames of its contact nodes:
 /// K' = T K T^T, f' = T f with T block diagonal (rotation at contact nodes, identity elsewhere).
 #[allow(clippy::needless_range_loop)] // two rows (columns) of k change together
-fn rotate(k: &mut [[f64; 12]; 12], f: &mut [f64; 12], el: &[usize; 6], dofs: &DofMap) {
+fn rotate(k: &mut [[f64; 12]; 12], mut f: Option<&mut [f64; 12]>, el: &[usize; 6], dofs: &DofMap) {
     for (a, &p) in el.iter().enumerate() {
         let Some(r) = dofs.frame(p) else { continue };
         let (i0, i1) = (2 * a, 2 * a + 1);
@@ -641,9 +677,11 @@ fn rotate(k: &mut [[f64; 12]; 12], f: &mut [f64; 12], el: &[usize; 6], dofs: &Do
             row[i0] = r[0][0] * x + r[0][1] * y;
             row[i1] = r[1][0] * x + r[1][1] * y;
         }
-        let (x, y) = (f[i0], f[i1]);
-        f[i0] = r[0][0] * x + r[0][1] * y;
-        f[i1] = r[1][0] * x + r[1][1] * y;
+        if let Some(f) = f.as_deref_mut() {
+            let (x, y) = (f[i0], f[i1]);
+            f[i0] = r[0][0] * x + r[0][1] * y;
+            f[i1] = r[1][0] * x + r[1][1] * y;
+        }
     }
 }
 
@@ -789,7 +827,7 @@ mod tests {
         let mut entries = std::collections::BTreeMap::new();
         for (t, el) in nodes.elements.iter().enumerate() {
             let mut k = element_stiffness(&Affine::new(mesh.corners(t)), problem.material(), &rule);
-            rotate(&mut k, &mut [0.0; 12], el, dofs);
+            rotate(&mut k, None, el, dofs);
             let global: [usize; 12] = std::array::from_fn(|l| dofs.dof[el[l / 2]][l % 2]);
             for (r, &gr) in global.iter().enumerate() {
                 for (c, &gc) in global.iter().enumerate() {
@@ -830,5 +868,31 @@ mod tests {
         let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(m.values()), bits(two.matrix.values()), "matrix on 1 and 2 threads");
         assert_eq!(bits(&one.rhs), bits(&two.rhs), "load on 1 and 2 threads");
+    }
+
+    /// K u element by element is the assembled matrix times u up to round-off (relative to the
+    /// sum of the magnitudes of the terms), and the same bits on one thread and on two.
+    #[test]
+    fn stiffness_times_is_the_matrix_product_on_any_thread_count() {
+        let problem = crate::problems::Patch { normal: [0.8, -0.6], ..Default::default() };
+        let mesh = crate::mesh::MeshSpec::parse("structured:100").unwrap().build(&problem).unwrap();
+        let nodes = P2Nodes::new(&mesh);
+        let dofs = DofMap::new(&nodes, &problem);
+        assert!(mesh.n_triangles() > 4096, "several chunks of elements");
+        let m = assemble(&mesh, &nodes, &dofs, &problem).matrix;
+        let u: Vec<f64> = (0..m.n()).map(|i| ((i * 37 % 101) as f64 - 50.0) / 7.0).collect();
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| stiffness_times(&mesh, &nodes, &dofs, problem.material(), &u))
+        };
+        let (one, two) = (on(1), on(2));
+        assert!(one.iter().zip(&two).all(|(a, b)| a.to_bits() == b.to_bits()), "1 and 2 threads differ");
+        let assembled = m.mul(&u);
+        let abs = SymCsc::new(m.n(), m.col_ptr().to_vec(), m.row_idx().to_vec(), m.values().iter().map(|v| v.abs()).collect()).unwrap();
+        let magnitude = abs.mul(&u.iter().map(|v| v.abs()).collect::<Vec<_>>());
+        for i in 0..m.n() {
+            let diff = (one[i] - assembled[i]).abs();
+            assert!(diff <= 64.0 * f64::EPSILON * magnitude[i], "unknown {i}: {} against {} ({diff:.2e})", one[i], assembled[i]);
+        }
     }
 }

@@ -1,8 +1,10 @@
 //! The numeric supernodal Cholesky factorisation P K P^T = L L^T, on every core.
 //!
 //! [`crate::symbolic`] computes the structure (the supernodes: runs of columns of L with one row
-//! pattern, the layout of L's values, where the matrix's entries go); this module fills L's
-//! values ([`factorize`]) and solves with L ([`solve_in_place`]). faer's
+//! pattern, the layout of L's values) and where the matrix's entries go; this module puts the
+//! matrix's values in L's layout ([`load`]), factorises them there ([`factorize`]) and solves
+//! with L ([`solve_in_place`]). Loading first lets a caller release the matrix before L fills up
+//! (peak memory). faer's
 //! own numeric step visits the supernodes one after another and parallelises only inside a
 //! supernode's dense kernels, which on our matrices was slower than one thread. Yet most of the
 //! work of a nested-dissection ordering lies in subtrees of the elimination tree that share
@@ -25,7 +27,7 @@
 //! structure computed elsewhere). The dense kernels (products, Cholesky, triangular solve) are
 //! faer's.
 
-use crate::symbolic::Symbolic;
+use crate::symbolic::{Placement, Symbolic};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{LltParams, LltRegularization};
 use faer::linalg::matmul::triangular::BlockStructure;
@@ -294,10 +296,9 @@ impl<T> Shared<T> {
     }
 }
 
-/// Per-thread scratch: the position of each row of the current supernode in its block, the
-/// update product and the dense Cholesky's workspace.
+/// Per-thread scratch of the factorisation: the update product and the dense Cholesky's
+/// workspace.
 struct Scratch {
-    local: Vec<u32>,
     update: Vec<f64>,
     stack: MemBuffer,
     stack_bytes: usize,
@@ -305,26 +306,96 @@ struct Scratch {
 
 thread_local! {
     static SCRATCH: RefCell<Option<Scratch>> = const { RefCell::new(None) };
+    /// Per thread: the position of each row of the current supernode in its block (the rows of
+    /// its pattern; its own columns are found by subtraction).
+    static LOCAL: RefCell<Vec<u32>> = const { RefCell::new(Vec::new()) };
 }
 
-/// Fill `l` (the layout of `sn`) with the Cholesky factor of the matrix whose lower triangle
-/// has the pattern the plan was made for and the given values, permuted as planned.
-pub fn factorize(sn: &Symbolic, plan: &Plan, values: &[f64], l: &mut [f64]) -> Result<(), NotPositiveDefinite> {
+/// Run `f` with this thread's row map, at least `n` long.
+fn with_local_map<R>(n: usize, f: impl FnOnce(&mut [u32]) -> R) -> R {
+    LOCAL.with_borrow_mut(|local| {
+        if local.len() < n {
+            local.resize(n, 0);
+        }
+        f(local)
+    })
+}
+
+/// Runs of supernodes that [`load`] hands to the threads, each about this share of L's values.
+const LOAD_RUNS: usize = 64;
+
+/// Put a matrix's values (the pattern `placement` was made for) in `l`, the layout of `sn`: the
+/// lower triangle of P K P^T, zeros elsewhere, ready for [`factorize`]. Each supernode's block is
+/// zeroed (unless `zeroed`: `l` holds zeros already) and each entry added to its slot, which no
+/// other entry shares: the same bits as a copy. In parallel over runs of supernodes of about
+/// equal size. On a fresh allocation (`zeroed`) only the pages with entries are touched here; the
+/// rest of L is first touched by the factorisation, after the caller could release the matrix.
+pub fn load(sn: &Symbolic, placement: &Placement, values: &[f64], l: &mut [f64], zeroed: bool) {
+    assert_eq!(l.len(), sn.len_val());
+    let (ns, val_ptr) = (sn.n_supernodes(), sn.val_ptr());
+    let total = sn.len_val();
+    let mut bounds = vec![0usize];
+    for r in 1..=LOAD_RUNS {
+        let s = if r == LOAD_RUNS { ns } else { val_ptr.partition_point(|&v| v < total * r / LOAD_RUNS).min(ns) };
+        if s > *bounds.last().unwrap() {
+            bounds.push(s);
+        }
+    }
+    let mut runs = Vec::with_capacity(bounds.len());
+    let mut rest = l;
+    for w in bounds.windows(2) {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(val_ptr[w[1]] - val_ptr[w[0]]);
+        runs.push((w[0], w[1], head));
+        rest = tail;
+    }
+    runs.into_par_iter().for_each(|(first, last, run)| {
+        with_local_map(sn.n(), |local| {
+            let base = val_ptr[first];
+            for s in first..last {
+                let node = supernode(sn, s);
+                let (ncols, nrows) = (node.ncols, node.nrows());
+                let block = &mut run[node.offset - base..][..nrows * ncols];
+                if !zeroed {
+                    block.fill(0.0);
+                }
+                for (i, &r) in node.pattern.iter().enumerate() {
+                    local[r as usize] = (ncols + i) as u32;
+                }
+                let end = node.begin + ncols;
+                for j in node.begin..end {
+                    let column = &mut block[(j - node.begin) * nrows..][..nrows];
+                    for &(r, pos) in placement.entries(j) {
+                        let r = r as usize;
+                        // a store, not `+=`: no other entry shares the slot, which holds zero, so
+                        // the bits are those of adding the value to zero; and a first access that
+                        // writes is one page fault on a fresh L (a read first maps the zero page,
+                        // and the write then faults again: 3.5x slower at structured:512)
+                        column[if r < end { r - node.begin } else { local[r] as usize }] = 0.0 + values[pos as usize];
+                    }
+                }
+            }
+        })
+    });
+}
+
+/// Overwrite `l` (the layout of `sn`, holding a matrix's values from [`load`]) with the
+/// Cholesky factor of that matrix, permuted as planned.
+pub fn factorize(sn: &Symbolic, plan: &Plan, l: &mut [f64]) -> Result<(), NotPositiveDefinite> {
     assert_eq!(l.len(), sn.len_val());
     let shared = Shared::new(l);
-    let ctx = Context { sn, plan, values, l: shared };
+    let ctx = Context { sn, plan, l: shared };
     plan.upward(&|s, alone| ctx.supernode(s, alone))
 }
 
 struct Context<'a> {
     sn: &'a Symbolic,
     plan: &'a Plan,
-    values: &'a [f64],
     l: Shared,
 }
 
 impl Context<'_> {
-    /// Compute supernode s's block of L from the matrix and its (finished) descendants.
+    /// Compute supernode s's block of L from the matrix's values there and its (finished)
+    /// descendants.
     fn supernode(&self, s: usize, alone: bool) -> Result<(), NotPositiveDefinite> {
         let (sn, plan) = (self.sn, self.plan);
         // faer's parallel dense kernels give the same bits as its sequential ones (tested: one and
@@ -335,17 +406,12 @@ impl Context<'_> {
         let len = nrows * ncols;
         // SAFETY: this block is written only here, and nothing reads it before this task ends
         let block = unsafe { self.l.slice(node.offset, len) };
-        block.fill(0.0);
         SCRATCH.with_borrow_mut(|scratch| {
             let scratch = scratch.get_or_insert_with(|| Scratch {
-                local: Vec::new(),
                 update: Vec::new(),
                 stack: MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
                 stack_bytes: 0,
             });
-            if scratch.local.len() < sn.n() {
-                scratch.local.resize(sn.n(), 0);
-            }
             if scratch.update.len() < plan.max_update {
                 scratch.update.resize(plan.max_update, 0.0);
             }
@@ -358,54 +424,47 @@ impl Context<'_> {
                 scratch.stack = MemBuffer::new(need);
                 scratch.stack_bytes = need.unaligned_bytes_required();
             }
-            let local = &mut scratch.local;
-            for (i, &r) in node.pattern.iter().enumerate() {
-                local[r as usize] = (ncols + i) as u32;
-            }
-            let end = node.begin + ncols;
-            for j in node.begin..end {
-                let column = &mut block[(j - node.begin) * nrows..][..nrows];
-                for &(r, pos) in sn.entries(j) {
-                    let r = r as usize;
-                    column[if r < end { r - node.begin } else { local[r] as usize }] += self.values[pos as usize];
-                }
-            }
             let mut ls = MatMut::from_column_major_slice_mut(block, nrows, ncols);
-            for u in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
-                let dn = supernode(sn, u.d as usize);
-                // SAFETY: supernode d is a descendant of s, finished before this task started
-                let dvals: &[f64] = unsafe { self.l.slice(dn.offset, dn.nrows() * dn.ncols) };
-                let ld = MatRef::from_column_major_slice(dvals, dn.nrows(), dn.ncols);
-                let (first, mid) = (u.first as usize, u.mid as usize);
-                let rows = dn.pattern.len() - first;
-                let below = ld.subrows(dn.ncols + first, rows);
-                let (ld_mid, ld_bot) = below.split_at_row(mid);
-                let mut upd = MatMut::from_column_major_slice_mut(&mut scratch.update[..rows * mid], rows, mid);
-                {
-                    let (top, bot) = upd.rb_mut().split_at_row_mut(mid);
-                    faer::linalg::matmul::triangular::matmul(
-                        top,
-                        BlockStructure::TriangularLower,
-                        Accum::Replace,
-                        ld_mid,
-                        BlockStructure::Rectangular,
-                        ld_mid.transpose(),
-                        BlockStructure::Rectangular,
-                        1.0,
-                        par,
-                    );
-                    faer::linalg::matmul::matmul(bot, Accum::Replace, ld_bot, ld_mid.transpose(), 1.0, par);
+            with_local_map(sn.n(), |local| {
+                for (i, &r) in node.pattern.iter().enumerate() {
+                    local[r as usize] = (ncols + i) as u32;
                 }
-                let rows_of = &dn.pattern[first..];
-                for jj in 0..mid {
-                    let col = rows_of[jj] as usize - node.begin;
-                    for ii in jj..rows {
-                        let r = rows_of[ii] as usize;
-                        let at = if ii < mid { r - node.begin } else { local[r] as usize };
-                        ls[(at, col)] -= upd[(ii, jj)];
+                for u in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
+                    let dn = supernode(sn, u.d as usize);
+                    // SAFETY: supernode d is a descendant of s, finished before this task started
+                    let dvals: &[f64] = unsafe { self.l.slice(dn.offset, dn.nrows() * dn.ncols) };
+                    let ld = MatRef::from_column_major_slice(dvals, dn.nrows(), dn.ncols);
+                    let (first, mid) = (u.first as usize, u.mid as usize);
+                    let rows = dn.pattern.len() - first;
+                    let below = ld.subrows(dn.ncols + first, rows);
+                    let (ld_mid, ld_bot) = below.split_at_row(mid);
+                    let mut upd = MatMut::from_column_major_slice_mut(&mut scratch.update[..rows * mid], rows, mid);
+                    {
+                        let (top, bot) = upd.rb_mut().split_at_row_mut(mid);
+                        faer::linalg::matmul::triangular::matmul(
+                            top,
+                            BlockStructure::TriangularLower,
+                            Accum::Replace,
+                            ld_mid,
+                            BlockStructure::Rectangular,
+                            ld_mid.transpose(),
+                            BlockStructure::Rectangular,
+                            1.0,
+                            par,
+                        );
+                        faer::linalg::matmul::matmul(bot, Accum::Replace, ld_bot, ld_mid.transpose(), 1.0, par);
+                    }
+                    let rows_of = &dn.pattern[first..];
+                    for jj in 0..mid {
+                        let col = rows_of[jj] as usize - node.begin;
+                        for ii in jj..rows {
+                            let r = rows_of[ii] as usize;
+                            let at = if ii < mid { r - node.begin } else { local[r] as usize };
+                            ls[(at, col)] -= upd[(ii, jj)];
+                        }
                     }
                 }
-            }
+            });
             let (mut top, bot) = ls.split_at_row_mut(ncols);
             faer::linalg::cholesky::llt::factor::cholesky_in_place(
                 top.rb_mut(),

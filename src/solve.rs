@@ -86,7 +86,8 @@ pub struct DiscreteSolution {
     /// Cartesian displacement at every P2 node.
     pub u: Vec<[f64; 2]>,
     /// Nodal contact force lambda_p = L(phi_p n) - a(u_h, phi_p n) per contact node (in the order
-    /// of `dofs.contact`), computed from the assembled residual (eq. 4.5 / Lemma 5.2).
+    /// of `dofs.contact`), computed from the residual F - K u, element by element (eq. 4.5 /
+    /// Lemma 5.2; [`assembly::stiffness_times`]).
     pub lambda: Vec<f64>,
     /// Active contact nodes (u_h(p).n = chi_h(p) enforced).
     pub active: Vec<bool>,
@@ -158,18 +159,21 @@ pub fn solve(
     let System { matrix, rhs, dirichlet } = assembly::assemble(mesh, &nodes, &dofs, problem);
     let assembly_time = t0.elapsed().as_secs_f64();
     let strategy = options.strategy.unwrap_or(Strategy::auto(dofs.contact.len(), dofs.n_free));
-    let mut solver = ContactSolver::with_strategy(&matrix, dofs.n_interior, &dofs.unknown_coords(&nodes), strategy)?;
+    // the solver takes the matrix (and releases it before factorising, for the Schur strategy)
+    let mut solver = ContactSolver::with_strategy(matrix, dofs.n_interior, &dofs.unknown_coords(&nodes), strategy)?;
     let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
-    let out = solver.solve_contact(&matrix, &rhs, &gap, options, observe)?.converged()?;
-    // the residual F - K u: zero at free unknowns, lambda_p at contact normals
-    let ku = matrix.mul(&out.u);
+    let out = solver.solve_contact(&rhs, &gap, options, observe)?.converged()?;
+    let contact_timings = solver.timings.clone();
+    drop(solver);
+    // the residual F - K u, element by element: zero at free unknowns, lambda_p at contact normals
+    let ku = assembly::stiffness_times(mesh, &nodes, &dofs, problem.material(), &out.u);
     let r: Vec<f64> = rhs.iter().zip(&ku).map(|(f, k)| f - k).collect();
     let f_scale = rhs.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
     let force_scale = ku.iter().fold(f_scale, |a, v| a.max(v.abs()));
     let free_residual = r[..dofs.n_interior].iter().fold(0.0f64, |a, v| a.max(v.abs())) / f_scale;
     let lambda = r[dofs.n_interior..].to_vec();
     let u = dofs.displacement(&out.u, &dirichlet);
-    let timings = SolveTimings { assembly: assembly_time, contact: solver.timings.clone(), total: t_all.elapsed().as_secs_f64() };
+    let timings = SolveTimings { assembly: assembly_time, contact: contact_timings, total: t_all.elapsed().as_secs_f64() };
     Ok(DiscreteSolution {
         nodes,
         dofs,

@@ -48,8 +48,16 @@ pub struct Symbolic {
     /// ... and its values, column-major (rows: its columns, then its pattern), at
     /// `val_ptr[s]..val_ptr[s + 1]` of L's values.
     val_ptr: Vec<usize>,
-    /// The matrix entries of column j of P K P^T: `entries[entry_ptr[j]..entry_ptr[j + 1]]`,
-    /// each (row, position in the matrix's values).
+}
+
+/// Where the entries of a matrix go in L: for each column j of P K P^T, its entries on and
+/// below the diagonal, each as (row of P K P^T, position in the matrix's values). It depends on
+/// the matrix's pattern and the ordering only, so it serves every matrix with that pattern
+/// ([`crate::cholesky::load`] puts the values in place); once L holds them a solver that will
+/// not refactorise can release it (a quarter of the memory of the symbolic phase at
+/// `structured:512`).
+pub struct Placement {
+    /// Column j's entries: `entries[entry_ptr[j]..entry_ptr[j + 1]]`.
     entry_ptr: Vec<usize>,
     entries: Vec<(u32, u32)>,
 }
@@ -58,19 +66,22 @@ pub struct Symbolic {
 type Structure = (Vec<usize>, Vec<usize>, Vec<u32>, Vec<usize>);
 
 /// Order the unknowns `0..n_order` of `matrix` (as [`crate::ordering::fill_reducing`] does; the
-/// others stay at the end in place) and compute the symbolic factorisation with that order.
-pub fn analyse(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (Symbolic, OrderingChoice) {
-    crate::ordering::fill_reducing_then(matrix, n_order, coords, |graph, node_order| Symbolic::new(matrix, n_order, graph, node_order))
+/// others stay at the end in place) and compute the symbolic factorisation with that order, and
+/// where the matrix's entries go in it.
+pub fn analyse(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (Symbolic, Placement, OrderingChoice) {
+    let ((symbolic, placement), choice) =
+        crate::ordering::fill_reducing_then(matrix, n_order, coords, |graph, node_order| Symbolic::new(matrix, n_order, graph, node_order));
+    (symbolic, placement, choice)
 }
 
 impl Symbolic {
     /// The structure of L for `matrix` with the nodes of `graph` (the unknowns `0..n_order`) in
     /// `node_order` (`node_order[new] = old`), each node's unknowns together, followed by the
-    /// unknowns `n_order..n` in place, each a node of its own; with the flops of factorising the
-    /// ordered block (the leading block of L).
-    pub(crate) fn new(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize]) -> (Self, f64) {
+    /// unknowns `n_order..n` in place, each a node of its own; with the placement of the
+    /// matrix's entries and the flops of factorising the ordered block (the leading block of L).
+    pub(crate) fn new(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize]) -> ((Self, Placement), f64) {
         let n = matrix.n();
-        assert!(matrix.values().len() < u32::MAX as usize, "more than 2^32 matrix entries: widen the symbolic factorisation's indices");
+        assert!(n < NONE as usize, "2^32 unknowns or more: widen the symbolic factorisation's indices");
         let mut perm = graph.unknowns(node_order);
         perm.extend(n_order..n);
         let mut inv = vec![0usize; n];
@@ -78,9 +89,9 @@ impl Symbolic {
             inv[old] = new;
         }
         // where the matrix entries go needs only the ordering: on the other core meanwhile
-        let (((begin, row_ptr, rows, val_ptr), flops), (entry_ptr, entries)) =
-            rayon::join(|| structure(matrix, n_order, graph, node_order), || place_entries(matrix, &inv));
-        (Symbolic { perm, inv, begin, row_ptr, rows, val_ptr, entry_ptr, entries }, flops)
+        let (((begin, row_ptr, rows, val_ptr), flops), placement) =
+            rayon::join(|| structure(matrix, n_order, graph, node_order), || Placement::new(matrix, &inv));
+        ((Symbolic { perm, inv, begin, row_ptr, rows, val_ptr }, placement), flops)
     }
 
     /// Unknowns (rows and columns of L).
@@ -115,12 +126,6 @@ impl Symbolic {
     /// Supernode s's values lie at `val_ptr[s]..val_ptr[s + 1]` of L's values.
     pub fn val_ptr(&self) -> &[usize] {
         &self.val_ptr
-    }
-
-    /// The matrix entries of column j of P K P^T below the diagonal and on it, each as (row of
-    /// P K P^T, position in the matrix's values).
-    pub fn entries(&self, j: usize) -> &[(u32, u32)] {
-        &self.entries[self.entry_ptr[j]..self.entry_ptr[j + 1]]
     }
 
     /// The number of values of L.
@@ -301,23 +306,34 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
     ((begin, row_ptr, rows, val_ptr), flops)
 }
 
-/// Where each matrix entry (i, j), i >= j, goes: column min(inv i, inv j) of P K P^T, row max
-/// (its place in the column's supernode is looked up when factorising, where the supernode's
-/// rows are mapped anyway); grouped by column in the order of the matrix's entries
-/// ([`crate::assembly::group_by_target`] over [`PLACE_CHUNKS`] runs of the matrix's columns).
-fn place_entries(matrix: &SymCsc, inv: &[usize]) -> (Vec<usize>, Vec<(u32, u32)>) {
-    let (n, cols, row_idx) = (matrix.n(), matrix.col_ptr(), matrix.row_idx());
-    let nnz = cols[n];
-    // chunk b holds the columns bounds[b]..bounds[b + 1], about nnz / PLACE_CHUNKS entries each
-    let bounds: Vec<usize> = (0..=PLACE_CHUNKS).map(|b| cols.partition_point(|&c| c < nnz * b / PLACE_CHUNKS).min(n)).collect();
-    crate::assembly::group_by_target(n, PLACE_CHUNKS, &|b, sink| {
-        for j in bounds[b]..bounds[b + 1] {
-            for (k, &i) in (cols[j]..cols[j + 1]).zip(&row_idx[cols[j]..cols[j + 1]]) {
-                let (a, c) = (inv[i], inv[j]);
-                sink(a.min(c), (a.max(c) as u32, k as u32));
+impl Placement {
+    /// Where each entry (i, j), i >= j, of `matrix` goes with the ordering `inv` (`inv[old] =
+    /// new`): column min(inv i, inv j) of P K P^T, row max (its place in the column's supernode is
+    /// looked up when loading, where the supernode's rows are mapped anyway); grouped by column in
+    /// the order of the matrix's entries (a deterministic parallel counting sort over a fixed
+    /// number of runs of the matrix's columns: the same on any number of threads).
+    pub fn new(matrix: &SymCsc, inv: &[usize]) -> Self {
+        let (n, cols, row_idx) = (matrix.n(), matrix.col_ptr(), matrix.row_idx());
+        assert!(cols[n] < u32::MAX as usize, "more than 2^32 matrix entries: widen the placement's indices");
+        let nnz = cols[n];
+        // chunk b holds the columns bounds[b]..bounds[b + 1], about nnz / PLACE_CHUNKS entries each
+        let bounds: Vec<usize> = (0..=PLACE_CHUNKS).map(|b| cols.partition_point(|&c| c < nnz * b / PLACE_CHUNKS).min(n)).collect();
+        let (entry_ptr, entries) = crate::assembly::group_by_target(n, PLACE_CHUNKS, &|b, sink| {
+            for j in bounds[b]..bounds[b + 1] {
+                for (k, &i) in (cols[j]..cols[j + 1]).zip(&row_idx[cols[j]..cols[j + 1]]) {
+                    let (a, c) = (inv[i], inv[j]);
+                    sink(a.min(c), (a.max(c) as u32, k as u32));
+                }
             }
-        }
-    })
+        });
+        Placement { entry_ptr, entries }
+    }
+
+    /// The matrix entries of column j of P K P^T below the diagonal and on it, each as (row of
+    /// P K P^T, position in the matrix's values).
+    pub fn entries(&self, j: usize) -> &[(u32, u32)] {
+        &self.entries[self.entry_ptr[j]..self.entry_ptr[j + 1]]
+    }
 }
 
 /// The matrix's columns are placed in this many chunks (a constant, so that the work does not
@@ -524,13 +540,13 @@ mod tests {
     #[test]
     fn systems_without_unknowns_or_with_one() {
         let empty = SymCsc::new(0, vec![0], Vec::new(), Vec::new()).unwrap();
-        let (sym, _) = analyse(&empty, 0, &[]);
+        let (sym, _, _) = analyse(&empty, 0, &[]);
         assert_eq!((sym.n(), sym.n_supernodes(), sym.len_val()), (0, 0, 0));
         // one unknown, ordered or kept in place at the end (a contact normal)
         let one = SymCsc::new(1, vec![0, 1], vec![0], vec![2.0]).unwrap();
         for n_order in [0, 1] {
-            let (sym, _) = analyse(&one, n_order, &[[0.0, 0.0]]);
-            assert_eq!((sym.n(), sym.n_supernodes(), sym.len_val(), sym.entries(0)), (1, 1, 1, &[(0, 0)][..]));
+            let (sym, placement, _) = analyse(&one, n_order, &[[0.0, 0.0]]);
+            assert_eq!((sym.n(), sym.n_supernodes(), sym.len_val(), placement.entries(0)), (1, 1, 1, &[(0, 0)][..]));
         }
     }
 }

@@ -18,7 +18,7 @@ use signorini::assembly::{self, DofMap, SymCsc};
 use signorini::cholesky::{self, Plan};
 use signorini::mesh::{Mesh, P2Nodes, refine::refine};
 use signorini::problems;
-use signorini::symbolic::Symbolic;
+use signorini::symbolic::{Placement, Symbolic};
 
 /// Example 7.2's stiffness on `mesh`, the position of every unknown, and the number of unknowns
 /// that are not contact normals.
@@ -62,6 +62,11 @@ fn symbolic(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> Symbolic {
     signorini::symbolic::analyse(matrix, n_order, coords).0
 }
 
+/// Where the entries of `matrix` go in the structure `symbolic`.
+fn placement(matrix: &SymCsc, symbolic: &Symbolic) -> Placement {
+    Placement::new(matrix, symbolic.inv())
+}
+
 /// faer's supernodal symbolic factorisation with the ordering of `ours`.
 fn faers_symbolic(matrix: &SymCsc, ours: &Symbolic) -> SymbolicCholesky<usize> {
     let perm = faer::perm::PermRef::new_checked(ours.perm(), ours.inv(), matrix.n());
@@ -69,12 +74,15 @@ fn faers_symbolic(matrix: &SymCsc, ours: &Symbolic) -> SymbolicCholesky<usize> {
     factorize_symbolic_cholesky(matrix.as_faer().symbolic(), Side::Lower, SymmetricOrdering::Custom(perm), params).unwrap()
 }
 
-/// Our factor of `values` (on the pattern of `matrix`) on `threads` threads.
-fn ours(symbolic: &Symbolic, values: &[f64], threads: usize) -> Result<Vec<f64>, cholesky::NotPositiveDefinite> {
+/// Our factor of `matrix` (or of other `values` on its pattern) on `threads` threads.
+fn ours(matrix: &SymCsc, symbolic: &Symbolic, values: &[f64], threads: usize) -> Result<Vec<f64>, cholesky::NotPositiveDefinite> {
     let plan = Plan::new(symbolic);
     let mut l = vec![f64::NAN; symbolic.len_val()];
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    pool.install(|| cholesky::factorize(symbolic, &plan, values, &mut l))?;
+    pool.install(|| {
+        cholesky::load(symbolic, &placement(matrix, symbolic), values, &mut l, false);
+        cholesky::factorize(symbolic, &plan, &mut l)
+    })?;
     Ok(l)
 }
 
@@ -129,14 +137,16 @@ fn the_factor_is_faers_and_the_same_on_any_number_of_threads() {
         let (matrix, coords) = stiffness(&m);
         let symbolic = symbolic(&matrix, matrix.n(), &coords);
         let reference = faers(&faers_symbolic(&matrix, &symbolic), &matrix);
-        let one = ours(&symbolic, matrix.values(), 1).unwrap();
-        let two = ours(&symbolic, matrix.values(), 2).unwrap();
+        let one = ours(&matrix, &symbolic, matrix.values(), 1).unwrap();
+        let two = ours(&matrix, &symbolic, matrix.values(), 2).unwrap();
         assert!(one.iter().zip(&two).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}: one and two threads differ");
         let scale = reference.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let worst = reference.iter().zip(&one).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         assert!(worst <= 1e-13 * scale, "{name}: largest difference from faer's factor {worst:.2e} (largest entry {scale:.2e})");
-        // a second factorisation on the same plan (a refactorisation) gives the same again
-        let again = ours(&symbolic, matrix.values(), 2).unwrap();
+        // a refactorisation in place (loading over the finished factor) gives the same again
+        let mut again = two.clone();
+        cholesky::load(&symbolic, &placement(&matrix, &symbolic), matrix.values(), &mut again, false);
+        cholesky::factorize(&symbolic, &Plan::new(&symbolic), &mut again).unwrap();
         assert!(again.iter().zip(&two).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}: refactorisation differs");
     }
 }
@@ -149,7 +159,7 @@ fn a_matrix_that_is_not_positive_definite_is_an_error_naming_its_column() {
     // a negative diagonal entry at unknown 5
     let at = matrix.position(5, 5);
     values[at] = -values[at];
-    let err = ours(&symbolic, &values, 2).unwrap_err();
+    let err = ours(&matrix, &symbolic, &values, 2).unwrap_err();
     let inv = symbolic.inv();
     // columns before it do not see the entry; at its own column the pivot is -K_55 minus squares
     assert_eq!(err.column, inv[5], "{err}");
@@ -164,7 +174,7 @@ fn solves_agree_with_faers_and_on_any_number_of_threads() {
         let (matrix, coords) = stiffness(&m);
         let symbolic = symbolic(&matrix, matrix.n(), &coords);
         let plan = Plan::new(&symbolic);
-        let l = ours(&symbolic, matrix.values(), 2).unwrap();
+        let l = ours(&matrix, &symbolic, matrix.values(), 2).unwrap();
         let faers_symbolic = faers_symbolic(&matrix, &symbolic);
         let n = matrix.n();
         let b: Vec<f64> = (0..n).map(|i| ((i * 37 % 101) as f64 - 50.0) / 7.0).collect();
@@ -209,12 +219,12 @@ fn the_symbolic_analysis_is_the_same_on_any_number_of_threads() {
                 let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
                 pool.install(|| signorini::symbolic::analyse(&matrix, n_order, &coords))
             };
-            let ((one, choice_one), (two, choice_two)) = (on(1), on(2));
+            let ((one, place_one, choice_one), (two, place_two, choice_two)) = (on(1), on(2));
             assert_eq!(choice_one, choice_two, "{name}: ordering choice");
             assert_eq!(one.perm(), two.perm(), "{name}: ordering");
             assert_eq!(one.supernode_begin(), two.supernode_begin(), "{name}: supernodes");
             assert!((0..one.n_supernodes()).all(|s| one.pattern(s) == two.pattern(s)), "{name}: row patterns");
-            assert!((0..matrix.n()).all(|j| one.entries(j) == two.entries(j)), "{name}: placement of the matrix entries");
+            assert!((0..matrix.n()).all(|j| place_one.entries(j) == place_two.entries(j)), "{name}: placement of the matrix entries");
         }
     }
 }

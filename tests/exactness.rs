@@ -97,7 +97,7 @@ fn schur_complement_inverts_the_contact_block_of_the_inverse() {
     let nodes = P2Nodes::new(&m);
     let dofs = DofMap::new(&nodes, &p);
     let sys = assembly::assemble(&m, &nodes, &dofs, &p);
-    let mut solver = ContactSolver::new(&sys.matrix, dofs.n_interior, &dofs.unknown_coords(&nodes)).unwrap();
+    let mut solver = ContactSolver::new(sys.matrix.clone(), dofs.n_interior, &dofs.unknown_coords(&nodes)).unwrap();
     let (ni, mc) = (dofs.n_interior, dofs.contact.len());
     assert_eq!(mc, 13);
     let s = solver.schur().clone();
