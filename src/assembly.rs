@@ -841,19 +841,27 @@ mod tests {
     }
 
     /// The pattern holds exactly the couplings of the elements, and every entry is the plain sum
-    /// in element order, to the bit, on one thread and on two (with oblique contact normals, so
-    /// that the local frames are exercised, and several element chunks).
-    #[test]
-    fn assembled_matrix_is_the_plain_sum_in_element_order_on_any_thread_count() {
+    /// in element order, to the bit, on one thread and on two.
+    /// A patch test on structured:100 with oblique contact normals (the local frames are
+    /// exercised; 20000 triangles: several element chunks).
+    fn oblique_patch() -> (crate::problems::Patch, Mesh, P2Nodes, DofMap) {
         let problem = crate::problems::Patch { normal: [0.8, -0.6], ..Default::default() };
         let mesh = crate::mesh::MeshSpec::parse("structured:100").unwrap().build(&problem).unwrap();
         let nodes = P2Nodes::new(&mesh);
         let dofs = DofMap::new(&nodes, &problem);
+        (problem, mesh, nodes, dofs)
+    }
+
+    /// `f` on a pool of `threads` threads.
+    fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(f)
+    }
+
+    #[test]
+    fn assembled_matrix_is_the_plain_sum_in_element_order_on_any_thread_count() {
+        let (problem, mesh, nodes, dofs) = oblique_patch();
         assert!(!dofs.contact.is_empty() && dofs.n_interior < dofs.n_free && mesh.n_triangles() > 16384);
-        let on = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            pool.install(|| assemble(&mesh, &nodes, &dofs, &problem))
-        };
+        let on = |threads: usize| on_threads(threads, || assemble(&mesh, &nodes, &dofs, &problem));
         let (one, two) = (on(1), on(2));
         let plain = plain_assembly(&mesh, &nodes, &dofs, &problem);
         let m = &one.matrix;
@@ -874,17 +882,11 @@ mod tests {
     /// sum of the magnitudes of the terms), and the same bits on one thread and on two.
     #[test]
     fn stiffness_times_is_the_matrix_product_on_any_thread_count() {
-        let problem = crate::problems::Patch { normal: [0.8, -0.6], ..Default::default() };
-        let mesh = crate::mesh::MeshSpec::parse("structured:100").unwrap().build(&problem).unwrap();
-        let nodes = P2Nodes::new(&mesh);
-        let dofs = DofMap::new(&nodes, &problem);
+        let (problem, mesh, nodes, dofs) = oblique_patch();
         assert!(mesh.n_triangles() > 4096, "several chunks of elements");
         let m = assemble(&mesh, &nodes, &dofs, &problem).matrix;
         let u: Vec<f64> = (0..m.n()).map(|i| ((i * 37 % 101) as f64 - 50.0) / 7.0).collect();
-        let on = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            pool.install(|| stiffness_times(&mesh, &nodes, &dofs, problem.material(), &u))
-        };
+        let on = |threads: usize| on_threads(threads, || stiffness_times(&mesh, &nodes, &dofs, problem.material(), &u));
         let (one, two) = (on(1), on(2));
         assert!(one.iter().zip(&two).all(|(a, b)| a.to_bits() == b.to_bits()), "1 and 2 threads differ");
         let assembled = m.mul(&u);
