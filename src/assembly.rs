@@ -463,8 +463,12 @@ fn pattern(nodes: &P2Nodes, dofs: &DofMap) -> SymCsc {
         let start = column(j, s);
         col.copy_from_slice(&s.1[start..]);
     });
-    let nnz = row_idx.len();
-    SymCsc::new(n, col_ptr, row_idx, vec![0.0; nnz])
+    // the values' pages are written here, in order and on every core: the scatter's first access
+    // to a fresh page would be a read (it adds), which maps the zero page, and its write a second
+    // fault, in element order all over the array
+    let mut values = vec![0.0; row_idx.len()];
+    values.par_chunks_mut(1 << 15).for_each(|c| c.fill(0.0));
+    SymCsc::new(n, col_ptr, row_idx, values)
         .expect("the stiffness pattern: every column holds its diagonal and sorted, unique rows below it")
 }
 
