@@ -45,6 +45,10 @@ pub enum AdaptError {
     Config(#[from] ConfigError),
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// The next level would not fit in memory: levels `0..level` were solved (and seen by the
+    /// observer), level `level` was not.
+    #[error("stopped before level {level} ({}): {error}", if *level == 0 { "no level was solved".to_string() } else { format!("levels 0 to {} were solved", level - 1) })]
+    Memory { level: usize, error: solve::MemoryError },
 }
 
 impl AdaptConfig {
@@ -222,14 +226,17 @@ pub fn run(
     let mut termination = Termination::LevelsReached;
     let mut initial_active: Option<Vec<bool>> = None;
     for level in 0..config.levels {
-        if let Some(max) = config.max_ndof {
-            // edges of a triangulation: (3 triangles + boundary edges) / 2; no need to number them
-            let ndof = 2 * (mesh.n_vertices() + (3 * mesh.n_triangles() + mesh.boundary.len()) / 2);
-            if level > 0 && ndof > max {
-                termination = Termination::MaxNdofReached;
-                break;
-            }
+        let ndof = mesh.p2_ndof();
+        if let Some(max) = config.max_ndof
+            && level > 0
+            && ndof > max
+        {
+            termination = Termination::MaxNdofReached;
+            break;
         }
+        // before every level, not only the first: an adaptive loop grows until it does not fit
+        solve::check_memory(&format!("level {level} of the adaptive loop"), ndof as f64)
+            .map_err(|error| AdaptError::Memory { level, error })?;
         let t_level = Instant::now();
         let mut options = config.pdas.clone();
         if config.warm_start {

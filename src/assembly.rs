@@ -530,35 +530,66 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
 /// same bits on any number of threads). This is a(u_h, phi) for every basis function phi of an
 /// unknown without the assembled matrix, which the contact solver releases before factorising
 /// (see [`crate::contact`]); it equals `matrix.mul(u)` up to round-off (a test checks it).
-pub fn stiffness_times(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, material: Material, u: &[f64]) -> Vec<f64> {
+///
+/// With it, the magnitude sum_T |K_T| |u| of the same terms and the rows' absolute sums
+/// sum_T |K_T| 1: the scales against which the round-off of F - K u is judged
+/// ([`crate::certify`]).
+pub fn stiffness_times(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, material: Material, u: &[f64]) -> StiffnessProduct {
     assert_eq!(u.len(), dofs.n_free);
     let rule = element::triangle_rule(2);
-    let product = |t: usize, out: &mut ([f64; 12], [usize; 12])| {
+    let product = |t: usize, out: &mut ElementProduct| {
         let el = &nodes.elements[t];
         let mut k = element_stiffness(&Affine::new(mesh.corners(t)), material, &rule);
         rotate(&mut k, None, el, dofs);
         let global: [usize; 12] = std::array::from_fn(|l| dofs.dof[el[l / 2]][l % 2]);
         let free = || (0..12).filter(|&l| global[l] != FIXED);
-        out.0 = std::array::from_fn(|r| if global[r] == FIXED { 0.0 } else { free().map(|l| k[r][l] * u[global[l]]).sum() });
-        out.1 = global;
+        let row = |r: usize, term: &dyn Fn(f64, f64) -> f64| {
+            if global[r] == FIXED { 0.0 } else { free().map(|l| term(k[r][l], u[global[l]])).sum() }
+        };
+        out.ku = std::array::from_fn(|r| row(r, &|k, u| k * u));
+        out.magnitude = std::array::from_fn(|r| row(r, &|k, u| (k * u).abs()));
+        out.row_norm = std::array::from_fn(|r| row(r, &|k, _| k.abs()));
+        out.global = global;
     };
     // a chunk of elements in parallel, then its products added in element order
     const CHUNK: usize = 4096;
     let n_el = mesh.n_triangles();
-    let mut ku = vec![0.0; dofs.n_free];
-    let mut local = vec![([0.0; 12], [FIXED; 12]); CHUNK.min(n_el)];
+    let zeros = || vec![0.0; dofs.n_free];
+    let mut sum = StiffnessProduct { ku: zeros(), magnitude: zeros(), row_norm: zeros() };
+    let empty = ElementProduct { ku: [0.0; 12], magnitude: [0.0; 12], row_norm: [0.0; 12], global: [FIXED; 12] };
+    let mut local = vec![empty; CHUNK.min(n_el)];
     for start in (0..n_el).step_by(CHUNK) {
         let chunk = &mut local[..CHUNK.min(n_el - start)];
         chunk.par_iter_mut().enumerate().for_each(|(i, out)| product(start + i, out));
-        for (y, global) in chunk.iter() {
-            for (v, &g) in y.iter().zip(global) {
+        for e in chunk.iter() {
+            for (r, &g) in e.global.iter().enumerate() {
                 if g != FIXED {
-                    ku[g] += v;
+                    sum.ku[g] += e.ku[r];
+                    sum.magnitude[g] += e.magnitude[r];
+                    sum.row_norm[g] += e.row_norm[r];
                 }
             }
         }
     }
-    ku
+    sum
+}
+
+/// K u on the unknowns and the magnitude of its terms ([`stiffness_times`]).
+pub struct StiffnessProduct {
+    pub ku: Vec<f64>,
+    /// sum over elements T of |K_T| |u| (every term's magnitude): the round-off scale of `ku`.
+    pub magnitude: Vec<f64>,
+    /// sum over elements T of |K_T| 1: the row's absolute sum, over the unknowns.
+    pub row_norm: Vec<f64>,
+}
+
+/// One element's share of [`stiffness_times`].
+#[derive(Clone, Copy)]
+struct ElementProduct {
+    ku: [f64; 12],
+    magnitude: [f64; 12],
+    row_norm: [f64; 12],
+    global: [usize; 12],
 }
 
 /// One element's share of the system, ready to scatter: its stiffness and load in the local
@@ -890,7 +921,7 @@ mod tests {
         assert!(mesh.n_triangles() > 4096, "several chunks of elements");
         let m = assemble(&mesh, &nodes, &dofs, &problem).matrix;
         let u: Vec<f64> = (0..m.n()).map(|i| ((i * 37 % 101) as f64 - 50.0) / 7.0).collect();
-        let on = |threads: usize| on_threads(threads, || stiffness_times(&mesh, &nodes, &dofs, problem.material(), &u));
+        let on = |threads: usize| on_threads(threads, || stiffness_times(&mesh, &nodes, &dofs, problem.material(), &u).ku);
         let (one, two) = (on(1), on(2));
         assert!(one.iter().zip(&two).all(|(a, b)| a.to_bits() == b.to_bits()), "1 and 2 threads differ");
         let assembled = m.mul(&u);
@@ -899,6 +930,16 @@ mod tests {
         for i in 0..m.n() {
             let diff = (one[i] - assembled[i]).abs();
             assert!(diff <= 64.0 * f64::EPSILON * magnitude[i], "unknown {i}: {} against {} ({diff:.2e})", one[i], assembled[i]);
+        }
+        // the element-wise magnitude bounds the assembled one (|sum| <= sum ||), up to round-off
+        let element_magnitude = stiffness_times(&mesh, &nodes, &dofs, problem.material(), &u).magnitude;
+        for i in 0..m.n() {
+            assert!(
+                element_magnitude[i] >= magnitude[i] * (1.0 - 1e-12),
+                "unknown {i}: magnitude {} < {}",
+                element_magnitude[i],
+                magnitude[i]
+            );
         }
     }
 }

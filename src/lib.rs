@@ -10,6 +10,7 @@
 
 pub mod adapt;
 pub mod assembly;
+pub mod certify;
 pub mod cholesky;
 pub mod claims;
 pub mod contact;

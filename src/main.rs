@@ -466,6 +466,13 @@ fn install_interrupt_handler() {
 }
 
 fn main() -> ExitCode {
+    // A closed stdout (`signorini drift | head -5`) ends the process quietly, as command-line
+    // tools do: Rust ignores SIGPIPE, and `println!` then panics on the broken pipe. Results stay
+    // consistent: every file is written to a temporary name and renamed.
+    // SAFETY: setting a signal's disposition to the default, before any thread is started.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     if let Err(e) = signorini::ordering::forced() {
         eprintln!("error: {e}");

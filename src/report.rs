@@ -62,6 +62,10 @@ pub struct SolveReport {
     /// ([`DiscreteSolution::contact_zones`]).
     pub contact_zones: Vec<ContactInterval>,
     pub kkt: Kkt,
+    /// The KKT conditions relative to their round-off scales, each within `certificate_tolerance`
+    /// (a solve that misses one is an error, [`crate::certify`]).
+    pub certificate: crate::certify::Certificate,
+    pub certificate_tolerance: f64,
     /// Largest |F - K u_h| over unknowns other than contact normals, relative to max |F|.
     pub free_residual: f64,
     pub error: Option<LinfError>,
@@ -112,6 +116,8 @@ impl SolveReport {
             contact_zone: sol.contact_zone(),
             contact_zones: sol.contact_zones(),
             kkt: sol.kkt(),
+            certificate: sol.certificate,
+            certificate_tolerance: crate::certify::TOLERANCE,
             free_residual: sol.free_residual,
             error,
             error_sampling: ErrorSampling {
@@ -157,6 +163,12 @@ impl SolveReport {
             s,
             "KKT: penetration {:.2e}, min lambda {:.2e}, complementarity {:.2e}",
             self.kkt.max_penetration, self.kkt.min_lambda, self.kkt.max_complementarity
+        );
+        let c = &self.certificate;
+        let _ = writeln!(
+            s,
+            "certified: relative to round-off scales, equations {:.1e}, sign {:.1e}, penetration {:.1e}, complementarity {:.1e} (tolerance {:.0e})",
+            c.equations, c.sign, c.penetration, c.complementarity, self.certificate_tolerance
         );
         match &self.error {
             Some(e) => {

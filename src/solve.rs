@@ -2,6 +2,7 @@
 //! discrete contact force (eq. 4.5) and its KKT report.
 
 use crate::assembly::{self, DofMap, System};
+use crate::certify::{self, Certificate, KktError, KktInput, RigidMotionError};
 use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, Strategy, Termination, Timings};
 use crate::element::{self, Affine};
 use crate::mesh::locate::Locator;
@@ -22,13 +23,42 @@ pub fn memory_estimate(ndof: f64) -> f64 {
 
 const MIB: f64 = 1024.0 * 1024.0;
 
-/// Memory the machine can give a new process without swapping (`MemAvailable` in
-/// `/proc/meminfo`), in bytes; `None` where that file does not exist.
+/// Memory this process can still allocate, in bytes: the machine's memory available without
+/// swapping (`MemAvailable` in `/proc/meminfo`), and, where the process's address space is
+/// limited (`ulimit -v`, `prlimit --as`: "Max address space" in `/proc/self/limits`), no more
+/// than what that limit leaves above the current virtual size (`/proc/self/statm`); `None`
+/// where `/proc/meminfo` does not exist.
 pub fn available_memory() -> Option<f64> {
+    available().map(|a| a.bytes)
+}
+
+/// [`available_memory`] and which of the two bounds it is.
+#[derive(Clone, Copy, Debug)]
+pub struct Available {
+    pub bytes: f64,
+    /// The address-space limit, not the machine, is the bound.
+    pub by_address_space: bool,
+}
+
+fn available() -> Option<Available> {
     let info = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024.0)
+    let machine = line.split_whitespace().nth(1)?.parse::<f64>().ok()? * 1024.0;
+    Some(match address_space_left() {
+        Some(left) if left < machine => Available { bytes: left, by_address_space: true },
+        _ => Available { bytes: machine, by_address_space: false },
+    })
+}
+
+/// The address-space limit's soft value minus the current virtual size (pages of 4 KiB, as on
+/// x86-64 Linux), if there is a limit.
+fn address_space_left() -> Option<f64> {
+    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = limits.lines().find(|l| l.starts_with("Max address space"))?;
+    let limit: f64 = line["Max address space".len()..].split_whitespace().next()?.parse().ok()?; // "unlimited" fails here
+    let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
+    let pages: f64 = statm.split_whitespace().next()?.parse().ok()?;
+    Some((limit - pages * 4096.0).max(0.0))
 }
 
 /// Where the machine's available memory is unknown (no `/proc/meminfo`), solves whose estimate
@@ -38,22 +68,23 @@ pub const UNKNOWN_MEMORY_LIMIT: f64 = 1024.0 * 1024.0 * MIB;
 /// A solve that would not fit in memory.
 #[derive(Debug, thiserror::Error)]
 #[error("{what} has {ndof:.0} unknowns: solving needs about {} (estimate: 64 MiB + 2 KiB per unknown), but {}", human_bytes(*.needed), match .available {
-    Some(a) => format!("this machine has {} available (MemAvailable in /proc/meminfo)", human_bytes(*a)),
+    Some(a) if a.by_address_space => format!("this process's address-space limit (ulimit -v) leaves {}", human_bytes(a.bytes)),
+    Some(a) => format!("this machine has {} available (MemAvailable in /proc/meminfo)", human_bytes(a.bytes)),
     None => format!("this machine's available memory is unknown (no /proc/meminfo) and more than {} is refused", human_bytes(UNKNOWN_MEMORY_LIMIT)),
 })]
 pub struct MemoryError {
     pub what: String,
     pub ndof: f64,
     pub needed: f64,
-    pub available: Option<f64>,
+    pub available: Option<Available>,
 }
 
 /// Refuse a solve with `ndof` unknowns before allocating anything, if its memory estimate exceeds
 /// the machine's available memory (or [`UNKNOWN_MEMORY_LIMIT`] where that is unknown).
 pub fn check_memory(what: &str, ndof: f64) -> Result<(), MemoryError> {
     let needed = memory_estimate(ndof);
-    let available = available_memory();
-    if needed > available.unwrap_or(UNKNOWN_MEMORY_LIMIT) {
+    let available = available();
+    if needed > available.map_or(UNKNOWN_MEMORY_LIMIT, |a| a.bytes) {
         return Err(MemoryError { what: what.to_string(), ndof, needed, available });
     }
     Ok(())
@@ -77,6 +108,10 @@ pub enum SolveError {
     Mesh(#[from] MeshError),
     #[error(transparent)]
     Contact(#[from] ContactError),
+    #[error(transparent)]
+    RigidMotion(#[from] RigidMotionError),
+    #[error(transparent)]
+    NotCertified(#[from] KktError),
 }
 
 /// A discrete solution and everything computed on the way.
@@ -100,6 +135,8 @@ pub struct DiscreteSolution {
     /// max(|F|, |K u|): the scale of nodal forces, against which lambda_p's round-off is judged.
     pub force_scale: f64,
     pub strategy: Strategy,
+    /// The KKT conditions' relative values, each within [`certify::TOLERANCE`].
+    pub certificate: Certificate,
     pub timings: SolveTimings,
 }
 
@@ -128,7 +165,9 @@ pub struct Kkt {
 
 /// Assemble, factorise and solve the contact problem on `mesh`. `observe` sees every
 /// active-set iteration. An active-set method that does not converge is an error naming the
-/// iterations and the residual.
+/// iterations and the residual. A mesh on which the Dirichlet part does not hold every body is
+/// refused before factorising, and the solution is returned only once its KKT conditions hold
+/// to [`certify::TOLERANCE`] ([`crate::certify`]).
 ///
 /// ```rust
 /// use signorini::contact::PdasOptions;
@@ -156,6 +195,7 @@ pub fn solve(
     let t0 = Instant::now();
     let nodes = P2Nodes::new(mesh);
     let dofs = DofMap::new(&nodes, problem);
+    certify::check_held(mesh, &nodes, &dofs, problem)?;
     let System { matrix, rhs, dirichlet } = assembly::assemble(mesh, &nodes, &dofs, problem);
     let assembly_time = t0.elapsed().as_secs_f64();
     let strategy = options.strategy.unwrap_or(Strategy::auto(dofs.contact.len(), dofs.n_free));
@@ -166,7 +206,22 @@ pub fn solve(
     let contact_timings = solver.timings.clone();
     drop(solver);
     // the residual F - K u, element by element: zero at free unknowns, lambda_p at contact normals
-    let ku = assembly::stiffness_times(mesh, &nodes, &dofs, problem.material(), &out.u);
+    let assembly::StiffnessProduct { ku, magnitude, row_norm } = assembly::stiffness_times(mesh, &nodes, &dofs, problem.material(), &out.u);
+    let normal_displacement = &out.u[dofs.n_interior..];
+    let u_max = out.u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let kkt = KktInput {
+        nodes: &nodes,
+        dofs: &dofs,
+        rhs: &rhs,
+        ku: &ku,
+        magnitude: &magnitude,
+        row_norm: &row_norm,
+        u_max,
+        normal_displacement,
+        active: &out.active,
+    };
+    let certificate = certify::certify(&kkt, certify::TOLERANCE)?;
+    drop((magnitude, row_norm));
     let r: Vec<f64> = rhs.iter().zip(&ku).map(|(f, k)| f - k).collect();
     let f_scale = rhs.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
     let force_scale = ku.iter().fold(f_scale, |a, v| a.max(v.abs()));
@@ -186,6 +241,7 @@ pub fn solve(
         free_residual,
         force_scale,
         strategy,
+        certificate,
         timings,
     })
 }

@@ -285,3 +285,36 @@ fn every_flag_of_every_subcommand_has_a_description() {
         assert!(flags >= 1, "{cmd:?}: no flags found in\n{out}");
     }
 }
+
+/// An adaptive loop that outgrows the memory it may use stops before the level that would not
+/// fit, with the levels it solved printed and the level it reached named, never an allocation
+/// failure (the address space is limited with the shell's `ulimit -v`, in KiB).
+#[test]
+fn bad_adaptive_loop_outgrowing_memory_stops_with_the_level_reached() {
+    let bin = env!("CARGO_BIN_EXE_signorini");
+    let script = format!("ulimit -v 1500000 && exec {bin} adapt --problem ex72 --mesh structured:8 --uniform --levels 10000");
+    let out = Command::new("sh").args(["-c", &script]).output().unwrap();
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(!stderr.contains("panicked") && !stderr.contains("memory allocation"), "{stderr}");
+    let level: usize =
+        stderr.split("stopped before level ").nth(1).and_then(|s| s.split(' ').next()).and_then(|s| s.parse().ok()).expect(&stderr);
+    assert!(level >= 3, "{stderr}");
+    assert!(stderr.contains(&format!("levels 0 to {} were solved", level - 1)) && stderr.contains("address-space limit"), "{stderr}");
+    // the solved levels were printed, one row each, the last one being level - 1
+    let last_row = stdout.lines().rev().find(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).expect(&stdout);
+    assert_eq!(last_row.split_whitespace().next(), Some((level - 1).to_string().as_str()), "{stdout}");
+}
+
+/// A closed standard output (`signorini adapt ... | head -c 1`) ends the process quietly, with
+/// SIGPIPE's exit status 141 as command-line tools do, not a panic about a broken pipe (the
+/// levels are printed as they are solved, so later rows meet the closed pipe).
+#[test]
+fn closed_stdout_ends_quietly() {
+    let bin = env!("CARGO_BIN_EXE_signorini");
+    let script = format!("set -o pipefail; {bin} adapt --problem ex72 --mesh structured:8 --levels 6 | head -c 1 >/dev/null; echo $?");
+    let out = Command::new("bash").args(["-c", &script]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked") && !stderr.contains("Broken pipe"), "{stderr}");
+    assert_eq!(String::from_utf8_lossy(&out.stdout).trim(), "141", "{stderr}");
+}

@@ -92,3 +92,151 @@ fn cycling_active_set_method_returns_its_last_iterate() {
     let err = Termination::Cycling { first_seen: 1, residual: 0.25 }.error(2).unwrap().to_string();
     assert!(err.contains("cycling") && err.contains("iteration 2") && err.contains("iteration 1"), "{err}");
 }
+
+/// Example 7.2's mesh with a second copy of the unit square shifted by `shift`, merged with the
+/// first at any vertex they share; the copy's boundary edges are traction free.
+fn two_bodies(shift: [f64; 2]) -> signorini::mesh::Mesh {
+    use signorini::mesh::{BoundaryEdge, Part};
+    let mut m = mesh(&problems::Ex72, "structured:4");
+    let n = m.vertices.len();
+    let mut index = Vec::with_capacity(n);
+    for v in 0..n {
+        let x = [m.vertices[v][0] + shift[0], m.vertices[v][1] + shift[1]];
+        index.push(match m.vertices[..n].iter().position(|y| *y == x) {
+            Some(shared) => shared,
+            None => {
+                m.vertices.push(x);
+                m.vertices.len() - 1
+            }
+        });
+    }
+    let copy_tris: Vec<[usize; 3]> = m.triangles.iter().map(|t| t.map(|v| index[v])).collect();
+    let copy_edges: Vec<BoundaryEdge> =
+        m.boundary.iter().map(|e| BoundaryEdge { v: e.v.map(|v| index[v]), part: Part::Neumann, curve: None }).collect();
+    m.triangles.extend(copy_tris);
+    m.boundary.extend(copy_edges);
+    m
+}
+
+fn solve_err(m: &signorini::mesh::Mesh) -> signorini::solve::SolveError {
+    let sol = signorini::solve::solve(m, &problems::Ex72, &signorini::contact::PdasOptions::default(), &mut |_| {});
+    sol.err().expect("a body that can move rigidly is refused")
+}
+
+/// A second body with no Dirichlet node, and one touching the first only at a Dirichlet vertex
+/// (it can turn about it): refused before factorising, naming the body and the point.
+#[test]
+fn a_body_the_dirichlet_part_does_not_hold_is_refused() {
+    use signorini::solve::SolveError;
+    let apart = solve_err(&two_bodies([2.0, 0.0]));
+    let msg = apart.to_string();
+    assert!(matches!(apart, SolveError::RigidMotion(_)), "{msg}");
+    assert!(msg.contains("body 2 of the 2 separate bodies") && msg.contains("has no Dirichlet node"), "{msg}");
+    assert!(msg.contains("4 Dirichlet, 4 contact, 24 Neumann"), "{msg}");
+    // the copy at (-1, 1) shares the vertex (0, 1) of the first body's Dirichlet side
+    let hinge = solve_err(&two_bodies([-1.0, 1.0]));
+    let msg = hinge.to_string();
+    assert!(matches!(hinge, SolveError::RigidMotion(_)), "{msg}");
+    assert!(msg.contains("body 2 of the 2 separate bodies") && msg.contains("held at one point only, (0.000000, 1.000000)"), "{msg}");
+}
+
+/// A problem file whose Dirichlet part matches nothing (the reviewer's `dirichlet = "x < -1"`):
+/// a named error naming the declared parts, and exit code 1 from the command line, never a
+/// solution.
+#[test]
+fn a_problem_file_whose_dirichlet_part_matches_nothing_is_refused() {
+    let dir = std::env::temp_dir().join(format!("signorini-kkt-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string("experiments/problems/ex72.toml").unwrap();
+    assert!(text.contains("dirichlet = \"x < 1e-12\""));
+    let file = dir.join("free.toml");
+    std::fs::write(&file, text.replace("dirichlet = \"x < 1e-12\"", "dirichlet = \"x < -1\"")).unwrap();
+    let problem = signorini::problems::by_name(file.to_str().unwrap()).unwrap();
+    let m = mesh(problem.as_ref(), "structured:8");
+    let err = signorini::solve::solve(&m, problem.as_ref(), &signorini::contact::PdasOptions::default(), &mut |_| {}).err().unwrap();
+    let msg = err.to_string();
+    assert!(msg.contains("the body can move rigidly") && msg.contains("has no Dirichlet node"), "{msg}");
+    assert!(msg.contains("0 Dirichlet, 8 contact, 24 Neumann") && msg.contains("parts.dirichlet = \"x < -1\""), "{msg}");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["solve", "--problem", file.to_str().unwrap(), "--mesh", "structured:8"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(out.stdout.is_empty() && stderr.contains("the body can move rigidly"), "{stderr}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The certificate of a converged solve is at round-off, and each KKT condition violated on
+/// purpose (a load changed, a force of the wrong sign, a node pushed through the obstacle, an
+/// active node off it) is named with the point where it fails.
+#[test]
+fn the_kkt_certificate_names_each_violated_condition() {
+    use signorini::assembly::{self, DofMap};
+    use signorini::certify::{KktInput, TOLERANCE, certify};
+    use signorini::contact::{ContactSolver, PdasOptions};
+    use signorini::mesh::P2Nodes;
+    let p = problems::Ex72;
+    let m = mesh(&p, "structured:16");
+    let nodes = P2Nodes::new(&m);
+    let dofs = DofMap::new(&nodes, &p);
+    let sys = assembly::assemble(&m, &nodes, &dofs, &p);
+    let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
+    let mut solver = ContactSolver::new(sys.matrix.clone(), dofs.n_interior, &dofs.unknown_coords(&nodes)).unwrap();
+    let out = solver.solve_contact(&sys.rhs, &gap, &PdasOptions::default(), &mut |_| {}).unwrap().converged().unwrap();
+    let prod = assembly::stiffness_times(&m, &nodes, &dofs, p.material(), &out.u);
+    let ni = dofs.n_interior;
+    let check = |rhs: &[f64], un: &[f64]| {
+        let input = KktInput {
+            nodes: &nodes,
+            dofs: &dofs,
+            rhs,
+            ku: &prod.ku,
+            magnitude: &prod.magnitude,
+            row_norm: &prod.row_norm,
+            u_max: out.u.iter().fold(0.0f64, |a, v| a.max(v.abs())),
+            normal_displacement: un,
+            active: &out.active,
+        };
+        certify(&input, TOLERANCE)
+    };
+    let un = out.u[ni..].to_vec();
+    let c = check(&sys.rhs, &un).expect("the converged solve is certified");
+    assert!(c.equations < 1e-12 && c.sign < 1e-12 && c.penetration < 1e-12 && c.complementarity < 1e-12, "{c:?}");
+    let a = out.active.iter().position(|&x| x).unwrap();
+    let i = out.active.iter().position(|&x| !x).unwrap();
+    let named = |rhs: &[f64], un: &[f64], condition: &str, node: usize| {
+        let e = check(rhs, un).expect_err(condition);
+        let at = nodes.coords[node];
+        assert!(e.condition.contains(condition) && e.at == at && e.value > TOLERANCE, "{condition}: {e}");
+        assert!(e.to_string().contains(&format!("({:.6}, {:.6})", at[0], at[1])), "{e}");
+    };
+    // a load changed at one interior unknown: the equations
+    let k = 0;
+    let node = (0..dofs.dof.len()).find(|&q| dofs.dof[q].contains(&k)).unwrap();
+    let mut rhs = sys.rhs.clone();
+    rhs[k] += 1e-6 * (sys.rhs[k].abs() + prod.magnitude[k] + prod.row_norm[k]);
+    named(&rhs, &un, "the equations", node);
+    // a pulling force at an active node: the sign
+    let mut rhs = sys.rhs.clone();
+    rhs[ni + a] = prod.ku[ni + a] - 1e-3 * (prod.magnitude[ni + a] + prod.row_norm[ni + a]);
+    named(&rhs, &un, "the sign", dofs.contact[a].node);
+    // an inactive node through the obstacle: penetration
+    let mut through = un.clone();
+    through[i] = gap[i] + 1e-6;
+    named(&sys.rhs, &through, "non-penetration", dofs.contact[i].node);
+    // an active node (pressed, lambda > 0) off the obstacle: complementarity
+    let mut off = un.clone();
+    off[a] = gap[a] - 1e-3;
+    named(&sys.rhs, &off, "complementarity", dofs.contact[a].node);
+}
+
+/// Every solve carries its certificate, and it is at round-off on both examples.
+#[test]
+fn every_solve_is_certified_at_round_off() {
+    for p in [&problems::Ex71 as &dyn Problem, &problems::Ex72, &problems::Fb] {
+        let sol = solve_on(p, &mesh(p, "structured:32"));
+        let c = sol.certificate;
+        assert!(c.equations < 1e-12 && c.sign <= 1e-12 && c.penetration <= 1e-12 && c.complementarity < 1e-12, "{}: {c:?}", p.name());
+    }
+}

@@ -256,6 +256,12 @@ impl Mesh {
         (0..3).map(|i| dist(p[i], p[(i + 1) % 3])).fold(0.0, f64::max)
     }
 
+    /// The number of P2 degrees of freedom, 2 x (vertices + edges), counted without numbering the
+    /// edges: a triangulation has (3 triangles + boundary edges) / 2 edges.
+    pub fn p2_ndof(&self) -> usize {
+        2 * (self.n_vertices() + (3 * self.n_triangles() + self.boundary.len()) / 2)
+    }
+
     /// (h_min, h_max) over the triangles' diameters (paper Section 3).
     pub fn h_range(&self) -> (f64, f64) {
         (0..self.n_triangles()).map(|t| self.diameter(t)).fold((f64::INFINITY, 0.0), |(lo, hi), d| (lo.min(d), hi.max(d)))

@@ -311,6 +311,8 @@ pub struct FileProblem {
     dirichlet_predicate: Option<Predicate>,
     /// Physical group -> part (Gmsh meshes).
     groups: BTreeMap<String, Part>,
+    /// The `[parts]` entries as written, for error messages.
+    declared_parts: Vec<String>,
     curves: BTreeMap<String, Curve>,
     body_force: [Expr; 2],
     traction: VectorData,
@@ -615,12 +617,17 @@ impl FileProblem {
         // parts
         let mut groups = BTreeMap::new();
         let mut predicates = [None, None];
+        let mut declared_parts = Vec::new();
         for (key, part, value) in [
             ("parts.contact", Part::Contact, Some(&raw.parts.contact)),
             ("parts.dirichlet", Part::Dirichlet, raw.parts.dirichlet.as_ref()),
             ("parts.neumann", Part::Neumann, raw.parts.neumann.as_ref()),
         ] {
             let Some(value) = value else { continue };
+            declared_parts.push(match value.get_ref() {
+                PartToml::Predicate(p) => format!("{key} = {p:?}"),
+                PartToml::Groups(list) => format!("{key} = {list:?}"),
+            });
             match value.get_ref() {
                 PartToml::Predicate(_) if part == Part::Neumann => {
                     return Err(r.error(
@@ -768,6 +775,7 @@ impl FileProblem {
             contact_predicate,
             dirichlet_predicate,
             groups,
+            declared_parts,
             curves,
             body_force,
             traction,
@@ -807,6 +815,9 @@ impl Problem for FileProblem {
     }
     fn groups(&self) -> Vec<String> {
         self.groups.keys().cloned().collect()
+    }
+    fn declared_parts(&self) -> Vec<String> {
+        self.declared_parts.clone()
     }
     fn curve_of_group(&self, group: &str) -> Option<Curve> {
         self.curves.get(group).copied()

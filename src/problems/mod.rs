@@ -107,6 +107,11 @@ pub trait Problem: Send + Sync {
     fn exact(&self) -> Option<&dyn Exact> {
         None
     }
+    /// How the problem declares its boundary parts, as its source states them (e.g.
+    /// `parts.dirichlet = "x < 1e-12"`), for error messages; empty if it states none.
+    fn declared_parts(&self) -> Vec<String> {
+        Vec::new()
+    }
 }
 
 /// The built-in problems' names.
