@@ -3,7 +3,7 @@
 CARGO ?= cargo
 BIN := target/release/signorini
 
-.PHONY: all build test figures reproduce drift crosscheck bench roundoff meshes clean
+.PHONY: all build test figures reproduce drift crosscheck bench roundoff meshes mesh clean
 
 all: build
 
@@ -75,6 +75,14 @@ roundoff: build
 meshes:
 	crosscheck/setup.sh
 	crosscheck/.venv/bin/python experiments/meshes/generate.py
+
+# Mesh a .geo of one's own: `make mesh GEO=path/to/disc.geo` writes path/to/disc.msh beside it
+# (gmsh's Python module from the cross-check environment; its `gmsh` script cannot be run directly,
+# its shebang names a `python` that is not the environment's).
+mesh:
+	@test -n "$(GEO)" || { echo "usage: make mesh GEO=path/to/file.geo"; exit 2; }
+	crosscheck/setup.sh
+	crosscheck/.venv/bin/python experiments/meshes/generate.py $(GEO)
 
 clean:
 	$(CARGO) clean

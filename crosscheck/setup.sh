@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Create crosscheck/.venv with the pinned requirements. Idempotent: does nothing when the venv
 # exists and is at least as new as requirements.txt; otherwise rebuilds it from scratch (--clear),
-# so a changed requirements.txt never leaves stale packages behind. Needs python3 (>= 3.10) and PyPI.
+# so a changed requirements.txt never leaves stale packages behind. Needs python3 (>= 3.11, for the pinned numpy) and PyPI.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 venv="$here/.venv"
