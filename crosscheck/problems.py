@@ -152,7 +152,7 @@ def check_data(name, mesh):
     NGSolve differentiates the exact coefficient function symbolically (CF.Diff), which is an
     independent route to the same formulas. Returns (err_f, err_g, err_contact) where err_contact is
     the deviation of the tangential stress on y = 0 from 0 and of sigma_22 from the stated normal
-    stress (ex71: 3x - 6, PAPER-NOTES; fb: p(x) = -((x - a)_+)^(5/2)).
+    stress (ex71: 3x - 6, from the exact solution; fb: p(x) = -((x - a)_+)^(5/2)).
     """
     p = problem(name)
     u = p.exact
