@@ -20,6 +20,7 @@ pub mod hertz;
 pub mod mesh;
 pub mod norms;
 pub mod ordering;
+pub mod page;
 pub mod plot;
 pub mod problems;
 pub mod records;

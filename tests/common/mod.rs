@@ -1,6 +1,8 @@
 //! Shared helpers for the integration tests.
 #![allow(dead_code)]
 
+pub mod browser;
+
 use signorini::contact::PdasOptions;
 use signorini::mesh::{Mesh, MeshSpec};
 use signorini::problems::Problem;

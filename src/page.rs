@@ -1,0 +1,258 @@
+//! One page per study for a reviewer's browser: `signorini report` writes `STUDY.html`, a
+//! single self-contained file (figures embedded as PNG data, no script, no external resource)
+//! with the study's CLAIMS rows, its figures, the run table, the drift status and the provenance.
+//!
+//! Everything on the page is read from files the other commands wrote: the records and
+//! `provenance.json` under the results folder, the PNGs under the figures folder, CLAIMS rows
+//! recomputed from the records ([`crate::claims`]), and the drift report `signorini drift` wrote
+//! (`target/drift/report.json` by default), whose date and scope the page states.
+
+use crate::claims::Claim;
+use crate::records::{RunRecord, StudyDir};
+use base64::Engine;
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+/// Which study each figure of [`crate::plot::FIGURES`] draws (a test checks that every figure
+/// is listed).
+pub const FIGURE_STUDY: [(&str, &str); 15] = [
+    ("fig2a", "ex71"),
+    ("fig2b", "ex71"),
+    ("fig4a", "ex71"),
+    ("fig3a", "ex72"),
+    ("fig3b", "ex72"),
+    ("fig4b", "ex72"),
+    ("fig3b_variant", "contact_term_ablation"),
+    ("contact_term_ablation", "contact_term_ablation"),
+    ("c0_sweep", "c0_sweep"),
+    ("log_ablation", "log_ablation"),
+    ("theta_ablation", "theta_ablation"),
+    ("fb_error", "fb"),
+    ("fb_mesh", "fb"),
+    ("hertz_pressure", "hertz"),
+    ("hertz_mesh", "hertz"),
+];
+
+/// The studies a CLAIMS row rests on, from its id (a test checks that every row maps to one).
+pub fn claim_studies(id: &str) -> &'static [&'static str] {
+    match id {
+        "c0" => &["c0_sweep"],
+        "sampling" => &["ex71", "ex72", "contact_term_ablation"],
+        "hertz" => &["hertz"],
+        _ if id.starts_with("7.1-eta5") => &["ex71", "contact_term_ablation"],
+        _ if id.starts_with("7.1-") => &["ex71"],
+        _ if id.starts_with("7.2-") => &["ex72", "ex72_large"],
+        _ if id.starts_with("log-factor") => &["log_ablation"],
+        _ if id.starts_with("fb-") => &["fb"],
+        _ => &[],
+    }
+}
+
+/// What the page says about drift: the report's date, whether it compared this study and what
+/// it found.
+fn drift_status(report: Option<&serde_json::Value>, study: &str) -> String {
+    let Some(r) = report else {
+        return "not checked: no drift report found (run <code>signorini drift --study STUDY</code>)".replace("STUDY", &escape(study));
+    };
+    let date = r["date"].as_str().unwrap_or("an unknown date");
+    let scope = if r["quick"].as_bool() == Some(true) { "quick prefixes" } else { "every level" };
+    let against = r["against"].as_str().map(|a| format!(" against {}", escape(a))).unwrap_or_default();
+    let entry = r["studies"].as_array().and_then(|s| s.iter().find(|e| e["study"] == study));
+    match entry {
+        None => format!("not checked in the drift report of {date}{against} (it did not include this study)"),
+        Some(e) => match e["drift"].as_u64() {
+            Some(0) => format!("<b>no drift</b>: rerun and compared at {scope}{against} on {date}, {} run(s)", e["runs"]),
+            Some(n) => format!("<b class=\"bad\">drift</b>: {n} field(s) moved ({scope}{against}, {date}); see the drift report"),
+            None => format!("unreadable entry in the drift report of {date}"),
+        },
+    }
+}
+
+/// HTML-escape text.
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// "1.234e-5", "-" for none.
+fn num(v: Option<f64>) -> String {
+    v.map_or("–".to_string(), |v| format!("{v:.3e}"))
+}
+
+fn run_table(runs: &[RunRecord]) -> String {
+    let mut s = String::from(
+        "<table><tr><th>run</th><th>problem</th><th>refinement</th><th>levels</th><th>final NDF</th><th>final estimate</th><th>final error</th><th>efficiency</th></tr>\n",
+    );
+    for r in runs {
+        let last = r.levels.last();
+        let _ = writeln!(
+            s,
+            "<tr><td>{}</td><td>{}</td><td>{:?}{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            escape(&r.run.id),
+            escape(&r.run.problem),
+            r.run.refine,
+            if matches!(r.run.refine, crate::records::Refine::Adaptive) { format!(", θ = {}", r.run.theta) } else { String::new() },
+            r.levels.len(),
+            last.map_or("–".into(), |l| l.ndof.to_string()),
+            num(last.map(|l| l.estimate)),
+            num(last.and_then(|l| l.err_quadrature)),
+            last.and_then(|l| l.efficiency).map_or("–".into(), |e| format!("{e:.2}")),
+        );
+    }
+    s + "</table>\n"
+}
+
+fn claims_table(claims: &[&Claim]) -> String {
+    if claims.is_empty() {
+        return "<p>No CLAIMS row rests on this study.</p>\n".into();
+    }
+    let mut s = String::from("<table class=\"claims\"><tr><th>claim</th><th>measured</th><th>verdict</th></tr>\n");
+    for c in claims {
+        // the verdict text marks failures in markdown bold; render it as HTML
+        let verdict = escape(&c.verdict.text().replace("**", ""));
+        let _ = writeln!(
+            s,
+            "<tr class=\"claim\" id=\"claim-{id}\"><td><b>{id}</b>: {}</td><td>{}</td><td>{verdict}</td></tr>",
+            escape(&c.claim),
+            escape(&c.measured),
+            id = escape(c.id)
+        );
+    }
+    s + "</table>\n"
+}
+
+fn figures_html(figures: &Path, study: &str) -> std::io::Result<String> {
+    let mut s = String::new();
+    for (name, _) in FIGURE_STUDY.iter().filter(|(_, st)| *st == study) {
+        let png = figures.join(format!("{name}.png"));
+        match std::fs::read(&png) {
+            Ok(bytes) => {
+                let data = base64::engine::general_purpose::STANDARD.encode(bytes);
+                let _ = writeln!(
+                    s,
+                    "<figure><img alt=\"{name}\" src=\"data:image/png;base64,{data}\"><figcaption>{name}</figcaption></figure>"
+                );
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                let _ = writeln!(
+                    s,
+                    "<p>Figure {name}: not drawn (no {}; run <code>signorini figures</code>).</p>",
+                    escape(&png.display().to_string())
+                );
+            }
+            Err(e) => return Err(std::io::Error::new(e.kind(), format!("reading {}: {e}", png.display()))),
+        }
+    }
+    Ok(s)
+}
+
+fn provenance_html(study: &StudyDir) -> String {
+    let Ok(text) = std::fs::read_to_string(study.provenance_file()) else { return "<p>No provenance.json.</p>\n".into() };
+    let Ok(serde_json::Value::Object(map)) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return "<p>provenance.json is not a JSON object.</p>\n".into();
+    };
+    let mut s = String::from("<table class=\"provenance\">\n");
+    for (k, v) in map {
+        let v = match v {
+            serde_json::Value::String(t) => t,
+            other => other.to_string(),
+        };
+        let _ = writeln!(s, "<tr><th>{}</th><td><code>{}</code></td></tr>", escape(&k), escape(&v));
+    }
+    s + "</table>\n"
+}
+
+const STYLE: &str = "body{font-family:'DejaVu Sans',sans-serif;max-width:1100px;margin:2em auto;color:#222}\
+table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:4px 8px;text-align:left;vertical-align:top}\
+th{background:#f4f4f4}figure{margin:1em 0}img{max-width:100%}.bad{color:#b00}code{font-size:90%}";
+
+/// The page of `study`: `results` holds its records, `figures` its PNGs, `claims` every CLAIMS
+/// row (those of the study are shown), `drift` the drift report if one was found.
+pub fn study_page(
+    results: &Path,
+    figures: &Path,
+    study: &str,
+    claims: &[Claim],
+    drift: Option<&serde_json::Value>,
+) -> std::io::Result<String> {
+    let dir = StudyDir::new(results, study);
+    let runs = dir.read_runs()?;
+    let rows: Vec<&Claim> = claims.iter().filter(|c| claim_studies(c.id).contains(&study)).collect();
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>signorini: {0}</title><style>{STYLE}</style></head><body>\n<h1>Study {0}</h1>\n",
+        escape(study)
+    );
+    let _ = writeln!(
+        s,
+        "<p>Results from <code>{}</code>, figures from <code>{}</code>.</p>",
+        escape(&results.display().to_string()),
+        escape(&figures.display().to_string())
+    );
+    let _ = writeln!(s, "<h2>Drift</h2><p>{}</p>", drift_status(drift, study));
+    let _ = writeln!(s, "<h2>Claims</h2>\n{}", claims_table(&rows));
+    let _ = writeln!(s, "<h2>Figures</h2>\n{}", figures_html(figures, study)?);
+    let _ = writeln!(s, "<h2>Runs</h2>\n{}", run_table(&runs));
+    let _ = writeln!(s, "<h2>Provenance</h2>\n{}", provenance_html(&dir));
+    s += "</body></html>\n";
+    Ok(s)
+}
+
+/// The studies present under `results`: folders holding a `runs/` folder, by name.
+pub fn studies_in(results: &Path) -> std::io::Result<Vec<String>> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(results).map_err(|e| std::io::Error::new(e.kind(), format!("reading {}: {e}", results.display())))? {
+        let e = e?;
+        if e.path().join("runs").is_dir() {
+            out.push(e.file_name().to_string_lossy().into_owned());
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// Write `out/STUDY.html` for each of `studies` (every study under `results` if empty), atomically;
+/// returns the pages written. A named study without records is an error.
+pub fn write_pages(results: &Path, figures: &Path, out: &Path, studies: &[String], drift_report: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    use anyhow::Context;
+    let present = studies_in(results)?;
+    let chosen: Vec<String> = if studies.is_empty() { present.clone() } else { studies.to_vec() };
+    if chosen.is_empty() {
+        anyhow::bail!("{} holds no study (no STUDY/runs/ folder): nothing to report", results.display());
+    }
+    if let Some(missing) = chosen.iter().find(|s| !present.contains(s)) {
+        anyhow::bail!("study {missing} has no records in {} (studies there: {})", results.display(), present.join(", "));
+    }
+    let claims = crate::claims::claims(results).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
+    let drift = match std::fs::read_to_string(drift_report) {
+        Ok(t) => Some(serde_json::from_str(&t).with_context(|| format!("reading the drift report {}", drift_report.display()))?),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+        Err(e) => return Err(e).with_context(|| format!("reading the drift report {}", drift_report.display())),
+    };
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let mut written = Vec::new();
+    for study in &chosen {
+        let page = study_page(results, figures, study, &claims, drift.as_ref())?;
+        let path = out.join(format!("{study}.html"));
+        crate::records::write_atomic(&path, page.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_figure_has_its_study() {
+        for f in crate::plot::FIGURES {
+            assert!(FIGURE_STUDY.iter().any(|(name, _)| *name == f), "figure {f} is not in FIGURE_STUDY");
+        }
+    }
+
+    #[test]
+    fn escaping() {
+        assert_eq!(escape("a < b & \"c\" > d"), "a &lt; b &amp; &quot;c&quot; &gt; d");
+    }
+}

@@ -1,0 +1,44 @@
+//! The study pages a reviewer opens in a browser (`signorini report`): built from the stored
+//! results and figures, loaded in headless Chromium, every image must load, every CLAIMS row of
+//! the study must be on the page, and no console error may appear.
+
+mod common;
+use std::path::Path;
+
+#[test]
+fn every_claims_row_belongs_to_a_study() {
+    for c in signorini::claims::claims(Path::new("results")).unwrap() {
+        assert!(!signorini::page::claim_studies(c.id).is_empty(), "CLAIMS row {} maps to no study (page::claim_studies)", c.id);
+    }
+}
+
+#[test]
+fn study_pages_load_in_chromium_with_every_image_and_claim() {
+    let out = std::env::temp_dir().join(format!("signorini-pages-{}", std::process::id()));
+    let pages =
+        signorini::page::write_pages(Path::new("results"), Path::new("figures"), &out, &[], Path::new("target/drift/report.json")).unwrap();
+    assert!(pages.len() >= 9, "one page per stored study: {pages:?}");
+    let claims = signorini::claims::claims(Path::new("results")).unwrap();
+    let Some(chromium) = common::browser::chromium() else {
+        // never a silent pass: `make test` prints the same note, and CI installs chromium
+        eprintln!("SKIPPED the browser check of {} study pages: no chromium on this machine (apt-get install chromium)", pages.len());
+        std::fs::remove_dir_all(&out).unwrap();
+        return;
+    };
+    for page in &pages {
+        let study = page.file_stem().unwrap().to_string_lossy().into_owned();
+        let seen = common::browser::check_page(&chromium, page);
+        let expected: Vec<&str> = signorini::page::FIGURE_STUDY.iter().filter(|(_, s)| *s == study).map(|(f, _)| *f).collect();
+        let names: Vec<&str> = seen.images.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, expected, "{study}: the page's images");
+        for (name, loaded) in &seen.images {
+            assert!(loaded, "{study}: image {name} did not load");
+        }
+        for c in claims.iter().filter(|c| signorini::page::claim_studies(c.id).contains(&study.as_str())) {
+            assert!(seen.text.contains(&format!("{}:", c.id)), "{study}: CLAIMS row {} missing from the page", c.id);
+        }
+        assert!(seen.text.contains(&format!("Study {study}")) && seen.text.contains("Provenance"), "{study}: {}", seen.text);
+        assert!(seen.errors.is_empty(), "{study}: console errors {:?}", seen.errors);
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
