@@ -1,7 +1,8 @@
 # The harness's front door. Everything a fresh machine needs is installed here: Rust crates
 # through cargo, the Python environment of the NGSolve cross-check by crosscheck/setup.sh.
 CARGO ?= cargo
-BIN := target/release/signorini
+# cargo builds into $(CARGO_TARGET_DIR) when it is set, target/ otherwise
+BIN := $(or $(CARGO_TARGET_DIR),target)/release/signorini
 
 .PHONY: all build test figures reproduce drift crosscheck bench roundoff meshes mesh clean
 
@@ -22,7 +23,7 @@ test: build
 	$(CARGO) test --release --locked
 	$(CARGO) run --release --locked --example own_problem
 	$(BIN) drift
-	CROSSCHECK_OUT=target/crosscheck-report crosscheck/run.sh
+	SIGNORINI=$(abspath $(BIN)) CROSSCHECK_OUT=target/crosscheck-report crosscheck/run.sh
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-after-test
 	@diff target/status-before-test target/status-after-test >/dev/null || { echo "make test changed files git sees (before/after below); test outputs belong under target/"; diff target/status-before-test target/status-after-test; exit 1; }
 
@@ -43,7 +44,7 @@ drift: build
 # NGSolve cross-check: creates crosscheck/.venv from the pinned requirements on first use and
 # stores its tables in results/crosscheck/.
 crosscheck: build
-	crosscheck/run.sh
+	SIGNORINI=$(abspath $(BIN)) crosscheck/run.sh
 
 # NGSolve's phase timings first (warm, medians over repeats in one process per size), then ours
 # side by side; then whole solves in fresh processes, ours and NGSolve's interleaved (medians of

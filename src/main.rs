@@ -19,8 +19,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// One solve on a structured mesh (or on a mesh of the adaptive loop: --adapt-levels,
-    /// --adapt-min-ndof), with its error, estimator and KKT report.
+    /// One solve on a mesh (structured:N, symmetric:N or a Gmsh file gmsh:PATH.msh), or on a
+    /// mesh of the adaptive loop from it (--adapt-levels, --adapt-min-ndof), with its error,
+    /// estimator and KKT report.
     Solve {
         #[command(flatten)]
         args: SolveArgs,
@@ -39,10 +40,12 @@ enum Command {
         /// Written to target/quick-results/ unless --results is given.
         #[arg(long)]
         quick: bool,
-        /// Threads for assembly, estimator and errors (results do not depend on it).
+        /// Threads for assembly, estimator and errors (results do not depend on it); more than
+        /// the cores available is reduced to them, with a note.
         #[arg(long, allow_negative_numbers = true)]
         jobs: Option<usize>,
         /// Run every N-th run only: K/N, 1 <= K <= N (cluster job arrays); shards merge by run id.
+        /// A shard that holds no run of the manifests given is an error.
         #[arg(long)]
         shard: Option<String>,
         /// Start over instead of resuming after the runs already finished.
@@ -57,20 +60,25 @@ enum Command {
     },
     /// Rerun every declared study and compare with the stored results at every level, field by
     /// field, within the manifests' tolerances; check levels.csv, provenance.json and CLAIMS.md
-    /// against the records; exit non-zero on drift. The report goes to target/drift/.
+    /// against the records; exit non-zero on drift. The report goes to target/drift/ (with
+    /// --against DIR: DIR/drift-report.json).
     Drift {
         /// Rerun the quick forms only (prefixes of the stored full runs: the first levels).
         #[arg(long)]
         quick: bool,
-        /// Compare with the records in this results folder instead of rerunning (e.g. the
-        /// studies rerun with another ordering or thread count, to measure round-off).
+        /// Compare the records in this results folder with the stored ones instead of rerunning
+        /// (a study rerun into a scratch folder; or every study rerun with another ordering or
+        /// thread count, to measure round-off): the studies DIR holds, their provenance
+        /// (manifest, problem files, meshes) included; the others are named as not compared.
         #[arg(long, value_name = "DIR", conflicts_with = "quick")]
         against: Option<std::path::PathBuf>,
-        /// Where to write the JSON report (default: target/drift/report[_quick][-STUDY...].json).
+        /// Where to write the JSON report (default: target/drift/report[_quick][-STUDY...].json;
+        /// with --against DIR: DIR/drift-report.json).
         #[arg(long, value_name = "FILE")]
         report: Option<std::path::PathBuf>,
-        /// Accept a deliberate change: rerun STUDY in full and rewrite its stored results.
-        #[arg(long, value_name = "STUDY")]
+        /// Accept a deliberate change: rerun STUDY in full and rewrite its stored results (in
+        /// --results); nothing is compared, so --quick, --against, --report and --study do not apply.
+        #[arg(long, value_name = "STUDY", conflicts_with_all = ["quick", "against", "report", "study"])]
         accept: Vec<String>,
         /// Check only these studies (default: every experiments/*.toml).
         #[arg(long, value_name = "STUDY")]
@@ -82,19 +90,24 @@ enum Command {
         #[arg(long, default_value = "results")]
         results: std::path::PathBuf,
     },
-    /// Redraw every figure under figures/ and results/CLAIMS.md from the stored results alone.
-    /// Refuses if a declared study's stored runs do not match its manifest (interrupted, sharded
-    /// or partial), naming what is missing.
+    /// Redraw every figure under figures/ and results/CLAIMS.md from the stored results alone;
+    /// with --results DIR (a study rerun into a scratch folder), the figures of the declared
+    /// studies DIR holds into DIR/figures/ and DIR/CLAIMS.md. Refuses if a study's runs do not
+    /// match its manifest (interrupted, sharded or partial), naming what is missing.
     Figures {
-        /// Results root to read (CLAIMS.md is written there).
-        #[arg(long, default_value = "results")]
-        results: std::path::PathBuf,
-        /// The declared studies the stored results must match.
+        /// Results root to read; CLAIMS.md is written there [default: results, where every
+        /// declared study must be complete].
+        #[arg(long)]
+        results: Option<std::path::PathBuf>,
+        /// The declared studies the results must match.
         #[arg(long, default_value = "experiments")]
         experiments: std::path::PathBuf,
-        /// Folder the figures are written to.
-        #[arg(long, default_value = "figures")]
-        figures: std::path::PathBuf,
+        /// Folder the figures are written to [default: figures, or DIR/figures with --results DIR].
+        #[arg(long, visible_alias = "out")]
+        figures: Option<std::path::PathBuf>,
+        /// Draw only these studies' figures (repeatable) [default: every study the results hold].
+        #[arg(long, value_name = "STUDY")]
+        study: Vec<String>,
     },
     /// Solve as `solve` does and write the mesh and solution for the NGSolve cross-check
     /// (OUT/mesh.vtu, OUT/case.json: the report `solve --json` prints).
@@ -352,21 +365,139 @@ fn run_studies(
     wait: bool,
 ) -> Result<()> {
     if let Some(j) = jobs {
-        if j == 0 {
-            bail!("--jobs must be at least 1");
-        }
-        rayon::ThreadPoolBuilder::new().num_threads(j).build_global().context("setting the thread count")?;
+        rayon::ThreadPoolBuilder::new().num_threads(threads(j)?).build_global().context("setting the thread count")?;
     }
     let shard = shard.map(study::parse_shard).transpose()?;
     let results = results.unwrap_or_else(|| if quick { "target/quick-results".into() } else { "results".into() });
-    // parse every manifest first: a typo in the last one should not cost the first one's run
+    // parse and check every run of every manifest first: a mistake in the last one should not
+    // cost the first one's run
     let parsed = manifests.iter().map(|m| study::manifest::Manifest::load(m)).collect::<Result<Vec<_>, _>>()?;
+    for manifest in &parsed {
+        manifest.check_runs()?;
+    }
+    if let Some(shard) = shard {
+        check_shard(&parsed, shard)?;
+    }
     for manifest in &parsed {
         let options = study::RunOptions { quick, shard, fresh, results: results.clone(), progress: true, wait_for_lock: wait };
         let executed = study::run_study(manifest, &options)?;
         eprintln!("{}: {} run(s) executed, results in {}", manifest.study, executed.len(), results.join(&manifest.study).display());
     }
     Ok(())
+}
+
+/// The thread count for `--jobs J`: at least 1; more than the cores available to this process
+/// is reduced to them with a note (results do not depend on it, and a pool of thousands of
+/// threads on a few cores only adds overhead; refusing would break a script that passes the
+/// machine's nominal core count where a container allows fewer).
+fn threads(jobs: usize) -> Result<usize> {
+    if jobs == 0 {
+        bail!("--jobs must be at least 1");
+    }
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    if jobs > cores {
+        eprintln!(
+            "note: --jobs {jobs} is more than the {cores} core(s) available to this process; using {cores} (the results do not depend on the thread count; more threads than cores only add overhead)"
+        );
+    }
+    Ok(jobs.min(cores))
+}
+
+/// A shard must hold at least one run of the manifests given (each manifest's runs are dealt
+/// out to the shards in order); a manifest of which it holds none gets a note.
+fn check_shard(manifests: &[study::manifest::Manifest], (k, n): (usize, usize)) -> Result<()> {
+    let counts: Vec<(&str, usize, usize)> =
+        manifests.iter().map(|m| (m.study.as_str(), m.runs.len(), (0..m.runs.len()).filter(|i| i % n == k - 1).count())).collect();
+    if counts.iter().all(|c| c.2 == 0) {
+        let sizes: Vec<String> = counts.iter().map(|(s, r, _)| format!("{s} has {r} run(s)")).collect();
+        bail!(
+            "--shard {k}/{n}: this shard holds no run ({}); shard K of N runs the runs K, K + N, K + 2N, ... of each study, so K must be at most its number of runs",
+            sizes.join(", ")
+        );
+    }
+    for (s, r, _) in counts.iter().filter(|c| c.2 == 0) {
+        eprintln!("note: --shard {k}/{n} holds no run of {s} ({r} run(s)); other shards run them");
+    }
+    Ok(())
+}
+
+/// Whether `dir` is the tracked results folder `results/` of the current directory, the one
+/// `CLAIMS.md` names as `results/` and where every declared study must be complete.
+fn is_tracked_results(dir: &std::path::Path) -> bool {
+    let tracked = std::path::Path::new("results");
+    dir == tracked || matches!((dir.canonicalize(), tracked.canonicalize()), (Ok(a), Ok(b)) if a == b)
+}
+
+/// `drift --accept`: rerun the studies in full (every run checked first) and rewrite their results.
+fn accept_studies(accept: &[String], experiments: &std::path::Path, results: &std::path::Path) -> Result<()> {
+    let manifests = study::manifest::declared(experiments, accept)?;
+    for m in &manifests {
+        m.check_runs()?;
+    }
+    for m in &manifests {
+        let options = study::RunOptions {
+            quick: false,
+            shard: None,
+            fresh: true,
+            results: results.to_path_buf(),
+            progress: true,
+            wait_for_lock: false,
+        };
+        study::run_study(m, &options)?;
+        eprintln!(
+            "accepted: {} rewritten from a full rerun of {}; run `signorini figures`, review and commit the change",
+            results.join(&m.study).display(),
+            m.file.display()
+        );
+    }
+    Ok(())
+}
+
+/// Where the drift report goes by default: `target/drift/report[_quick][-STUDY...].json`, or
+/// `DIR/drift-report.json` for a comparison against DIR (not the report `make test` leaves).
+fn default_report(quick: bool, against: Option<&std::path::Path>, only: &[String]) -> std::path::PathBuf {
+    match against {
+        Some(dir) => dir.join("drift-report.json"),
+        None => std::path::Path::new("target/drift").join(format!(
+            "report{}{}.json",
+            if quick { "_quick" } else { "" },
+            only.iter().map(|s| format!("-{s}")).collect::<String>()
+        )),
+    }
+}
+
+/// The verdict line of a drift run: none, or what moved and what to do about it.
+fn drift_outcome(report: &study::drift::DriftReport, against: Option<&std::path::Path>, results: &std::path::Path) -> Result<()> {
+    let n = report.studies.len();
+    let studies = format!("{n} {}", if n == 1 { "study" } else { "studies" });
+    let not_compared = if report.not_compared.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; not compared (not in {}): {}",
+            against.map(|d| d.display().to_string()).unwrap_or_default(),
+            report.not_compared.join(", ")
+        )
+    };
+    match (report.rows.len(), against) {
+        (0, None) => {
+            println!("drift: none ({studies} checked at every level{})", if report.quick { " of the quick forms" } else { "" });
+            Ok(())
+        }
+        (0, Some(dir)) => {
+            println!("drift: none ({studies} of {} compared with {} at every level{not_compared})", dir.display(), results.display());
+            Ok(())
+        }
+        (rows, None) => bail!(
+            "drift: {rows} field(s) moved; if the change is deliberate, run `signorini drift --accept STUDY`, then `signorini figures`, and commit results/ and figures/"
+        ),
+        (rows, Some(dir)) => bail!(
+            "drift: {rows} field(s) of {dir} differ from the stored results in {} ({studies} compared{not_compared}); the stored results are unchanged. \
+             If {dir} was rerun with other settings on purpose, the rows above are what they changed; to recompute {dir}, rerun the study into it with `signorini run experiments/STUDY.toml --fresh --results {dir}`",
+            results.display(),
+            dir = dir.display()
+        ),
+    }
 }
 
 fn run_drift(
@@ -379,24 +510,9 @@ fn run_drift(
     results: &std::path::Path,
 ) -> Result<()> {
     if !accept.is_empty() {
-        for m in study::manifest::declared(experiments, accept)? {
-            let options = study::RunOptions {
-                quick: false,
-                shard: None,
-                fresh: true,
-                results: results.to_path_buf(),
-                progress: true,
-                wait_for_lock: false,
-            };
-            study::run_study(&m, &options)?;
-            eprintln!(
-                "accepted: {} rewritten from a full rerun of {}; run `signorini figures`, review and commit the change",
-                results.join(&m.study).display(),
-                m.file.display()
-            );
-        }
-        return Ok(());
+        return accept_studies(accept, experiments, results);
     }
+    let results = if is_tracked_results(results) { std::path::Path::new("results") } else { results };
     let manifests = study::manifest::declared(experiments, only)?;
     let scratch = std::path::PathBuf::from("target/drift").join(if quick { "quick" } else { "full" });
     let options = study::drift::DriftOptions {
@@ -407,45 +523,88 @@ fn run_drift(
         progress: true,
     };
     let report = study::drift::run(&manifests, only.is_empty(), &options, &|r| {
-        signorini::claims::claims(r).map(|c| signorini::claims::markdown(&c))
+        signorini::claims::claims(r).map(|c| signorini::claims::markdown_for(&c, r))
     })?;
     // the table first: a report that cannot be written must not cost it
-    if report.rows.is_empty() {
-        println!(
-            "drift: none ({} {} checked at every level{})",
-            manifests.len(),
-            if manifests.len() == 1 { "study" } else { "studies" },
-            if quick { " of the quick forms" } else { "" }
-        );
-    } else {
+    if !report.rows.is_empty() {
         print!("{}", study::drift::table(&report.rows));
     }
     println!("\nlargest change of each float field (whether within tolerance or not):\n{}", study::drift::changes_table(&report));
-    let default_name =
-        format!("report{}{}.json", if quick { "_quick" } else { "" }, only.iter().map(|s| format!("-{s}")).collect::<String>());
-    let file = report_file.map(|p| p.to_path_buf()).unwrap_or_else(|| std::path::Path::new("target/drift").join(default_name));
+    let file = report_file.map(|p| p.to_path_buf()).unwrap_or_else(|| default_report(quick, against, only));
     signorini::records::write_json(&file, &report).with_context(|| format!("writing the drift report {}", file.display()))?;
     println!("report: {}", file.display());
-    if report.rows.is_empty() {
-        Ok(())
-    } else {
-        bail!(
-            "drift: {} field(s) moved; if the change is deliberate, run `signorini drift --accept STUDY`, then `signorini figures`, and commit results/ and figures/",
-            report.rows.len()
-        )
-    }
+    drift_outcome(&report, against, results)
 }
 
-fn run_figures(results: &std::path::Path, figures: &std::path::Path, experiments: &std::path::Path) -> Result<()> {
-    for m in study::manifest::declared(experiments, &[])? {
-        study::check_complete(&m, results)?;
+/// The declared studies `figures` checks complete in `results` and those whose figures it draws
+/// (`None`: every figure): in the tracked `results/`, every declared study is checked; in
+/// another folder, those it holds. `--study` names the drawn ones, each of which the folder must hold.
+fn figure_studies(
+    results: &std::path::Path,
+    tracked: bool,
+    experiments: &std::path::Path,
+    only: &[String],
+) -> Result<(Vec<study::manifest::Manifest>, Option<Vec<String>>)> {
+    let all = study::manifest::declared(experiments, &[])?;
+    let named = if only.is_empty() {
+        None
+    } else {
+        Some(study::manifest::declared(experiments, only)?.into_iter().map(|m| m.study).collect::<Vec<_>>())
+    };
+    if tracked {
+        return Ok((all, named));
     }
-    let written = signorini::plot::draw_all(results, figures)?;
-    for f in &written {
+    let held = study::drift::held_by(results, &all).with_context(|| format!("--results {}", results.display()))?;
+    let present: Vec<String> = held.present.iter().map(|m| m.study.clone()).collect();
+    let (dir, holds) = (results.display(), if present.is_empty() { "no declared study".to_string() } else { present.join(", ") });
+    if let Some(s) = named.iter().flatten().find(|s| !present.contains(s)) {
+        bail!(
+            "--study {s}: {dir} does not hold it (it holds: {holds}); rerun it there with `signorini run experiments/{s}.toml --results {dir}`"
+        );
+    }
+    if present.is_empty() {
+        let declared: Vec<&str> = all.iter().map(|m| m.study.as_str()).collect();
+        bail!(
+            "nothing to draw: {dir} holds none of the declared studies ({}); rerun one there with `signorini run experiments/STUDY.toml --results {dir}`",
+            declared.join(", ")
+        );
+    }
+    if !held.absent.is_empty() {
+        eprintln!("figures: {dir} does not hold {}: their figures and claims are not drawn", held.absent.join(", "));
+    }
+    Ok((held.present, Some(named.unwrap_or(present))))
+}
+
+fn run_figures(
+    results: Option<&std::path::Path>,
+    figures: Option<&std::path::Path>,
+    experiments: &std::path::Path,
+    only: &[String],
+) -> Result<()> {
+    let tracked = results.is_none_or(is_tracked_results);
+    let results = match results {
+        Some(r) if !tracked => r.to_path_buf(),
+        _ => std::path::PathBuf::from("results"),
+    };
+    let figures = figures.map(|f| f.to_path_buf()).unwrap_or_else(|| if tracked { "figures".into() } else { results.join("figures") });
+    let (checked, drawn) = figure_studies(&results, tracked, experiments, only)?;
+    for m in &checked {
+        study::check_complete(m, &results)?;
+    }
+    for f in signorini::plot::draw_studies(&results, &figures, drawn.as_deref())? {
         println!("wrote {}", f.display());
     }
-    signorini::claims::write(results).with_context(|| format!("writing {}", results.join("CLAIMS.md").display()))?;
+    signorini::claims::write(&results).with_context(|| format!("writing {}", results.join("CLAIMS.md").display()))?;
     println!("wrote {}", results.join("CLAIMS.md").display());
+    Ok(())
+}
+
+/// `export`: solve, write the case files, say where.
+fn run_export(args: &SolveArgs, out: &std::path::Path) -> Result<()> {
+    let (mesh, sol, r) = run_solve(args)?;
+    for f in report::export_case(out, &mesh, &sol, &r)? {
+        println!("wrote {}", f.display());
+    }
     Ok(())
 }
 
@@ -490,14 +649,16 @@ fn main() -> ExitCode {
             }
         }),
         Command::Adapt(args) => run_adapt(args),
-        Command::Figures { results, figures, experiments } => run_figures(results, figures, experiments),
+        Command::Figures { results, figures, experiments, study } => {
+            run_figures(results.as_deref(), figures.as_deref(), experiments, study)
+        }
         Command::Drift { quick, against, report, accept, study, experiments, results } => {
             run_drift(*quick, against.as_deref(), report.as_deref(), accept, study, experiments, results)
         }
         Command::Run { manifests, quick, jobs, shard, fresh, results, wait } => {
             run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, results.clone(), *wait)
         }
-        Command::Export { args, out } => run_solve(args).and_then(|(mesh, sol, r)| report::export_case(out, &mesh, &sol, &r)),
+        Command::Export { args, out } => run_export(args, out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

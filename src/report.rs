@@ -144,7 +144,7 @@ impl SolveReport {
         let interval = |z: &ContactInterval| {
             let component =
                 if self.contact_zones.iter().any(|z| z.component > 0) { format!(" of part {}", z.component + 1) } else { String::new() };
-            format!("[{}, {}]{component}", z.s[0], z.s[1])
+            format!("[{}, {}]{component}", significant(z.s[0]), significant(z.s[1]))
         };
         let zone = match self.contact_zones.as_slice() {
             [] => "no contact zone".to_string(),
@@ -198,8 +198,20 @@ impl SolveReport {
     }
 }
 
-/// Write `mesh.vtu` (displacement, contact force, active set) and `case.json` into `dir`.
-pub fn export_case(dir: &Path, mesh: &Mesh, sol: &DiscreteSolution, report: &SolveReport) -> Result<()> {
+/// `v` to 6 significant digits without trailing zeros (0.1875, 0.254745): an arc length in the
+/// summary, not the 17 digits of a point on a curved Gmsh boundary (`--json` keeps those).
+fn significant(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return v.to_string();
+    }
+    let decimals = (5 - v.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
+}
+
+/// Write `mesh.vtu` (displacement, contact force, active set) and `case.json` into `dir`;
+/// returns the files written.
+pub fn export_case(dir: &Path, mesh: &Mesh, sol: &DiscreteSolution, report: &SolveReport) -> Result<Vec<std::path::PathBuf>> {
     let n = sol.nodes.len();
     let mut lambda = vec![0.0; n];
     let mut active = vec![0i32; n];
@@ -220,7 +232,8 @@ pub fn export_case(dir: &Path, mesh: &Mesh, sol: &DiscreteSolution, report: &Sol
         ],
         &[],
     );
-    records::write_atomic(&dir.join("mesh.vtu"), doc.as_bytes())?;
-    records::write_json(&dir.join("case.json"), report)?;
-    Ok(())
+    let (vtu, case) = (dir.join("mesh.vtu"), dir.join("case.json"));
+    records::write_atomic(&vtu, doc.as_bytes())?;
+    records::write_json(&case, report)?;
+    Ok(vec![vtu, case])
 }

@@ -85,6 +85,21 @@ pub const FIGURES: [&str; 15] = [
     "hertz_mesh",
 ];
 
+/// The study a figure is drawn from (the table above).
+pub fn study_of(figure: &str) -> Option<&'static str> {
+    Some(match figure {
+        "fig2a" | "fig2b" | "fig4a" => "ex71",
+        "fig3a" | "fig3b" | "fig4b" => "ex72",
+        "fig3b_variant" | "contact_term_ablation" => "contact_term_ablation",
+        "c0_sweep" => "c0_sweep",
+        "log_ablation" => "log_ablation",
+        "theta_ablation" => "theta_ablation",
+        "fb_error" | "fb_mesh" => "fb",
+        "hertz_pressure" | "hertz_mesh" => "hertz",
+        _ => return None,
+    })
+}
+
 /// C0 of Section 7.
 const C0_PAPER: f64 = 0.45;
 /// An estimator term below `ROUNDOFF` times the largest term of its level is round-off: drawn
@@ -119,7 +134,13 @@ pub struct Outcome {
 /// Draw every figure whose results exist into `figures/`; figures without results are skipped
 /// with a note on stderr. Returns the files written.
 pub fn draw_all(results: &Path, figures: &Path) -> anyhow::Result<Vec<PathBuf>> {
-    let outcome = draw_figures(results, figures)?;
+    draw_studies(results, figures, None)
+}
+
+/// [`draw_all`] for the figures of some studies only (`None`: every figure).
+pub fn draw_studies(results: &Path, figures: &Path, studies: Option<&[String]>) -> anyhow::Result<Vec<PathBuf>> {
+    let keep = |figure: &str| studies.is_none_or(|s| study_of(figure).is_some_and(|st| s.iter().any(|x| x == st)));
+    let outcome = draw_figures_where(results, figures, &keep)?;
     for (name, why) in &outcome.skipped {
         eprintln!("figures: skipped {name}: {why}");
     }
@@ -130,11 +151,16 @@ pub fn draw_all(results: &Path, figures: &Path) -> anyhow::Result<Vec<PathBuf>> 
 /// A figure that fails (unreadable record, drawing error) does not stop the others; the errors
 /// are reported together at the end.
 pub fn draw_figures(results: &Path, figures: &Path) -> anyhow::Result<Outcome> {
+    draw_figures_where(results, figures, &|_| true)
+}
+
+/// [`draw_figures`] for the figures `keep` accepts.
+pub fn draw_figures_where(results: &Path, figures: &Path, keep: &dyn Fn(&str) -> bool) -> anyhow::Result<Outcome> {
     register_font()?;
     std::fs::create_dir_all(figures).with_context(|| format!("creating {}", figures.display()))?;
     let mut outcome = Outcome::default();
     let mut errors = Vec::new();
-    for name in FIGURES {
+    for name in FIGURES.into_iter().filter(|f| keep(f)) {
         match build(name, results).and_then(|b| match b {
             Ok(fig) => write_figure(&fig, figures, name).map(Ok),
             Err(why) => Ok(Err(why)),

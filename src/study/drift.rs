@@ -21,6 +21,12 @@
 //! Besides the numbers, the files derived from the records are checked: `levels.csv` and
 //! `provenance.json`'s run list must be exactly what the stored records give
 //! ([`check_derived`]), so a hand edit or a bad merge of a view is drift too.
+//!
+//! `--against DIR` compares the records of another results folder (a study rerun into a scratch
+//! folder, or all of them with another ordering) with the stored ones instead of rerunning: the
+//! studies DIR holds are compared and the others named as not compared ([`select_against`]); a
+//! folder holding none is an error. Their provenance must match too ([`compare_provenance`]):
+//! records made from an edited manifest, problem file or mesh are reported as such.
 
 use super::manifest::{DriftSpec, Manifest, Tolerance};
 use crate::records::LevelRecord;
@@ -402,12 +408,116 @@ pub struct DriftReport {
     pub rows: Vec<DriftRow>,
     /// Per study, per float field: the largest change seen (drift or not).
     pub changes: BTreeMap<String, BTreeMap<String, FieldChange>>,
+    /// With `against`: the declared studies the folder does not hold, which were not compared.
+    #[serde(default)]
+    pub not_compared: Vec<String>,
+}
+
+/// The declared studies a results folder holds (a folder `DIR/STUDY`), those it does not, and
+/// its other folders (not declared studies).
+#[derive(Clone, Debug)]
+pub struct Held {
+    pub present: Vec<Manifest>,
+    pub absent: Vec<String>,
+    pub undeclared: Vec<String>,
+}
+
+/// Which of `manifests`' studies `dir` holds. A `dir` that is not a readable folder is an error.
+pub fn held_by(dir: &Path, manifests: &[Manifest]) -> std::io::Result<Held> {
+    let entries =
+        std::fs::read_dir(dir).map_err(|e| std::io::Error::new(e.kind(), format!("reading the folder {}: {e}", dir.display())))?;
+    let mut folders: Vec<String> =
+        entries.flatten().filter(|e| e.path().is_dir()).map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+    folders.sort();
+    let (present, absent): (Vec<&Manifest>, Vec<&Manifest>) = manifests.iter().partition(|m| folders.contains(&m.study));
+    let undeclared = folders.into_iter().filter(|f| !manifests.iter().any(|m| &m.study == f)).collect();
+    Ok(Held { present: present.into_iter().cloned().collect(), absent: absent.iter().map(|m| m.study.clone()).collect(), undeclared })
+}
+
+/// "a, b" or "none".
+fn listed(names: &[String]) -> String {
+    if names.is_empty() { "none".into() } else { names.join(", ") }
+}
+
+/// The studies a comparison `against` a folder covers: those of `manifests` the folder holds
+/// (with `named`, the studies were named one by one and each must be there), and the names of
+/// those it does not. A folder holding none of them is an error: there is nothing to compare.
+pub fn select_against(dir: &Path, manifests: &[Manifest], named: bool) -> anyhow::Result<(Vec<Manifest>, Vec<String>)> {
+    let held = held_by(dir, manifests).map_err(|e| anyhow::anyhow!("--against {}: {e}", dir.display()))?;
+    if named && !held.absent.is_empty() {
+        anyhow::bail!(
+            "--against {}: the folder does not hold {} (it holds: {}); nothing of {} to compare",
+            dir.display(),
+            held.absent.join(", "),
+            listed(&held.present.iter().map(|m| m.study.clone()).chain(held.undeclared.clone()).collect::<Vec<_>>()),
+            if held.absent.len() == 1 { "it" } else { "theirs" }
+        );
+    }
+    if held.present.is_empty() {
+        anyhow::bail!(
+            "--against {}: nothing to compare: the folder holds none of the declared studies ({}); its folders: {}. Rerun a study into it with `signorini run experiments/STUDY.toml --results {}`",
+            dir.display(),
+            manifests.iter().map(|m| m.study.as_str()).collect::<Vec<_>>().join(", "),
+            listed(&held.undeclared),
+            dir.display()
+        );
+    }
+    Ok((held.present, held.absent))
+}
+
+/// The provenance of a study in `fresh` against the stored one: the manifest, problem files and
+/// meshes the runs were made with (by hash). Records made from an edited manifest or problem
+/// file differ even where every number agrees.
+pub fn compare_provenance(study: &str, stored: &StudyDir, fresh: &StudyDir) -> Vec<DriftRow> {
+    use super::provenance::Provenance;
+    let read = |d: &StudyDir| std::fs::read_to_string(d.provenance_file()).ok().and_then(|t| serde_json::from_str::<Provenance>(&t).ok());
+    let tol = "exact (what the runs were made with)";
+    let (Some(s), Some(f)) = (read(stored), read(fresh)) else {
+        // a stored provenance that cannot be read is drift of the store already (check_derived)
+        return match read(fresh) {
+            None => vec![row(
+                study,
+                "*",
+                None,
+                "provenance.json",
+                "present".into(),
+                format!("(missing or unreadable: {})", fresh.provenance_file().display()),
+                None,
+                tol.into(),
+            )],
+            Some(_) => Vec::new(),
+        };
+    };
+    let mut out = Vec::new();
+    if s.manifest_sha256 != f.manifest_sha256 {
+        let text = |p: &Provenance| format!("{} (sha256 {})", p.manifest, &p.manifest_sha256[..p.manifest_sha256.len().min(12)]);
+        out.push(row(study, "*", None, "manifest_sha256", text(&s), text(&f), None, tol.into()));
+    }
+    let hashes = |mut v: Vec<String>| {
+        v.sort();
+        v.join(" ")
+    };
+    let problems = |p: &Provenance| hashes(p.problem_files.iter().map(|f| f.sha256.clone().unwrap_or("(unreadable)".into())).collect());
+    if problems(&s) != problems(&f) {
+        out.push(row(study, "*", None, "problem file sha256", problems(&s), problems(&f), None, tol.into()));
+    }
+    let meshes = |p: &Provenance| hashes(p.mesh_sha256.values().cloned().collect());
+    if meshes(&s) != meshes(&f) {
+        out.push(row(study, "*", None, "mesh_sha256", meshes(&s), meshes(&f), None, tol.into()));
+    }
+    out
 }
 
 /// Rerun (or read, with `against`) every manifest's study and compare it with the stored
 /// results: numbers within the manifests' tolerances and the derived files. `claims` renders
 /// `CLAIMS.md` from the results folder; it is compared with the stored file when every
-/// declared study is checked.
+/// declared study is checked (not with `against`, which compares another folder's records).
+///
+/// With `against`, the studies compared are those the folder holds ([`select_against`]; with
+/// `all_studies` false the manifests were named and each must be there), the others are listed
+/// in [`DriftReport::not_compared`], and the provenance of each study (manifest, problem files
+/// and meshes, by hash) must match the stored one ([`compare_provenance`]). Without it, every
+/// run of every manifest is checked ([`Manifest::check_runs`]) before any is rerun.
 pub fn run(
     manifests: &[Manifest],
     all_studies: bool,
@@ -415,6 +525,15 @@ pub fn run(
     claims: &dyn Fn(&Path) -> std::io::Result<String>,
 ) -> anyhow::Result<DriftReport> {
     use anyhow::Context;
+    let (manifests, not_compared) = match &opts.against {
+        Some(dir) => select_against(dir, manifests, !all_studies)?,
+        None => {
+            for m in manifests {
+                m.check_runs()?;
+            }
+            (manifests.to_vec(), Vec::new())
+        }
+    };
     let mut report = DriftReport {
         date: super::provenance::utc_now(),
         quick: opts.quick,
@@ -422,8 +541,9 @@ pub fn run(
         studies: Vec::new(),
         rows: Vec::new(),
         changes: BTreeMap::new(),
+        not_compared,
     };
-    for m in manifests {
+    for m in &manifests {
         let fresh_root = match &opts.against {
             Some(dir) => dir.clone(),
             None => {
@@ -448,6 +568,9 @@ pub fn run(
         if !stored.is_empty() {
             c.rows.extend(check_derived(&stored_dir, &m.study, &stored));
         }
+        if opts.against.is_some() {
+            c.rows.extend(compare_provenance(&m.study, &stored_dir, &StudyDir::new(&fresh_root, &m.study)));
+        }
         if opts.progress {
             eprintln!(
                 "{}: {}",
@@ -459,7 +582,7 @@ pub fn run(
         report.rows.extend(c.rows);
         report.changes.insert(m.study.clone(), c.changes);
     }
-    if all_studies {
+    if all_studies && opts.against.is_none() {
         let file = opts.results.join("CLAIMS.md");
         let stored = std::fs::read_to_string(&file).unwrap_or_default();
         let rendered = claims(&opts.results).with_context(|| format!("rendering {}", file.display()))?;

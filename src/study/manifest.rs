@@ -30,22 +30,26 @@
 //! id = "uniform"
 //! refine = "uniform"
 //! levels = 9
-//! no_reference = true        # drop the defaults' reference in this run
+//! no_reference = true        # drop the defaults' reference in this run (only where [defaults] has one)
 //!
 //! [drift]                    # tolerances of the drift check (study::drift): a float passes
 //!                            # when |fresh - stored| <= rel |stored| + floor max_run |stored|
+//!                            # (rel and floor in [0, 1]: a larger tolerance lets anything pass)
 //! default = { rel = 1e-9, floor = 1e-14 }
 //! fields = { err_nodal = { rel = 1e-6, floor = 1e-12 } }   # float fields of LevelRecord only
 //! [[drift.rates]]            # one-sided floors on observed rates in NDF
 //! run = "uniform"
-//! field = "err_quadrature"
+//! field = "err_quadrature"   # a float field of LevelRecord
 //! min = 1.4
-//! last = 4
+//! last = 4                   # 2 ..= the run's levels
 //! ```
 //!
 //! Every error names the file, the key and what was expected; unknown keys are errors. The run's
 //! loop settings are checked by [`AdaptConfig::validate`](crate::adapt::AdaptConfig::validate),
-//! as on the command line.
+//! as on the command line. `save_levels` may not repeat a level. What needs the runs' files
+//! and this machine (the meshes built with their problems, memory for the initial mesh and the
+//! reference, `max_ndof` against the initial mesh) is checked by [`Manifest::check_runs`] for
+//! every run before any is solved.
 
 use crate::adapt::{AdaptConfig, Refine};
 use crate::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
@@ -130,6 +134,8 @@ pub struct RateFloor {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DriftSpec {
+    /// The tolerance of fields not listed in `fields` (rel 1e-9, floor 0 when not given).
+    #[serde(default = "default_tolerance")]
     pub default: Tolerance,
     #[serde(default)]
     pub fields: BTreeMap<String, Tolerance>,
@@ -137,9 +143,13 @@ pub struct DriftSpec {
     pub rates: Vec<RateFloor>,
 }
 
+fn default_tolerance() -> Tolerance {
+    Tolerance { rel: 1e-9, floor: 0.0 }
+}
+
 impl Default for DriftSpec {
     fn default() -> Self {
-        DriftSpec { default: Tolerance { rel: 1e-9, floor: 0.0 }, fields: BTreeMap::new(), rates: Vec::new() }
+        DriftSpec { default: default_tolerance(), fields: BTreeMap::new(), rates: Vec::new() }
     }
 }
 
@@ -264,6 +274,7 @@ impl Manifest {
                 sampling: eo.sampling.or(ed.sampling).unwrap_or(e.sampling),
                 stress_frame: eo.stress_frame.or(ed.stress_frame).unwrap_or(e.stress_frame),
             };
+            check_no_reference(r, &d).map_err(|(expected, got)| invalid(key("no_reference"), expected, got))?;
             let reference = if r.no_reference == Some(true) { None } else { r.reference.clone().or(d.reference.clone()) };
             if let Some(rf) = &reference
                 && !(rf.theta > 0.0 && rf.theta <= 1.0)
@@ -299,6 +310,13 @@ impl Manifest {
                     l.to_string(),
                 ));
             }
+            if let Some(l) = first_repeated(&spec.save_levels) {
+                return Err(invalid(
+                    key("save_levels"),
+                    "distinct levels (each level is saved once)",
+                    format!("{:?} (level {l} more than once)", spec.save_levels),
+                ));
+            }
             if spec.reference.as_ref().is_some_and(|rf| rf.min_ndof == 0) {
                 return Err(invalid(key("reference.min_ndof"), "a number of unknowns >= 1", "0".into()));
             }
@@ -326,21 +344,66 @@ impl Manifest {
                 }
             }
             for (part, v) in [("rel", tol.rel), ("floor", tol.floor)] {
-                if !(v.is_finite() && v >= 0.0) {
-                    return Err(invalid(format!("drift.{key}.{part}"), "a finite number >= 0", v.to_string()));
+                if !(v.is_finite() && (0.0..=MAX_TOLERANCE).contains(&v)) {
+                    return Err(invalid(format!("drift.{key}.{part}"), TOLERANCE_RANGE, format!("{v:e}")));
                 }
             }
         }
         for (i, r) in drift.rates.iter().enumerate() {
-            if !runs.iter().any(|p: &PlannedRun| p.spec.id == r.run) {
-                return Err(invalid(format!("drift.rates[{i}].run"), "the id of a declared run", format!("{:?}", r.run)));
+            let key = |k: &str| format!("drift.rates[{i}].{k}");
+            let Some(run) = runs.iter().find(|p: &&PlannedRun| p.spec.id == r.run) else {
+                return Err(invalid(key("run"), "the id of a declared run", format!("{:?}", r.run)));
+            };
+            if !floats.contains(&r.field) {
+                return Err(invalid(
+                    key("field"),
+                    &format!("a float field of the level records ({})", floats.join(", ")),
+                    format!("{:?}", r.field),
+                ));
             }
-            if r.last < 2 {
-                return Err(invalid(format!("drift.rates[{i}].last"), "at least 2 levels", r.last.to_string()));
+            if !r.min.is_finite() {
+                return Err(invalid(key("min"), "a finite rate", r.min.to_string()));
+            }
+            if r.last < 2 || r.last > run.spec.levels {
+                return Err(invalid(
+                    key("last"),
+                    &format!("a number of levels in 2..={} (run {} has {} levels)", run.spec.levels, r.run, run.spec.levels),
+                    r.last.to_string(),
+                ));
             }
         }
         Ok(Manifest { study, file, description: raw.description.unwrap_or_default(), runs, drift, bytes: text.as_bytes().to_vec() })
     }
+}
+
+/// The largest drift tolerance, `rel` or `floor`: a relative change of 1 already lets a number
+/// fall to 0 or double unnoticed, and `floor = 1` lets it move by the largest value the field
+/// takes in its run, so a larger tolerance checks nothing. The measured ones
+/// (`results/roundoff/`) are below 1e-6.
+pub const MAX_TOLERANCE: f64 = 1.0;
+const TOLERANCE_RANGE: &str = "a number in [0, 1] (a tolerance above 1 lets any change pass: rel = 1 already accepts a number falling to 0 or doubling; the measured tolerances are below 1e-6)";
+
+/// `no_reference = true` drops the defaults' reference from one run; anything else is a mistake:
+/// `false` (which means nothing), alongside the run's own `reference` (which it would silently
+/// drop), or with no reference in `[defaults]` to drop. The error's (expected, got).
+fn check_no_reference(run: &RunToml, defaults: &RunToml) -> Result<(), (&'static str, String)> {
+    match run.no_reference {
+        None => Ok(()),
+        Some(false) => Err(("true (drop the reference of [defaults] in this run) or no key at all", "false".into())),
+        Some(true) if run.reference.is_some() => {
+            Err(("either the run's own reference or no_reference = true, not both", "no_reference = true beside reference".into()))
+        }
+        Some(true) if defaults.reference.is_none() => {
+            Err(("no_reference = true only where [defaults] declares a reference to drop", "true, but [defaults] has no reference".into()))
+        }
+        Some(true) => Ok(()),
+    }
+}
+
+/// The first value that occurs twice in `values`.
+fn first_repeated(values: &[usize]) -> Option<usize> {
+    let mut seen = std::collections::BTreeSet::new();
+    values.iter().copied().find(|v| !seen.insert(*v))
 }
 
 /// The problem a manifest at `manifest` means by `problem`: a built-in name as it is, the path of
@@ -391,6 +454,63 @@ impl Manifest {
     }
 }
 
+impl Manifest {
+    /// What a run needs of its files and of this machine, checked for every run before any is
+    /// solved (a mistake in the last run must not cost the first one's): the mesh is read and
+    /// built with the run's problem (a missing or malformed mesh file, a boundary group the
+    /// problem does not name, a kink that is not a vertex), the initial mesh and the reference
+    /// solution's `min_ndof` fit in this machine's memory ([`check_memory`](crate::solve::check_memory)),
+    /// `max_ndof` is at least the initial mesh's unknowns (level 0 is always solved), and a
+    /// reference is declared only for a problem without an exact solution.
+    pub fn check_runs(&self) -> Result<(), ManifestError> {
+        for (i, planned) in self.runs.iter().enumerate() {
+            self.check_run(i, &planned.spec)?;
+        }
+        Ok(())
+    }
+
+    fn check_run(&self, i: usize, spec: &RunSpec) -> Result<(), ManifestError> {
+        let invalid = |k: &str, expected: String, got: String| ManifestError::Invalid {
+            file: self.file.clone(),
+            key: format!("run[{i}].{k}"),
+            expected,
+            got: format!("{got} (run {})", spec.id),
+        };
+        let problem = crate::problems::load(&resolve_problem(&self.file, &spec.problem), &spec.constants)
+            .map_err(|e| invalid("problem", "a problem that loads".into(), format!("{:?}: {e}", spec.problem)))?;
+        let mesh_spec = MeshSpec::parse(&resolve_mesh(&self.file, &spec.mesh))
+            .map_err(|e| invalid("mesh", "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'".into(), format!("{:?}: {e}", spec.mesh)))?;
+        let ndof = mesh_spec.ndof().map_err(|e| invalid("mesh", "a readable mesh file".into(), format!("{:?}: {e}", spec.mesh)))?;
+        crate::solve::check_memory(&format!("the initial mesh {}", spec.mesh), ndof)
+            .map_err(|e| invalid("mesh", "an initial mesh that fits in this machine's memory".into(), e.to_string()))?;
+        mesh_spec
+            .build(problem.as_ref())
+            .map_err(|e| invalid("mesh", format!("a mesh problem {} can be solved on", spec.problem), format!("{:?}: {e}", spec.mesh)))?;
+        if let Some(max) = spec.max_ndof
+            && (max as f64) < ndof
+        {
+            return Err(invalid(
+                "max_ndof",
+                format!("a number of unknowns >= {ndof} (the initial mesh {} has {ndof}, and level 0 is always solved)", spec.mesh),
+                max.to_string(),
+            ));
+        }
+        if let Some(rf) = &spec.reference {
+            if problem.exact().is_some() {
+                return Err(invalid(
+                    "reference",
+                    format!("no reference: problem {} has an exact solution, which the errors are measured against", spec.problem),
+                    format!("a reference with min_ndof {}", rf.min_ndof),
+                ));
+            }
+            crate::solve::check_memory(&format!("the reference solution (min_ndof {})", rf.min_ndof), rf.min_ndof as f64).map_err(|e| {
+                invalid("reference.min_ndof", "a reference solution that fits in this machine's memory".into(), e.to_string())
+            })?;
+        }
+        Ok(())
+    }
+}
+
 /// The declared studies: every `*.toml` in `dir`, sorted by name; with `only`, just those
 /// (an unknown name is an error listing the declared ones).
 pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
@@ -401,6 +521,9 @@ pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
         .collect();
     files.sort();
+    if files.is_empty() {
+        anyhow::bail!("{} holds no study manifest (*.toml): nothing to do (the studies are declared in experiments/)", dir.display());
+    }
     let all = files.iter().map(|f| Manifest::load(f)).collect::<Result<Vec<_>, _>>()?;
     for name in only {
         if !all.iter().any(|m| &m.study == name) {

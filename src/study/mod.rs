@@ -328,8 +328,10 @@ pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<
         }
     }
     if !problems.is_empty() {
+        // the advice writes into the folder being checked, never into results/ unless that is it
+        let into = if results == std::path::Path::new("results") { String::new() } else { format!(" --results {}", results.display()) };
         bail!(
-            "{} does not match {}: {}. Complete it with `signorini run {}` (or start over with --fresh) before drawing from it",
+            "{} does not match {}: {}. Complete it with `signorini run {}{into}` (or start over with --fresh) before drawing from it",
             dir.root.display(),
             manifest.file.display(),
             problems.join("; "),
@@ -341,13 +343,18 @@ pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<
 
 /// The problem a stored run of `study` solved: its spec's problem resolved against the manifest
 /// the provenance names, with the run's constants (for figures and claims that need the problem's
-/// data, such as Hertz's radius and material).
+/// data, such as Hertz's radius and material). A problem file not found there (the study was
+/// run from another folder) is looked for beside `experiments/STUDY.toml`, so a study rerun
+/// into a scratch folder is drawn without copying its manifest and problem files.
 pub fn stored_problem(results: &std::path::Path, study: &str, spec: &RunSpec) -> Result<Box<dyn problems::Problem>> {
     let dir = StudyDir::new(results, study);
     let file = dir.provenance_file();
     let text = std::fs::read_to_string(&file).with_context(|| format!("reading {}", file.display()))?;
     let prov: provenance::Provenance = serde_json::from_str(&text).with_context(|| format!("reading {}", file.display()))?;
-    let path = manifest::resolve_problem(std::path::Path::new(&prov.manifest), &spec.problem);
+    let recorded = manifest::resolve_problem(std::path::Path::new(&prov.manifest), &spec.problem);
+    let declared = manifest::resolve_problem(&PathBuf::from("experiments").join(format!("{study}.toml")), &spec.problem);
+    let found = |p: &String| !problems::is_file(p) || std::path::Path::new(p).exists();
+    let path = [recorded.clone(), declared].into_iter().find(found).unwrap_or(recorded);
     problems::load(&path, &spec.constants).with_context(|| format!("the problem of {study}/{}", spec.id))
 }
 

@@ -40,23 +40,49 @@ impl ReferenceField {
     }
 }
 
+/// Levels the reference loop may refine through before giving up on `min_ndof`.
+pub const REFERENCE_LEVELS: usize = 200;
+
+/// Why a reference solution could not be computed.
+#[derive(Debug, thiserror::Error)]
+pub enum ReferenceError {
+    #[error(transparent)]
+    Adapt(#[from] adapt::AdaptError),
+    /// The loop ended before the reference reached `min_ndof` unknowns.
+    #[error("the reference solution reached {ndof} unknowns after {levels} levels, short of reference.min_ndof = {min_ndof}: {why}")]
+    Short { ndof: usize, levels: usize, min_ndof: usize, why: String },
+}
+
 /// Compute the reference solution: adaptive refinement from `mesh_spec` (estimator with
 /// `spec.contact_term`, otherwise the defaults) until the NDF reaches `spec.min_ndof`; the last
 /// level's solution. `on_level` sees every level (progress) and may stop the loop (an
-/// interrupt): then the result is `None`.
+/// interrupt): then the result is `None`. A loop that ends short of `min_ndof` (after
+/// [`REFERENCE_LEVELS`] levels) is an error saying how far it got.
 pub fn compute(
     problem: &dyn Problem,
     mesh_spec: &MeshSpec,
     spec: &ReferenceSpec,
     on_level: &mut dyn FnMut(&crate::adapt::LevelRecord) -> std::ops::ControlFlow<()>,
-) -> Result<Option<ReferenceField>, crate::adapt::AdaptError> {
+) -> Result<Option<ReferenceField>, ReferenceError> {
     let mesh = mesh_spec.build(problem).map_err(|e| adapt::AdaptError::Solve(e.into()))?;
     let estimator = crate::estimate::EstimatorConfig { contact_term: spec.contact_term, ..Default::default() };
-    let config = AdaptConfig { levels: 200, refine: Refine::Adaptive, theta: spec.theta, estimator, ..Default::default() };
+    let config = AdaptConfig { levels: REFERENCE_LEVELS, refine: Refine::Adaptive, theta: spec.theta, estimator, ..Default::default() };
     let out = adapt::run(problem, mesh, &config, None, &mut |level| {
         if level.record.ndof >= spec.min_ndof { std::ops::ControlFlow::Break(()) } else { on_level(level.record) }
     })?;
-    // the last level solved is the reference if it reached min_ndof (not if on_level stopped the loop)
-    let reached = out.termination == adapt::Termination::StoppedByObserver && out.records.last().is_some_and(|r| r.ndof >= spec.min_ndof);
-    Ok(reached.then(|| ReferenceField::new(out.mesh, out.solution.nodes.elements, out.solution.u)))
+    let last = out.records.last().expect("level 0 is always solved");
+    if last.ndof >= spec.min_ndof {
+        return Ok(Some(ReferenceField::new(out.mesh, out.solution.nodes.elements, out.solution.u)));
+    }
+    if out.termination == adapt::Termination::StoppedByObserver {
+        return Ok(None); // on_level stopped it (an interrupt)
+    }
+    let why = format!(
+        "the reference loop stops after {REFERENCE_LEVELS} levels, and marking with theta = {} added about {:.0} unknowns per level \
+         (the largest level-to-level growth was {}); lower reference.theta (more elements marked per level) or reference.min_ndof",
+        spec.theta,
+        last.ndof.saturating_sub(out.records[0].ndof) as f64 / (out.records.len() - 1).max(1) as f64,
+        out.records.windows(2).map(|w| w[1].ndof.saturating_sub(w[0].ndof)).max().unwrap_or(0)
+    );
+    Err(ReferenceError::Short { ndof: last.ndof, levels: out.records.len(), min_ndof: spec.min_ndof, why })
 }
