@@ -20,9 +20,11 @@ test: build
 	@mkdir -p target && (git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-before-test
 	$(CARGO) fmt --check
 	$(CARGO) clippy --release --locked --all-targets -- -D warnings
+	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || echo "NOTE: no chromium on this machine: the browser check of the study pages (tests/report_page.rs) is SKIPPED (apt-get install chromium; CI installs it)"
 	$(CARGO) test --release --locked
 	$(CARGO) run --release --locked --example own_problem
 	$(BIN) drift
+	$(BIN) report
 	SIGNORINI=$(abspath $(BIN)) CROSSCHECK_OUT=target/crosscheck-report crosscheck/run.sh
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-after-test
 	@diff target/status-before-test target/status-after-test >/dev/null || { echo "make test changed files git sees (before/after below); test outputs belong under target/"; diff target/status-before-test target/status-after-test; exit 1; }

@@ -109,6 +109,28 @@ enum Command {
         #[arg(long, value_name = "STUDY")]
         study: Vec<String>,
     },
+    /// Write one self-contained HTML page per study for a browser (OUT/STUDY.html): its figures
+    /// embedded, its CLAIMS rows, the drift status from the last drift report, the run table and
+    /// the provenance. Reads only files (records, PNGs, the drift report): run `figures` and
+    /// `drift` first for a current page.
+    Report {
+        /// Results root to read [default: results].
+        #[arg(long)]
+        results: Option<std::path::PathBuf>,
+        /// Folder of the figures' PNGs [default: figures, or DIR/figures with --results DIR].
+        #[arg(long)]
+        figures: Option<std::path::PathBuf>,
+        /// Folder the pages are written to [default: target/report, or DIR/report with --results DIR].
+        #[arg(long)]
+        out: Option<std::path::PathBuf>,
+        /// Only these studies (repeatable) [default: every study the results hold].
+        #[arg(long, value_name = "STUDY")]
+        study: Vec<String>,
+        /// The drift report the pages quote [default: target/drift/report.json, or
+        /// DIR/drift-report.json with --results DIR].
+        #[arg(long, value_name = "FILE")]
+        drift_report: Option<std::path::PathBuf>,
+    },
     /// Solve as `solve` does and write the mesh and solution for the NGSolve cross-check
     /// (OUT/mesh.vtu, OUT/case.json: the report `solve --json` prints).
     Export {
@@ -599,6 +621,26 @@ fn run_figures(
     Ok(())
 }
 
+/// `report`: the study pages, with the defaults of a scratch folder when --results names one.
+fn run_report(
+    results: Option<&std::path::Path>,
+    figures: Option<&std::path::Path>,
+    out: Option<&std::path::Path>,
+    studies: &[String],
+    drift_report: Option<&std::path::Path>,
+) -> Result<()> {
+    let tracked = results.is_none_or(is_tracked_results);
+    let results = results.map_or_else(|| std::path::PathBuf::from("results"), |r| r.to_path_buf());
+    let under = |tracked_default: &str, scratch: &str| if tracked { tracked_default.into() } else { results.join(scratch) };
+    let figures = figures.map_or_else(|| under("figures", "figures"), |f| f.to_path_buf());
+    let out = out.map_or_else(|| under("target/report", "report"), |o| o.to_path_buf());
+    let drift = drift_report.map_or_else(|| under("target/drift/report.json", "drift-report.json"), |d| d.to_path_buf());
+    for page in signorini::page::write_pages(&results, &figures, &out, studies, &drift)? {
+        println!("wrote {}", page.display());
+    }
+    Ok(())
+}
+
 /// `export`: solve, write the case files, say where.
 fn run_export(args: &SolveArgs, out: &std::path::Path) -> Result<()> {
     let (mesh, sol, r) = run_solve(args)?;
@@ -659,6 +701,9 @@ fn main() -> ExitCode {
             run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, results.clone(), *wait)
         }
         Command::Export { args, out } => run_export(args, out),
+        Command::Report { results, figures, out, study, drift_report } => {
+            run_report(results.as_deref(), figures.as_deref(), out.as_deref(), study, drift_report.as_deref())
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

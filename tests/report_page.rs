@@ -42,3 +42,23 @@ fn study_pages_load_in_chromium_with_every_image_and_claim() {
     }
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// `signorini report --study S --out DIR` writes exactly DIR/S.html; an unknown study is an error
+/// listing the ones present.
+#[test]
+fn report_command_writes_the_pages_asked_for() {
+    let out = std::env::temp_dir().join(format!("signorini-report-cli-{}", std::process::id()));
+    let bin = env!("CARGO_BIN_EXE_signorini");
+    let run = |args: &[&str]| std::process::Command::new(bin).arg("report").args(args).output().unwrap();
+    let ok = run(&["--study", "hertz", "--out", out.to_str().unwrap()]);
+    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    let files: Vec<_> = std::fs::read_dir(&out).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    assert_eq!(files, ["hertz.html"]);
+    let page = std::fs::read_to_string(out.join("hertz.html")).unwrap();
+    assert!(page.contains("<h1>Study hertz</h1>") && page.contains("data:image/png;base64,") && page.contains("id=\"claim-hertz\""));
+    let bad = run(&["--study", "nope", "--out", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert_eq!(bad.status.code(), Some(1), "{err}");
+    assert!(err.contains("study nope has no records") && err.contains("hertz"), "{err}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
