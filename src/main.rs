@@ -51,6 +51,11 @@ enum Command {
         /// Start over instead of resuming after the runs already finished.
         #[arg(long)]
         fresh: bool,
+        /// Replace stored runs whose spec differs from the manifest's (records and mesh
+        /// snapshots; each when its new run has finished) and remove stored runs the manifest
+        /// does not declare. Without it such a study is refused, naming the runs and keys.
+        #[arg(long, conflicts_with = "fresh")]
+        replace: bool,
         /// Results root [default: results, or target/quick-results with --quick].
         #[arg(long)]
         results: Option<std::path::PathBuf>,
@@ -383,6 +388,7 @@ fn run_studies(
     jobs: Option<usize>,
     shard: Option<&str>,
     fresh: bool,
+    replace: bool,
     results: Option<std::path::PathBuf>,
     wait: bool,
 ) -> Result<()> {
@@ -401,7 +407,7 @@ fn run_studies(
         check_shard(&parsed, shard)?;
     }
     for manifest in &parsed {
-        let options = study::RunOptions { quick, shard, fresh, results: results.clone(), progress: true, wait_for_lock: wait };
+        let options = study::RunOptions { quick, shard, fresh, replace, results: results.clone(), progress: true, wait_for_lock: wait };
         let executed = study::run_study(manifest, &options)?;
         eprintln!("{}: {} run(s) executed, results in {}", manifest.study, executed.len(), results.join(&manifest.study).display());
     }
@@ -461,6 +467,7 @@ fn accept_studies(accept: &[String], experiments: &std::path::Path, results: &st
             quick: false,
             shard: None,
             fresh: true,
+            replace: false,
             results: results.to_path_buf(),
             progress: true,
             wait_for_lock: false,
@@ -697,8 +704,8 @@ fn main() -> ExitCode {
         Command::Drift { quick, against, report, accept, study, experiments, results } => {
             run_drift(*quick, against.as_deref(), report.as_deref(), accept, study, experiments, results)
         }
-        Command::Run { manifests, quick, jobs, shard, fresh, results, wait } => {
-            run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, results.clone(), *wait)
+        Command::Run { manifests, quick, jobs, shard, fresh, replace, results, wait } => {
+            run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, *replace, results.clone(), *wait)
         }
         Command::Export { args, out } => run_export(args, out),
         Command::Report { results, figures, out, study, drift_report } => {
