@@ -147,7 +147,8 @@ struct EstimatorArgs {
     /// Estimator constant C_0 (estimate = C_0 eta_h).
     #[arg(long, allow_negative_numbers = true, default_value_t = 0.45)]
     c0: f64,
-    /// eta_5 over all contact nodes (as-written) or without full-contact nodes.
+    /// eta_5 over all contact nodes (as-written), without full-contact nodes, or the repaired
+    /// contact terms (only the tensile normal stress at full-contact nodes, eta_7 on a narrower set).
     #[arg(long, value_enum, default_value = "as-written")]
     contact_term: ContactTermArg,
     /// The log factor l_h.
@@ -162,6 +163,7 @@ struct EstimatorArgs {
 enum ContactTermArg {
     AsWritten,
     WithoutFullContact,
+    TensileOnFullContact,
 }
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum LogFactorArg {
@@ -182,6 +184,7 @@ impl EstimatorArgs {
             contact_term: match self.contact_term {
                 ContactTermArg::AsWritten => ContactTerm::AsWritten,
                 ContactTermArg::WithoutFullContact => ContactTerm::WithoutFullContact,
+                ContactTermArg::TensileOnFullContact => ContactTerm::TensileOnFullContact,
             },
             log_factor: match self.log_factor {
                 LogFactorArg::Squared => LogFactor::Squared,
