@@ -61,7 +61,7 @@ fn adapt_saves_its_last_level() {
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // the table's last row is level 3; the file has that level's triangles
-    let last = stdout.lines().filter(|l| l.trim_start().starts_with(char::is_numeric)).next_back().unwrap();
+    let last = stdout.lines().rfind(|l| l.trim_start().starts_with(char::is_numeric)).unwrap();
     let ndof: usize = last.split_whitespace().nth(1).unwrap().parse().unwrap();
     assert!(stdout.contains(&format!("wrote {} (level 3, NDF {ndof})", vtu.display())), "{stdout}");
     let cells = check_indicators(&vtu);
