@@ -27,7 +27,12 @@ pub(super) fn uniform_ndof_for(uniform: &RunRecord, err_field: &str, err: f64) -
 fn same_parity(r: &RunRecord, err_field: &str) -> Vec<(f64, f64)> {
     let err = verdict::field(r, err_field);
     let last = r.levels.len().saturating_sub(1);
-    r.levels.iter().zip(&err).filter(|(l, _)| (last - l.level) % 2 == 0).filter_map(|(l, e)| Some((l.ndof as f64, (*e)?))).collect()
+    r.levels
+        .iter()
+        .zip(&err)
+        .filter(|(l, _)| (last - l.level).is_multiple_of(2))
+        .filter_map(|(l, e)| Some((l.ndof as f64, (*e)?)))
+        .collect()
 }
 
 /// "at NDF 3.4e5 the adaptive error 1.87e-7; uniform refinement needs NDF 2.6e5 for it (0.77x)":
@@ -75,8 +80,7 @@ fn criteria(ctx: &Ctx, runs: &[RunRecord], problem: &str) -> (Vec<String>, Vec<O
         Trend::Inconclusive => None,
         _ => Some(false),
     }));
-    let rel: Vec<(String, f64)> =
-        [ad, l1].into_iter().flatten().filter_map(|r| c0_text(&format!("{}", r.run.id), r, ctx.err_field())).collect();
+    let rel: Vec<(String, f64)> = [ad, l1].into_iter().flatten().filter_map(|r| c0_text(&r.run.id, r, ctx.err_field())).collect();
     texts.push(if rel.is_empty() {
         "reliability: no error measured".into()
     } else {
