@@ -25,6 +25,8 @@
 //! Norms are maxima over a declared sampling: the element quadrature points or a dense lattice
 //! (elements), Gauss points or equispaced points with the end points (edges).
 
+pub mod repair;
+
 use crate::assembly::edge_basis;
 use crate::element::{self, Affine, EDGE_VERTICES, N_NODES};
 use crate::mesh::{Mesh, Part, dist};
@@ -45,8 +47,17 @@ pub enum ContactTerm {
     /// All contact nodes, as the paper writes eta_5.
     AsWritten,
     /// Without full-contact nodes N_h^FC (u_h.n = chi_h on all of Gamma_{p,C}), as in
-    /// Krause–Veeser–Walloth; PAPER-NOTES.md explains why.
+    /// Krause–Veeser–Walloth. At a node in full contact the exact normal stress is a compressive
+    /// contact pressure, not an error: taken over all contact nodes, eta_5 measures that pressure
+    /// and decays only like h (measured: the `contact_term_ablation` study).
     WithoutFullContact,
+    /// The repaired contact terms (beyond the paper): at a full-contact node eta_5 takes only the
+    /// tensile part (n . sigma(u_h) n)^+ of the normal stress, at other contact nodes it is as
+    /// written; eta_7 is taken over a narrower Lambda_h^C, the full-contact edges (all three
+    /// nodes active) and the edges through an active node with positive contact force that lies
+    /// on no full-contact edge (an isolated active node). See [`repair`] for why, and for the
+    /// step of the proof that is open.
+    TensileOnFullContact,
 }
 
 /// The log factor l_h multiplying the residual terms.
@@ -147,6 +158,11 @@ pub struct Estimate {
     pub element: Vec<f64>,
     /// Number of full-contact nodes (N_h^FC).
     pub full_contact_nodes: usize,
+    /// The largest eta_{5,p} over full-contact nodes p, as this variant takes it there: |sigma_nn|
+    /// (as written), 0 (without full-contact nodes), (sigma_nn)^+ (repaired). A diagnostic: it
+    /// shows where the repaired term sees a tensile normal stress that the variant without
+    /// full-contact nodes is blind to.
+    pub eta5_full_contact: f64,
 }
 
 /// Local (per element) quantities before they are gathered on patches.
@@ -155,9 +171,11 @@ struct ElementLocal {
     /// max |f + div sigma(u_h)| over the element
     residual: f64,
     /// per local edge: max |g - sigma n| (Neumann), or on contact edges the max |sigma_t|, max |sigma_n|
+    /// and max (sigma_n)^+ (the tensile part)
     neumann: [f64; 3],
     tangential: [f64; 3],
     normal: [f64; 3],
+    tensile: [f64; 3],
     /// per local edge on Gamma_C: max (u.n - chi)^+ and max (chi - u.n)^+
     penetration: [f64; 3],
     separation: [f64; 3],
@@ -295,6 +313,7 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
                                 StressFrame::Cartesian => (tr[0], tr[1]),
                             };
                             out.normal[le] = out.normal[le].max(s1.abs());
+                            out.tensile[le] = out.tensile[le].max(s1.max(0.0));
                             out.tangential[le] = out.tangential[le].max(s2.abs());
                             let phi = edge_basis(s);
                             let mut un = 0.0;
@@ -374,6 +393,9 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
         })
         .collect();
 
+    let repaired = config.contact_term == ContactTerm::TensileOnFullContact;
+    let in_lambda_repaired = repair::narrow_lambda(mesh, sol, &positive);
+
     // Gather per node.
     let (h_min, _) = mesh.h_range();
     let l_h = config.log_factor.value(h_min);
@@ -387,6 +409,7 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
             let mut full_contact = true;
             let mut has_contact_edge = false;
             let (mut pen, mut sep) = (0.0f64, 0.0f64);
+            let mut tensile = 0.0f64;
             for &t in els {
                 e[0] = e[0].max(local[t].residual);
                 for le in 0..3 {
@@ -397,10 +420,11 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
                             has_contact_edge = true;
                             e[3] = e[3].max(local[t].tangential[le]);
                             e[4] = e[4].max(local[t].normal[le]);
+                            tensile = tensile.max(local[t].tensile[le]);
                             let bn = nodes.boundary_nodes[bi];
                             full_contact &= bn.iter().all(|&q| sol.dofs.contact_index[q].is_some_and(|k| sol.active[k]));
                             pen = pen.max(local[t].penetration[le]);
-                            if positive(p) {
+                            if if repaired { in_lambda_repaired[bi] } else { positive(p) } {
                                 sep = sep.max(local[t].separation[le]);
                             }
                         }
@@ -425,6 +449,9 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
             if config.contact_term == ContactTerm::WithoutFullContact && full {
                 e[4] = 0.0;
             }
+            if repaired && full {
+                e[4] = tensile;
+            }
             let scaled = [hp * hp * e[0], hp * e[1], hp * e[2], hp * e[3], hp * e[4]];
             (scaled, full, pen, sep)
         })
@@ -432,6 +459,7 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
 
     let mut terms = Terms { l_h, c0: config.c0, ..Default::default() };
     let mut full_contact_nodes = 0;
+    let mut eta5_full_contact = 0.0f64;
     for (e, full, pen, sep) in &node_terms {
         terms.eta1 = terms.eta1.max(e[0]);
         terms.eta2 = terms.eta2.max(e[1]);
@@ -441,6 +469,9 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
         terms.eta6 = terms.eta6.max(*pen);
         terms.eta7 = terms.eta7.max(*sep);
         full_contact_nodes += *full as usize;
+        if *full {
+            eta5_full_contact = eta5_full_contact.max(e[4]);
+        }
     }
     terms.psi = terms.eta1 + terms.eta2 + terms.eta3 + terms.eta4 + terms.eta5;
     terms.eta_h = l_h * terms.psi + terms.eta6 + terms.eta7;
@@ -459,7 +490,8 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
                     continue;
                 }
                 let bn = nodes.boundary_nodes[bi];
-                let in_lambda = el.iter().any(|&p| positive(p)) || bn.iter().any(|&p| positive(p));
+                let in_lambda =
+                    if repaired { in_lambda_repaired[bi] } else { el.iter().any(|&p| positive(p)) || bn.iter().any(|&p| positive(p)) };
                 let sep = if in_lambda { local[t].separation[le].max(0.0) } else { 0.0 };
                 contact = contact.max(local[t].penetration[le].max(0.0) + sep);
             }
@@ -467,5 +499,5 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
         })
         .collect();
 
-    Estimate { terms, config: *config, element, full_contact_nodes }
+    Estimate { terms, config: *config, element, full_contact_nodes, eta5_full_contact }
 }

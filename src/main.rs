@@ -152,7 +152,8 @@ struct EstimatorArgs {
     /// Estimator constant C_0 (estimate = C_0 eta_h).
     #[arg(long, allow_negative_numbers = true, default_value_t = 0.45)]
     c0: f64,
-    /// eta_5 over all contact nodes (as-written) or without full-contact nodes.
+    /// eta_5 over all contact nodes (as-written), without full-contact nodes, or the repaired
+    /// contact terms (only the tensile normal stress at full-contact nodes, eta_7 on a narrower set).
     #[arg(long, value_enum, default_value = "as-written")]
     contact_term: ContactTermArg,
     /// The log factor l_h.
@@ -167,6 +168,7 @@ struct EstimatorArgs {
 enum ContactTermArg {
     AsWritten,
     WithoutFullContact,
+    TensileOnFullContact,
 }
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum LogFactorArg {
@@ -187,6 +189,7 @@ impl EstimatorArgs {
             contact_term: match self.contact_term {
                 ContactTermArg::AsWritten => ContactTerm::AsWritten,
                 ContactTermArg::WithoutFullContact => ContactTerm::WithoutFullContact,
+                ContactTermArg::TensileOnFullContact => ContactTerm::TensileOnFullContact,
             },
             log_factor: match self.log_factor {
                 LogFactorArg::Squared => LogFactor::Squared,
@@ -224,6 +227,10 @@ struct AdaptArgs {
     /// Stop before a level with more unknowns than this.
     #[arg(long, allow_negative_numbers = true)]
     max_ndof: Option<usize>,
+    /// Write the last level's mesh and solution to this VTU file (ParaView, meshio: displacement,
+    /// contact force, active set, element indicators).
+    #[arg(long, value_name = "PATH.vtu")]
+    save: Option<std::path::PathBuf>,
     #[command(flatten)]
     estimator: EstimatorArgs,
 }
@@ -280,7 +287,10 @@ fn validate(config: &AdaptConfig) -> Result<()> {
     config.validate().map_err(|e| anyhow::anyhow!("{}: expected {}, got {}", flag_of(e.key), e.expected, e.got))
 }
 
-fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::DiscreteSolution, report::SolveReport)> {
+/// A solve's mesh, solution, element indicators and report.
+type Solved = (signorini::mesh::Mesh, solve::DiscreteSolution, Vec<f64>, report::SolveReport);
+
+fn run_solve(args: &SolveArgs) -> Result<Solved> {
     let problem = problems::by_name(&args.problem)?;
     let spec = MeshSpec::parse(&args.mesh)?;
     let probes = args.probes.iter().map(|p| report::parse_probe(p)).collect::<Result<Vec<_>, _>>()?;
@@ -326,7 +336,7 @@ fn run_solve(args: &SolveArgs) -> Result<(signorini::mesh::Mesh, solve::Discrete
     let error = problem.exact().map(|e| norms::linf_error(&mesh, &sol, &|x| e.u(x)));
     let est = estimate::estimate(&mesh, problem.as_ref(), &sol, &estimator);
     let report = report::SolveReport::new(problem.name(), &mesh_name, &mesh, &sol, error, &est, &probes)?;
-    Ok((mesh, sol, report))
+    Ok((mesh, sol, est.element, report))
 }
 
 fn run_adapt(args: &AdaptArgs) -> Result<()> {
@@ -341,6 +351,9 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
         ..Default::default()
     };
     validate(&config)?;
+    if let Some(path) = &args.save {
+        check_writable(path)?;
+    }
     solve::check_memory(&spec.to_string(), spec.ndof()?)?;
     let mesh = spec.build(problem.as_ref())?;
     let exact = problem.exact();
@@ -357,7 +370,7 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
         "{:>3} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>6} {:>4} {:>7}",
         "lvl", "ndof", "h_min", "error", "estimate", "eff", "eta1", "eta2", "eta3", "eta4", "eta5", "eta6+7", "active", "its", "time"
     );
-    adapt::run(problem.as_ref(), mesh, &config, reference.as_ref().map(|r| r as norms::Reference), &mut |l| {
+    let result = adapt::run(problem.as_ref(), mesh, &config, reference.as_ref().map(|r| r as norms::Reference), &mut |l| {
         let r = l.record;
         println!(
             "{:>3} {:>8} {:>9.3e} {:>9} {:>9.3e} {:>9} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>9.3e} {:>6} {:>4} {:>7.3}",
@@ -379,6 +392,21 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
         );
         std::ops::ControlFlow::Continue(())
     })?;
+    if let Some(path) = &args.save {
+        let level = result.records.last().map_or(0, |r| r.level);
+        let doc = report::solution_vtu(&result.mesh, &result.solution, &result.estimate.element);
+        signorini::records::write_atomic(path, doc.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+        println!("# wrote {} (level {level}, NDF {})", path.display(), result.mesh.p2_ndof());
+    }
+    Ok(())
+}
+
+/// Refuse an output path whose folder does not exist before hours of work are spent, not after.
+fn check_writable(path: &std::path::Path) -> Result<()> {
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    if !dir.is_dir() {
+        bail!("--save {}: the folder {} does not exist", path.display(), dir.display());
+    }
     Ok(())
 }
 
@@ -650,8 +678,8 @@ fn run_report(
 
 /// `export`: solve, write the case files, say where.
 fn run_export(args: &SolveArgs, out: &std::path::Path) -> Result<()> {
-    let (mesh, sol, r) = run_solve(args)?;
-    for f in report::export_case(out, &mesh, &sol, &r)? {
+    let (mesh, sol, indicator, r) = run_solve(args)?;
+    for f in report::export_case(out, &mesh, &sol, &indicator, &r)? {
         println!("wrote {}", f.display());
     }
     Ok(())
@@ -690,7 +718,7 @@ fn main() -> ExitCode {
         install_interrupt_handler();
     }
     let result = match &cli.command {
-        Command::Solve { args, json } => run_solve(args).map(|(_, _, r)| {
+        Command::Solve { args, json } => run_solve(args).map(|(_, _, _, r)| {
             if *json {
                 println!("{}", serde_json::to_string_pretty(&r).expect("a report serialises"));
             } else {

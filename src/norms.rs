@@ -1,4 +1,5 @@
-//! L-infinity norms of the error u - u_h, evaluated three ways (PAPER-NOTES.md): at the
+//! L-infinity norms of the error u - u_h, evaluated three ways (the paper does not say how it
+//! evaluates the maximum; the choice moves the observed rates, so all three are kept): at the
 //! quadrature points of every element (the paper's way), on a dense barycentric lattice of every
 //! element, and over the nodal values only (which is not the L-infinity norm).
 

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 /// Which study each figure of [`crate::plot::FIGURES`] draws (a test checks that every figure
 /// is listed).
-pub const FIGURE_STUDY: [(&str, &str); 15] = [
+pub const FIGURE_STUDY: [(&str, &str); 16] = [
     ("fig2a", "ex71"),
     ("fig2b", "ex71"),
     ("fig4a", "ex71"),
@@ -31,6 +31,7 @@ pub const FIGURE_STUDY: [(&str, &str); 15] = [
     ("fb_mesh", "fb"),
     ("hertz_pressure", "hertz"),
     ("hertz_mesh", "hertz"),
+    ("estimator_repair", "estimator_repair"),
 ];
 
 /// The studies a CLAIMS row rests on, from its id (a test checks that every row maps to one).
@@ -44,6 +45,7 @@ pub fn claim_studies(id: &str) -> &'static [&'static str] {
         _ if id.starts_with("7.2-") => &["ex72", "ex72_large"],
         _ if id.starts_with("log-factor") => &["log_ablation"],
         _ if id.starts_with("fb-") => &["fb"],
+        _ if id.starts_with("estimator-repair") => &["estimator_repair"],
         _ => &[],
     }
 }

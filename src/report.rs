@@ -209,19 +209,18 @@ fn significant(v: f64) -> String {
     if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
 }
 
-/// Write `mesh.vtu` (displacement, contact force, active set) and `case.json` into `dir`;
-/// returns the files written.
-pub fn export_case(dir: &Path, mesh: &Mesh, sol: &DiscreteSolution, report: &SolveReport) -> Result<Vec<std::path::PathBuf>> {
+/// The VTU document of a solved mesh, as ParaView and meshio read it: per P2 node the
+/// displacement `u`, the contact force `lambda`, `active` and `contact` (1 on contact nodes); per
+/// triangle the estimator's element indicator `indicator` (eta_T, what the marking compares).
+pub fn solution_vtu(mesh: &Mesh, sol: &DiscreteSolution, indicator: &[f64]) -> String {
     let n = sol.nodes.len();
-    let mut lambda = vec![0.0; n];
-    let mut active = vec![0i32; n];
-    let mut contact = vec![0i32; n];
+    let (mut lambda, mut active, mut contact) = (vec![0.0; n], vec![0i32; n], vec![0i32; n]);
     for (k, c) in sol.dofs.contact.iter().enumerate() {
         lambda[c.node] = sol.lambda[k];
         active[c.node] = sol.active[k] as i32;
         contact[c.node] = 1;
     }
-    let doc = io::vtu(
+    io::vtu(
         mesh,
         &sol.nodes,
         &[
@@ -230,10 +229,21 @@ pub fn export_case(dir: &Path, mesh: &Mesh, sol: &DiscreteSolution, report: &Sol
             ("active", io::Field::Int(&active)),
             ("contact", io::Field::Int(&contact)),
         ],
-        &[],
-    );
+        &[("indicator", io::Field::Scalar(indicator))],
+    )
+}
+
+/// Write `mesh.vtu` ([`solution_vtu`]: displacement, contact force, active set, element
+/// indicators) and `case.json` into `dir`; returns the files written.
+pub fn export_case(
+    dir: &Path,
+    mesh: &Mesh,
+    sol: &DiscreteSolution,
+    indicator: &[f64],
+    report: &SolveReport,
+) -> Result<Vec<std::path::PathBuf>> {
     let (vtu, case) = (dir.join("mesh.vtu"), dir.join("case.json"));
-    records::write_atomic(&vtu, doc.as_bytes())?;
+    records::write_atomic(&vtu, solution_vtu(mesh, sol, indicator).as_bytes())?;
     records::write_json(&case, report)?;
     Ok(vec![vtu, case])
 }

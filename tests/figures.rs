@@ -235,6 +235,17 @@ fn full_results(results: &Path) {
     let snapshot = MeshSnapshot { study: "fb".into(), run: "adaptive_wfc".into(), level: 12, kinks: vec![], ..mesh_snapshot() };
     write_json(&StudyDir::new(results, "fb").mesh_file("adaptive_wfc", 12, "json"), &snapshot).unwrap();
     hertz_results(results);
+    let repaired = |r: Run<'static>| with_estimator(r, |e| e.contact_term = ContactTerm::TensileOnFullContact);
+    write_study(
+        results,
+        "estimator_repair",
+        &[
+            repaired(run("ex71_adaptive", "ex71", Adaptive)),
+            repaired(with_estimator(run("ex71_adaptive_l1", "ex71", Adaptive), |e| e.log_factor = LogFactor::One)),
+            repaired(run("ex71_uniform", "ex71", Uniform)),
+            repaired(Run { missing: never, ..run("fb_adaptive", "fb", Adaptive) }),
+        ],
+    );
 }
 
 /// The hertz study: one run of the repository's Hertz problem file (found through the provenance's

@@ -1,5 +1,6 @@
 //! The problem data agree with their definitions: Example 7.1's f and g against finite
-//! differences of the exact stress (PAPER-NOTES.md asks us to check them ourselves).
+//! differences of the exact stress (the paper prints u but not f and g: we derive them, and
+//! check the derivation here).
 
 use signorini::problems::{Ex71, Exact, Problem};
 

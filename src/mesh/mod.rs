@@ -404,7 +404,8 @@ pub struct P2Nodes {
     pub coords: Vec<[f64; 2]>,
     /// The boundary part of every node: `None` inside; on a corner shared by two parts the
     /// strongest one in the order Dirichlet > Contact > Neumann (nodes on the closure of
-    /// Gamma_D are Dirichlet nodes, PAPER-NOTES.md).
+    /// Gamma_D are Dirichlet nodes: the paper's spaces take the Dirichlet condition on the closed
+    /// set Gamma_D, so a corner where Gamma_D meets Gamma_C carries no contact constraint).
     pub part: Vec<Option<Part>>,
     /// Per boundary edge of the mesh (same order as `Mesh::boundary`), its three nodes
     /// `[a, b, midpoint]`.

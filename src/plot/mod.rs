@@ -28,6 +28,7 @@
 //! | `theta_ablation` | `theta_ablation`, a panel per problem | `err_quadrature` vs NDF for each theta and uniform, with NDF^-3/2; where some run of a problem has fewer than two errors, the estimate for all runs of that problem instead (the y label says which) |
 //! | `fb_error`, `fb_mesh` | `fb` | see `plot/fb.rs`: error and estimate vs NDF of the free-boundary problem, and its late adaptive mesh with x = a marked |
 //! | `hertz_pressure`, `hertz_mesh` | `hertz` | see `plot/hertz.rs`: the contact pressure against Hertz's, and the mesh near the contact |
+//! | `estimator_repair` | `estimator_repair`, a panel per problem | `err_quadrature` (solid) and `estimate` (dashed) vs NDF for each run (adaptive or uniform, and its l_h) of the repaired estimator |
 //!
 //! Style: log axes labelled at the decades (`10⁻⁴`; also 2x and 5x when less than two decades
 //! show), light grid lines at 2..9 x each decade; one colour and marker shape per series; the
@@ -67,7 +68,7 @@ use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// Every figure, in the order drawn.
-pub const FIGURES: [&str; 15] = [
+pub const FIGURES: [&str; 16] = [
     "fig2a",
     "fig2b",
     "fig3a",
@@ -83,6 +84,7 @@ pub const FIGURES: [&str; 15] = [
     "fb_mesh",
     "hertz_pressure",
     "hertz_mesh",
+    "estimator_repair",
 ];
 
 /// The study a figure is drawn from (the table above).
@@ -96,6 +98,7 @@ pub fn study_of(figure: &str) -> Option<&'static str> {
         "theta_ablation" => "theta_ablation",
         "fb_error" | "fb_mesh" => "fb",
         "hertz_pressure" | "hertz_mesh" => "hertz",
+        "estimator_repair" => "estimator_repair",
         _ => return None,
     })
 }
@@ -224,6 +227,7 @@ fn build(name: &str, results: &Path) -> anyhow::Result<Built> {
         "c0_sweep" => c0_sweep(results),
         "log_ablation" => log_ablation(results),
         "contact_term_ablation" => contact_term_ablation(results),
+        "estimator_repair" => estimator_repair(results),
         "theta_ablation" => theta_ablation(results),
         "fb_error" => fb::fb_error(results),
         "fb_mesh" => fb::fb_mesh(results),
@@ -628,6 +632,7 @@ fn contact_label(c: ContactTerm) -> &'static str {
     match c {
         ContactTerm::AsWritten => "as written",
         ContactTerm::WithoutFullContact => "without full-contact nodes",
+        ContactTerm::TensileOnFullContact => "repaired (tensile part at full contact)",
     }
 }
 
@@ -650,6 +655,29 @@ fn contact_term_ablation(results: &Path) -> anyhow::Result<Built> {
         out.push(p);
     }
     Ok(Ok(panels("Contact term ablation: η_{5} with and without full-contact nodes", out)))
+}
+
+fn estimator_repair(results: &Path) -> anyhow::Result<Built> {
+    let runs = match runs(results, "estimator_repair")? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let mut out = Vec::new();
+    for (problem, group) in by_problem(&runs) {
+        let mut p = Panel::new(problem_title(&problem), NDF_DESC, format!("error {ERR} (solid) and {ESTIMATE} (dashed)"));
+        for (k, r) in group.iter().enumerate() {
+            let how = |o: &RunRecord| {
+                let refine = if o.run.refine == Refine::Uniform { "uniform" } else { "adaptive" };
+                format!("{refine}, {}", log_label(o.run.estimator.log_factor))
+            };
+            let st = Style::nth(k);
+            p.series.push(series(r, format!("error, {}", how(r)), st, |l| l.err_quadrature));
+            let dashed = Style { marker: render::MARKERS[(k + 4) % render::MARKERS.len()], ..st }.dashed(true);
+            p.series.push(series(r, format!("estimate, {}", how(r)), dashed, |l| Some(l.estimate)));
+        }
+        out.push(p);
+    }
+    Ok(Ok(panels("The repaired estimator: tensile η_{5} at full contact, η_{7} on full-contact edges", out)))
 }
 
 fn theta_ablation(results: &Path) -> anyhow::Result<Built> {

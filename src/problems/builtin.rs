@@ -61,8 +61,9 @@ impl Problem for Ex71 {
     fn part_of(&self, x: [f64; 2]) -> Part {
         contact_bottom_dirichlet_top(x)
     }
-    /// f = -div sigma(u) = (2 e^y (y^2 + y - 1) - 6 y + 2, 3 y (x - 2)(y + 3) e^y) (PAPER-NOTES.md,
-    /// checked against finite differences of the exact stress in tests/problems.rs).
+    /// f = -div sigma(u) = (2 e^y (y^2 + y - 1) - 6 y + 2, 3 y (x - 2)(y + 3) e^y), derived here
+    /// from the exact u of Example 7.1 (the paper prints no f) and checked against finite
+    /// differences of the exact stress in tests/problems.rs.
     fn body_force(&self, x: [f64; 2]) -> [f64; 2] {
         let (x, y) = (x[0], x[1]);
         let e = y.exp();

@@ -25,7 +25,7 @@ pub mod store;
 pub use lock::StudyLock;
 
 use crate::adapt::{self, AdaptConfig, Level};
-use crate::mesh::{MeshSpec, io};
+use crate::mesh::MeshSpec;
 use crate::problems;
 use crate::records::{Batch, MeshSnapshot, RunRecord, RunSpec, StudyDir};
 use anyhow::{Context, Result, bail};
@@ -441,24 +441,7 @@ fn keep_level(study: &str, spec: &RunSpec, dir: &StudyDir, meshes: &mut Batch, l
 /// indicators) and the mesh snapshot JSON the mesh figure reads to `meshes`.
 fn save_level(study: &str, spec: &RunSpec, dir: &StudyDir, meshes: &mut Batch, level: &Level, problem: &dyn problems::Problem) -> Result<()> {
     let (mesh, sol) = (level.mesh, level.solution);
-    let n = sol.nodes.len();
-    let (mut lambda, mut active, mut contact) = (vec![0.0; n], vec![0i32; n], vec![0i32; n]);
-    for (k, c) in sol.dofs.contact.iter().enumerate() {
-        lambda[c.node] = sol.lambda[k];
-        active[c.node] = sol.active[k] as i32;
-        contact[c.node] = 1;
-    }
-    let doc = io::vtu(
-        mesh,
-        &sol.nodes,
-        &[
-            ("u", io::Field::Vector(&sol.u)),
-            ("lambda", io::Field::Scalar(&lambda)),
-            ("active", io::Field::Int(&active)),
-            ("contact", io::Field::Int(&contact)),
-        ],
-        &[("indicator", io::Field::Scalar(&level.estimate.element))],
-    );
+    let doc = crate::report::solution_vtu(mesh, sol, &level.estimate.element);
     let l = level.record.level;
     meshes.add(&dir.mesh_file(&spec.id, l, "vtu"), doc.as_bytes())?;
     let snapshot = MeshSnapshot {

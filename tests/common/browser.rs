@@ -27,9 +27,11 @@ pub struct PageCheck {
     pub errors: Vec<String>,
 }
 
-/// The Chromium binary: `$CHROMIUM`, else `chromium` or `chromium-browser` on the PATH.
+/// The Chromium binary: `$CHROMIUM`, else `chromium`, `chromium-browser` or Google Chrome on the PATH.
 pub fn chromium() -> Option<String> {
-    let candidates = std::env::var("CHROMIUM").into_iter().chain(["chromium".to_string(), "chromium-browser".to_string()]);
+    let candidates = std::env::var("CHROMIUM")
+        .into_iter()
+        .chain(["chromium", "chromium-browser", "google-chrome", "google-chrome-stable"].map(String::from));
     candidates
         .into_iter()
         .find(|c| Command::new(c).arg("--version").stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok_and(|s| s.success()))

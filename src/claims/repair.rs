@@ -1,0 +1,139 @@
+//! The `estimator-repair` row: the repaired contact terms (`estimate::repair`, study
+//! `estimator_repair`) judged per problem against four criteria, each with its own verdict:
+//!
+//! 1. error rate: the 95% interval of the adaptive error rate lies inside 1.5 ± 0.1 (the rule of
+//!    [`verdict::judge_rate`]: no wider than 0.2, so within the 0.3 the issue allows);
+//! 2. efficiency: the trend of estimate / error is bounded ([`verdict::judge_trend`]), for l_h = 1
+//!    (the repaired estimator's efficiency; marking does not depend on l_h, the efficiency does)
+//!    and, for reference, for l_h of eq. 6.3;
+//! 3. reliability: C_0 = 0.45 gives estimate >= error at every level; the smallest reliable C_0;
+//! 4. unknowns: at the adaptive run's last level, the NDF uniform refinement needs for the same
+//!    error ([`uniform_ndof_for`]) is larger (fewer unknowns adaptively).
+
+use super::{Claim, Ctx, OPTIMAL, Q, Verdict, c0_text, growth_text, rate_text, run};
+use crate::records::{RunRecord, StudyDir};
+use crate::verdict::{self, RateVerdict, Trend};
+
+/// The NDF a uniform run needs for the error `err` (same interpolation), None outside its range.
+pub(super) fn uniform_ndof_for(uniform: &RunRecord, err_field: &str, err: f64) -> Option<f64> {
+    let pts = same_parity(uniform, err_field);
+    pts.windows(2).find(|w| w[1].1 <= err && err <= w[0].1).map(|w| {
+        let t = (err / w[0].1).ln() / (w[1].1 / w[0].1).ln();
+        (w[0].0.ln() + t * (w[1].0 / w[0].0).ln()).exp()
+    })
+}
+
+/// (NDF, error) of the levels with the parity of the last one, increasing NDF.
+fn same_parity(r: &RunRecord, err_field: &str) -> Vec<(f64, f64)> {
+    let err = verdict::field(r, err_field);
+    let last = r.levels.len().saturating_sub(1);
+    r.levels
+        .iter()
+        .zip(&err)
+        .filter(|(l, _)| (last - l.level).is_multiple_of(2))
+        .filter_map(|(l, e)| Some((l.ndof as f64, (*e)?)))
+        .collect()
+}
+
+/// "at NDF 3.4e5 the adaptive error 1.87e-7; uniform refinement needs NDF 2.6e5 for it (0.77x)":
+/// the text and whether the adaptive run needs fewer unknowns (None: outside the uniform range).
+pub(super) fn unknowns_text(adaptive: &RunRecord, uniform: &RunRecord, err_field: &str) -> (String, Option<bool>) {
+    let Some((l, e)) = adaptive.levels.iter().zip(verdict::field(adaptive, err_field)).filter_map(|(l, e)| Some((l, e?))).next_back()
+    else {
+        return ("no error measured".into(), None);
+    };
+    let n = l.ndof as f64;
+    match uniform_ndof_for(uniform, err_field, e) {
+        Some(nu) => (
+            format!(
+                "at NDF {n:.2e} (level {}) the adaptive error is {e:.3e}; uniform refinement reaches it at NDF {nu:.2e}, interpolated on its levels of one parity: adaptive / uniform unknowns {:.2}",
+                l.level,
+                n / nu
+            ),
+            Some(n < nu),
+        ),
+        None => (format!("the adaptive error {e:.3e} at NDF {n:.2e} lies outside the uniform run's range"), None),
+    }
+}
+
+/// The four criteria for one problem: texts and verdicts (None where not computable).
+fn criteria(ctx: &Ctx, runs: &[RunRecord], problem: &str) -> (Vec<String>, Vec<Option<bool>>) {
+    let (ad, l1, un) =
+        (run(runs, &format!("{problem}_adaptive")), run(runs, &format!("{problem}_adaptive_l1")), run(runs, &format!("{problem}_uniform")));
+    let (mut texts, mut oks) = (Vec::new(), Vec::new());
+    let rate = ctx.rate(ad, Q::Error);
+    texts.push(rate_text("error rate", rate.as_ref(), Some(OPTIMAL)));
+    oks.push(rate.as_ref().map(|r| verdict::judge_rate(&r.main, OPTIMAL)).and_then(|v| match v {
+        RateVerdict::Reproduced => Some(true),
+        RateVerdict::Inconclusive => None,
+        _ => Some(false),
+    }));
+    let trend = |r: Option<&RunRecord>| ctx.growth(r, Q::Efficiency);
+    let g1 = trend(l1.or(ad));
+    texts.push(format!(
+        "{}; {}",
+        growth_text(if l1.is_some() { "efficiency, l_h = 1" } else { "efficiency" }, g1.as_ref()),
+        growth_text("efficiency, l_h of eq. 6.3", trend(ad).as_ref())
+    ));
+    oks.push(g1.map(|g| verdict::judge_trend(&g)).and_then(|t| match t {
+        Trend::Bounded => Some(true),
+        Trend::Inconclusive => None,
+        _ => Some(false),
+    }));
+    let rel: Vec<(String, f64)> = [ad, l1].into_iter().flatten().filter_map(|r| c0_text(&r.run.id, r, ctx.err_field())).collect();
+    texts.push(if rel.is_empty() {
+        "reliability: no error measured".into()
+    } else {
+        rel.iter().map(|r| r.0.clone()).collect::<Vec<_>>().join("; ")
+    });
+    oks.push((!rel.is_empty()).then(|| rel.iter().all(|r| r.1 <= 0.45)));
+    match (ad, un) {
+        (Some(a), Some(u)) => {
+            let (t, ok) = unknowns_text(a, u, ctx.err_field());
+            texts.push(t);
+            oks.push(ok);
+        }
+        _ => {
+            texts.push("no uniform companion".into());
+            oks.push(None);
+        }
+    }
+    (texts, oks)
+}
+
+pub(super) fn estimator_repair_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
+    let runs = StudyDir::new(ctx.results, "estimator_repair").read_runs()?;
+    let mut parts = Vec::new();
+    let mut all = Vec::new();
+    for problem in ["ex71", "fb", "ex72", "hertz"] {
+        if run(&runs, &format!("{problem}_adaptive")).is_none() {
+            continue;
+        }
+        let (texts, oks) = criteria(ctx, &runs, problem);
+        let mark = |ok: &Option<bool>| match ok {
+            Some(true) => "holds",
+            Some(false) => "fails",
+            None => "not decided",
+        };
+        let names = ["error rate", "efficiency", "reliability", "unknowns"];
+        let judged: Vec<String> = names.iter().zip(&oks).map(|(n, o)| format!("{n} {}", mark(o))).collect();
+        parts.push(format!("{problem}: {} [{}]", texts.join("; "), judged.join(", ")));
+        all.extend(oks);
+    }
+    out.push(Claim {
+        fragile: None,
+        id: "estimator-repair (beyond the paper)",
+        claim: "The repaired estimator (contact_term = \"tensile_on_full_contact\": only the tensile normal stress at full-contact nodes in eta_5, eta_7 on full-contact edges and the edges of isolated active nodes), study estimator_repair, per problem: (1) the adaptive error rate's interval inside 1.5 ± 0.1; (2) the efficiency trend bounded (judged for l_h = 1); (3) C_0 = 0.45 reliable at every level; (4) fewer unknowns than uniform refinement for the same error at the last adaptive level".into(),
+        measured: if parts.is_empty() { "no data".into() } else { parts.join(". ") },
+        verdict: if all.is_empty() {
+            Verdict::NoData
+        } else if all.contains(&Some(false)) {
+            Verdict::Fails
+        } else if all.contains(&None) {
+            Verdict::Inconclusive
+        } else {
+            Verdict::Holds
+        },
+    });
+    Ok(())
+}
