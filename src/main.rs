@@ -410,16 +410,22 @@ fn check_writable(path: &std::path::Path) -> Result<()> {
     Ok(())
 }
 
-fn run_studies(
-    manifests: &[std::path::PathBuf],
+/// The switches of `signorini run` that shape what a run does with the store.
+struct RunFlags {
     quick: bool,
-    jobs: Option<usize>,
-    shard: Option<&str>,
     fresh: bool,
     replace: bool,
-    results: Option<std::path::PathBuf>,
     wait: bool,
+}
+
+fn run_studies(
+    manifests: &[std::path::PathBuf],
+    jobs: Option<usize>,
+    shard: Option<&str>,
+    results: Option<std::path::PathBuf>,
+    flags: RunFlags,
 ) -> Result<()> {
+    let RunFlags { quick, fresh, replace, wait } = flags;
     if let Some(j) = jobs {
         rayon::ThreadPoolBuilder::new().num_threads(threads(j)?).build_global().context("setting the thread count")?;
     }
@@ -708,6 +714,9 @@ fn main() -> ExitCode {
     // SAFETY: setting a signal's disposition to the default, before any thread is started.
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        // A file-size limit (`ulimit -f`, a quota) makes a write fail with EFBIG instead of
+        // killing the process, so the store can clean up and say which file it was writing.
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
     let cli = Cli::parse();
     if let Err(e) = signorini::ordering::forced() {
@@ -733,7 +742,8 @@ fn main() -> ExitCode {
             run_drift(*quick, against.as_deref(), report.as_deref(), accept, study, experiments, results)
         }
         Command::Run { manifests, quick, jobs, shard, fresh, replace, results, wait } => {
-            run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, *replace, results.clone(), *wait)
+            let flags = RunFlags { quick: *quick, fresh: *fresh, replace: *replace, wait: *wait };
+            run_studies(manifests, *jobs, shard.as_deref(), results.clone(), flags)
         }
         Command::Export { args, out } => run_export(args, out),
         Command::Report { results, figures, out, study, drift_report } => {

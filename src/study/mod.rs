@@ -422,14 +422,17 @@ fn bar(progress: bool, len: u64, prefix: &str) -> ProgressBar {
 /// A level just solved: its record must be one a file can hold (every float finite; otherwise
 /// the run stops here, naming the level, the field and the value), and its mesh snapshot is
 /// added to `meshes` if the run saves it.
-fn keep_level(study: &str, spec: &RunSpec, dir: &StudyDir, meshes: &mut Batch, level: &Level, problem: &dyn problems::Problem) -> Result<()> {
+fn keep_level(
+    study: &str,
+    spec: &RunSpec,
+    dir: &StudyDir,
+    meshes: &mut Batch,
+    level: &Level,
+    problem: &dyn problems::Problem,
+) -> Result<()> {
     let r = level.record;
     if let Some(bad) = crate::records::first_non_finite(r) {
-        bail!(
-            "{study}/{}: level {}: {bad}; a record cannot hold it, so the run stops here and nothing of it is stored",
-            spec.id,
-            r.level
-        );
+        bail!("{study}/{}: level {}: {bad}; a record cannot hold it, so the run stops here and nothing of it is stored", spec.id, r.level);
     }
     if spec.save_levels.contains(&r.level) {
         save_level(study, spec, dir, meshes, level, problem)?;
@@ -439,7 +442,14 @@ fn keep_level(study: &str, spec: &RunSpec, dir: &StudyDir, meshes: &mut Batch, l
 
 /// Add a level's mesh and fields as VTU (displacement, contact force, active set, element
 /// indicators) and the mesh snapshot JSON the mesh figure reads to `meshes`.
-fn save_level(study: &str, spec: &RunSpec, dir: &StudyDir, meshes: &mut Batch, level: &Level, problem: &dyn problems::Problem) -> Result<()> {
+fn save_level(
+    study: &str,
+    spec: &RunSpec,
+    dir: &StudyDir,
+    meshes: &mut Batch,
+    level: &Level,
+    problem: &dyn problems::Problem,
+) -> Result<()> {
     let (mesh, sol) = (level.mesh, level.solution);
     let doc = crate::report::solution_vtu(mesh, sol, &level.estimate.element);
     let l = level.record.level;

@@ -76,9 +76,7 @@ pub fn stale_runs(manifest: &Manifest, runs: &[RunRecord], planned: &[RunSpec]) 
         .map(|r| Stale::Differs { id: r.run.id.clone(), differences: spec_differences(&r.run, planned_spec(planned, &r.run.id)) })
         .collect();
     out.extend(
-        runs.iter()
-            .filter(|r| !manifest.runs.iter().any(|p| p.spec.id == r.run.id))
-            .map(|r| Stale::Undeclared { id: r.run.id.clone() }),
+        runs.iter().filter(|r| !manifest.runs.iter().any(|p| p.spec.id == r.run.id)).map(|r| Stale::Undeclared { id: r.run.id.clone() }),
     );
     out
 }
@@ -135,8 +133,7 @@ pub fn orphans(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<PathBuf>> {
     let mut out = Vec::new();
     for sub in [dir.root.clone(), dir.root.join("runs"), meshes.clone()] {
         for (name, path) in files_in(&sub)? {
-            let stray_mesh =
-                sub == meshes && StudyDir::parse_mesh_name(&name).is_some_and(|(run, level)| !saved(runs, run, level));
+            let stray_mesh = sub == meshes && StudyDir::parse_mesh_name(&name).is_some_and(|(run, level)| !saved(runs, run, level));
             if records::is_temporary(&name) || stray_mesh {
                 out.push(path);
             }
