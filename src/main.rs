@@ -51,6 +51,11 @@ enum Command {
         /// Start over instead of resuming after the runs already finished.
         #[arg(long)]
         fresh: bool,
+        /// Replace stored runs whose spec differs from the manifest's (records and mesh
+        /// snapshots; each when its new run has finished) and remove stored runs the manifest
+        /// does not declare. Without it such a study is refused, naming the runs and keys.
+        #[arg(long, conflicts_with = "fresh")]
+        replace: bool,
         /// Results root [default: results, or target/quick-results with --quick].
         #[arg(long)]
         results: Option<std::path::PathBuf>,
@@ -405,15 +410,22 @@ fn check_writable(path: &std::path::Path) -> Result<()> {
     Ok(())
 }
 
+/// The switches of `signorini run` that shape what a run does with the store.
+struct RunFlags {
+    quick: bool,
+    fresh: bool,
+    replace: bool,
+    wait: bool,
+}
+
 fn run_studies(
     manifests: &[std::path::PathBuf],
-    quick: bool,
     jobs: Option<usize>,
     shard: Option<&str>,
-    fresh: bool,
     results: Option<std::path::PathBuf>,
-    wait: bool,
+    flags: RunFlags,
 ) -> Result<()> {
+    let RunFlags { quick, fresh, replace, wait } = flags;
     if let Some(j) = jobs {
         rayon::ThreadPoolBuilder::new().num_threads(threads(j)?).build_global().context("setting the thread count")?;
     }
@@ -429,7 +441,7 @@ fn run_studies(
         check_shard(&parsed, shard)?;
     }
     for manifest in &parsed {
-        let options = study::RunOptions { quick, shard, fresh, results: results.clone(), progress: true, wait_for_lock: wait };
+        let options = study::RunOptions { quick, shard, fresh, replace, results: results.clone(), progress: true, wait_for_lock: wait };
         let executed = study::run_study(manifest, &options)?;
         eprintln!("{}: {} run(s) executed, results in {}", manifest.study, executed.len(), results.join(&manifest.study).display());
     }
@@ -489,6 +501,7 @@ fn accept_studies(accept: &[String], experiments: &std::path::Path, results: &st
             quick: false,
             shard: None,
             fresh: true,
+            replace: false,
             results: results.to_path_buf(),
             progress: true,
             wait_for_lock: false,
@@ -701,6 +714,9 @@ fn main() -> ExitCode {
     // SAFETY: setting a signal's disposition to the default, before any thread is started.
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        // A file-size limit (`ulimit -f`, a quota) makes a write fail with EFBIG instead of
+        // killing the process, so the store can clean up and say which file it was writing.
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
     let cli = Cli::parse();
     if let Err(e) = signorini::ordering::forced() {
@@ -725,8 +741,9 @@ fn main() -> ExitCode {
         Command::Drift { quick, against, report, accept, study, experiments, results } => {
             run_drift(*quick, against.as_deref(), report.as_deref(), accept, study, experiments, results)
         }
-        Command::Run { manifests, quick, jobs, shard, fresh, results, wait } => {
-            run_studies(manifests, *quick, *jobs, shard.as_deref(), *fresh, results.clone(), *wait)
+        Command::Run { manifests, quick, jobs, shard, fresh, replace, results, wait } => {
+            let flags = RunFlags { quick: *quick, fresh: *fresh, replace: *replace, wait: *wait };
+            run_studies(manifests, *jobs, shard.as_deref(), results.clone(), flags)
         }
         Command::Export { args, out } => run_export(args, out),
         Command::Report { results, figures, out, study, drift_report } => {

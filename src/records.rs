@@ -1,31 +1,106 @@
 //! Writing records to disk: always atomically (a temporary file in the same directory, then a
-//! rename), so an interrupted run never leaves a half-written file behind.
+//! rename), so an interrupted run never leaves a half-written file behind, and a write that
+//! fails leaves no temporary file either. Several files that must change together (a run's
+//! record, its mesh snapshots and the summaries that list it) go through one [`Batch`]: every
+//! file is written in full before any of them is renamed into place. JSON is checked before it
+//! is written: a float JSON cannot hold (NaN, an infinity, which `serde_json` would write as
+//! `null` and then refuse to read) is an error naming the field ([`first_non_finite`]).
+
+mod finite;
+pub use finite::{NonFinite, first_non_finite};
 
 use std::io::Write;
 use std::path::Path;
 
-/// Write `bytes` to `path` atomically, creating the parent directory. An error names the path
-/// and the step that failed.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+/// Wrap an I/O error with the step that failed and the path it failed on.
+fn step(what: &str, on: &Path) -> impl FnOnce(std::io::Error) -> std::io::Error {
+    let (what, on) = (what.to_string(), on.display().to_string());
+    move |e: std::io::Error| std::io::Error::new(e.kind(), format!("{what} {on}: {e}"))
+}
+
+/// Whether a file name is one of [`Batch`]'s temporary files (`.NAME.tmpPID.N`): what a process
+/// killed while writing leaves behind.
+pub fn is_temporary(name: &str) -> bool {
+    let Some((_, tail)) = name.strip_prefix('.').and_then(|n| n.rsplit_once(".tmp")) else { return false };
+    !tail.is_empty() && tail.split('.').all(|part| !part.is_empty() && part.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// A temporary file next to `path`, unique within this process.
+fn temporary_for(path: &Path) -> std::path::PathBuf {
+    static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-    let step = |what: &str, on: &Path| {
-        let what = what.to_string();
-        let on = on.display().to_string();
-        move |e: std::io::Error| std::io::Error::new(e.kind(), format!("{what} {on}: {e}"))
-    };
-    std::fs::create_dir_all(dir).map_err(step("creating the directory", dir))?;
-    let written = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()
-    })();
-    written.map_err(step("writing", &tmp))?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        step("renaming the temporary file to", path)(e)
-    })
+    path.with_file_name(format!(".{name}.tmp{}.{n}", std::process::id()))
+}
+
+/// Files written in full to temporary files, then renamed into place together by
+/// [`Batch::commit`], in the order they were added. Dropped without a commit (an error, an
+/// interrupt), it removes its temporary files: nothing of it reaches the folder.
+#[derive(Debug, Default)]
+pub struct Batch {
+    /// (temporary file, destination), in order.
+    staged: Vec<(std::path::PathBuf, std::path::PathBuf)>,
+}
+
+impl Batch {
+    /// Write `bytes` to a temporary file next to `path` (creating the directory). On an error
+    /// the temporary file is removed and the error names the path and the step.
+    pub fn add(&mut self, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+        let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        std::fs::create_dir_all(dir).map_err(step("creating the directory", dir))?;
+        let tmp = temporary_for(path);
+        let written = std::fs::File::create(&tmp).and_then(|mut f| {
+            f.write_all(bytes)?;
+            f.sync_all()
+        });
+        if let Err(e) = written {
+            let _ = std::fs::remove_file(&tmp);
+            return Err(step("writing", &tmp)(e));
+        }
+        self.staged.push((tmp, path.to_path_buf()));
+        Ok(())
+    }
+
+    /// [`Batch::add`] for a value serialised as pretty JSON (see [`json_bytes`]).
+    pub fn add_json<T: serde::Serialize>(&mut self, path: &Path, value: &T) -> std::io::Result<()> {
+        self.add(path, &json_bytes(path, value)?)
+    }
+
+    /// The destinations of the files added so far, in order.
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        self.staged.iter().map(|(_, p)| p.as_path())
+    }
+
+    /// Rename every file into place, in order. If a rename fails, the files not yet renamed are
+    /// removed (those renamed before stay) and the error names the file.
+    pub fn commit(mut self) -> std::io::Result<()> {
+        let staged = std::mem::take(&mut self.staged);
+        let mut rest = staged.iter();
+        for (tmp, path) in rest.by_ref() {
+            if let Err(e) = std::fs::rename(tmp, path) {
+                let _ = std::fs::remove_file(tmp);
+                rest.for_each(|(t, _)| drop(std::fs::remove_file(t)));
+                return Err(step("renaming the temporary file to", path)(e));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Batch {
+    fn drop(&mut self) {
+        for (tmp, _) in &self.staged {
+            let _ = std::fs::remove_file(tmp);
+        }
+    }
+}
+
+/// Write `bytes` to `path` atomically, creating the parent directory. An error names the path
+/// and the step that failed; no temporary file is left.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut batch = Batch::default();
+    batch.add(path, bytes)?;
+    batch.commit()
 }
 
 /// Read a text file; an error names the path.
@@ -33,11 +108,23 @@ pub fn read_text(path: &Path) -> std::io::Result<String> {
     std::fs::read_to_string(path).map_err(|e| std::io::Error::new(e.kind(), format!("reading {}: {e}", path.display())))
 }
 
-/// Serialise as pretty JSON and write atomically.
-pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Result<()> {
+/// `value` as pretty JSON with a final newline, for the file `path`; an error (naming the path
+/// and the field) if a float in it is not finite, since JSON cannot hold it.
+pub fn json_bytes<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Result<Vec<u8>> {
+    if let Some(bad) = first_non_finite(value) {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("not writing {}: {bad} (JSON cannot hold it, and the file could not be read back)", path.display()),
+        ));
+    }
     let mut s = serde_json::to_string_pretty(value).map_err(|e| std::io::Error::other(format!("serialising {}: {e}", path.display())))?;
     s.push('\n');
-    write_atomic(path, s.as_bytes())
+    Ok(s.into_bytes())
+}
+
+/// Serialise as pretty JSON (checked by [`json_bytes`]) and write atomically.
+pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Result<()> {
+    write_atomic(path, &json_bytes(path, value)?)
 }
 
 /// The option enums a [`RunSpec`] holds, re-exported so that readers of records need nothing
@@ -232,6 +319,18 @@ impl StudyDir {
     /// `meshes/RUN_levelL.vtu` and `.json`.
     pub fn mesh_file(&self, run: &str, level: usize, ext: &str) -> PathBuf {
         self.root.join("meshes").join(format!("{run}_level{level}.{ext}"))
+    }
+
+    /// The run and level of a mesh file's name (`RUN_levelL.vtu` or `.json`, the inverse of
+    /// [`StudyDir::mesh_file`]); `None` for any other name.
+    pub fn parse_mesh_name(name: &str) -> Option<(&str, usize)> {
+        let stem = name.strip_suffix(".vtu").or_else(|| name.strip_suffix(".json"))?;
+        let (run, level) = stem.rsplit_once("_level")?;
+        let digits = !run.is_empty() && !level.is_empty() && level.bytes().all(|b| b.is_ascii_digit());
+        if !digits {
+            return None;
+        }
+        Some((run, level.parse().ok()?))
     }
 
     /// Every finished run of the study, in file-name order.

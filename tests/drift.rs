@@ -21,7 +21,15 @@ fn stored_and_quick() -> &'static (Vec<RunRecord>, Vec<RunRecord>, Vec<RunRecord
             let results = root.join(sub);
             study::run_study(
                 &m,
-                &RunOptions { quick, shard: None, fresh: true, results: results.clone(), progress: false, wait_for_lock: false },
+                &RunOptions {
+                    quick,
+                    shard: None,
+                    fresh: true,
+                    replace: false,
+                    results: results.clone(),
+                    progress: false,
+                    wait_for_lock: false,
+                },
             )
             .unwrap();
             StudyDir::new(&results, &m.study).read_runs().unwrap()

@@ -354,7 +354,15 @@ fn manifests_resolve_problem_files_relative_to_themselves() {
     let file = experiments.join("wedge.toml");
     std::fs::write(&file, text).unwrap();
     let manifest = Manifest::load(&file).unwrap();
-    let opts = RunOptions { quick: false, shard: None, fresh: true, results: results.clone(), progress: false, wait_for_lock: false };
+    let opts = RunOptions {
+        quick: false,
+        shard: None,
+        fresh: true,
+        replace: false,
+        results: results.clone(),
+        progress: false,
+        wait_for_lock: false,
+    };
     study::run_study(&manifest, &opts).unwrap();
     let runs = signorini::records::StudyDir::new(&results, "wedge").read_runs().unwrap();
     assert_eq!(runs[0].run.problem, "problems/wedge.toml");

@@ -373,10 +373,7 @@ pub fn check_derived(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<Dri
         (_, Err(e)) => out.push(file_row("levels.csv", "present".into(), format!("(cannot render: {e})"))),
     }
     let ids: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
-    let listed = std::fs::read_to_string(dir.provenance_file())
-        .ok()
-        .and_then(|t| serde_json::from_str::<super::provenance::Provenance>(&t).ok())
-        .map(|p| p.runs);
+    let listed = super::store::listed_runs(dir);
     if listed.as_ref() != Some(&ids) {
         out.push(file_row("provenance.json runs", listed.map(|l| l.join(" ")).unwrap_or("(unreadable)".into()), ids.join(" ")));
     }
@@ -551,6 +548,7 @@ pub fn run(
                     quick: opts.quick,
                     shard: None,
                     fresh: true,
+                    replace: false,
                     results: opts.scratch.clone(),
                     progress: opts.progress,
                     wait_for_lock: true,
@@ -571,6 +569,7 @@ pub fn run(
         if opts.against.is_some() {
             c.rows.extend(compare_provenance(&m.study, &stored_dir, &StudyDir::new(&fresh_root, &m.study)));
         }
+        note_orphans(&stored_dir, &m.study, &stored)?;
         if opts.progress {
             eprintln!(
                 "{}: {}",
@@ -592,6 +591,22 @@ pub fn run(
         }
     }
     Ok(report)
+}
+
+/// The drift check reads the stored results and never changes them: files of an unfinished run
+/// there (see [`super::store::orphans`]) are ignored, and named in one line so that the next
+/// `signorini run` of the study (which removes them) is not a surprise.
+fn note_orphans(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> anyhow::Result<()> {
+    let found = super::store::orphans(dir, runs)?;
+    if !found.is_empty() {
+        eprintln!(
+            "{study}: ignoring {} file(s) of an unfinished run in {} (`signorini run` removes them): {}",
+            found.len(),
+            dir.root.display(),
+            super::store::names(dir, &found)
+        );
+    }
+    Ok(())
 }
 
 /// The largest change of every float field over the studies of a report, as a table.

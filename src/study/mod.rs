@@ -7,21 +7,27 @@
 //! are rebuilt from all run records present. `--quick` runs the first `quick_levels` levels of
 //! the same runs: the exact prefix of the full study (same meshes, same numbers).
 //!
-//! The store stays consistent whatever happens: `levels.csv` and `provenance.json` are rewritten
-//! after every finished run (they always describe exactly the runs on disk); `--fresh` with
-//! `--shard K/N` removes only shard K's runs; a lock on the study folder ([`StudyLock`]) keeps
-//! a second process from running the same study at the same time; an interrupt stops after the
-//! current level and keeps every finished run ([`Interrupted`]).
+//! The store stays consistent whatever happens ([`store`]): a finished run, its mesh snapshots
+//! and the summaries listing it (`levels.csv`, `provenance.json`) land together or not at all;
+//! what a killed process leaves is removed by the next run; a run that executes nothing changes
+//! no file; a stored run whose spec differs from the manifest's is replaced only when asked
+//! (`replace`). `--fresh` with `--shard K/N` removes only shard K's runs; a lock on the study
+//! folder ([`StudyLock`]) keeps a second process from running the same study at the same time;
+//! an interrupt stops after the current level and keeps every finished run ([`Interrupted`]).
 
 pub mod drift;
+mod lock;
 pub mod manifest;
 pub mod provenance;
 pub mod reference;
+pub mod store;
+
+pub use lock::StudyLock;
 
 use crate::adapt::{self, AdaptConfig, Level};
 use crate::mesh::MeshSpec;
 use crate::problems;
-use crate::records::{self, MeshSnapshot, RunRecord, RunSpec, StudyDir};
+use crate::records::{Batch, MeshSnapshot, RunRecord, RunSpec, StudyDir};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use manifest::Manifest;
@@ -78,6 +84,9 @@ pub struct RunOptions {
     /// Delete the stored runs this invocation is responsible for first (all of the study's, or
     /// only shard K's with `shard`) instead of resuming after them.
     pub fresh: bool,
+    /// Replace the stored runs whose spec differs from the manifest's (each when its new run
+    /// has finished) and remove stored runs the manifest does not declare, instead of refusing.
+    pub replace: bool,
     /// The results root (`results/`).
     pub results: PathBuf,
     pub progress: bool,
@@ -106,103 +115,11 @@ pub fn effective_spec(planned: &manifest::PlannedRun, quick: bool) -> RunSpec {
     spec
 }
 
-/// An exclusive lock on a study's results folder (`STUDY/.lock`, holding the owner's process id
-/// and command line), held while a study is written, so that two runs of one study neither
-/// compute everything twice nor delete each other's runs. Released when dropped (or when the
-/// process dies: the operating system drops the lock with the file descriptor).
-pub struct StudyLock {
-    _file: std::fs::File,
-}
-
-impl StudyLock {
-    pub fn acquire(dir: &StudyDir, wait: bool) -> Result<StudyLock> {
-        use std::io::{Read, Seek, Write};
-        std::fs::create_dir_all(&dir.root).with_context(|| format!("creating {}", dir.root.display()))?;
-        let path = dir.root.join(".lock");
-        let mut file = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&path)
-            .with_context(|| format!("opening the lock file {}", path.display()))?;
-        match file.try_lock() {
-            Ok(()) => {}
-            Err(std::fs::TryLockError::WouldBlock) => {
-                let mut holder = String::new();
-                let _ = file.read_to_string(&mut holder);
-                let holder = if holder.trim().is_empty() { "another process".to_string() } else { holder.trim().to_string() };
-                if !wait {
-                    bail!(
-                        "{} is being written by {holder}; wait for it to finish, or pass --wait to wait for it (the lock is {})",
-                        dir.root.display(),
-                        path.display()
-                    );
-                }
-                eprintln!("{} is being written by {holder}; waiting for it to finish", dir.root.display());
-                file.lock().with_context(|| format!("waiting for the lock {}", path.display()))?;
-            }
-            Err(std::fs::TryLockError::Error(e)) => return Err(e).with_context(|| format!("locking {}", path.display())),
-        }
-        let me =
-            format!("process {} ({}) since {}", std::process::id(), std::env::args().collect::<Vec<_>>().join(" "), provenance::utc_now());
-        file.set_len(0)
-            .and_then(|_| file.rewind())
-            .and_then(|_| file.write_all(me.as_bytes()))
-            .with_context(|| format!("writing {}", path.display()))?;
-        Ok(StudyLock { _file: file })
-    }
-}
-
-/// Remove a run's record and its saved meshes.
-fn remove_run(dir: &StudyDir, id: &str) -> Result<()> {
-    let file = dir.run_file(id);
-    match std::fs::remove_file(&file) {
-        Ok(()) => {}
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-        Err(e) => return Err(e).with_context(|| format!("removing {}", file.display())),
-    }
-    remove_meshes(dir, id)
-}
-
-/// Remove the meshes saved for a run (`meshes/RUN_levelL.*`).
-fn remove_meshes(dir: &StudyDir, id: &str) -> Result<()> {
-    let meshes = dir.root.join("meshes");
-    let Ok(entries) = std::fs::read_dir(&meshes) else { return Ok(()) };
-    let prefix = format!("{id}_level");
-    for e in entries.flatten() {
-        let name = e.file_name().to_string_lossy().into_owned();
-        if name.strip_prefix(&prefix).is_some_and(|rest| rest.starts_with(|c: char| c.is_ascii_digit())) {
-            std::fs::remove_file(e.path()).with_context(|| format!("removing {}", e.path().display()))?;
-        }
-    }
-    Ok(())
-}
-
-/// Rewrite `levels.csv` and `provenance.json` from the run records present, so that they
-/// always describe exactly the runs on disk.
-fn write_summaries(manifest: &Manifest, dir: &StudyDir, quick: bool) -> Result<Vec<RunRecord>> {
-    let runs = dir.read_runs().with_context(|| format!("reading the runs in {}", dir.root.join("runs").display()))?;
-    dir.write_csv(&runs).with_context(|| format!("writing {}", dir.csv_file().display()))?;
-    let meshes = manifest.mesh_files();
-    let meshes: Vec<&std::path::Path> = meshes.iter().map(|p| p.as_path()).collect();
-    let mut prov = provenance::collect(
-        &manifest.study,
-        &manifest.file,
-        &manifest.bytes,
-        quick,
-        runs.iter().map(|r| r.run.id.clone()).collect(),
-        &meshes,
-    );
-    prov.problem_files = manifest.problem_files().iter().map(|f| provenance::ProblemFile::of(f)).collect();
-    records::write_json(&dir.provenance_file(), &prov).with_context(|| format!("writing {}", dir.provenance_file().display()))?;
-    Ok(runs)
-}
-
 /// Run a study; returns the ids of the runs executed (not resumed). Holds the study's lock
-/// throughout. Every finished run is written at once and the summaries rewritten after it; on
-/// an interrupt ([`interrupt`]) the run in progress is dropped and an [`Interrupted`] error says
-/// what was kept.
+/// throughout. First removes what an unfinished run left ([`store::remove_orphans`]) and refuses
+/// stale stored runs unless `replace` ([`store::refusal`]); every finished run is then stored
+/// together with the summaries listing it ([`store::commit_run`]). On an interrupt
+/// ([`interrupt`]) the run in progress is dropped and an [`Interrupted`] error says what was kept.
 ///
 /// ```rust
 /// use signorini::study::{self, RunOptions, manifest::Manifest};
@@ -223,7 +140,7 @@ fn write_summaries(manifest: &Manifest, dir: &StudyDir, quick: bool) -> Result<V
 /// "#;
 /// let manifest = Manifest::parse(Path::new("doc.toml"), text).unwrap();
 /// let results = std::env::temp_dir().join(format!("signorini-doc-{}", std::process::id()));
-/// let opts = RunOptions { quick: false, shard: None, fresh: true, results: results.clone(), progress: false, wait_for_lock: false };
+/// let opts = RunOptions { quick: false, shard: None, fresh: true, replace: false, results: results.clone(), progress: false, wait_for_lock: false };
 /// let ran = study::run_study(&manifest, &opts).unwrap();
 /// assert_eq!(ran, ["adaptive", "uniform"]);
 /// let runs = signorini::records::StudyDir::new(&results, &manifest.study).read_runs().unwrap();
@@ -234,68 +151,102 @@ pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> 
     let dir = StudyDir::new(&opts.results, &manifest.study);
     let _lock = StudyLock::acquire(&dir, opts.wait_for_lock)?;
     let in_shard = |i: usize| opts.shard.is_none_or(|(k, n)| i % n == k - 1);
+    let planned: Vec<RunSpec> =
+        manifest.runs.iter().enumerate().filter(|(i, _)| in_shard(*i)).map(|(_, p)| effective_spec(p, opts.quick)).collect();
     if opts.fresh {
-        match opts.shard {
-            // the whole study: also runs no longer declared
-            None => {
-                for sub in ["runs", "meshes"] {
-                    let p = dir.root.join(sub);
-                    if p.exists() {
-                        std::fs::remove_dir_all(&p).with_context(|| format!("removing {}", p.display()))?;
-                    }
-                }
-            }
-            // only this shard's runs: the other shards' are someone else's
-            Some(_) => {
-                for (_, planned) in manifest.runs.iter().enumerate().filter(|(i, _)| in_shard(*i)) {
-                    remove_run(&dir, &planned.spec.id)?;
-                }
-            }
-        }
-        write_summaries(manifest, &dir, opts.quick)?;
+        start_over(&dir, opts.shard.is_some(), &planned)?;
     }
-    let mut executed = Vec::new();
-    for (i, planned) in manifest.runs.iter().enumerate() {
-        if !in_shard(i) {
-            continue;
+    let mut runs = store::read_runs(&dir)?;
+    store::remove_orphans(&manifest.study, &dir, &runs)?;
+    let stale = store::stale_runs(manifest, &runs, &planned);
+    if !stale.is_empty() && !opts.replace && !opts.fresh {
+        return Err(store::refusal(manifest, &dir, &stale));
+    }
+    for s in &stale {
+        if let store::Stale::Undeclared { id } = s {
+            eprintln!("{}/{id}: removing the stored run, not declared in {}", manifest.study, manifest.file.display());
+            store::remove_run(&dir, id)?;
         }
-        let spec = effective_spec(planned, opts.quick);
-        if let Some(existing) = dir.read_run(&spec.id).with_context(|| format!("reading {}", dir.run_file(&spec.id).display()))? {
-            if existing.run == spec {
+    }
+    runs.retain(|r| manifest.runs.iter().any(|p| p.spec.id == r.run.id));
+    store::sync_summaries(manifest, &dir, &runs, opts.quick)?;
+    run_planned(manifest, &dir, &runs, &planned, opts).map_err(|e| {
+        if e.downcast_ref::<Interrupted>().is_some() {
+            return e;
+        }
+        // a removal or rename may have failed part-way: leave the folder consistent
+        match store::repair(manifest, &dir, opts.quick) {
+            Ok(()) => e,
+            Err(r) => e.context(format!("and bringing {} in line with its runs failed too: {r:#}", dir.root.display())),
+        }
+    })
+}
+
+/// `--fresh`: remove the stored runs this invocation is responsible for (with a shard, only its
+/// runs: the other shards' are someone else's; without, the whole study, also runs no longer
+/// declared).
+fn start_over(dir: &StudyDir, sharded: bool, planned: &[RunSpec]) -> Result<()> {
+    if sharded {
+        return planned.iter().try_for_each(|spec| store::remove_run(dir, &spec.id));
+    }
+    for sub in ["runs", "meshes"] {
+        let p = dir.root.join(sub);
+        if p.exists() {
+            std::fs::remove_dir_all(&p).with_context(|| format!("removing {}", p.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// Run the planned runs not stored with their spec yet, storing each as it finishes.
+fn run_planned(manifest: &Manifest, dir: &StudyDir, stored: &[RunRecord], planned: &[RunSpec], opts: &RunOptions) -> Result<Vec<String>> {
+    let mut executed = Vec::new();
+    for spec in planned {
+        match stored.iter().find(|r| r.run.id == spec.id) {
+            Some(r) if r.run == *spec => {
                 if opts.progress {
                     eprintln!("{}/{}: finished earlier, kept (use --fresh to start over)", manifest.study, spec.id);
                 }
                 continue;
             }
-            eprintln!("{}/{}: stored run has another spec, running it again", manifest.study, spec.id);
+            Some(r) => eprintln!(
+                "{}/{}: replacing the stored run when the new one has finished ({})",
+                manifest.study,
+                spec.id,
+                store::spec_differences(&r.run, spec).join("; ")
+            ),
+            None => {}
         }
-        let record = match run_one(&manifest.study, &spec, &manifest.file, &dir, opts.progress)? {
-            Some(r) => r,
-            None => {
-                // interrupted: drop what the unfinished run saved, keep the finished ones
-                remove_meshes(&dir, &spec.id)?;
-                let runs = write_summaries(manifest, &dir, opts.quick)?;
-                let kept: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
-                let missing = manifest.runs.iter().map(|p| p.spec.id.clone()).filter(|id| !kept.contains(id)).collect();
-                let mut resume = format!("signorini run {}", manifest.file.display());
-                if opts.quick {
-                    resume += " --quick";
-                }
-                if let Some((k, n)) = opts.shard {
-                    resume += &format!(" --shard {k}/{n}");
-                }
-                if opts.results != std::path::Path::new(if opts.quick { "target/quick-results" } else { "results" }) {
-                    resume += &format!(" --results {}", opts.results.display());
-                }
-                return Err(Interrupted { study: manifest.study.clone(), resume, kept, missing }.into());
-            }
+        let mut meshes = Batch::default();
+        let Some(record) = run_one(&manifest.study, spec, &manifest.file, dir, &mut meshes, opts.progress)? else {
+            // interrupted: what the unfinished run wrote goes with `meshes`; the finished ones stay
+            drop(meshes);
+            return Err(interruption(manifest, dir, opts));
         };
-        records::write_json(&dir.run_file(&spec.id), &record).with_context(|| format!("writing {}", dir.run_file(&spec.id).display()))?;
-        write_summaries(manifest, &dir, opts.quick)?;
+        store::commit_run(manifest, dir, &record, meshes, opts.quick)?;
         executed.push(spec.id.clone());
     }
-    write_summaries(manifest, &dir, opts.quick)?;
     Ok(executed)
+}
+
+/// The error of an interrupted study: the runs kept, those missing, the command that resumes.
+fn interruption(manifest: &Manifest, dir: &StudyDir, opts: &RunOptions) -> anyhow::Error {
+    let kept: Vec<String> = match store::read_runs(dir) {
+        Ok(runs) => runs.iter().map(|r| r.run.id.clone()).collect(),
+        Err(e) => return e,
+    };
+    let missing = manifest.runs.iter().map(|p| p.spec.id.clone()).filter(|id| !kept.contains(id)).collect();
+    let mut resume = format!("signorini run {}", manifest.file.display());
+    if opts.quick {
+        resume += " --quick";
+    }
+    if let Some((k, n)) = opts.shard {
+        resume += &format!(" --shard {k}/{n}");
+    }
+    if opts.results != std::path::Path::new(if opts.quick { "target/quick-results" } else { "results" }) {
+        resume += &format!(" --results {}", opts.results.display());
+    }
+    Interrupted { study: manifest.study.clone(), resume, kept, missing }.into()
 }
 
 /// Every declared run is stored with exactly its declared (full) spec, and nothing else is:
@@ -303,22 +254,16 @@ pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> 
 /// or different and how to complete the study.
 pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<()> {
     let dir = StudyDir::new(results, &manifest.study);
-    let runs = dir.read_runs().with_context(|| format!("reading the runs in {}", dir.root.join("runs").display()))?;
+    let runs = store::read_runs(&dir)?;
     let mut problems = Vec::new();
     for planned in &manifest.runs {
         match runs.iter().find(|r| r.run.id == planned.spec.id) {
             None => problems.push(format!("run {} is missing", planned.spec.id)),
-            Some(r) if r.run != planned.spec => {
-                let (a, b) = (serde_json::to_value(&r.run).unwrap_or_default(), serde_json::to_value(&planned.spec).unwrap_or_default());
-                let differ: Vec<String> = a
-                    .as_object()
-                    .into_iter()
-                    .flatten()
-                    .filter(|(k, v)| b.get(k.as_str()) != Some(v))
-                    .map(|(k, v)| format!("{k} {v} stored, {} declared", b.get(k.as_str()).unwrap_or(&serde_json::Value::Null)))
-                    .collect();
-                problems.push(format!("run {} was computed with another spec ({})", planned.spec.id, differ.join(", ")))
-            }
+            Some(r) if r.run != planned.spec => problems.push(format!(
+                "run {} was computed with another spec ({})",
+                planned.spec.id,
+                store::spec_differences(&r.run, &planned.spec).join("; ")
+            )),
             Some(_) => {}
         }
     }
@@ -365,8 +310,16 @@ fn reference_key(spec: &RunSpec, problem: &str, mesh: &str) -> Option<String> {
 }
 
 /// One run of the manifest at `manifest_file` (its problem and mesh files are relative to it): the
-/// adaptive loop with a progress bar, saving the declared levels. `None` when interrupted.
-fn run_one(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, dir: &StudyDir, progress: bool) -> Result<Option<RunRecord>> {
+/// adaptive loop with a progress bar, adding the declared levels' mesh snapshots to `meshes`.
+/// `None` when interrupted.
+fn run_one(
+    study: &str,
+    spec: &RunSpec,
+    manifest_file: &std::path::Path,
+    dir: &StudyDir,
+    meshes: &mut Batch,
+    progress: bool,
+) -> Result<Option<RunRecord>> {
     let problem_path = manifest::resolve_problem(manifest_file, &spec.problem);
     let mesh_path = manifest::resolve_mesh(manifest_file, &spec.mesh);
     let problem = problems::load(&problem_path, &spec.constants)?;
@@ -411,7 +364,7 @@ fn run_one(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, dir: &S
     };
     let config = AdaptConfig::for_run(spec);
     let pb = bar(progress, spec.levels as u64, &format!("{study}/{}", spec.id));
-    let mut save_error: Option<anyhow::Error> = None;
+    let mut level_error: Option<anyhow::Error> = None;
     let mut stopped = false;
     let mesh = mesh_spec.build(problem.as_ref())?;
     let levels = adapt::run(problem.as_ref(), mesh, &config, error_against, &mut |level: Level| {
@@ -424,10 +377,8 @@ fn run_one(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, dir: &S
             r.err_quadrature.map(|e| format!(" error {e:.3e}")).unwrap_or_default()
         ));
         pb.inc(1);
-        if spec.save_levels.contains(&r.level)
-            && let Err(e) = save_level(study, spec, dir, &level, problem.as_ref())
-        {
-            save_error = Some(e);
+        if let Err(e) = keep_level(study, spec, dir, meshes, &level, problem.as_ref()) {
+            level_error = Some(e);
             return ControlFlow::Break(());
         }
         if interrupted() {
@@ -439,7 +390,7 @@ fn run_one(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, dir: &S
     .with_context(|| format!("{study}/{}", spec.id))?
     .records;
     pb.finish_and_clear();
-    if let Some(e) = save_error {
+    if let Some(e) = level_error {
         return Err(e);
     }
     if stopped {
@@ -468,13 +419,41 @@ fn bar(progress: bool, len: u64, prefix: &str) -> ProgressBar {
     pb
 }
 
-/// Write a level's mesh and fields as VTU (displacement, contact force, active set, element
-/// indicators) and the mesh snapshot JSON the mesh figure reads.
-fn save_level(study: &str, spec: &RunSpec, dir: &StudyDir, level: &Level, problem: &dyn problems::Problem) -> Result<()> {
+/// A level just solved: its record must be one a file can hold (every float finite; otherwise
+/// the run stops here, naming the level, the field and the value), and its mesh snapshot is
+/// added to `meshes` if the run saves it.
+fn keep_level(
+    study: &str,
+    spec: &RunSpec,
+    dir: &StudyDir,
+    meshes: &mut Batch,
+    level: &Level,
+    problem: &dyn problems::Problem,
+) -> Result<()> {
+    let r = level.record;
+    if let Some(bad) = crate::records::first_non_finite(r) {
+        bail!("{study}/{}: level {}: {bad}; a record cannot hold it, so the run stops here and nothing of it is stored", spec.id, r.level);
+    }
+    if spec.save_levels.contains(&r.level) {
+        save_level(study, spec, dir, meshes, level, problem)?;
+    }
+    Ok(())
+}
+
+/// Add a level's mesh and fields as VTU (displacement, contact force, active set, element
+/// indicators) and the mesh snapshot JSON the mesh figure reads to `meshes`.
+fn save_level(
+    study: &str,
+    spec: &RunSpec,
+    dir: &StudyDir,
+    meshes: &mut Batch,
+    level: &Level,
+    problem: &dyn problems::Problem,
+) -> Result<()> {
     let (mesh, sol) = (level.mesh, level.solution);
     let doc = crate::report::solution_vtu(mesh, sol, &level.estimate.element);
     let l = level.record.level;
-    records::write_atomic(&dir.mesh_file(&spec.id, l, "vtu"), doc.as_bytes())?;
+    meshes.add(&dir.mesh_file(&spec.id, l, "vtu"), doc.as_bytes())?;
     let snapshot = MeshSnapshot {
         study: study.to_string(),
         run: spec.id.clone(),
@@ -485,6 +464,6 @@ fn save_level(study: &str, spec: &RunSpec, dir: &StudyDir, level: &Level, proble
         contact_nodes: crate::solve::contact_samples(mesh, sol),
         kinks: problem.required_vertices(),
     };
-    records::write_json(&dir.mesh_file(&spec.id, l, "json"), &snapshot)?;
+    meshes.add_json(&dir.mesh_file(&spec.id, l, "json"), &snapshot)?;
     Ok(())
 }

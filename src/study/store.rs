@@ -1,0 +1,239 @@
+//! The study folder `results/STUDY/` kept readable and consistent whatever happens.
+//!
+//! - A finished run lands in one [`Batch`]: its mesh snapshots (written while it ran), its record
+//!   and the summaries listing it (`levels.csv`, `provenance.json`) are all written in full to
+//!   temporary files first, then renamed into place ([`commit_run`]). A write that fails (a full
+//!   disk) leaves nothing of the run and no temporary file; a run that stops (an interrupt, an
+//!   error) leaves nothing either.
+//! - What a killed process leaves (temporary files, mesh snapshots of a run without a record) is
+//!   an orphan: the next run removes it and says so ([`remove_orphans`]).
+//! - The summaries are rewritten only when their content would change ([`sync_summaries`]): a run
+//!   that executes nothing leaves every file as it was.
+//! - A stored run is never replaced silently: a manifest whose run differs from the stored one, or
+//!   a stored run the manifest does not declare, is refused unless told to replace it
+//!   ([`stale_runs`], [`refusal`]).
+
+use super::manifest::Manifest;
+use super::provenance::{self, Provenance};
+use crate::records::{self, Batch, RunRecord, RunSpec, StudyDir};
+use anyhow::{Context, Result};
+use serde_json::Value;
+use std::path::PathBuf;
+
+/// Every run record of the study; an unreadable one is an error naming it (and is then never
+/// overwritten: nothing is written after this fails).
+pub fn read_runs(dir: &StudyDir) -> Result<Vec<RunRecord>> {
+    dir.read_runs().with_context(|| format!("reading the runs in {}", dir.root.join("runs").display()))
+}
+
+/// The leaves of a JSON value by dotted key (`estimator.c0`), in order.
+fn flatten(prefix: &str, value: &Value, out: &mut Vec<(String, Value)>) {
+    match value {
+        Value::Object(map) => {
+            for (k, v) in map {
+                flatten(&if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") }, v, out);
+            }
+        }
+        leaf => out.push((prefix.to_string(), leaf.clone())),
+    }
+}
+
+/// The keys in which a stored run's spec differs from the declared one, each with both values:
+/// `estimator.c0: 0.45 stored, 1e308 declared`.
+pub fn spec_differences(stored: &RunSpec, declared: &RunSpec) -> Vec<String> {
+    let leaves = |s: &RunSpec| {
+        let mut out = Vec::new();
+        flatten("", &serde_json::to_value(s).unwrap_or_default(), &mut out);
+        out
+    };
+    let (a, b) = (leaves(stored), leaves(declared));
+    let get = |side: &[(String, Value)], key: &str| side.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
+    let mut keys: Vec<&String> = a.iter().map(|(k, _)| k).collect();
+    keys.extend(b.iter().map(|(k, _)| k).filter(|k| !a.iter().any(|(ka, _)| ka == *k)));
+    let show = |v: Option<Value>| v.map_or("(absent)".to_string(), |v| v.to_string());
+    keys.into_iter()
+        .filter(|k| get(&a, k) != get(&b, k))
+        .map(|k| format!("{k}: {} stored, {} declared", show(get(&a, k)), show(get(&b, k))))
+        .collect()
+}
+
+/// A stored run the manifest does not ask for as it is.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stale {
+    /// Declared with another spec: the differing keys ([`spec_differences`]).
+    Differs { id: String, differences: Vec<String> },
+    /// Not declared by the manifest at all.
+    Undeclared { id: String },
+}
+
+/// The stored runs that are stale: among `planned` (the runs this invocation is responsible
+/// for, as they would run), those stored with another spec; among all stored runs, those the
+/// manifest does not declare.
+pub fn stale_runs(manifest: &Manifest, runs: &[RunRecord], planned: &[RunSpec]) -> Vec<Stale> {
+    let mut out: Vec<Stale> = planned
+        .iter()
+        .filter_map(|spec| runs.iter().find(|r| r.run.id == spec.id && r.run != *spec))
+        .map(|r| Stale::Differs { id: r.run.id.clone(), differences: spec_differences(&r.run, planned_spec(planned, &r.run.id)) })
+        .collect();
+    out.extend(
+        runs.iter().filter(|r| !manifest.runs.iter().any(|p| p.spec.id == r.run.id)).map(|r| Stale::Undeclared { id: r.run.id.clone() }),
+    );
+    out
+}
+
+fn planned_spec<'a>(planned: &'a [RunSpec], id: &str) -> &'a RunSpec {
+    planned.iter().find(|s| s.id == id).expect("a planned run")
+}
+
+/// The error refusing to overwrite stale runs: each run with what differs, and the way out.
+pub fn refusal(manifest: &Manifest, dir: &StudyDir, stale: &[Stale]) -> anyhow::Error {
+    let what: Vec<String> = stale
+        .iter()
+        .map(|s| match s {
+            Stale::Differs { id, differences } => format!("run {id} is stored with another spec ({})", differences.join("; ")),
+            Stale::Undeclared { id } => format!("run {id} is stored but not declared in {}", manifest.file.display()),
+        })
+        .collect();
+    anyhow::anyhow!(
+        "{}: not overwriting the stored results in {}: {}. Nothing was run or changed. Pass --replace to replace these runs \
+         (records and mesh snapshots; the other stored runs are kept), or --fresh to start the study over",
+        manifest.file.display(),
+        dir.root.display(),
+        what.join("; ")
+    )
+}
+
+/// Whether a finished run's record accounts for the snapshot of `run` at `level`.
+fn saved(runs: &[RunRecord], run: &str, level: usize) -> bool {
+    runs.iter().any(|r| r.run.id == run && r.run.save_levels.contains(&level) && level < r.levels.len())
+}
+
+/// The files of `dir` (one level, sorted by name); none if it does not exist.
+fn files_in(dir: &std::path::Path) -> Result<Vec<(String, PathBuf)>> {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(e).with_context(|| format!("reading the directory {}", dir.display())),
+    };
+    let mut out: Vec<(String, PathBuf)> = entries
+        .flatten()
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+        .map(|e| (e.file_name().to_string_lossy().into_owned(), e.path()))
+        .collect();
+    out.sort();
+    Ok(out)
+}
+
+/// The files of the study folder no finished run accounts for: temporary files (of a process
+/// killed while writing) anywhere in it, and mesh snapshots of a run without a record or of a
+/// level its record does not save (a run killed before it finished, an old binary's leftovers).
+/// Files the study never writes are left alone.
+pub fn orphans(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<PathBuf>> {
+    let meshes = dir.root.join("meshes");
+    let mut out = Vec::new();
+    for sub in [dir.root.clone(), dir.root.join("runs"), meshes.clone()] {
+        for (name, path) in files_in(&sub)? {
+            let stray_mesh = sub == meshes && StudyDir::parse_mesh_name(&name).is_some_and(|(run, level)| !saved(runs, run, level));
+            if records::is_temporary(&name) || stray_mesh {
+                out.push(path);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The orphans' paths relative to the study folder, comma-separated.
+pub fn names(dir: &StudyDir, files: &[PathBuf]) -> String {
+    files.iter().map(|f| f.strip_prefix(&dir.root).unwrap_or(f).display().to_string()).collect::<Vec<_>>().join(", ")
+}
+
+/// Remove the [`orphans`], saying so in one line that names them.
+pub fn remove_orphans(study: &str, dir: &StudyDir, runs: &[RunRecord]) -> Result<()> {
+    let found = orphans(dir, runs)?;
+    if found.is_empty() {
+        return Ok(());
+    }
+    for f in &found {
+        std::fs::remove_file(f).with_context(|| format!("removing {}", f.display()))?;
+    }
+    eprintln!("{study}: removed {} file(s) of an unfinished run (no finished run accounts for them): {}", found.len(), names(dir, &found));
+    Ok(())
+}
+
+/// Remove a run's record and its mesh snapshots (`meshes/RUN_levelL.*`).
+pub fn remove_run(dir: &StudyDir, id: &str) -> Result<()> {
+    let file = dir.run_file(id);
+    match std::fs::remove_file(&file) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(e).with_context(|| format!("removing {}", file.display())),
+    }
+    for (name, path) in files_in(&dir.root.join("meshes"))? {
+        if StudyDir::parse_mesh_name(&name).is_some_and(|(run, _)| run == id) {
+            std::fs::remove_file(&path).with_context(|| format!("removing {}", path.display()))?;
+        }
+    }
+    Ok(())
+}
+
+/// The provenance of the study as it is now, for these runs.
+fn provenance_of(manifest: &Manifest, runs: &[RunRecord], quick: bool) -> Provenance {
+    let meshes = manifest.mesh_files();
+    let meshes: Vec<&std::path::Path> = meshes.iter().map(|p| p.as_path()).collect();
+    let ids = runs.iter().map(|r| r.run.id.clone()).collect();
+    let mut prov = provenance::collect(&manifest.study, &manifest.file, &manifest.bytes, quick, ids, &meshes);
+    prov.problem_files = manifest.problem_files().iter().map(|f| provenance::ProblemFile::of(f)).collect();
+    prov
+}
+
+/// The runs `provenance.json` lists, if it can be read.
+pub fn listed_runs(dir: &StudyDir) -> Option<Vec<String>> {
+    let text = std::fs::read_to_string(dir.provenance_file()).ok()?;
+    serde_json::from_str::<Provenance>(&text).ok().map(|p| p.runs)
+}
+
+fn csv_bytes(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<u8>> {
+    dir.csv_bytes(runs).with_context(|| format!("rendering {}", dir.csv_file().display()))
+}
+
+/// Make `levels.csv` and `provenance.json` describe exactly `runs` (the runs present), writing
+/// only what would change: the CSV when its bytes differ, the provenance when it is missing,
+/// unreadable or lists other runs. (A provenance records who computed the runs; a process that
+/// computed none of them has nothing to add to it.) Both are written together.
+pub fn sync_summaries(manifest: &Manifest, dir: &StudyDir, runs: &[RunRecord], quick: bool) -> Result<()> {
+    let mut batch = Batch::default();
+    let csv = csv_bytes(dir, runs)?;
+    if std::fs::read(dir.csv_file()).ok().as_deref() != Some(csv.as_slice()) {
+        batch.add(&dir.csv_file(), &csv)?;
+    }
+    let ids: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
+    if listed_runs(dir).as_ref() != Some(&ids) {
+        batch.add_json(&dir.provenance_file(), &provenance_of(manifest, runs, quick))?;
+    }
+    Ok(batch.commit()?)
+}
+
+/// Store a finished run. `batch` holds its mesh snapshots, written while it ran; its record and
+/// the summaries listing it join them, then the run's previous record and snapshots (a replaced
+/// run) are removed and everything is renamed into place. If a write fails, nothing of the run
+/// reaches the folder and no temporary file is left.
+pub fn commit_run(manifest: &Manifest, dir: &StudyDir, record: &RunRecord, mut batch: Batch, quick: bool) -> Result<()> {
+    let id = &record.run.id;
+    let mut runs = read_runs(dir)?;
+    runs.retain(|r| &r.run.id != id);
+    runs.push(record.clone());
+    runs.sort_by_key(|r| dir.run_file(&r.run.id));
+    batch.add_json(&dir.run_file(id), record)?;
+    batch.add(&dir.csv_file(), &csv_bytes(dir, &runs)?)?;
+    batch.add_json(&dir.provenance_file(), &provenance_of(manifest, &runs, quick))?;
+    remove_run(dir, id)?;
+    Ok(batch.commit()?)
+}
+
+/// After a failure part-way through changing the folder (a removal or a rename that failed):
+/// remove the orphans and bring the summaries in line with the runs present.
+pub fn repair(manifest: &Manifest, dir: &StudyDir, quick: bool) -> Result<()> {
+    let runs = read_runs(dir)?;
+    remove_orphans(&manifest.study, dir, &runs)?;
+    sync_summaries(manifest, dir, &runs, quick)
+}
