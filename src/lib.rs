@@ -17,6 +17,7 @@ pub mod contact;
 pub mod element;
 pub mod estimate;
 pub mod hertz;
+pub mod memory;
 pub mod mesh;
 pub mod norms;
 pub mod ordering;

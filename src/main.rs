@@ -335,6 +335,9 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
         solve::solve(&mesh, problem.as_ref(), &pdas, &mut log).with_context(|| format!("solving {} on {}", problem.name(), mesh_name))?;
     let error = problem.exact().map(|e| norms::linf_error(&mesh, &sol, &|x| e.u(x)));
     let est = estimate::estimate(&mesh, problem.as_ref(), &sol, &estimator);
+    if let Some(bad) = problem.bad_datum() {
+        return Err(solve::SolveError::Data(bad)).with_context(|| format!("estimating on {mesh_name}"));
+    }
     let report = report::SolveReport::new(problem.name(), &mesh_name, &mesh, &sol, error, &est, &probes)?;
     Ok((mesh, sol, est.element, report))
 }

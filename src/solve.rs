@@ -10,97 +10,7 @@ use crate::mesh::{Mesh, MeshError, P2Nodes};
 use crate::problems::Problem;
 use std::time::Instant;
 
-/// Peak memory of one solve with `ndof` unknowns, in bytes: 64 MiB + 2 KiB per unknown.
-///
-/// Fitted to the peak resident set of `signorini solve` (`/usr/bin/time -v`, rustc 1.95, faer
-/// 0.24) on structured meshes: 1.62, 1.53, 1.59, 1.64 and 1.67 KiB per unknown at 33 282,
-/// 132 098, 526 338, 1 182 722 and 2 101 250 unknowns (Examples 7.1 and 7.2 alike). The sparse
-/// Cholesky factor grows slightly faster than linearly; 2 KiB per unknown keeps a margin of at
-/// least 20 % over every measurement.
-pub fn memory_estimate(ndof: f64) -> f64 {
-    64.0 * MIB + 2048.0 * ndof
-}
-
-const MIB: f64 = 1024.0 * 1024.0;
-
-/// Memory this process can still allocate, in bytes: the machine's memory available without
-/// swapping (`MemAvailable` in `/proc/meminfo`), and, where the process's address space is
-/// limited (`ulimit -v`, `prlimit --as`: "Max address space" in `/proc/self/limits`), no more
-/// than what that limit leaves above the current virtual size (`/proc/self/statm`); `None`
-/// where `/proc/meminfo` does not exist.
-pub fn available_memory() -> Option<f64> {
-    available().map(|a| a.bytes)
-}
-
-/// [`available_memory`] and which of the two bounds it is.
-#[derive(Clone, Copy, Debug)]
-pub struct Available {
-    pub bytes: f64,
-    /// The address-space limit, not the machine, is the bound.
-    pub by_address_space: bool,
-}
-
-fn available() -> Option<Available> {
-    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
-    let machine = line.split_whitespace().nth(1)?.parse::<f64>().ok()? * 1024.0;
-    Some(match address_space_left() {
-        Some(left) if left < machine => Available { bytes: left, by_address_space: true },
-        _ => Available { bytes: machine, by_address_space: false },
-    })
-}
-
-/// The address-space limit's soft value minus the current virtual size (pages of 4 KiB, as on
-/// x86-64 Linux), if there is a limit.
-fn address_space_left() -> Option<f64> {
-    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
-    let line = limits.lines().find(|l| l.starts_with("Max address space"))?;
-    let limit: f64 = line["Max address space".len()..].split_whitespace().next()?.parse().ok()?; // "unlimited" fails here
-    let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
-    let pages: f64 = statm.split_whitespace().next()?.parse().ok()?;
-    Some((limit - pages * 4096.0).max(0.0))
-}
-
-/// Where the machine's available memory is unknown (no `/proc/meminfo`), solves whose estimate
-/// exceeds this (1 TiB) are refused all the same.
-pub const UNKNOWN_MEMORY_LIMIT: f64 = 1024.0 * 1024.0 * MIB;
-
-/// A solve that would not fit in memory.
-#[derive(Debug, thiserror::Error)]
-#[error("{what} has {ndof:.0} unknowns: solving needs about {} (estimate: 64 MiB + 2 KiB per unknown), but {}", human_bytes(*.needed), match .available {
-    Some(a) if a.by_address_space => format!("this process's address-space limit (ulimit -v) leaves {}", human_bytes(a.bytes)),
-    Some(a) => format!("this machine has {} available (MemAvailable in /proc/meminfo)", human_bytes(a.bytes)),
-    None => format!("this machine's available memory is unknown (no /proc/meminfo) and more than {} is refused", human_bytes(UNKNOWN_MEMORY_LIMIT)),
-})]
-pub struct MemoryError {
-    pub what: String,
-    pub ndof: f64,
-    pub needed: f64,
-    pub available: Option<Available>,
-}
-
-/// Refuse a solve with `ndof` unknowns before allocating anything, if its memory estimate exceeds
-/// the machine's available memory (or [`UNKNOWN_MEMORY_LIMIT`] where that is unknown).
-pub fn check_memory(what: &str, ndof: f64) -> Result<(), MemoryError> {
-    let needed = memory_estimate(ndof);
-    let available = available();
-    if needed > available.map_or(UNKNOWN_MEMORY_LIMIT, |a| a.bytes) {
-        return Err(MemoryError { what: what.to_string(), ndof, needed, available });
-    }
-    Ok(())
-}
-
-/// Bytes in binary units: "3.4 GiB".
-pub fn human_bytes(b: f64) -> String {
-    let units = ["B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"];
-    let mut v = b;
-    let mut u = 0;
-    while v >= 1024.0 && u + 1 < units.len() {
-        v /= 1024.0;
-        u += 1;
-    }
-    if u == 0 { format!("{v:.0} B") } else { format!("{v:.1} {}", units[u]) }
-}
+pub use crate::memory::{Available, MemoryError, UNKNOWN_MEMORY_LIMIT, available_memory, check_memory, human_bytes, memory_estimate};
 
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {
@@ -112,6 +22,11 @@ pub enum SolveError {
     RigidMotion(#[from] RigidMotionError),
     #[error(transparent)]
     NotCertified(#[from] KktError),
+    #[error(transparent)]
+    Data(#[from] crate::problems::BadDatum),
+    /// No boundary edge of the mesh is in the contact part.
+    #[error("the problem's contact part matches no boundary edge of the mesh: there is nothing to be in contact (the problem declares: {})", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") })]
+    NoContact { declared: Vec<String> },
 }
 
 /// A discrete solution and everything computed on the way.
@@ -196,7 +111,15 @@ pub fn solve(
     let nodes = P2Nodes::new(mesh);
     let dofs = DofMap::new(&nodes, problem);
     certify::check_held(mesh, &nodes, &dofs, problem)?;
+    if dofs.contact.is_empty() {
+        return Err(SolveError::NoContact { declared: problem.declared_parts() });
+    }
     let System { matrix, rhs, dirichlet } = assembly::assemble(mesh, &nodes, &dofs, problem);
+    // the data were evaluated where they are used (gap and normal in the DofMap, load and
+    // Dirichlet data in the assembly): any that was not a finite number stops here
+    if let Some(bad) = problem.bad_datum() {
+        return Err(SolveError::Data(bad));
+    }
     let assembly_time = t0.elapsed().as_secs_f64();
     let strategy = options.strategy.unwrap_or(Strategy::auto(dofs.contact.len(), dofs.n_free));
     // the solver takes the matrix (and releases it before factorising, for the Schur strategy)

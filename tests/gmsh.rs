@@ -65,46 +65,7 @@ fn area(m: &Mesh) -> f64 {
 
 /// The unit square as two triangles (the second listed clockwise), "bottom" on y = 0 and
 /// "sides" on the other three sides: a hand-written MSH 4.1 ASCII file.
-const SQUARE: &str = r#"$MeshFormat
-4.1 0 8
-$EndMeshFormat
-$PhysicalNames
-3
-1 1 "bottom"
-1 2 "sides"
-2 3 "body"
-$EndPhysicalNames
-$Entities
-0 2 1 0
-1 0 0 0 1 0 0 1 1 0
-2 0 0 0 1 1 0 1 2 0
-1 0 0 0 1 1 0 1 3 2 1 2
-$EndEntities
-$Nodes
-1 4 1 4
-2 1 0 4
-1
-2
-3
-4
-0 0 0
-1 0 0
-1 1 0
-0 1 0
-$EndNodes
-$Elements
-3 6 1 6
-1 1 1 1
-1 1 2
-1 2 1 3
-2 2 3
-3 3 4
-4 4 1
-2 1 2 2
-5 1 2 3
-6 1 4 3
-$EndElements
-"#;
+const SQUARE: &str = include_str!("fixtures/square.msh");
 
 fn square_problem() -> Named {
     Named { groups: vec![("bottom", Part::Contact, None), ("sides", Part::Dirichlet, None)] }

@@ -110,8 +110,73 @@ fn element_lines(bytes: &[u8]) -> HashMap<u64, usize> {
     out
 }
 
+/// Refuse what is not a regular file (`/dev/zero`, a pipe: they have no end to read to) and a
+/// file too large for the memory this process can allocate (parsing holds the file and its
+/// nodes and elements: about eight times its size).
+fn check_size(path: &Path) -> Result<(), MeshError> {
+    let meta = std::fs::metadata(path).map_err(|e| error(path, None, format!("cannot read the mesh file: {e}")))?;
+    if !meta.is_file() {
+        return Err(error(path, None, "not a regular file: a mesh is read from a file of known size"));
+    }
+    let needed = 8.0 * meta.len() as f64;
+    let available = crate::memory::available_memory().unwrap_or(crate::memory::UNKNOWN_MEMORY_LIMIT);
+    if needed > available {
+        return Err(error(
+            path,
+            None,
+            format!(
+                "the file has {}: reading it needs about {}, more than the {} this process can allocate",
+                crate::memory::human_bytes(meta.len() as f64),
+                crate::memory::human_bytes(needed),
+                crate::memory::human_bytes(available)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A triangulation, not a folded or overlapping set of triangles: with every triangle turned
+/// counter-clockwise, an edge inside the mesh is run through once in each direction by the two
+/// triangles that share it. An edge run twice in the same direction belongs to two triangles
+/// on the same side of it (one folded over the other); an edge in three or more triangles is
+/// not a 2D mesh.
+fn check_folds(
+    path: &Path,
+    vertices: &[[f64; 2]],
+    triangles: &[[usize; 3]],
+    tags: &[([u64; 3], u64)],
+    line_of: &dyn Fn(u64) -> Option<usize>,
+) -> Result<(), MeshError> {
+    let mut seen: HashMap<[usize; 2], (usize, usize)> = HashMap::with_capacity(3 * triangles.len());
+    for (t, tri) in triangles.iter().enumerate() {
+        for i in 0..3 {
+            let (a, b) = (tri[i], tri[(i + 1) % 3]);
+            let (count, first) = seen.entry([a.min(b), a.max(b)]).or_insert((0, t));
+            *count += 1;
+            let other = triangles[*first];
+            let same_direction = *first != t && (0..3).any(|k| other[k] == a && other[(k + 1) % 3] == b);
+            if same_direction || *count > 2 {
+                let (tag, other_tag) = (tags[t].1, tags[*first].1);
+                let [pa, pb] = [vertices[a], vertices[b]];
+                let why = if *count > 2 {
+                    "is shared by three or more triangles"
+                } else {
+                    "has both on the same side: one is folded over the other"
+                };
+                return Err(error(
+                    path,
+                    line_of(tag),
+                    format!("triangles {other_tag} and {tag} overlap: their edge ({}, {})-({}, {}) {why}", pa[0], pa[1], pb[0], pb[1]),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Read and check a Gmsh file (everything that does not depend on the problem).
 pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
+    check_size(path)?;
     let bytes = std::fs::read(path).map_err(|e| error(path, None, format!("cannot read the mesh file: {e}")))?;
     let names = physical_names(path, &bytes)?;
     // mshio has a few `expect`s left on malformed input: a panic there is a malformed file too
@@ -152,7 +217,22 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     for block in &nodes.node_blocks {
         let mut tags: Vec<u64> = vec![0; block.nodes.len()];
         match &block.node_tags {
-            Some(map) => map.iter().for_each(|(&tag, &i)| tags[i] = tag),
+            Some(map) => {
+                map.iter().for_each(|(&tag, &i)| tags[i] = tag);
+                // mshio keeps one index per tag: a tag listed twice in a block leaves a hole
+                if map.len() < tags.len() {
+                    return Err(error(
+                        path,
+                        None,
+                        format!(
+                            "a node block of entity {} lists {} nodes under {} distinct tags: some node tag is listed twice",
+                            block.entity_tag,
+                            tags.len(),
+                            map.len()
+                        ),
+                    ));
+                }
+            }
             None => {
                 for t in tags.iter_mut() {
                     *t = next_tag;
@@ -161,9 +241,52 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
             }
         }
         for (tag, n) in tags.into_iter().zip(&block.nodes) {
-            node_at.insert(tag, [n.x, n.y, n.z]);
-            node_order.push(tag);
+            let at = [n.x, n.y, n.z];
+            if let Some(c) = at.iter().find(|c| !c.is_finite()) {
+                return Err(error(path, None, format!("node {tag} has the coordinate {c}: every coordinate must be a finite number")));
+            }
+            match node_at.insert(tag, at) {
+                Some(before) if before != at => {
+                    return Err(error(
+                        path,
+                        None,
+                        format!(
+                            "node tag {tag} is listed twice, at ({}, {}, {}) and at ({}, {}, {})",
+                            before[0], before[1], before[2], at[0], at[1], at[2]
+                        ),
+                    ));
+                }
+                Some(_) => {}
+                None => node_order.push(tag),
+            }
         }
+    }
+    // more nodes than tags between the smallest and the largest: some tag is listed twice (mshio
+    // drops the tags of such a section, so the duplicate itself cannot be shown)
+    if nodes.num_nodes > nodes.max_node_tag.saturating_sub(nodes.min_node_tag) + 1 {
+        return Err(error(
+            path,
+            None,
+            format!(
+                "the $Nodes section has {} nodes but only {} tags between {} and {}: some node tag is listed twice",
+                nodes.num_nodes,
+                nodes.max_node_tag.saturating_sub(nodes.min_node_tag) + 1,
+                nodes.min_node_tag,
+                nodes.max_node_tag
+            ),
+        ));
+    }
+    let listed: usize = nodes.node_blocks.iter().map(|b| b.nodes.len()).sum();
+    if listed as u64 != nodes.num_nodes {
+        return Err(error(path, None, format!("the $Nodes header declares {} nodes, its blocks hold {listed}", nodes.num_nodes)));
+    }
+    let listed: usize = elements.element_blocks.iter().map(|b| b.elements.len()).sum();
+    if listed as u64 != elements.num_elements {
+        return Err(error(
+            path,
+            None,
+            format!("the $Elements header declares {} elements, its blocks hold {listed}", elements.num_elements),
+        ));
     }
     // the physical groups of every curve entity
     let curve_groups: HashMap<i32, Vec<i32>> = msh
@@ -247,6 +370,7 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
         triangles.push([t[first], t[(first + 1) % 3], t[(first + 2) % 3]]);
         triangle_lines.push(line_of(*tag));
     }
+    check_folds(path, &vertices, &triangles, &tri_nodes, &line_of)?;
     // line elements of physical groups
     let mut groups: Vec<(String, Option<usize>)> = Vec::new();
     let mut group_index: BTreeMap<i32, usize> = BTreeMap::new();

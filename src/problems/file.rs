@@ -322,6 +322,8 @@ pub struct FileProblem {
     required_vertices: Vec<[f64; 2]>,
     load_breaks: Vec<f64>,
     exact: Option<ExactExprs>,
+    /// The first datum evaluated to something other than a finite number.
+    watch: super::DatumWatch,
 }
 
 /// Line and column (from 1) of byte `offset` in `text`.
@@ -785,7 +787,21 @@ impl FileProblem {
             required_vertices,
             load_breaks,
             exact,
+            watch: Default::default(),
         })
+    }
+}
+
+impl FileProblem {
+    /// The two components of a vector datum, each checked under the key `key[i]`.
+    #[inline]
+    fn checked(&self, key: &str, x: [f64; 2], v: [f64; 2]) -> [f64; 2] {
+        if !(v[0].is_finite() && v[1].is_finite()) {
+            for (i, c) in v.iter().enumerate() {
+                self.watch.check(&self.name, &format!("{key}[{i}]"), x, *c);
+            }
+        }
+        v
     }
 }
 
@@ -823,27 +839,36 @@ impl Problem for FileProblem {
         self.curves.get(group).copied()
     }
     fn body_force(&self, x: [f64; 2]) -> [f64; 2] {
-        [self.body_force[0].at(x), self.body_force[1].at(x)]
+        self.checked("body_force", x, [self.body_force[0].at(x), self.body_force[1].at(x)])
     }
     fn traction(&self, x: [f64; 2], n: [f64; 2]) -> [f64; 2] {
-        match (&self.traction, &self.exact) {
+        let t = match (&self.traction, &self.exact) {
             (VectorData::Exprs(t), _) => [t[0].eval(x, n), t[1].eval(x, n)],
             (VectorData::FromExact, Some(e)) => self.material.traction(e.grad(x), n),
             (VectorData::FromExact, None) => unreachable!("\"exact\" is refused without [exact]"),
-        }
+        };
+        self.checked("traction", x, t)
     }
     fn dirichlet(&self, x: [f64; 2]) -> [f64; 2] {
-        match (&self.dirichlet, &self.exact) {
+        let u = match (&self.dirichlet, &self.exact) {
             (VectorData::Exprs(u), _) => [u[0].at(x), u[1].at(x)],
             (VectorData::FromExact, Some(e)) => e.u(x),
             (VectorData::FromExact, None) => unreachable!("\"exact\" is refused without [exact]"),
-        }
+        };
+        self.checked("dirichlet", x, u)
+    }
+    fn bad_datum(&self) -> Option<super::BadDatum> {
+        self.watch.first()
     }
     fn contact_normal(&self, x: [f64; 2]) -> [f64; 2] {
         match &self.normal {
             Normal::Fixed(n) => {
                 let (a, b) = (n[0].at(x), n[1].at(x));
                 let l = a.hypot(b);
+                // a normal of length 0 (or not a number) has no direction: name its length
+                if !(l > 0.0 && l.is_finite()) {
+                    self.watch.note(super::BadDatum { problem: self.name.clone(), key: "contact.normal (its length)".into(), x, value: l });
+                }
                 [a / l, b / l]
             }
             Normal::Circles(circles) => {
@@ -861,7 +886,7 @@ impl Problem for FileProblem {
         }
     }
     fn gap(&self, x: [f64; 2]) -> f64 {
-        self.chi.at(x)
+        self.watch.check(&self.name, "contact.chi", x, self.chi.at(x))
     }
     fn required_vertices(&self) -> Vec<[f64; 2]> {
         self.required_vertices.clone()

@@ -112,6 +112,62 @@ pub trait Problem: Send + Sync {
     fn declared_parts(&self) -> Vec<String> {
         Vec::new()
     }
+    /// The first datum (in a fixed order: by key, then point) that was not a finite number
+    /// where it was evaluated since the problem was made; `None` for problems whose data are
+    /// finite by construction (the built-ins). The SOLVE step checks it after assembling and the
+    /// estimator after evaluating (`solve::SolveError::Data`).
+    fn bad_datum(&self) -> Option<BadDatum> {
+        None
+    }
+}
+
+/// A datum of a problem that is not a finite number at a point where it is used (a body force
+/// `sqrt(x - 2)`, Dirichlet data `0.1 / x` at x = 0, a gap `ln(0)`, a contact normal of length 0).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("problem {problem}: `{key}` is {value} at ({}, {}): every datum must be a finite number (a normal, of positive length) at the quadrature and boundary points where it is used", .x[0], .x[1])]
+pub struct BadDatum {
+    pub problem: String,
+    /// The key as the problem file spells it (`body_force[0]`, `contact.chi`, ...).
+    pub key: String,
+    pub x: [f64; 2],
+    pub value: f64,
+}
+
+/// Keeps the first [`BadDatum`] seen, in a fixed order (key, then x, then y), so that the error
+/// does not depend on which thread evaluated which point. Cloning starts a fresh watch.
+#[derive(Debug, Default)]
+pub struct DatumWatch(std::sync::Mutex<Option<BadDatum>>);
+
+impl Clone for DatumWatch {
+    fn clone(&self) -> Self {
+        DatumWatch::default()
+    }
+}
+
+impl DatumWatch {
+    /// `value`, noting it if it is not finite.
+    #[inline]
+    pub fn check(&self, problem: &str, key: &str, x: [f64; 2], value: f64) -> f64 {
+        if !value.is_finite() {
+            self.note(BadDatum { problem: problem.to_string(), key: key.to_string(), x, value });
+        }
+        value
+    }
+
+    /// Note `bad` (kept if it comes first in the fixed order).
+    #[cold]
+    pub fn note(&self, bad: BadDatum) {
+        let mut first = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        let earlier =
+            |a: &BadDatum, b: &BadDatum| (&a.key, a.x[0], a.x[1]).partial_cmp(&(&b.key, b.x[0], b.x[1])) == Some(std::cmp::Ordering::Less);
+        if first.as_ref().is_none_or(|f| earlier(&bad, f)) {
+            *first = Some(bad);
+        }
+    }
+
+    pub fn first(&self) -> Option<BadDatum> {
+        self.0.lock().unwrap_or_else(|p| p.into_inner()).clone()
+    }
 }
 
 /// The built-in problems' names.
