@@ -1,32 +1,53 @@
 //! signorini: a P2 finite element harness for the Signorini contact problem and its
 //! supremum-norm a posteriori error estimator (Khandelwal, Porwal, Wadhawan).
 //!
-//! Data flows one way: `problems` and `mesh` describe a case, `assembly` builds the linear
-//! elasticity system, `contact` solves the discrete variational inequality (paper eq. 3.4),
-//! `solve` ties them into the SOLVE step, `norms` measures errors.
+//! The crate is built in floors, one folder each; code uses only its own floor and the floors
+//! below (`tests/layers.rs` checks it, and that no two files use each other):
+//!
+//! ```text
+//!   main.rs, bin/     the command line, the benchmark
+//!   plot/             figures and study pages, from records only
+//!   analysis/         rates, verdict rules, the claims of Section 7, Hertz
+//!   study/            manifests, runner, store, references, provenance, drift
+//!   adapt.rs          SOLVE -> ESTIMATE -> MARK -> REFINE
+//!   records/          level, run and solve records; atomic writes
+//!   estimator/        eta_1 .. eta_7 and their variants
+//!   contact/          active-set method, the SOLVE step, KKT certificate, error norms
+//!   fem/              P2 unknowns, element stiffness, assembly
+//!   sparse/           symmetric CSC, orderings, symbolic and numeric Cholesky
+//!   mesh/             triangulations, refinement, Gmsh, point location
+//!   problems/         the Problem trait, boundary parts, built-ins, problem files
+//!   base/             reference element, statistics, memory
+//! ```
+//!
+//! Three entry points: [`solve::solve`] (one discrete solution on a mesh, certified by its KKT
+//! conditions), [`adapt::run`] (the adaptive loop) and [`study::run_study`] (a declared study
+//! into its results folder). Every module keeps a short name at the root (`signorini::solve`,
+//! `signorini::estimate`, `signorini::cholesky`).
 
 // `!(x > 0.0)` is how this crate rejects NaN together with the out-of-range values, on purpose.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod adapt;
-pub mod assembly;
-pub mod certify;
-pub mod cholesky;
-pub mod claims;
+pub mod analysis;
+pub mod base;
 pub mod contact;
-pub mod element;
-pub mod estimate;
-pub mod hertz;
-pub mod memory;
+pub mod estimator;
+pub mod fem;
 pub mod mesh;
-pub mod norms;
-pub mod ordering;
-pub mod page;
 pub mod plot;
 pub mod problems;
 pub mod records;
-pub mod report;
-pub mod solve;
+pub mod sparse;
 pub mod study;
-pub mod symbolic;
-pub mod verdict;
+
+// Every module keeps its short name at the root (`signorini::solve`, `signorini::estimate`):
+// what examples, tests and user programs call.
+pub use analysis::{claims, hertz, verdict};
+pub use base::{element, memory};
+pub use contact::{certify, norms, solve};
+pub use estimator::estimate;
+pub use fem::assembly;
+pub use plot::page;
+pub use records::report;
+pub use sparse::{cholesky, ordering, symbolic};

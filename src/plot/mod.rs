@@ -54,7 +54,9 @@
 
 mod axis;
 mod fb;
+mod font;
 mod hertz;
+pub mod page;
 mod render;
 mod rich;
 
@@ -181,7 +183,7 @@ pub fn draw_figures_where(results: &Path, figures: &Path, keep: &dyn Fn(&str) ->
 
 fn register_font() -> anyhow::Result<()> {
     static REGISTERED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    let ok = *REGISTERED.get_or_init(|| plotters::style::register_font(render::FONT, FontStyle::Normal, FONT_BYTES).is_ok());
+    let ok = *REGISTERED.get_or_init(|| plotters::style::register_font(font::FONT, FontStyle::Normal, FONT_BYTES).is_ok());
     anyhow::ensure!(ok, "the bundled font DejaVuSans.ttf could not be loaded");
     Ok(())
 }

@@ -10,13 +10,11 @@
 //! legend says how many levels were zero ("η₆ = 0 at all levels").
 
 use super::axis::Axis;
+use super::font::{DrawResult, font};
 use super::rich::{self, Metrics};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
-
-/// The registered font: one name for ab_glyph and a CSS font list for the SVG viewer.
-pub(crate) const FONT: &str = "DejaVu Sans, sans-serif";
 
 const FS_FIGURE_TITLE: f64 = 24.0;
 const FS_TITLE: f64 = 20.0;
@@ -29,21 +27,6 @@ const MARKER: i32 = 5;
 const LEGEND_CLEARANCE: i32 = 14;
 const X_LABEL_AREA: i32 = 62;
 const Y_LABEL_AREA: i32 = 96;
-
-pub(crate) fn font(size: f64) -> TextStyle<'static> {
-    TextStyle::from((FONT, size).into_font())
-}
-
-/// Map plotters' drawing errors (which are generic over the backend) to anyhow.
-pub(crate) trait DrawResult<T> {
-    fn drawn(self) -> anyhow::Result<T>;
-}
-
-impl<T, E: std::fmt::Display> DrawResult<T> for Result<T, E> {
-    fn drawn(self) -> anyhow::Result<T> {
-        self.map_err(|e| anyhow::anyhow!("drawing failed: {e}"))
-    }
-}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Marker {

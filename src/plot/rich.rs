@@ -11,7 +11,7 @@
 //! SVG text is relative to the ab_glyph width estimate (the SVG em is size / 1.24, ab_glyph's is
 //! size * 2048 / 2384 for DejaVu Sans).
 
-use super::render::{DrawResult, font};
+use super::font::{DrawResult, font};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};

@@ -2,8 +2,8 @@
 //! the patch test. `experiments/problems/{ex71,ex72,fb}.toml` state the first three as problem
 //! files; `tests/problem_files.rs` keeps the two equal.
 
+use super::Part;
 use super::{Exact, Material, Problem};
-use crate::mesh::Part;
 
 const EPS: f64 = 1e-12;
 

@@ -17,8 +17,8 @@
 //! Every error names the file, the key, the line and column of its value, and what was
 //! expected (for an expression, what exmex said).
 
+use super::{Curve, Part};
 use super::{Exact, Material, Problem};
-use crate::mesh::{Curve, Part};
 use exmex::prelude::*;
 use exmex::{FloatOpsFactory, MatchLiteral, literal_matcher_from_pattern};
 use serde::Deserialize;

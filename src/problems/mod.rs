@@ -12,7 +12,8 @@ pub mod file;
 pub use builtin::{Ex71, Ex72, Fb, Patch, contact_bottom_dirichlet_top};
 pub use file::{FileProblem, ProblemFileError};
 
-use crate::mesh::{Curve, Part};
+mod boundary;
+pub use boundary::{Curve, Part};
 use std::path::Path;
 
 /// Plane elasticity with Lamé constants: sigma(u) = 2 mu eps(u) + zeta tr(eps(u)) I

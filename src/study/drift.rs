@@ -28,6 +28,7 @@
 //! folder holding none is an error. Their provenance must match too ([`compare_provenance`]):
 //! records made from an edited manifest, problem file or mesh are reported as such.
 
+use super::manifest::DERIVED;
 use super::manifest::{DriftSpec, Manifest, Tolerance};
 use crate::records::LevelRecord;
 use crate::records::{RunRecord, StudyDir};
@@ -87,16 +88,6 @@ pub struct FieldChange {
     /// Entries compared.
     pub entries: usize,
 }
-
-/// A derived field's value as a function of its record.
-pub type Definition = fn(&LevelRecord) -> Option<f64>;
-
-/// Fields that are functions of other fields of the same record, checked as such (the stored
-/// and the fresh value each equal the function of the record's own fields, to the bit) rather
-/// than within a tolerance of their own: the efficiency index estimate / err_quadrature carries
-/// the error's relative round-off, which near the end of a run is far larger than anything a
-/// tolerance on the index itself could be honest about while still seeing a change of 1e-5.
-pub const DERIVED: [(&str, Definition); 1] = [("efficiency", |l| l.err_quadrature.map(|e| l.estimate / e))];
 
 fn is_derived(field: &str) -> bool {
     DERIVED.iter().any(|(f, _)| *f == field)
@@ -214,7 +205,7 @@ pub fn observed_rate(run: &RunRecord, field: &str, last: usize) -> Option<f64> {
         .iter()
         .map(|l| Some(((l["ndof"].as_f64()?).ln(), l[field].as_f64().filter(|v| *v > 0.0)?.ln())))
         .collect::<Option<_>>()?;
-    crate::verdict::fit_line(&pts).map(|f| -f.slope)
+    crate::base::stats::fit_line(&pts).map(|f| -f.slope)
 }
 
 /// Compare a study's fresh runs with its stored runs. `quick`: fresh runs are the quick forms

@@ -27,6 +27,7 @@
 //! structure computed elsewhere). The dense kernels (products, Cholesky, triangular solve) are
 //! faer's.
 
+use crate::sparse::csc::Shared;
 use crate::symbolic::{Placement, Symbolic};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{LltParams, LltRegularization};
@@ -107,7 +108,7 @@ impl Plan {
     pub fn new(sn: &Symbolic) -> Self {
         let ns = sn.n_supernodes();
         let begin = sn.supernode_begin();
-        let super_of = crate::assembly::group_of(begin);
+        let super_of = crate::sparse::csc::group_of(begin);
         // descendants: d updates every supernode its pattern rows fall in (each once, d ascending)
         let super_of = &super_of;
         let targets = |d: usize| {
@@ -263,36 +264,6 @@ impl Plan {
         }
         nodes.sort_unstable();
         nodes
-    }
-}
-
-/// L's values (or a solution vector), shared by the threads: each supernode's block (its
-/// columns of L, its rows of the vector) is written by the one task that computes it and read
-/// by others only after that task has finished (the schedules [`Plan::upward`] and
-/// [`Plan::downward`] order them), so no value is ever accessed concurrently with a write.
-#[derive(Clone, Copy)]
-pub(crate) struct Shared<T = f64> {
-    ptr: *mut T,
-    len: usize,
-}
-
-// SAFETY: see the type's documentation; the schedule keeps accesses disjoint or ordered
-unsafe impl<T: Send> Send for Shared<T> {}
-unsafe impl<T: Send> Sync for Shared<T> {}
-
-impl<T> Shared<T> {
-    pub(crate) fn new(values: &mut [T]) -> Self {
-        Shared { ptr: values.as_mut_ptr(), len: values.len() }
-    }
-
-    /// `len` values from `begin`.
-    /// # Safety
-    /// No other live reference to them may be used while the slice is (see [`Shared`]).
-    #[allow(clippy::mut_from_ref)]
-    pub(crate) unsafe fn slice(&self, begin: usize, len: usize) -> &mut [T] {
-        assert!(begin + len <= self.len);
-        // SAFETY: inside the allocation (checked); exclusivity is the caller's
-        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(begin), len) }
     }
 }
 

@@ -37,8 +37,8 @@
 //! (in parallel) and concatenated in a fixed order, so the ordering does not depend on the
 //! number of threads.
 
-use crate::assembly::SymCsc;
-use crate::symbolic::Adjacency;
+use super::etree::Adjacency;
+use crate::sparse::csc::SymCsc;
 use rayon::prelude::*;
 use std::sync::atomic::AtomicU8;
 use std::sync::atomic::Ordering::Relaxed;
@@ -78,7 +78,7 @@ impl Graph {
             first.push(n); // (no unknowns: no node)
         }
         let nodes = first.len() - 1;
-        let node_of = crate::assembly::group_of(&first);
+        let node_of = crate::sparse::csc::group_of(&first);
         // couplings (k, l), k < l, each once: node numbers follow the unknowns', so an entry (i, j),
         // i > j, of the lower triangle lies in a column of node k = node(j) <= l = node(i); `seen`
         // drops the repeats within node k's columns
@@ -99,7 +99,7 @@ impl Graph {
         let mut bounds: Vec<usize> =
             (0..GRAPH_CHUNKS).map(|b| first[..nodes].partition_point(|&f| matrix.col_ptr()[f] < nnz * b / GRAPH_CHUNKS)).collect();
         bounds.push(nodes);
-        let (ptr, adj) = crate::assembly::group_by_target(nodes, GRAPH_CHUNKS, &|b, sink| {
+        let (ptr, adj) = crate::sparse::csc::group_by_target(nodes, GRAPH_CHUNKS, &|b, sink| {
             let mut seen = vec![u32::MAX; nodes];
             for k in bounds[b]..bounds[b + 1] {
                 couplings(k, &mut seen, &mut |l| {
@@ -445,7 +445,7 @@ impl Dissection<'_> {
 
 /// Flops of the Cholesky factorisation of the matrix of the unknowns with the nodes in the given
 /// order (each node's unknowns together), from the column counts of the node graph
-/// ([`crate::symbolic::tree_and_counts`], [`crate::symbolic::Counts::flops`]).
+/// ([`super::etree::tree_and_counts`], `Counts::flops`).
 fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
     let mut position = vec![0u32; order.len()];
     for (new, &old) in order.iter().enumerate() {
@@ -454,7 +454,7 @@ fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
     let weight = |p: usize| graph.weight(order[p]);
     let adjacency =
         Adjacency::gather(order.len(), &|p| graph.degree(order[p]), &|p, f| graph.neighbours(order[p]).for_each(|q| f(position[q])));
-    crate::symbolic::tree_and_counts(&adjacency, order.len(), &weight).flops(order.len(), &weight)
+    super::etree::tree_and_counts(&adjacency, order.len(), &weight).flops(order.len(), &weight)
 }
 
 #[cfg(test)]

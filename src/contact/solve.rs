@@ -341,6 +341,17 @@ fn contact_weights(mesh: &Mesh, sol: &DiscreteSolution, share: impl Fn(bool, f64
     weight
 }
 
+/// A contact node of a discrete solution: its position, the nodal contact force lambda_p (paper
+/// eq. 3.6, in the constraint direction), the pressure lambda_p / int_{Gamma_C} psi_p ds (psi_p the
+/// P2 basis function of the node; see `solve::contact_samples`) and whether it is active.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ContactSample {
+    pub x: [f64; 2],
+    pub lambda: f64,
+    pub pressure: f64,
+    pub active: bool,
+}
+
 /// The contact nodes with their nodal forces and the pressure p_h(p) = lambda_p / int psi_p ds, psi_p
 /// the node's P2 basis function on Gamma_C (a sixth of each adjacent contact edge's length for a
 /// vertex, two thirds of its edge for an edge midpoint): the weights for which a constant or
@@ -348,13 +359,13 @@ fn contact_weights(mesh: &Mesh, sol: &DiscreteSolution, share: impl Fn(bool, f64
 /// paper's density (`contact_density`, eq. 4.5) divides by integrals of piecewise-linear hats
 /// instead, which for a smooth pressure alternates between 2/3 p at vertices and 4/3 p at
 /// midpoints: fine for its sign, not for a pressure profile.
-pub fn contact_samples(mesh: &Mesh, sol: &DiscreteSolution) -> Vec<crate::records::ContactSample> {
+pub fn contact_samples(mesh: &Mesh, sol: &DiscreteSolution) -> Vec<ContactSample> {
     let weight = contact_weights(mesh, sol, |vertex, len| if vertex { len / 6.0 } else { 2.0 * len / 3.0 });
     sol.dofs
         .contact
         .iter()
         .enumerate()
-        .map(|(k, c)| crate::records::ContactSample {
+        .map(|(k, c)| ContactSample {
             x: sol.nodes.coords[c.node],
             lambda: sol.lambda[k],
             pressure: sol.lambda[k] / weight[k],

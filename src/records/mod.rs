@@ -1,3 +1,6 @@
+//! Floor 7: the records schema (what a level, a run and a solve report hold; [`report`]) and
+//! how records are written to disk. May import every floor below.
+//!
 //! Writing records to disk: always atomically (a temporary file in the same directory, then a
 //! rename), so an interrupted run never leaves a half-written file behind, and a write that
 //! fails leaves no temporary file either. Several files that must change together (a run's
@@ -7,6 +10,9 @@
 //! `null` and then refuse to read) is an error naming the field ([`first_non_finite`]).
 
 mod finite;
+pub mod report;
+
+pub use crate::contact::solve::ContactSample;
 pub use finite::{NonFinite, first_non_finite};
 
 use std::io::Write;
@@ -266,17 +272,6 @@ pub struct RunRecord {
     pub levels: Vec<LevelRecord>,
     /// NDF of the reference solution, when errors are against one.
     pub reference_ndof: Option<usize>,
-}
-
-/// A contact node of a discrete solution: its position, the nodal contact force lambda_p (paper
-/// eq. 3.6, in the constraint direction), the pressure lambda_p / int_{Gamma_C} psi_p ds (psi_p the
-/// P2 basis function of the node; see `solve::contact_samples`) and whether it is active.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ContactSample {
-    pub x: [f64; 2],
-    pub lambda: f64,
-    pub pressure: f64,
-    pub active: bool,
 }
 
 /// A mesh snapshot for the mesh figure: vertices, triangles, and the contact nodes (active or not,

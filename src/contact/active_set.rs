@@ -29,9 +29,9 @@
 //! L never shares the memory with them (at `structured:512` they take 0.6 GB, L 2.2 GB). The
 //! Refactor strategy keeps both: it changes the matrix's values in every iteration.
 
-use crate::assembly::SymCsc;
 use crate::cholesky;
 use crate::ordering::OrderingChoice;
+use crate::sparse::csc::SymCsc;
 use crate::symbolic::{self, Placement, Symbolic};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};

@@ -1,0 +1,42 @@
+//! The parts of a problem's boundary and the curves it may follow: what a problem declares and
+//! a mesh is tagged with (re-exported by `mesh`).
+
+/// The part of the boundary an edge belongs to (paper Section 1: Gamma_D, Gamma_N, Gamma_C).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Part {
+    Dirichlet,
+    Neumann,
+    Contact,
+}
+
+impl Part {
+    /// Integer code used in VTU files (0 is reserved for triangles).
+    pub fn code(self) -> i32 {
+        match self {
+            Part::Dirichlet => 1,
+            Part::Neumann => 2,
+            Part::Contact => 3,
+        }
+    }
+}
+
+/// A curved part of the boundary. A straight-sided mesh only approximates it; refinement puts the
+/// new vertex of a bisected boundary edge on the curve ([`Curve::project`]).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Curve {
+    /// The circle of centre `centre` and radius `radius`.
+    Circle { centre: [f64; 2], radius: f64 },
+}
+
+impl Curve {
+    /// The point of the curve closest to `x` (`x` itself if `x` is the circle's centre).
+    pub fn project(&self, x: [f64; 2]) -> [f64; 2] {
+        match *self {
+            Curve::Circle { centre, radius } => {
+                let d = [x[0] - centre[0], x[1] - centre[1]];
+                let r = d[0].hypot(d[1]);
+                if r == 0.0 { x } else { [centre[0] + radius * d[0] / r, centre[1] + radius * d[1] / r] }
+            }
+        }
+    }
+}
