@@ -529,3 +529,27 @@ fn legends_keep_clear_of_every_curve() {
         assert!(closest >= 12.0, "{name}: a curve passes {closest:.1} px from the legend");
     }
 }
+
+/// Every log y axis of every stored figure spans its data (and guide lines such as efficiency
+/// = 1) plus at most two decades in all (room for slopes, labels and the legend): a figure is
+/// its data, not empty decades. Checked on the records in `results/`.
+#[test]
+fn log_axes_stay_within_two_decades_of_their_data() {
+    let results = Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
+    let mut wide = Vec::new();
+    for name in FIGURES {
+        for r in plot::y_ranges(name, &results).unwrap() {
+            if !r.log {
+                continue;
+            }
+            let beyond = (r.axis_hi / r.data_hi).log10().max(0.0) + (r.data_lo / r.axis_lo).log10().max(0.0);
+            if beyond > 2.0 {
+                wide.push(format!(
+                    "{name} panel {}: axis {:.1e}..{:.1e}, data {:.1e}..{:.1e} ({beyond:.1} decades beyond)",
+                    r.title_index, r.axis_lo, r.axis_hi, r.data_lo, r.data_hi
+                ));
+            }
+        }
+    }
+    assert!(wide.is_empty(), "axes far beyond their data:\n{}", wide.join("\n"));
+}

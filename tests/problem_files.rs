@@ -316,6 +316,11 @@ fn group_errors() {
     // a curve for a group named nowhere
     let e = err(&(groups.clone() + "\n[curves]\nrim = { circle = { centre = [0, 1], radius = 1 } }\n"));
     assert!(e.contains("key `curves.rim`") && e.contains("referenced nowhere") && e.contains("arc, side, top"), "{e}");
+    // a typo in [parts] ("arcc") of the group [curves] names ("arc"): reported at [parts], both named
+    let typo =
+        groups.replace("contact = [\"arc\"]", "contact = [\"arcc\"]") + "\n[curves]\narc = { circle = { centre = [0, 1], radius = 1 } }\n";
+    let e = err(&typo);
+    assert!(e.contains("key `parts.contact`") && e.contains("\"arc\"") && e.contains("\"arcc\"") && e.contains("misspelt"), "{e}");
     // a group in two parts
     let e = err(&groups.replace("neumann = [\"side\"]", "neumann = [\"top\"]"));
     assert!(e.contains("key `parts.neumann`") && e.contains("\"top\""), "{e}");

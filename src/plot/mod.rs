@@ -57,7 +57,7 @@ mod fb;
 mod font;
 mod hertz;
 pub mod page;
-mod render;
+pub mod render;
 mod rich;
 
 use crate::estimate::{ContactTerm, LogFactor};
@@ -205,13 +205,23 @@ fn write_figure(fig: &Figure, dir: &Path, name: &str) -> anyhow::Result<Vec<Path
     let drawn = {
         // the backend saves the file when presented (or dropped), before the rename below
         let root = BitMapBackend::new(&tmp, size).into_drawing_area();
-        fig.render(&root, rich::BITMAP)
+        fig.render(&root, rich::BITMAP).map(|_| ())
     };
     if let Err(e) = drawn.and_then(|()| std::fs::rename(&tmp, &png).with_context(|| format!("writing {}", png.display()))) {
         std::fs::remove_file(&tmp).ok();
         return Err(e);
     }
     Ok(vec![svg, png])
+}
+
+/// The y range of every line panel of figure `name` drawn from `results` against the range of
+/// its data (what a test holds the axes to); empty for a mesh figure or one without results.
+pub fn y_ranges(name: &str, results: &Path) -> anyhow::Result<Vec<render::YRange>> {
+    register_font()?;
+    let Ok(fig) = build(name, results)? else { return Ok(Vec::new()) };
+    let mut text = String::new();
+    let root = SVGBackend::with_string(&mut text, fig.size()).into_drawing_area();
+    fig.render(&root, rich::SVG)
 }
 
 /// A figure, or the reason it cannot be drawn yet.

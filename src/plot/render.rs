@@ -5,7 +5,10 @@
 //! lines and hollow markers for secondary series, reference slopes dashed grey with their label
 //! next to the line, horizontal guide lines (efficiency = 1), and a legend in a white box put in
 //! the first corner of the plot (upper right, upper left, lower right, lower left) where it
-//! covers no data; if every corner is taken, the y range is extended upwards to make room.
+//! covers no data; if every corner is taken, the y range is extended upwards once, by at most
+//! half a decade (a quarter of a linear range), and if that is not enough the legend goes beside
+//! the plot, on the right, or under it (whichever leaves the plot's shorter side longer): the
+//! axes span the data, not the legend.
 //! On a log axis, points with value 0 (or missing) are not drawn: the line breaks there and the
 //! legend says how many levels were zero ("η₆ = 0 at all levels").
 
@@ -222,26 +225,46 @@ impl Figure {
     }
 
     /// Draw onto `root`; `m` describes how the backend places text (`rich::SVG`, `rich::BITMAP`).
-    pub fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, m: Metrics) -> anyhow::Result<()> {
+    /// Returns the y range of every line panel drawn and the range of its data ([`YRange`]).
+    pub fn render<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, m: Metrics) -> anyhow::Result<Vec<YRange>> {
         root.fill(&WHITE).drawn()?;
-        match self {
+        let ranges = match self {
             Figure::Lines(f) => render_lines(root, f, m)?,
-            Figure::Mesh(mesh) => render_mesh(root, mesh, m)?,
-        }
-        root.present().drawn()
+            Figure::Mesh(mesh) => {
+                render_mesh(root, mesh, m)?;
+                Vec::new()
+            }
+        };
+        root.present().drawn()?;
+        Ok(ranges)
     }
 }
 
-fn render_lines<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, f: &LineFigure, m: Metrics) -> anyhow::Result<()> {
+/// A line panel's y axis and the range of what it must show: the curves' points and the guide
+/// lines (the efficiency index's line at 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct YRange {
+    pub title_index: usize,
+    pub axis_lo: f64,
+    pub axis_hi: f64,
+    pub data_lo: f64,
+    pub data_hi: f64,
+    pub log: bool,
+}
+
+fn render_lines<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, f: &LineFigure, m: Metrics) -> anyhow::Result<Vec<YRange>> {
     let body = match &f.title {
         Some(t) => titled(root, root, t, FS_FIGURE_TITLE, m)?,
         None => root.clone(),
     };
     let areas = body.split_evenly((1, f.panels.len().max(1)));
-    for (area, panel) in areas.iter().zip(&f.panels) {
-        render_panel(root, area, panel, m)?;
+    let mut out = Vec::new();
+    for (k, (area, panel)) in areas.iter().zip(&f.panels).enumerate() {
+        if let Some(r) = render_panel(root, area, panel, m)? {
+            out.push(YRange { title_index: k, ..r });
+        }
     }
-    Ok(())
+    Ok(out)
 }
 
 /// Draw a centred title at the top of `area`; return the rest of the area.
@@ -366,10 +389,10 @@ fn render_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     p: &Panel,
     m: Metrics,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<Option<YRange>> {
     let area = titled(root, area, &p.title, FS_TITLE, m)?;
     if !p.has_data() {
-        return message(root, &area, "no results yet", m);
+        return message(root, &area, "no results yet", m).map(|()| None);
     }
 
     // y scale
@@ -392,8 +415,11 @@ fn render_panel<DB: DrawingBackend>(
     let mut yv: Vec<f64> = prepared.iter().flat_map(|s| s.points().map(|p| p.1)).collect();
     if xs.is_empty() {
         let msg = prepared.iter().map(|s| s.legend_label()).collect::<Vec<_>>().join("; ");
-        return message(root, &area, &msg, m);
+        return message(root, &area, &msg, m).map(|()| None);
     }
+    // the data and the guide lines (efficiency = 1 is part of what a reader must see)
+    let guides = p.hlines.iter().map(|h| h.y).filter(|y| !y_log || *y > 0.0);
+    let (data_lo, data_hi) = yv.iter().cloned().chain(guides).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
     let xa = padded(&xs, p.x_log, 0.06, 1.0);
 
     // reference slopes: (x0, y0, x1, y1)
@@ -461,10 +487,11 @@ fn render_panel<DB: DrawingBackend>(
     let legend_w = pad + swatch + 8 + text_w + pad;
     let legend_h = pad * 2 + row * entries.len() as i32;
 
-    let build = |ya: Axis| {
+    let build = |ya: Axis, right: i32, bottom: i32| {
         ChartBuilder::on(&area)
             .margin(14)
-            .margin_right(24)
+            .margin_right(right)
+            .margin_bottom(bottom)
             .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(xa, ya)
@@ -479,10 +506,11 @@ fn render_panel<DB: DrawingBackend>(
     }
     let hline_label_w: Vec<i32> = p.hlines.iter().map(|h| rich::width(root, &h.label, FS_LEGEND, m)).collect::<anyhow::Result<_>>()?;
     let inset = 10;
-    let mut chart = build(ya)?;
+    let mut chart = build(ya, 24, 14)?;
     let mut legend_at = None;
     let mut label_at: Vec<(i32, i32)> = Vec::new();
-    for attempt in 0..4 {
+    let (mut beside, mut below) = (false, false);
+    for attempt in 0..3 {
         let (xr, yr) = chart.plotting_area().get_pixel_range();
         let mut grid = Occupancy::new(xr.clone(), yr.clone());
         for q in obstacle_samples(&chart, &prepared, &slopes, &p.hlines, xa, ya) {
@@ -514,6 +542,15 @@ fn render_panel<DB: DrawingBackend>(
         if entries.is_empty() {
             break;
         }
+        if beside {
+            legend_at = Some(if below {
+                // under the x axis and its description, left-aligned with the plot
+                (xr.start, yr.end + X_LABEL_AREA + 8)
+            } else {
+                (xr.end + 16, yr.start)
+            });
+            break;
+        }
         if right >= left && bottom >= top {
             let xs_: Vec<i32> = (left..=right).step_by(6).chain([right]).collect();
             let ys_: Vec<i32> = (top..=bottom).step_by(6).chain([bottom]).collect();
@@ -530,16 +567,22 @@ fn render_panel<DB: DrawingBackend>(
                 break;
             }
         }
-        if attempt == 3 {
-            legend_at = Some((right.max(left), top));
-            break;
+        if attempt == 0 {
+            // once: room at the top, at most half a decade (a quarter of a linear range)
+            let plot_h = (yr.end - yr.start).max(1) as f64;
+            let f = ((legend_h + 2 * inset + 6) as f64 / plot_h).min(0.6);
+            let (a, b) = (ya.t(ya.lo), ya.t(ya.hi));
+            let cap = if ya.log { 0.5 } else { 0.25 * (b - a) };
+            ya = Axis { hi: ya.inv((a + (b - a) / (1.0 - f)).min(b + cap)), ..ya };
+            chart = build(ya, 24, 14)?;
+        } else {
+            // beside the plot, on the right, or under it: whichever leaves the plot's shorter
+            // side longer (a convergence plot squashed flat is as hard to read as a narrow one)
+            beside = true;
+            let (w, h) = (xr.end - xr.start, yr.end - yr.start);
+            below = w.min(h - legend_h - 12) > (w - legend_w - 16).min(h);
+            chart = if below { build(ya, 24, 14 + legend_h + 12)? } else { build(ya, 24 + legend_w + 16, 14)? };
         }
-        let plot_h = (yr.end - yr.start).max(1) as f64;
-        let f = ((legend_h + 2 * inset + 6) as f64 / plot_h).min(0.6);
-        let (a, b) = (ya.t(ya.lo), ya.t(ya.hi));
-        let hi = ya.inv(a + (b - a) / (1.0 - f));
-        ya = Axis { hi, ..ya };
-        chart = build(ya)?;
     }
 
     chart
@@ -650,7 +693,7 @@ fn render_panel<DB: DrawingBackend>(
             }
         }
     }
-    Ok(())
+    Ok(Some(YRange { title_index: 0, axis_lo: ya.lo, axis_hi: ya.hi, data_lo, data_hi, log: y_log }))
 }
 
 /// The axis descriptions, centred below and left of the plotting area (drawn here rather than by

@@ -618,6 +618,8 @@ impl FileProblem {
 
         // parts
         let mut groups = BTreeMap::new();
+        // where each group is named in [parts], for errors that belong there
+        let mut group_keys = BTreeMap::new();
         let mut predicates = [None, None];
         let mut declared_parts = Vec::new();
         for (key, part, value) in [
@@ -644,6 +646,7 @@ impl FileProblem {
                         if let Some(other) = groups.insert(g.clone(), part) {
                             return Err(r.error(key, value.span(), format!("physical group {g:?} is already in the {other:?} part")));
                         }
+                        group_keys.insert(g.clone(), (key, value.span()));
                     }
                 }
             }
@@ -652,6 +655,16 @@ impl FileProblem {
         let mut curves = BTreeMap::new();
         for (group, curve) in &raw.curves {
             let key = format!("curves.{group}");
+            // a near miss in [parts] ("contct" for "contact") is where the mistake most likely is
+            let near = groups.keys().find(|g| strsim::levenshtein(g, group) <= 2 && !raw.curves.contains_key(*g));
+            if let (false, Some(near)) = (groups.contains_key(group), near) {
+                let (parts_key, span) = group_keys[near].clone();
+                return Err(r.error(
+                    parts_key,
+                    span,
+                    format!("the physical group [curves] gives a circle for, {group:?}; {near:?} is named here instead: one of the two is misspelt (the mesh's groups decide)"),
+                ));
+            }
             if !groups.contains_key(group) {
                 return Err(r.error(
                     &key,
