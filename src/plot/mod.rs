@@ -356,16 +356,26 @@ const COLOR_ERROR: RGBColor = PALETTE[0];
 const COLOR_ESTIMATE: RGBColor = PALETTE[1];
 
 /// Error (blue circles) and estimate (red squares) per run; the first run solid, others dashed.
+/// The first run as in the paper (error: blue circles, estimate: red squares, both solid); every
+/// other run in a colour and marker of its own, its error solid and filled, its estimate dashed
+/// and hollow, so that no two series share a style.
 fn error_and_estimate(runs: &[RunRecord], panel: &mut Panel, error_label: &str) {
     for (k, r) in runs.iter().enumerate() {
-        let secondary = k > 0;
         let id = &r.run.id;
+        let (error_style, estimate_style) = if k == 0 {
+            (
+                Style { color: COLOR_ERROR, marker: Marker::Circle, dashed: false, filled: true },
+                Style { color: COLOR_ESTIMATE, marker: Marker::Square, dashed: false, filled: true },
+            )
+        } else {
+            // colours 0 and 1 of the palette are the first run's
+            let own = Style::nth(k + 1);
+            (own, own.dashed(true))
+        };
         if r.levels.iter().any(|l| l.err_quadrature.is_some()) {
-            let st = Style { color: COLOR_ERROR, marker: Marker::Circle, dashed: false, filled: true }.dashed(secondary);
-            panel.series.push(series(r, format!("{error_label}, {id}"), st, |l| l.err_quadrature));
+            panel.series.push(series(r, format!("{error_label}, {id}"), error_style, |l| l.err_quadrature));
         }
-        let st = Style { color: COLOR_ESTIMATE, marker: Marker::Square, dashed: false, filled: true }.dashed(secondary);
-        panel.series.push(series(r, format!("{ESTIMATE}, {id}"), st, |l| Some(l.estimate)));
+        panel.series.push(series(r, format!("{ESTIMATE}, {id}"), estimate_style, |l| Some(l.estimate)));
     }
 }
 
