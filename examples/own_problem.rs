@@ -52,7 +52,7 @@ fn main() -> anyhow::Result<()> {
     let result = adapt::run(&problem, mesh, &config, None, &mut |l| {
         let (r, zone) = (l.record, l.solution.contact_zone());
         let zone = zone.map_or("-".into(), |[a, b]| format!("[{a:.4}, {b:.4}]"));
-        println!("{:>5} {:>7} {:>10.3e} {:>6} {:>15}", r.level, r.ndof, r.estimate, r.active_nodes, zone);
+        println!("{:>5} {:>7} {:>10.3e} {:>6} {:>15}", r.level, r.ndof, r.terms.estimate, r.active_nodes, zone);
         ControlFlow::Continue(())
     })?;
     let why = match result.termination {

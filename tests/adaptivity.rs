@@ -419,7 +419,7 @@ fn run_reports_termination_and_final_state() {
     assert_eq!((r.termination, r.records.len()), (adapt::Termination::LevelsReached, 3));
     assert_eq!(r.records[2].n_elements, r.mesh.n_triangles());
     assert_eq!(r.records[2].ndof, 2 * r.solution.nodes.len());
-    assert_eq!(r.records[2].estimate, r.estimate.terms.estimate);
+    assert_eq!(r.records[2].terms.estimate, r.estimate.terms.estimate);
     let r = go(AdaptConfig { levels: 3, ..Default::default() }, 1);
     assert_eq!((r.termination, r.records.len()), (adapt::Termination::StoppedByObserver, 2));
     assert_eq!(r.records[1].n_elements, r.mesh.n_triangles());

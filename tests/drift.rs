@@ -50,7 +50,7 @@ fn unperturbed_copies_pass_quick_and_full() {
 fn perturbed_float_beyond_tolerance_is_reported_with_its_row() {
     let (stored, quick, _) = stored_and_quick();
     let mut s = stored.clone();
-    s[0].levels[2].eta1 *= 1.0 + 1e-6; // tolerance is rel 1e-9 by default
+    s[0].levels[2].terms.eta1 *= 1.0 + 1e-6; // tolerance is rel 1e-9 by default
     let rows = compare_study(&manifest(), &s, quick, true);
     assert_eq!(rows.len(), 1, "{rows:?}");
     let r = &rows[0];
@@ -58,7 +58,7 @@ fn perturbed_float_beyond_tolerance_is_reported_with_its_row() {
     assert!((r.relative_change.unwrap() - 1e-6).abs() < 1e-9);
     // within tolerance: no drift
     let mut s = stored.clone();
-    s[0].levels[2].eta1 *= 1.0 + 1e-12;
+    s[0].levels[2].terms.eta1 *= 1.0 + 1e-12;
     assert!(compare_study(&manifest(), &s, quick, true).is_empty());
 }
 
@@ -228,7 +228,7 @@ fn drift_command_fails_on_perturbed_record_csv_or_claims() {
     let original = std::fs::read_to_string(dir.run_file("b")).unwrap();
     let mut rec: RunRecord = serde_json::from_str(&original).unwrap();
     let last = rec.levels.len() - 1;
-    rec.levels[last].eta2 *= 1.0 + 1e-5;
+    rec.levels[last].terms.eta2 *= 1.0 + 1e-5;
     std::fs::write(dir.run_file("b"), serde_json::to_string_pretty(&rec).unwrap()).unwrap();
     dir.write_csv(&dir.read_runs().unwrap()).unwrap(); // keep the view in step: only the number moved
     let (ok, text) = drift();

@@ -435,10 +435,14 @@ fn roundoff_estimator_terms_are_zeros_and_the_legend_says_so() {
     // Example 7.2's adaptive run with eta6 at round-off (3e-17, next to eta1 of order 1e-2) at three levels
     let mut rec = run("adaptive", "ex72", Refine::Adaptive).record("ex72");
     for l in &mut rec.levels[8..11] {
-        l.eta6 = 2.78e-17;
+        l.terms.eta6 = 2.78e-17;
     }
-    let smallest =
-        rec.levels.iter().flat_map(|l| [l.eta1, l.eta2, l.eta3, l.eta4, l.eta5, l.eta7]).filter(|&v| v > 0.0).fold(f64::INFINITY, f64::min);
+    let smallest = rec
+        .levels
+        .iter()
+        .flat_map(|l| [l.terms.eta1, l.terms.eta2, l.terms.eta3, l.terms.eta4, l.terms.eta5, l.terms.eta7])
+        .filter(|&v| v > 0.0)
+        .fold(f64::INFINITY, f64::min);
     write_json(&StudyDir::new(&results, "ex72").run_file("adaptive"), &rec).unwrap();
     plot::draw_all(&results, &figures).expect("draw_all");
     let fig4b = read(&figures.join("fig4b.svg"));

@@ -134,7 +134,7 @@ fn built_ins_as_files_give_the_same_solutions() {
         for (a, c) in rf.iter().zip(&rb) {
             let ctx = format!("{name} adaptive level {}", c.level);
             assert_eq!((a.ndof, a.active_nodes, a.n_elements), (c.ndof, c.active_nodes, c.n_elements), "{ctx}: mesh and active set");
-            assert!(close(a.estimate, c.estimate, 1e-9, 0.0), "{ctx}: estimate {} vs {}", a.estimate, c.estimate);
+            assert!(close(a.terms.estimate, c.terms.estimate, 1e-9, 0.0), "{ctx}: estimate {} vs {}", a.terms.estimate, c.terms.estimate);
             if let (Some(x), Some(y)) = (a.err_quadrature, c.err_quadrature) {
                 assert!(close(x, y, 1e-9, 0.0), "{ctx}: error {x} vs {y}");
             }

@@ -201,10 +201,7 @@ fn synthetic_levels(rate: f64, growth: f64, n: usize) -> Vec<LevelRecord> {
                 h_min: h,
                 zone_min: Some(a + 0.7 * h),
                 zone_max: Some(1.0),
-                l_h: 1.0,
-                eta_h: estimate / 0.45,
-                c0: 0.45,
-                estimate,
+                terms: signorini::estimate::Terms { l_h: 1.0, eta_h: estimate / 0.45, c0: 0.45, estimate, ..Default::default() },
                 err_quadrature: Some(err),
                 err_dense: Some(1.1 * err),
                 efficiency: Some(estimate / err),
@@ -286,8 +283,8 @@ fn fb_rows_on_synthetic_records() {
     assert_eq!(row(&c, "fb-contact-zone").verdict, Verdict::Fails);
     // unreliable C_0: error above 0.45 eta_h at one level
     let mut bad = synthetic_levels(1.5, 0.0, 26);
-    bad[5].estimate = 0.5 * bad[5].err_quadrature.unwrap();
-    bad[5].eta_h = bad[5].estimate / 0.45;
+    bad[5].terms.estimate = 0.5 * bad[5].err_quadrature.unwrap();
+    bad[5].terms.eta_h = bad[5].terms.estimate / 0.45;
     write_json(&dir.run_file("uniform"), &record("uniform", Refine::Uniform, bad)).unwrap();
     let c = claims::claims(&d).unwrap();
     assert_eq!(row(&c, "fb-reliability").verdict, Verdict::Fails);

@@ -122,8 +122,10 @@ impl Ctx<'_> {
         match q {
             Q::Field(f) => verdict::field(r, f),
             Q::Error => err,
-            Q::Efficiency => r.levels.iter().zip(&err).map(|(l, e)| e.filter(|e| *e > 0.0).map(|e| l.estimate / e)).collect(),
-            Q::EfficiencyOverLh => r.levels.iter().zip(&err).map(|(l, e)| e.filter(|e| *e > 0.0).map(|e| l.estimate / e / l.l_h)).collect(),
+            Q::Efficiency => r.levels.iter().zip(&err).map(|(l, e)| e.filter(|e| *e > 0.0).map(|e| l.terms.estimate / e)).collect(),
+            Q::EfficiencyOverLh => {
+                r.levels.iter().zip(&err).map(|(l, e)| e.filter(|e| *e > 0.0).map(|e| l.terms.estimate / e / l.terms.l_h)).collect()
+            }
         }
     }
 
@@ -192,8 +194,12 @@ fn growth_text(name: &str, g: Option<&verdict::RateFit>) -> String {
 /// (max over the levels of error / eta_h).
 pub fn overestimation(r: &RunRecord, err_field: &str) -> Option<(f64, f64, f64)> {
     let err = verdict::field(r, err_field);
-    let pairs: Vec<(f64, f64)> =
-        r.levels.iter().zip(&err).map(|(l, e)| e.filter(|e| *e > 0.0).map(|e| (l.estimate / e, e / l.eta_h))).collect::<Option<_>>()?;
+    let pairs: Vec<(f64, f64)> = r
+        .levels
+        .iter()
+        .zip(&err)
+        .map(|(l, e)| e.filter(|e| *e > 0.0).map(|e| (l.terms.estimate / e, e / l.terms.eta_h)))
+        .collect::<Option<_>>()?;
     if pairs.is_empty() {
         return None;
     }
@@ -335,7 +341,7 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         },
     });
 
-    let eta67 = a71.map(|r| r.levels.iter().map(|l| l.eta6.max(l.eta7)).fold(0.0, f64::max));
+    let eta67 = a71.map(|r| r.levels.iter().map(|l| l.terms.eta6.max(l.terms.eta7)).fold(0.0, f64::max));
     out.push(Claim {
         fragile: None,
         id: "7.1-eta6-eta7",
@@ -554,11 +560,11 @@ fn ex72_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             .iter()
             .filter(|p| p.2 > p.1)
             .map(|p| {
-                let v: Vec<f64> = (p.1..=p.2).map(|i| r.levels[i].eta6 + r.levels[i].eta7).collect();
+                let v: Vec<f64> = (p.1..=p.2).map(|i| r.levels[i].terms.eta6 + r.levels[i].terms.eta7).collect();
                 v.iter().cloned().fold(0.0, f64::max) / v.iter().cloned().fold(f64::INFINITY, f64::min)
             })
             .fold(1.0, f64::max);
-        (fit(|l| l.eta6), fit(|l| l.eta7), plateaus, within)
+        (fit(|l| l.terms.eta6), fit(|l| l.terms.eta7), plateaus, within)
     });
     out.push(Claim {
         fragile: None,

@@ -36,7 +36,7 @@ pub(super) fn fb_error(results: &Path) -> anyhow::Result<Built> {
             }));
         }
         p.series.push(series(r, format!("estimate, {id}"), Style { color, marker: Marker::Square, dashed: true, filled: false }, |l| {
-            Some(l.estimate)
+            Some(l.terms.estimate)
         }));
     }
     for r in &runs {

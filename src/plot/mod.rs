@@ -324,7 +324,7 @@ fn series(r: &RunRecord, label: String, style: Style, y: impl Fn(&LevelRecord) -
 }
 
 fn efficiency(l: &LevelRecord) -> Option<f64> {
-    l.efficiency.or_else(|| l.err_quadrature.filter(|&e| e > 0.0).map(|e| l.estimate / e))
+    l.efficiency.or_else(|| l.err_quadrature.filter(|&e| e > 0.0).map(|e| l.terms.estimate / e))
 }
 
 fn slope() -> Slope {
@@ -356,16 +356,26 @@ const COLOR_ERROR: RGBColor = PALETTE[0];
 const COLOR_ESTIMATE: RGBColor = PALETTE[1];
 
 /// Error (blue circles) and estimate (red squares) per run; the first run solid, others dashed.
+/// The first run as in the paper (error: blue circles, estimate: red squares, both solid); every
+/// other run in a colour and marker of its own, its error solid and filled, its estimate dashed
+/// and hollow, so that no two series share a style.
 fn error_and_estimate(runs: &[RunRecord], panel: &mut Panel, error_label: &str) {
     for (k, r) in runs.iter().enumerate() {
-        let secondary = k > 0;
         let id = &r.run.id;
+        let (error_style, estimate_style) = if k == 0 {
+            (
+                Style { color: COLOR_ERROR, marker: Marker::Circle, dashed: false, filled: true },
+                Style { color: COLOR_ESTIMATE, marker: Marker::Square, dashed: false, filled: true },
+            )
+        } else {
+            // colours 0 and 1 of the palette are the first run's
+            let own = Style::nth(k + 1);
+            (own, own.dashed(true))
+        };
         if r.levels.iter().any(|l| l.err_quadrature.is_some()) {
-            let st = Style { color: COLOR_ERROR, marker: Marker::Circle, dashed: false, filled: true }.dashed(secondary);
-            panel.series.push(series(r, format!("{error_label}, {id}"), st, |l| l.err_quadrature));
+            panel.series.push(series(r, format!("{error_label}, {id}"), error_style, |l| l.err_quadrature));
         }
-        let st = Style { color: COLOR_ESTIMATE, marker: Marker::Square, dashed: false, filled: true }.dashed(secondary);
-        panel.series.push(series(r, format!("{ESTIMATE}, {id}"), st, |l| Some(l.estimate)));
+        panel.series.push(series(r, format!("{ESTIMATE}, {id}"), estimate_style, |l| Some(l.terms.estimate)));
     }
 }
 
@@ -425,7 +435,7 @@ fn fig4(results: &Path, study: &str, fig: &str, terms: usize) -> anyhow::Result<
     let Some(r) = adaptive_run(&runs) else {
         return Ok(Err(format!("study {study} has no adaptive run yet")));
     };
-    let etas = |l: &LevelRecord| [l.eta1, l.eta2, l.eta3, l.eta4, l.eta5, l.eta6, l.eta7];
+    let etas = |l: &LevelRecord| [l.terms.eta1, l.terms.eta2, l.terms.eta3, l.terms.eta4, l.terms.eta5, l.terms.eta6, l.terms.eta7];
     let mut p = Panel::new(
         format!("{}: individual estimators ({}, Fig. {fig})", problem_title(&r.run.problem), refine_label(r)),
         NDF_DESC,
@@ -588,7 +598,7 @@ fn c0_sweep(results: &Path) -> anyhow::Result<Built> {
         let mut p = Panel::new(problem_title(&problem), NDF_DESC, EFF_DESC);
         p.y_scale = YScale::Auto;
         for (k, r) in group.iter().enumerate() {
-            let ratio = |l: &LevelRecord| l.err_quadrature.filter(|&e| e > 0.0 && l.eta_h > 0.0).map(|e| l.eta_h / e);
+            let ratio = |l: &LevelRecord| l.err_quadrature.filter(|&e| e > 0.0 && l.terms.eta_h > 0.0).map(|e| l.terms.eta_h / e);
             let c0_min = r.levels.iter().filter_map(|l| ratio(l).map(|q| 1.0 / q)).fold(f64::NEG_INFINITY, f64::max);
             if !c0_min.is_finite() {
                 p.notes.push(format!("{}: no errors recorded", short_id(r)));
@@ -660,9 +670,9 @@ fn contact_term_ablation(results: &Path) -> anyhow::Result<Built> {
             let variant =
                 format!("{}{}", contact_label(r.run.estimator.contact_term), distinguish(&group, r, |o| o.run.estimator.contact_term));
             let st = Style::nth(k);
-            p.series.push(series(r, format!("estimate, {variant}"), st, |l| Some(l.estimate)));
+            p.series.push(series(r, format!("estimate, {variant}"), st, |l| Some(l.terms.estimate)));
             let st5 = Style { marker: render::MARKERS[(k + 4) % render::MARKERS.len()], ..st }.dashed(true);
-            p.series.push(series(r, format!("η_{{5}}, {variant}"), st5, |l| Some(l.eta5)));
+            p.series.push(series(r, format!("η_{{5}}, {variant}"), st5, |l| Some(l.terms.eta5)));
         }
         out.push(p);
     }
@@ -685,7 +695,7 @@ fn estimator_repair(results: &Path) -> anyhow::Result<Built> {
             let st = Style::nth(k);
             p.series.push(series(r, format!("error, {}", how(r)), st, |l| l.err_quadrature));
             let dashed = Style { marker: render::MARKERS[(k + 4) % render::MARKERS.len()], ..st }.dashed(true);
-            p.series.push(series(r, format!("estimate, {}", how(r)), dashed, |l| Some(l.estimate)));
+            p.series.push(series(r, format!("estimate, {}", how(r)), dashed, |l| Some(l.terms.estimate)));
         }
         out.push(p);
     }
@@ -716,7 +726,7 @@ fn theta_ablation(results: &Path) -> anyhow::Result<Built> {
             let theta =
                 |o: &RunRecord| if o.run.refine == Refine::Uniform { "uniform".to_string() } else { format!("θ = {}", o.run.theta) };
             let label = format!("{}{}", theta(r), distinguish(&group, r, theta));
-            let y = move |l: &LevelRecord| if errors { l.err_quadrature } else { Some(l.estimate) };
+            let y = move |l: &LevelRecord| if errors { l.err_quadrature } else { Some(l.terms.estimate) };
             p.series.push(series(r, label, Style::nth(k).dashed(uniform), y));
         }
         p.slopes.push(slope());

@@ -95,7 +95,7 @@ fn run_table(runs: &[RunRecord]) -> String {
             if matches!(r.run.refine, crate::records::Refine::Adaptive) { format!(", θ = {}", r.run.theta) } else { String::new() },
             r.levels.len(),
             last.map_or("–".into(), |l| l.ndof.to_string()),
-            num(last.map(|l| l.estimate)),
+            num(last.map(|l| l.terms.estimate)),
             num(last.and_then(|l| l.err_quadrature)),
             last.and_then(|l| l.efficiency).map_or("–".into(), |e| format!("{e:.2}")),
         );

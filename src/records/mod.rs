@@ -135,7 +135,7 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Resul
 
 /// The option enums a [`RunSpec`] holds, re-exported so that readers of records need nothing
 /// from the solver modules.
-pub use crate::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
+pub use crate::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame, Terms};
 pub use crate::norms::Sampling;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
@@ -169,18 +169,10 @@ pub struct LevelRecord {
     pub pdas_iterations: usize,
     pub zone_min: Option<f64>,
     pub zone_max: Option<f64>,
-    pub eta1: f64,
-    pub eta2: f64,
-    pub eta3: f64,
-    pub eta4: f64,
-    pub eta5: f64,
-    pub eta6: f64,
-    pub eta7: f64,
-    pub l_h: f64,
-    pub psi: f64,
-    pub eta_h: f64,
-    pub c0: f64,
-    pub estimate: f64,
+    /// The estimator's terms (eta_1 .. eta_7, l_h, Psi, eta_h, C_0, the estimate), flattened:
+    /// the same fields, in the same place, as in every stored record.
+    #[serde(flatten)]
+    pub terms: Terms,
     /// ||u - u_h||_Linf at the quadrature points (the paper's way), where u is known.
     pub err_quadrature: Option<f64>,
     pub err_dense: Option<f64>,

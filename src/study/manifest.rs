@@ -68,7 +68,7 @@ pub type Definition = fn(&crate::records::LevelRecord) -> Option<f64>;
 /// than within a tolerance of their own: the efficiency index estimate / err_quadrature carries
 /// the error's relative round-off, which near the end of a run is far larger than anything a
 /// tolerance on the index itself could be honest about while still seeing a change of 1e-5.
-pub const DERIVED: [(&str, Definition); 1] = [("efficiency", |l| l.err_quadrature.map(|e| l.estimate / e))];
+pub const DERIVED: [(&str, Definition); 1] = [("efficiency", |l| l.err_quadrature.map(|e| l.terms.estimate / e))];
 
 #[derive(Debug, thiserror::Error)]
 pub enum ManifestError {

@@ -373,7 +373,7 @@ fn run_one(
             "level {} NDF {} estimate {:.3e}{}",
             r.level,
             r.ndof,
-            r.estimate,
+            r.terms.estimate,
             r.err_quadrature.map(|e| format!(" error {e:.3e}")).unwrap_or_default()
         ));
         pb.inc(1);
@@ -398,7 +398,7 @@ fn run_one(
     }
     if progress {
         let last = levels.last().expect("at least one level");
-        eprintln!("{study}/{}: {} levels, final NDF {}, estimate {:.3e}", spec.id, levels.len(), last.ndof, last.estimate);
+        eprintln!("{study}/{}: {} levels, final NDF {}, estimate {:.3e}", spec.id, levels.len(), last.ndof, last.terms.estimate);
     }
     Ok(Some(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof: reference.as_ref().map(|r| r.ndof) }))
 }
