@@ -3,7 +3,7 @@
 //!
 //! | figure | study / runs | shows |
 //! |---|---|---|
-//! | `hertz_pressure` | `hertz`, the largest saved level of every run | the contact pressure p_h at the contact nodes (`ContactSample::pressure`) against Hertz's p(x) = p0 sqrt(1 - x^2/a^2) at the run's own contact force F, in the units x / a and p / p0 so that both loads lie on one curve, and beside it the deviation (p_h - p) / p0 at the active nodes; the legend gives F, a and p0 with their deviations from Hertz's |
+//! | `hertz_pressure` | `hertz`, the largest saved level of every run | the contact pressure p_h at the contact nodes (`ContactSample::pressure`) against Hertz's p(x) = p0 sqrt(1 - x^2/a^2) at the run's own contact force F, in the units x / a and p / p0 so that both loads lie on one curve, and beside it the deviation (p_h - p) / p0 at the active nodes, vertices (solid) and edge midpoints (dashed) as separate lines; the legend gives F, a and p0 with their deviations from Hertz's |
 //! | `hertz_mesh` | `hertz`, the largest saved level of run `adaptive` | the mesh near the contact, |x| <= 1.5a, 0 <= y <= 0.75a (active nodes red), with Hertz's half-width dashed |
 
 use super::render::{LineFigure, Series};
@@ -80,16 +80,26 @@ pub(super) fn hertz_pressure(results: &Path) -> anyhow::Result<Built> {
             style,
             roundoff: false,
         });
-        deviation.series.push(Series {
-            label: format!("{} (a/R = {:.3}): max {:.3}", r.run.id, a / h.radius, c.profile_deviation),
-            points: nodes
-                .iter()
-                .filter(|n| n.active)
-                .map(|n| (s(n), Some((n.pressure - h.pressure(c.force, n.x[0] - c.centre)) / p0)))
-                .collect(),
-            style,
-            roundoff: false,
-        });
+        // vertices and edge midpoints apart: their nodal pressures lambda_p / int psi_p carry
+        // different errors (the P2 basis functions of the two kinds differ), and one line through
+        // both zigzags between them
+        let vertices: std::collections::HashSet<[u64; 2]> = snap.vertices.iter().map(|v| v.map(f64::to_bits)).collect();
+        for (vertex, kind, dashed) in [(true, "vertices", false), (false, "midpoints", true)] {
+            deviation.series.push(Series {
+                label: if vertex {
+                    format!("{} (a/R = {:.3}), {kind}: max {:.3}", r.run.id, a / h.radius, c.profile_deviation)
+                } else {
+                    format!("{}, {kind}", r.run.id)
+                },
+                points: nodes
+                    .iter()
+                    .filter(|n| n.active && vertices.contains(&n.x.map(f64::to_bits)) == vertex)
+                    .map(|n| (s(n), Some((n.pressure - h.pressure(c.force, n.x[0] - c.centre)) / p0)))
+                    .collect(),
+                style: style.dashed(dashed),
+                roundoff: false,
+            });
+        }
     }
     if profile.series.len() < 2 {
         return Ok(Err(format!("no mesh snapshot of a run of study {STUDY}")));
