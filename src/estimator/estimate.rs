@@ -25,13 +25,13 @@
 //! Norms are maxima over a declared sampling: the element quadrature points or a dense lattice
 //! (elements), Gauss points or equispaced points with the end points (edges).
 
+mod local;
 pub mod repair;
 
-use crate::assembly::edge_basis;
-use crate::element::{self, Affine, EDGE_VERTICES, N_NODES};
+use crate::element::EDGE_VERTICES;
 use crate::mesh::{Mesh, Part, dist};
 use crate::norms::Sampling;
-use crate::problems::{Material, Problem};
+use crate::problems::Problem;
 use crate::solve::DiscreteSolution;
 use rayon::prelude::*;
 
@@ -165,78 +165,6 @@ pub struct Estimate {
     pub eta5_full_contact: f64,
 }
 
-/// Local (per element) quantities before they are gathered on patches.
-#[derive(Clone, Copy, Default)]
-struct ElementLocal {
-    /// max |f + div sigma(u_h)| over the element
-    residual: f64,
-    /// per local edge: max |g - sigma n| (Neumann), or on contact edges the max |sigma_t|, max |sigma_n|
-    /// and max (sigma_n)^+ (the tensile part)
-    neumann: [f64; 3],
-    tangential: [f64; 3],
-    normal: [f64; 3],
-    tensile: [f64; 3],
-    /// per local edge on Gamma_C: max (u.n - chi)^+ and max (chi - u.n)^+
-    penetration: [f64; 3],
-    separation: [f64; 3],
-}
-
-/// Stress (s11, s12, s22) of u_h at the three vertices of element t.
-fn vertex_stress(material: Material, map: &Affine, u: &[[f64; 2]; N_NODES]) -> [[f64; 3]; 3] {
-    let refs = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
-    refs.map(|r| {
-        let g = element::p2_gradients(r[0], r[1]);
-        let mut grad = [[0.0; 2]; 2];
-        for a in 0..N_NODES {
-            let ga = map.grad(g[a]);
-            for i in 0..2 {
-                for j in 0..2 {
-                    grad[i][j] += u[a][i] * ga[j];
-                }
-            }
-        }
-        material.stress(grad)
-    })
-}
-
-/// div sigma(u_h) on element t (constant): mu Laplace u + (mu + zeta) grad div u.
-fn div_stress(material: Material, map: &Affine, u: &[[f64; 2]; N_NODES]) -> [f64; 2] {
-    let h = element::p2_hessians(map);
-    let (mut lap, mut graddiv) = ([0.0; 2], [0.0; 2]);
-    for a in 0..N_NODES {
-        let [xx, xy, yy] = h[a];
-        lap[0] += u[a][0] * (xx + yy);
-        lap[1] += u[a][1] * (xx + yy);
-        graddiv[0] += u[a][0] * xx + u[a][1] * xy;
-        graddiv[1] += u[a][0] * xy + u[a][1] * yy;
-    }
-    let (mu, zeta) = (material.mu, material.zeta);
-    [mu * lap[0] + (mu + zeta) * graddiv[0], mu * lap[1] + (mu + zeta) * graddiv[1]]
-}
-
-#[inline]
-fn lerp3(a: [f64; 3], b: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2])]
-}
-
-#[inline]
-fn traction(s: [f64; 3], n: [f64; 2]) -> [f64; 2] {
-    [s[0] * n[0] + s[1] * n[1], s[1] * n[0] + s[2] * n[1]]
-}
-
-#[inline]
-fn inf_norm(v: [f64; 2]) -> f64 {
-    v[0].abs().max(v[1].abs())
-}
-
-/// Edge sampling parameters in [0, 1].
-fn edge_samples(sampling: Sampling) -> Vec<f64> {
-    match sampling {
-        Sampling::Quadrature => element::gauss_legendre(EDGE_GAUSS).points.iter().map(|p| p[0]).collect(),
-        Sampling::Dense => (0..=crate::norms::LATTICE_ORDER).map(|k| k as f64 / crate::norms::LATTICE_ORDER as f64).collect(),
-    }
-}
-
 /// Evaluate the estimator on a discrete solution.
 ///
 /// ```rust
@@ -254,235 +182,225 @@ fn edge_samples(sampling: Sampling) -> Vec<f64> {
 /// assert!(est.terms.estimate >= signorini::norms::linf_error(&mesh, &sol, &u).linf_quadrature);
 /// ```
 pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, config: &EstimatorConfig) -> Estimate {
-    let material = problem.material();
-    let nodes = &sol.nodes;
-    let n_el = mesh.n_triangles();
-    let nv = nodes.n_vertices;
-    let elem_refs = config.sampling.points();
-    let edge_s = edge_samples(config.sampling);
-
-    // Stress at the vertices of every element (sigma(u_h) is linear on each element).
-    let stress: Vec<[[f64; 3]; 3]> = (0..n_el)
-        .into_par_iter()
-        .map(|t| {
-            let el = &nodes.elements[t];
-            let u: [[f64; 2]; N_NODES] = std::array::from_fn(|a| sol.u[el[a]]);
-            vertex_stress(material, &Affine::new(mesh.corners(t)), &u)
-        })
-        .collect();
-
-    // positive discrete contact force, per node
+    let edge_s = local::edge_samples(config.sampling);
+    let stress = local::vertex_stresses(mesh, problem, sol);
+    let local = local::element_locals(mesh, problem, sol, config, &stress, &edge_s);
+    let jump = local::interior_jumps(mesh, sol, &stress, &edge_s);
+    let patches = Patches::new(mesh, sol);
     let positive = |p: usize| sol.dofs.contact_index[p].is_some_and(|k| sol.lambda[k] > LAMBDA_POSITIVE * sol.force_scale);
-
-    // Element-local quantities.
-    let local: Vec<ElementLocal> = (0..n_el)
-        .into_par_iter()
-        .map(|t| {
-            let map = Affine::new(mesh.corners(t));
-            let el = &nodes.elements[t];
-            let u: [[f64; 2]; N_NODES] = std::array::from_fn(|a| sol.u[el[a]]);
-            let div = div_stress(material, &map, &u);
-            let mut out = ElementLocal::default();
-            for r in &elem_refs {
-                let f = problem.body_force(map.map(*r));
-                out.residual = out.residual.max(inf_norm([f[0] + div[0], f[1] + div[1]]));
-            }
-            for (le, [i, j]) in EDGE_VERTICES.iter().enumerate() {
-                let Some(bi) = nodes.element_boundary[t][le] else { continue };
-                let be = mesh.boundary[bi];
-                // the boundary edge runs counter-clockwise from be.v[0] to be.v[1]
-                let (a, b) = (mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
-                let (normal, _) = crate::assembly::edge_normal(a, b);
-                // element stress at the boundary edge's start and end
-                let (sa, sb) = if el[*i] == be.v[0] { (stress[t][*i], stress[t][*j]) } else { (stress[t][*j], stress[t][*i]) };
-                let bn = nodes.boundary_nodes[bi];
-                for &s in &edge_s {
-                    let x = [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])];
-                    let tr = traction(lerp3(sa, sb, s), normal);
-                    match be.part {
-                        Part::Neumann => {
-                            let g = problem.traction(x, normal);
-                            out.neumann[le] = out.neumann[le].max(inf_norm([g[0] - tr[0], g[1] - tr[1]]));
-                        }
-                        Part::Contact => {
-                            let n = problem.contact_normal(x);
-                            let tng = [-n[1], n[0]];
-                            // (sigma-hat_1, sigma-hat_2): eta_5 takes the first, eta_4 the second
-                            let (s1, s2) = match config.stress_frame {
-                                StressFrame::Normal => (tr[0] * n[0] + tr[1] * n[1], tr[0] * tng[0] + tr[1] * tng[1]),
-                                StressFrame::Cartesian => (tr[0], tr[1]),
-                            };
-                            out.normal[le] = out.normal[le].max(s1.abs());
-                            out.tensile[le] = out.tensile[le].max(s1.max(0.0));
-                            out.tangential[le] = out.tangential[le].max(s2.abs());
-                            let phi = edge_basis(s);
-                            let mut un = 0.0;
-                            for k in 0..3 {
-                                let uk = sol.u[bn[k]];
-                                un += phi[k] * (uk[0] * n[0] + uk[1] * n[1]);
-                            }
-                            let gap = problem.gap(x);
-                            out.penetration[le] = out.penetration[le].max(un - gap);
-                            out.separation[le] = out.separation[le].max(gap - un);
-                        }
-                        Part::Dirichlet => {}
-                    }
-                }
-            }
-            out
-        })
-        .collect();
-
-    // Interior jumps per edge (node index nv + e), computed by the element of lower index.
-    let mut jump = vec![0.0f64; nodes.edges.len()];
-    for t in 0..n_el {
-        let el = &nodes.elements[t];
-        for (le, [i, j]) in EDGE_VERTICES.iter().enumerate() {
-            let Some(t2) = nodes.neighbours[t][le] else { continue };
-            if t2 > t {
-                continue;
-            }
-            let (a, b) = (mesh.vertices[el[*i]], mesh.vertices[el[*j]]);
-            let (n, _) = crate::assembly::edge_normal(a, b); // outward for t (counter-clockwise)
-            let el2 = &nodes.elements[t2];
-            let k2 = |v: usize| (0..3).find(|&k| el2[k] == v).expect("neighbour shares the edge");
-            let (s1a, s1b) = (stress[t][*i], stress[t][*j]);
-            let (s2a, s2b) = (stress[t2][k2(el[*i])], stress[t2][k2(el[*j])]);
-            let mut m = 0.0f64;
-            for &s in &edge_s {
-                let d = traction(lerp3(s2a, s2b, s), n);
-                let c = traction(lerp3(s1a, s1b, s), n);
-                m = m.max(inf_norm([d[0] - c[0], d[1] - c[1]]));
-            }
-            jump[el[3 + le] - nv] = m;
-        }
-    }
-
-    // Patches: node -> elements, and h_p = diameter of the patch.
-    let n_nodes = nodes.len();
-    let mut start = vec![0usize; n_nodes + 1];
-    for el in &nodes.elements {
-        for &p in el {
-            start[p + 1] += 1;
-        }
-    }
-    for p in 0..n_nodes {
-        start[p + 1] += start[p];
-    }
-    let mut patch = vec![0usize; start[n_nodes]];
-    let mut fill = start.clone();
-    for (t, el) in nodes.elements.iter().enumerate() {
-        for &p in el {
-            patch[fill[p]] = t;
-            fill[p] += 1;
-        }
-    }
-    let h_p: Vec<f64> = (0..n_nodes)
-        .into_par_iter()
-        .map(|p| {
-            let mut verts: Vec<usize> = patch[start[p]..start[p + 1]].iter().flat_map(|&t| mesh.triangles[t]).collect();
-            verts.sort_unstable();
-            verts.dedup();
-            let mut d = 0.0f64;
-            for (k, &a) in verts.iter().enumerate() {
-                for &b in &verts[k + 1..] {
-                    d = d.max(dist(mesh.vertices[a], mesh.vertices[b]));
-                }
-            }
-            d
-        })
-        .collect();
-
-    let repaired = config.contact_term == ContactTerm::TensileOnFullContact;
-    let in_lambda_repaired = repair::narrow_lambda(mesh, sol, &positive);
-
-    // Gather per node.
+    let lambda_c = LambdaC::new(mesh, sol, config, &positive);
     let (h_min, _) = mesh.h_range();
     let l_h = config.log_factor.value(h_min);
-    let node_terms: Vec<([f64; 5], bool, f64, f64)> = (0..n_nodes)
-        .into_par_iter()
-        .map(|p| {
-            let els = &patch[start[p]..start[p + 1]];
-            let hp = h_p[p];
-            let mut e = [0.0f64; 5];
-            let part = nodes.part[p];
-            let mut full_contact = true;
-            let mut has_contact_edge = false;
-            let (mut pen, mut sep) = (0.0f64, 0.0f64);
-            let mut tensile = 0.0f64;
-            for &t in els {
-                e[0] = e[0].max(local[t].residual);
-                for le in 0..3 {
-                    let Some(bi) = nodes.element_boundary[t][le] else { continue };
-                    match mesh.boundary[bi].part {
-                        Part::Neumann if part == Some(Part::Neumann) => e[2] = e[2].max(local[t].neumann[le]),
-                        Part::Contact if part == Some(Part::Contact) => {
-                            has_contact_edge = true;
-                            e[3] = e[3].max(local[t].tangential[le]);
-                            e[4] = e[4].max(local[t].normal[le]);
-                            tensile = tensile.max(local[t].tensile[le]);
-                            let bn = nodes.boundary_nodes[bi];
-                            full_contact &= bn.iter().all(|&q| sol.dofs.contact_index[q].is_some_and(|k| sol.active[k]));
-                            pen = pen.max(local[t].penetration[le]);
-                            if if repaired { in_lambda_repaired[bi] } else { positive(p) } {
-                                sep = sep.max(local[t].separation[le]);
-                            }
-                        }
-                        _ => {}
-                    }
-                }
-            }
-            // interior jumps on the edges through p (a vertex) or on p's own edge (a midpoint)
-            if p >= nv {
-                e[1] = jump[p - nv];
-            } else {
-                for &t in els {
-                    let el = &nodes.elements[t];
-                    for (le, [i, j]) in EDGE_VERTICES.iter().enumerate() {
-                        if el[*i] == p || el[*j] == p {
-                            e[1] = e[1].max(jump[el[3 + le] - nv]);
-                        }
-                    }
-                }
-            }
-            let full = has_contact_edge && full_contact;
-            if config.contact_term == ContactTerm::WithoutFullContact && full {
-                e[4] = 0.0;
-            }
-            if repaired && full {
-                e[4] = tensile;
-            }
-            let scaled = [hp * hp * e[0], hp * e[1], hp * e[2], hp * e[3], hp * e[4]];
-            (scaled, full, pen, sep)
-        })
-        .collect();
+    let nodal: Vec<NodeTerms> =
+        (0..sol.nodes.len()).into_par_iter().map(|p| node_terms(mesh, sol, config, &patches, &local, &jump, &lambda_c, p)).collect();
+    let (terms, full_contact_nodes, eta5_full_contact) = sum_terms(&nodal, l_h, config.c0);
+    let element = element_indicators(mesh, sol, &nodal, &local, &lambda_c, l_h);
+    Estimate { terms, config: *config, element, full_contact_nodes, eta5_full_contact }
+}
 
-    let mut terms = Terms { l_h, c0: config.c0, ..Default::default() };
+/// Which contact edges eta_7 is taken over (Lambda_h^C): those through a contact node with
+/// positive discrete contact force (Theorem 6.1), or the narrower set of the repaired variant.
+enum LambdaC<'a> {
+    Positive(&'a (dyn Fn(usize) -> bool + Sync)),
+    Repaired(Vec<bool>),
+}
+
+impl<'a> LambdaC<'a> {
+    fn new(mesh: &Mesh, sol: &DiscreteSolution, config: &EstimatorConfig, positive: &'a (dyn Fn(usize) -> bool + Sync)) -> Self {
+        if config.contact_term == ContactTerm::TensileOnFullContact {
+            LambdaC::Repaired(repair::narrow_lambda(mesh, sol, positive))
+        } else {
+            LambdaC::Positive(positive)
+        }
+    }
+
+    /// Whether eta_{7,p} at node p takes boundary edge `bi` (a contact edge of p's patch).
+    fn at_node(&self, p: usize, bi: usize) -> bool {
+        match self {
+            LambdaC::Positive(positive) => positive(p),
+            LambdaC::Repaired(edges) => edges[bi],
+        }
+    }
+
+    /// Whether element `el`'s indicator takes its contact edge `bi` (with nodes `bn`).
+    fn at_element(&self, el: &[usize], bn: &[usize], bi: usize) -> bool {
+        match self {
+            LambdaC::Positive(positive) => el.iter().any(|&p| positive(p)) || bn.iter().any(|&p| positive(p)),
+            LambdaC::Repaired(edges) => edges[bi],
+        }
+    }
+}
+
+/// Node -> elements of its patch Omega_p, and h_p, the patch's diameter.
+struct Patches {
+    start: Vec<usize>,
+    elements: Vec<usize>,
+    h_p: Vec<f64>,
+}
+
+impl Patches {
+    fn new(mesh: &Mesh, sol: &DiscreteSolution) -> Self {
+        let nodes = &sol.nodes;
+        let n_nodes = nodes.len();
+        let mut start = vec![0usize; n_nodes + 1];
+        for el in &nodes.elements {
+            for &p in el {
+                start[p + 1] += 1;
+            }
+        }
+        for p in 0..n_nodes {
+            start[p + 1] += start[p];
+        }
+        let mut elements = vec![0usize; start[n_nodes]];
+        let mut fill = start.clone();
+        for (t, el) in nodes.elements.iter().enumerate() {
+            for &p in el {
+                elements[fill[p]] = t;
+                fill[p] += 1;
+            }
+        }
+        let h_p = (0..n_nodes)
+            .into_par_iter()
+            .map(|p| {
+                let mut verts: Vec<usize> = elements[start[p]..start[p + 1]].iter().flat_map(|&t| mesh.triangles[t]).collect();
+                verts.sort_unstable();
+                verts.dedup();
+                let mut d = 0.0f64;
+                for (k, &a) in verts.iter().enumerate() {
+                    for &b in &verts[k + 1..] {
+                        d = d.max(dist(mesh.vertices[a], mesh.vertices[b]));
+                    }
+                }
+                d
+            })
+            .collect();
+        Patches { start, elements, h_p }
+    }
+
+    fn of(&self, p: usize) -> &[usize] {
+        &self.elements[self.start[p]..self.start[p + 1]]
+    }
+}
+
+/// One node's terms: (eta_{1,p}, ..., eta_{5,p}) already scaled by h_p^2 or h_p, whether p is
+/// a full-contact node, and its eta_6 and eta_7 parts.
+struct NodeTerms {
+    scaled: [f64; 5],
+    full: bool,
+    penetration: f64,
+    separation: f64,
+}
+
+/// Node p's terms, gathered over its patch.
+#[allow(clippy::too_many_arguments)]
+fn node_terms(
+    mesh: &Mesh,
+    sol: &DiscreteSolution,
+    config: &EstimatorConfig,
+    patches: &Patches,
+    local: &[local::ElementLocal],
+    jump: &[f64],
+    lambda_c: &LambdaC,
+    p: usize,
+) -> NodeTerms {
+    let nodes = &sol.nodes;
+    let nv = nodes.n_vertices;
+    let els = patches.of(p);
+    let hp = patches.h_p[p];
+    let mut e = [0.0f64; 5];
+    let part = nodes.part[p];
+    let mut full_contact = true;
+    let mut has_contact_edge = false;
+    let (mut pen, mut sep) = (0.0f64, 0.0f64);
+    let mut tensile = 0.0f64;
+    for &t in els {
+        e[0] = e[0].max(local[t].residual);
+        for le in 0..3 {
+            let Some(bi) = nodes.element_boundary[t][le] else { continue };
+            match mesh.boundary[bi].part {
+                Part::Neumann if part == Some(Part::Neumann) => e[2] = e[2].max(local[t].neumann[le]),
+                Part::Contact if part == Some(Part::Contact) => {
+                    has_contact_edge = true;
+                    e[3] = e[3].max(local[t].tangential[le]);
+                    e[4] = e[4].max(local[t].normal[le]);
+                    tensile = tensile.max(local[t].tensile[le]);
+                    let bn = nodes.boundary_nodes[bi];
+                    full_contact &= bn.iter().all(|&q| sol.dofs.contact_index[q].is_some_and(|k| sol.active[k]));
+                    pen = pen.max(local[t].penetration[le]);
+                    if lambda_c.at_node(p, bi) {
+                        sep = sep.max(local[t].separation[le]);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    // interior jumps on the edges through p (a vertex) or on p's own edge (a midpoint)
+    if p >= nv {
+        e[1] = jump[p - nv];
+    } else {
+        for &t in els {
+            let el = &nodes.elements[t];
+            for (le, [i, j]) in EDGE_VERTICES.iter().enumerate() {
+                if el[*i] == p || el[*j] == p {
+                    e[1] = e[1].max(jump[el[3 + le] - nv]);
+                }
+            }
+        }
+    }
+    let full = has_contact_edge && full_contact;
+    if config.contact_term == ContactTerm::WithoutFullContact && full {
+        e[4] = 0.0;
+    }
+    if config.contact_term == ContactTerm::TensileOnFullContact && full {
+        e[4] = tensile;
+    }
+    let scaled = [hp * hp * e[0], hp * e[1], hp * e[2], hp * e[3], hp * e[4]];
+    NodeTerms { scaled, full, penetration: pen, separation: sep }
+}
+
+/// eta_1..eta_7 as maxima over the nodes, eta_h and the estimate (eq. 6.3); also the number of
+/// full-contact nodes and the largest eta_{5,p} among them.
+fn sum_terms(nodal: &[NodeTerms], l_h: f64, c0: f64) -> (Terms, usize, f64) {
+    let mut terms = Terms { l_h, c0, ..Default::default() };
     let mut full_contact_nodes = 0;
     let mut eta5_full_contact = 0.0f64;
-    for (e, full, pen, sep) in &node_terms {
+    for n in nodal {
+        let e = &n.scaled;
         terms.eta1 = terms.eta1.max(e[0]);
         terms.eta2 = terms.eta2.max(e[1]);
         terms.eta3 = terms.eta3.max(e[2]);
         terms.eta4 = terms.eta4.max(e[3]);
         terms.eta5 = terms.eta5.max(e[4]);
-        terms.eta6 = terms.eta6.max(*pen);
-        terms.eta7 = terms.eta7.max(*sep);
-        full_contact_nodes += *full as usize;
-        if *full {
+        terms.eta6 = terms.eta6.max(n.penetration);
+        terms.eta7 = terms.eta7.max(n.separation);
+        full_contact_nodes += n.full as usize;
+        if n.full {
             eta5_full_contact = eta5_full_contact.max(e[4]);
         }
     }
     terms.psi = terms.eta1 + terms.eta2 + terms.eta3 + terms.eta4 + terms.eta5;
     terms.eta_h = l_h * terms.psi + terms.eta6 + terms.eta7;
-    terms.estimate = config.c0 * terms.eta_h;
+    terms.estimate = c0 * terms.eta_h;
+    (terms, full_contact_nodes, eta5_full_contact)
+}
 
-    // Element indicators for marking.
-    let element: Vec<f64> = (0..n_el)
+/// The marking indicator of every element: the largest l_h (eta_{1,p} + ... + eta_{5,p}) over its
+/// six nodes, plus eta_6 and eta_7 on its own contact edges.
+fn element_indicators(
+    mesh: &Mesh,
+    sol: &DiscreteSolution,
+    nodal: &[NodeTerms],
+    local: &[local::ElementLocal],
+    lambda_c: &LambdaC,
+    l_h: f64,
+) -> Vec<f64> {
+    let nodes = &sol.nodes;
+    (0..mesh.n_triangles())
         .into_par_iter()
         .map(|t| {
             let el = &nodes.elements[t];
-            let nodal = el.iter().map(|&p| l_h * node_terms[p].0.iter().sum::<f64>()).fold(0.0, f64::max);
+            let node_part = el.iter().map(|&p| l_h * nodal[p].scaled.iter().sum::<f64>()).fold(0.0, f64::max);
             let mut contact = 0.0f64;
             for le in 0..3 {
                 let Some(bi) = nodes.element_boundary[t][le] else { continue };
@@ -490,14 +408,10 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
                     continue;
                 }
                 let bn = nodes.boundary_nodes[bi];
-                let in_lambda =
-                    if repaired { in_lambda_repaired[bi] } else { el.iter().any(|&p| positive(p)) || bn.iter().any(|&p| positive(p)) };
-                let sep = if in_lambda { local[t].separation[le].max(0.0) } else { 0.0 };
+                let sep = if lambda_c.at_element(el, &bn, bi) { local[t].separation[le].max(0.0) } else { 0.0 };
                 contact = contact.max(local[t].penetration[le].max(0.0) + sep);
             }
-            nodal + contact
+            node_part + contact
         })
-        .collect();
-
-    Estimate { terms, config: *config, element, full_contact_nodes, eta5_full_contact }
+        .collect()
 }

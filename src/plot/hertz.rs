@@ -4,7 +4,7 @@
 //! | figure | study / runs | shows |
 //! |---|---|---|
 //! | `hertz_pressure` | `hertz`, the largest saved level of every run | the contact pressure p_h at the contact nodes (`ContactSample::pressure`) against Hertz's p(x) = p0 sqrt(1 - x^2/a^2) at the run's own contact force F, in the units x / a and p / p0 so that both loads lie on one curve, and beside it the deviation (p_h - p) / p0 at the active nodes, vertices (solid) and edge midpoints (dashed) as separate lines; the legend gives F, a and p0 with their deviations from Hertz's |
-//! | `hertz_mesh` | `hertz`, the largest saved level of run `adaptive` | the mesh near the contact, |x| <= 1.5a, 0 <= y <= 0.75a (active nodes red), with Hertz's half-width dashed |
+//! | `hertz_mesh` | `hertz`, the largest saved level of run `adaptive` | the mesh near the contact, |x| <= 1.5a, 0 <= y <= 0.75a at equal scale (edges clipped at the window; contact nodes denser than the pixels as red (active) and blue (inactive) bands, the ends of the active set marked), with Hertz's half-width dashed |
 
 use super::render::{LineFigure, Series};
 use super::{Built, Figure, Marker, PALETTE, Panel, Style, YScale, mesh_figure, runs, saved_levels};
@@ -127,10 +127,17 @@ pub(super) fn hertz_mesh(results: &Path) -> anyhow::Result<Built> {
     let a = c.hertz_half_width;
     // the contact and its ends: |x| <= 1.5 a, y <= 0.75 a
     let (x0, x1, y1) = (c.centre - 1.5 * a, c.centre + 1.5 * a, 0.75 * a);
-    let inside = |v: [f64; 2]| (x0..=x1).contains(&v[0]) && v[1] <= y1;
     let (n_t, n_v, level, ndof) = (snap.triangles.len(), snap.vertices.len(), snap.level, snap.ndof);
-    snap.triangles.retain(|t| t.iter().all(|&v| inside(snap.vertices[v])));
-    snap.contact_nodes.retain(|n| inside(n.x));
+    // the triangles that reach into the window (the figure clips their edges at its border)
+    let reaches = |t: &[usize; 3]| {
+        let v = t.map(|k| snap.vertices[k]);
+        let (lo, hi) = (
+            |i: usize| v.iter().map(|p| p[i]).fold(f64::INFINITY, f64::min),
+            |i: usize| v.iter().map(|p| p[i]).fold(f64::NEG_INFINITY, f64::max),
+        );
+        hi(0) >= x0 && lo(0) <= x1 && lo(1) <= y1
+    };
+    snap.triangles.retain(|t| reaches(t));
     let mut fig = mesh_figure(&snap, "");
     fig.bbox = [x0, 0.0, x1, y1];
     fig.title = format!("Hertz: {} mesh near the contact, level {level}, NDF = {ndof}", r.run.id);

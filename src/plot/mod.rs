@@ -55,6 +55,7 @@
 mod axis;
 mod fb;
 mod font;
+mod glyphs;
 mod hertz;
 pub mod page;
 pub mod render;
@@ -204,8 +205,8 @@ fn write_figure(fig: &Figure, dir: &Path, name: &str) -> anyhow::Result<Vec<Path
     let tmp = dir.join(format!(".{name}.tmp{}.png", std::process::id()));
     let drawn = {
         // the backend saves the file when presented (or dropped), before the rename below
-        let root = BitMapBackend::new(&tmp, size).into_drawing_area();
-        fig.render(&root, rich::BITMAP).map(|_| ())
+        glyphs::Glyphs::new(BitMapBackend::new(&tmp, size), FONT_BYTES)
+            .and_then(|backend| fig.render(&backend.into_drawing_area(), rich::BITMAP).map(|_| ()))
     };
     if let Err(e) = drawn.and_then(|()| std::fs::rename(&tmp, &png).with_context(|| format!("writing {}", png.display()))) {
         std::fs::remove_file(&tmp).ok();

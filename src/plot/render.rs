@@ -19,6 +19,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, VPos};
 
+mod mesh;
+pub(crate) use mesh::MeshFigure;
+
 const FS_FIGURE_TITLE: f64 = 24.0;
 const FS_TITLE: f64 = 20.0;
 const FS_DESC: f64 = 17.0;
@@ -195,22 +198,6 @@ pub(crate) struct LineFigure {
 }
 
 #[derive(Clone, Debug)]
-pub(crate) struct MeshFigure {
-    pub title: String,
-    /// Mesh edges joined into polylines (fewer SVG elements than one per edge).
-    pub edges: Vec<Vec<(f64, f64)>>,
-    pub active: Vec<(f64, f64)>,
-    pub inactive: Vec<(f64, f64)>,
-    pub kinks: Vec<(f64, f64)>,
-    /// Vertical lines x = c across the mesh, dashed, with their legend text (a free boundary).
-    pub vlines: Vec<(f64, String)>,
-    /// Bounding box of the vertices.
-    pub bbox: [f64; 4],
-    pub n_triangles: usize,
-    pub n_vertices: usize,
-}
-
-#[derive(Clone, Debug)]
 pub(crate) enum Figure {
     Lines(LineFigure),
     Mesh(MeshFigure),
@@ -220,7 +207,8 @@ impl Figure {
     pub fn size(&self) -> (u32, u32) {
         match self {
             Figure::Lines(f) if f.panels.len() > 1 => (800 * f.panels.len() as u32, 650),
-            _ => (900, 650),
+            Figure::Lines(_) => (900, 650),
+            Figure::Mesh(m) => m.size(900),
         }
     }
 
@@ -231,7 +219,7 @@ impl Figure {
         let ranges = match self {
             Figure::Lines(f) => render_lines(root, f, m)?,
             Figure::Mesh(mesh) => {
-                render_mesh(root, mesh, m)?;
+                mesh::render_mesh(root, mesh, m)?;
                 Vec::new()
             }
         };
@@ -805,91 +793,6 @@ pub(crate) fn draw_marker<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, (x,
             root.draw(&PathElement::new(vec![(x - r - 1, y), (x + r + 1, y)], edge)).drawn()?;
             root.draw(&PathElement::new(vec![(x, y - r - 1), (x, y + r + 1)], edge)).drawn()?;
         }
-    }
-    Ok(())
-}
-
-fn render_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, mesh: &MeshFigure, metrics: Metrics) -> anyhow::Result<()> {
-    let m = mesh;
-    let body = titled(root, root, &m.title, FS_TITLE + 2.0, metrics)?;
-    let (w, h) = body.dim_in_pixel();
-    let (margin, xlab, ylab, legend_w) = (14, 50, 62, 270);
-    let side = (h as i32 - 2 * margin - xlab).min(w as i32 - 2 * margin - ylab - legend_w).max(50);
-    let left_w = side + 2 * margin + ylab;
-    let left_h = side + 2 * margin + xlab;
-    let (left, right) = body.split_horizontally(left_w);
-    let left = left.shrink((0, 0), (left_w, left_h));
-
-    // equal aspect: the same span on both axes around the bounding box
-    let [x0, y0, x1, y1] = m.bbox;
-    let span = (x1 - x0).max(y1 - y0).max(1e-12) * 1.05;
-    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let xa = Axis::linear(cx - 0.5 * span, cx + 0.5 * span);
-    let ya = Axis::linear(cy - 0.5 * span, cy + 0.5 * span);
-    let mut chart =
-        ChartBuilder::on(&left).margin(margin).x_label_area_size(xlab).y_label_area_size(ylab).build_cartesian_2d(xa, ya).drawn()?;
-    chart
-        .configure_mesh()
-        .disable_mesh()
-        .x_desc("x")
-        .y_desc("y")
-        .label_style(font(FS_TICK))
-        .axis_desc_style(font(FS_DESC))
-        .set_all_tick_mark_size(6)
-        .draw()
-        .drawn()?;
-    let edge = RGBColor(40, 40, 40).mix(0.85).stroke_width(1);
-    chart.draw_series(m.edges.iter().map(|c| PathElement::new(c.clone(), edge))).drawn()?;
-
-    let inactive = Style { color: RGBColor(31, 119, 180), marker: Marker::Circle, dashed: false, filled: true };
-    let active = Style { color: RGBColor(214, 39, 40), marker: Marker::Circle, dashed: false, filled: true };
-    let kink = Style { color: BLACK, marker: Marker::Diamond, dashed: false, filled: false };
-    for p in &m.inactive {
-        draw_marker(root, chart.backend_coord(p), inactive, 3)?;
-    }
-    for p in &m.active {
-        draw_marker(root, chart.backend_coord(p), active, 3)?;
-    }
-    for p in &m.kinks {
-        draw_marker(root, chart.backend_coord(p), kink, 7)?;
-    }
-    let vline = PALETTE[3].stroke_width(2);
-    for (x, _) in &m.vlines {
-        chart.draw_series(DashedLineSeries::new(vec![(*x, y0), (*x, y1)], 8, 5, vline)).drawn()?;
-    }
-
-    // legend beside the square
-    let fmt = |v: f64| {
-        let s = format!("{v:.3}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    };
-    let kinks = m.kinks.iter().map(|&(x, y)| format!("({}, {})", fmt(x), fmt(y))).collect::<Vec<_>>().join(", ");
-    let entries: Vec<(Option<(Style, i32)>, String)> = vec![
-        (Some((active, 3)), format!("active contact node ({})", m.active.len())),
-        (Some((inactive, 3)), format!("inactive contact node ({})", m.inactive.len())),
-        (
-            Some((kink, 7)),
-            if kinks.is_empty() { "obstacle kink (none recorded)".to_string() } else { format!("kink of the obstacle {kinks}") },
-        ),
-        (None, format!("{} triangles, {} vertices", m.n_triangles, m.n_vertices)),
-    ];
-    let (rx, ry) = right.get_base_pixel();
-    let (x, y) = (rx + 10, ry + margin + 10);
-    let row = 26;
-    for (k, (marker, text)) in entries.iter().enumerate() {
-        let cy = y + row * k as i32 + row / 2;
-        if let Some((st, r)) = marker {
-            draw_marker(root, (x + 12, cy), *st, *r)?;
-        }
-        rich::draw(root, text, FS_LEGEND, &BLACK, (HPos::Left, VPos::Center), (x + 30, cy), false, metrics)?;
-    }
-    // lines without a text share the legend entry of the one before
-    for (k, (_, text)) in m.vlines.iter().filter(|v| !v.1.is_empty()).enumerate() {
-        let cy = y + row * (entries.len() + k) as i32 + row / 2;
-        for (s0, s1) in [(x + 2, x + 9), (x + 14, x + 22)] {
-            root.draw(&PathElement::new(vec![(s0, cy), (s1, cy)], vline)).drawn()?;
-        }
-        rich::draw(root, text, FS_LEGEND, &BLACK, (HPos::Left, VPos::Center), (x + 30, cy), false, metrics)?;
     }
     Ok(())
 }

@@ -214,176 +214,202 @@ impl Manifest {
         let raw: ManifestToml = toml::from_str(text)
             .map_err(|e| ManifestError::Syntax { file: file.clone(), message: plain_words(e.to_string().trim_end()) })?;
         let study = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        let invalid = |key: String, expected: &str, got: String| ManifestError::Invalid {
-            file: file.clone(),
-            key,
-            expected: expected.to_string(),
-            got,
-        };
+        let invalid = Invalid(&file);
         if raw.run.is_empty() {
-            return Err(invalid("run".into(), "at least one [[run]] table", "none".into()));
+            return Err(invalid.at("run".into(), "at least one [[run]] table", "none".into()));
         }
         let d = raw.defaults.clone().unwrap_or_default();
-        if d.id.is_some() {
-            return Err(invalid(
-                "defaults.id".into(),
-                "no id in [defaults] (every [[run]] names its own)",
-                format!("{:?}", d.id.unwrap_or_default()),
-            ));
-        }
-        if d.no_reference.is_some() {
-            return Err(invalid(
-                "defaults.no_reference".into(),
-                "no_reference only in a [[run]] (leave [defaults.reference] out instead)",
-                "a value".into(),
-            ));
-        }
-        let mut runs = Vec::new();
+        check_defaults(&d, &invalid)?;
         let mut ids = std::collections::BTreeSet::new();
-        for (i, r) in raw.run.iter().enumerate() {
-            let key = |k: &str| format!("run[{i}].{k}");
-            let id = r.id.clone().ok_or_else(|| invalid(key("id"), "a run name (string)", "nothing".into()))?;
-            if id.is_empty() || !id.chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) {
-                return Err(invalid(key("id"), "a name of letters, digits, '_', '-', '.'", format!("{id:?}")));
-            }
-            if !ids.insert(id.clone()) {
-                return Err(invalid(key("id"), "a name unique within the study", format!("{id:?} twice")));
-            }
-            let problem =
-                r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid(key("problem"), "a problem name", "nothing".into()))?;
-            let mut constants = d.constants.clone().unwrap_or_default();
-            constants.extend(r.constants.clone().unwrap_or_default());
-            if let Err(e) = crate::problems::load(&resolve_problem(path, &problem), &constants) {
-                let expected = match e {
-                    crate::problems::ProblemError::Unknown(_) => format!(
-                        "a built-in problem ({}) or the path of a problem file (NAME.toml, relative to the manifest)",
-                        crate::problems::KNOWN.join(", ")
-                    ),
-                    crate::problems::ProblemError::File(e) => format!("a valid problem file ({e})"),
-                    crate::problems::ProblemError::Constants(_) => {
-                        return Err(invalid(
-                            key("constants"),
-                            "no constants: the problem is built in",
-                            format!("{constants:?} for {problem:?}"),
-                        ));
-                    }
-                };
-                return Err(invalid(key("problem"), &expected, format!("{problem:?}")));
-            }
-            let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| "structured:4".into());
-            MeshSpec::parse(&resolve_mesh(path, &mesh))
-                .map_err(|_| invalid(key("mesh"), "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'", format!("{mesh:?}")))?;
-            let levels = r.levels.or(d.levels).ok_or_else(|| invalid(key("levels"), "a number of levels >= 1", "nothing".into()))?;
-            let theta = r.theta.or(d.theta).unwrap_or(0.5);
-            let e = EstimatorConfig::default();
-            let (eo, ed) = (r.estimator.clone().unwrap_or_default(), d.estimator.clone().unwrap_or_default());
-            let estimator = EstimatorConfig {
-                c0: eo.c0.or(ed.c0).unwrap_or(e.c0),
-                contact_term: eo.contact_term.or(ed.contact_term).unwrap_or(e.contact_term),
-                log_factor: eo.log_factor.or(ed.log_factor).unwrap_or(e.log_factor),
-                sampling: eo.sampling.or(ed.sampling).unwrap_or(e.sampling),
-                stress_frame: eo.stress_frame.or(ed.stress_frame).unwrap_or(e.stress_frame),
-            };
-            check_no_reference(r, &d).map_err(|(expected, got)| invalid(key("no_reference"), expected, got))?;
-            let reference = if r.no_reference == Some(true) { None } else { r.reference.clone().or(d.reference.clone()) };
-            if let Some(rf) = &reference
-                && !(rf.theta > 0.0 && rf.theta <= 1.0)
-            {
-                return Err(invalid(key("reference.theta"), "a number in (0, 1]", rf.theta.to_string()));
-            }
-            let spec = RunSpec {
-                id,
-                problem,
-                mesh,
-                refine: r.refine.or(d.refine).unwrap_or(Refine::Adaptive),
-                theta,
-                levels,
-                max_ndof: r.max_ndof.or(d.max_ndof),
-                estimator,
-                reference: reference.map(|rf| ReferenceSpec {
-                    theta: rf.theta,
-                    min_ndof: rf.min_ndof,
-                    contact_term: rf.contact_term.unwrap_or(ContactTerm::WithoutFullContact),
-                }),
-                save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
-                constants,
-            };
-            AdaptConfig::for_run(&spec).validate().map_err(|e| invalid(key(e.key), e.expected, e.got))?;
-            let quick_levels = r.quick_levels.or(d.quick_levels).unwrap_or(levels.min(6));
-            if quick_levels == 0 || quick_levels > levels {
-                return Err(invalid(key("quick_levels"), &format!("a number in 1..={levels} (levels)"), quick_levels.to_string()));
-            }
-            if let Some(&l) = spec.save_levels.iter().find(|&&l| l >= levels) {
-                return Err(invalid(
-                    key("save_levels"),
-                    &format!("levels in 0..={} (the run has {levels} levels, numbered from 0)", levels - 1),
-                    l.to_string(),
-                ));
-            }
-            if let Some(l) = first_repeated(&spec.save_levels) {
-                return Err(invalid(
-                    key("save_levels"),
-                    "distinct levels (each level is saved once)",
-                    format!("{:?} (level {l} more than once)", spec.save_levels),
-                ));
-            }
-            if spec.reference.as_ref().is_some_and(|rf| rf.min_ndof == 0) {
-                return Err(invalid(key("reference.min_ndof"), "a number of unknowns >= 1", "0".into()));
-            }
-            runs.push(PlannedRun { spec, quick_levels });
-        }
+        let runs = raw.run.iter().enumerate().map(|(i, r)| parse_run(path, i, r, &d, &mut ids, &invalid)).collect::<Result<Vec<_>, _>>()?;
         let drift = raw.drift.unwrap_or_default();
-        let floats = crate::records::float_fields();
-        for (key, tol) in
-            std::iter::once(("default".to_string(), &drift.default)).chain(drift.fields.iter().map(|(k, t)| (format!("fields.{k}"), t)))
-        {
-            if let Some(name) = key.strip_prefix("fields.") {
-                if DERIVED.iter().any(|(f, _)| *f == name) {
-                    return Err(invalid(
-                        format!("drift.{key}"),
-                        "a field with a tolerance of its own; this one is checked by its definition, exactly",
-                        format!("{name:?}"),
-                    ));
-                }
-                if !floats.iter().any(|f| f == name) {
-                    return Err(invalid(
-                        format!("drift.{key}"),
-                        &format!("a float field of the level records ({})", floats.join(", ")),
-                        format!("{name:?}"),
-                    ));
-                }
-            }
-            for (part, v) in [("rel", tol.rel), ("floor", tol.floor)] {
-                if !(v.is_finite() && (0.0..=MAX_TOLERANCE).contains(&v)) {
-                    return Err(invalid(format!("drift.{key}.{part}"), TOLERANCE_RANGE, format!("{v:e}")));
-                }
-            }
-        }
-        for (i, r) in drift.rates.iter().enumerate() {
-            let key = |k: &str| format!("drift.rates[{i}].{k}");
-            let Some(run) = runs.iter().find(|p: &&PlannedRun| p.spec.id == r.run) else {
-                return Err(invalid(key("run"), "the id of a declared run", format!("{:?}", r.run)));
-            };
-            if !floats.contains(&r.field) {
-                return Err(invalid(
-                    key("field"),
-                    &format!("a float field of the level records ({})", floats.join(", ")),
-                    format!("{:?}", r.field),
-                ));
-            }
-            if !r.min.is_finite() {
-                return Err(invalid(key("min"), "a finite rate", r.min.to_string()));
-            }
-            if r.last < 2 || r.last > run.spec.levels {
-                return Err(invalid(
-                    key("last"),
-                    &format!("a number of levels in 2..={} (run {} has {} levels)", run.spec.levels, r.run, run.spec.levels),
-                    r.last.to_string(),
-                ));
-            }
-        }
+        check_drift(&drift, &runs, &invalid)?;
         Ok(Manifest { study, file, description: raw.description.unwrap_or_default(), runs, drift, bytes: text.as_bytes().to_vec() })
     }
+}
+
+/// Builds the error for a key of the manifest `.0` that does not hold what is expected.
+struct Invalid<'a>(&'a Path);
+
+impl Invalid<'_> {
+    fn at(&self, key: String, expected: &str, got: String) -> ManifestError {
+        ManifestError::Invalid { file: self.0.to_path_buf(), key, expected: expected.to_string(), got }
+    }
+}
+
+/// `[defaults]` holds what runs share: no run name, no `no_reference`.
+fn check_defaults(d: &RunToml, invalid: &Invalid) -> Result<(), ManifestError> {
+    if d.id.is_some() {
+        return Err(invalid.at(
+            "defaults.id".into(),
+            "no id in [defaults] (every [[run]] names its own)",
+            format!("{:?}", d.id.clone().unwrap_or_default()),
+        ));
+    }
+    if d.no_reference.is_some() {
+        return Err(invalid.at(
+            "defaults.no_reference".into(),
+            "no_reference only in a [[run]] (leave [defaults.reference] out instead)",
+            "a value".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// `[[run]]` number `i`, completed from `[defaults]` `d` and checked key by key; `ids` holds the
+/// names of the runs before it.
+fn parse_run(
+    path: &Path,
+    i: usize,
+    r: &RunToml,
+    d: &RunToml,
+    ids: &mut std::collections::BTreeSet<String>,
+    invalid: &Invalid,
+) -> Result<PlannedRun, ManifestError> {
+    let key = |k: &str| format!("run[{i}].{k}");
+    let id = r.id.clone().ok_or_else(|| invalid.at(key("id"), "a run name (string)", "nothing".into()))?;
+    if id.is_empty() || !id.chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) {
+        return Err(invalid.at(key("id"), "a name of letters, digits, '_', '-', '.'", format!("{id:?}")));
+    }
+    if !ids.insert(id.clone()) {
+        return Err(invalid.at(key("id"), "a name unique within the study", format!("{id:?} twice")));
+    }
+    let problem = r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid.at(key("problem"), "a problem name", "nothing".into()))?;
+    let mut constants = d.constants.clone().unwrap_or_default();
+    constants.extend(r.constants.clone().unwrap_or_default());
+    if let Err(e) = crate::problems::load(&resolve_problem(path, &problem), &constants) {
+        let expected = match e {
+            crate::problems::ProblemError::Unknown(_) => format!(
+                "a built-in problem ({}) or the path of a problem file (NAME.toml, relative to the manifest)",
+                crate::problems::KNOWN.join(", ")
+            ),
+            crate::problems::ProblemError::File(e) => format!("a valid problem file ({e})"),
+            crate::problems::ProblemError::Constants(_) => {
+                return Err(invalid.at(
+                    key("constants"),
+                    "no constants: the problem is built in",
+                    format!("{constants:?} for {problem:?}"),
+                ));
+            }
+        };
+        return Err(invalid.at(key("problem"), &expected, format!("{problem:?}")));
+    }
+    let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| "structured:4".into());
+    MeshSpec::parse(&resolve_mesh(path, &mesh))
+        .map_err(|_| invalid.at(key("mesh"), "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'", format!("{mesh:?}")))?;
+    let levels = r.levels.or(d.levels).ok_or_else(|| invalid.at(key("levels"), "a number of levels >= 1", "nothing".into()))?;
+    let theta = r.theta.or(d.theta).unwrap_or(0.5);
+    let e = EstimatorConfig::default();
+    let (eo, ed) = (r.estimator.clone().unwrap_or_default(), d.estimator.clone().unwrap_or_default());
+    let estimator = EstimatorConfig {
+        c0: eo.c0.or(ed.c0).unwrap_or(e.c0),
+        contact_term: eo.contact_term.or(ed.contact_term).unwrap_or(e.contact_term),
+        log_factor: eo.log_factor.or(ed.log_factor).unwrap_or(e.log_factor),
+        sampling: eo.sampling.or(ed.sampling).unwrap_or(e.sampling),
+        stress_frame: eo.stress_frame.or(ed.stress_frame).unwrap_or(e.stress_frame),
+    };
+    check_no_reference(r, d).map_err(|(expected, got)| invalid.at(key("no_reference"), expected, got))?;
+    let reference = if r.no_reference == Some(true) { None } else { r.reference.clone().or(d.reference.clone()) };
+    if let Some(rf) = &reference
+        && !(rf.theta > 0.0 && rf.theta <= 1.0)
+    {
+        return Err(invalid.at(key("reference.theta"), "a number in (0, 1]", rf.theta.to_string()));
+    }
+    let spec = RunSpec {
+        id,
+        problem,
+        mesh,
+        refine: r.refine.or(d.refine).unwrap_or(Refine::Adaptive),
+        theta,
+        levels,
+        max_ndof: r.max_ndof.or(d.max_ndof),
+        estimator,
+        reference: reference.map(|rf| ReferenceSpec {
+            theta: rf.theta,
+            min_ndof: rf.min_ndof,
+            contact_term: rf.contact_term.unwrap_or(ContactTerm::WithoutFullContact),
+        }),
+        save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
+        constants,
+    };
+    AdaptConfig::for_run(&spec).validate().map_err(|e| invalid.at(key(e.key), e.expected, e.got))?;
+    let quick_levels = r.quick_levels.or(d.quick_levels).unwrap_or(levels.min(6));
+    if quick_levels == 0 || quick_levels > levels {
+        return Err(invalid.at(key("quick_levels"), &format!("a number in 1..={levels} (levels)"), quick_levels.to_string()));
+    }
+    if let Some(&l) = spec.save_levels.iter().find(|&&l| l >= levels) {
+        return Err(invalid.at(
+            key("save_levels"),
+            &format!("levels in 0..={} (the run has {levels} levels, numbered from 0)", levels - 1),
+            l.to_string(),
+        ));
+    }
+    if let Some(l) = first_repeated(&spec.save_levels) {
+        return Err(invalid.at(
+            key("save_levels"),
+            "distinct levels (each level is saved once)",
+            format!("{:?} (level {l} more than once)", spec.save_levels),
+        ));
+    }
+    if spec.reference.as_ref().is_some_and(|rf| rf.min_ndof == 0) {
+        return Err(invalid.at(key("reference.min_ndof"), "a number of unknowns >= 1", "0".into()));
+    }
+    Ok(PlannedRun { spec, quick_levels })
+}
+
+/// `[drift]`: tolerances in range for float fields of the records (not the derived ones, which
+/// are checked by definition), and rate checks on declared runs.
+fn check_drift(drift: &DriftSpec, runs: &[PlannedRun], invalid: &Invalid) -> Result<(), ManifestError> {
+    let floats = crate::records::float_fields();
+    for (key, tol) in
+        std::iter::once(("default".to_string(), &drift.default)).chain(drift.fields.iter().map(|(k, t)| (format!("fields.{k}"), t)))
+    {
+        if let Some(name) = key.strip_prefix("fields.") {
+            if DERIVED.iter().any(|(f, _)| *f == name) {
+                return Err(invalid.at(
+                    format!("drift.{key}"),
+                    "a field with a tolerance of its own; this one is checked by its definition, exactly",
+                    format!("{name:?}"),
+                ));
+            }
+            if !floats.iter().any(|f| f == name) {
+                return Err(invalid.at(
+                    format!("drift.{key}"),
+                    &format!("a float field of the level records ({})", floats.join(", ")),
+                    format!("{name:?}"),
+                ));
+            }
+        }
+        for (part, v) in [("rel", tol.rel), ("floor", tol.floor)] {
+            if !(v.is_finite() && (0.0..=MAX_TOLERANCE).contains(&v)) {
+                return Err(invalid.at(format!("drift.{key}.{part}"), TOLERANCE_RANGE, format!("{v:e}")));
+            }
+        }
+    }
+    for (i, r) in drift.rates.iter().enumerate() {
+        let key = |k: &str| format!("drift.rates[{i}].{k}");
+        let Some(run) = runs.iter().find(|p: &&PlannedRun| p.spec.id == r.run) else {
+            return Err(invalid.at(key("run"), "the id of a declared run", format!("{:?}", r.run)));
+        };
+        if !floats.contains(&r.field) {
+            return Err(invalid.at(
+                key("field"),
+                &format!("a float field of the level records ({})", floats.join(", ")),
+                format!("{:?}", r.field),
+            ));
+        }
+        if !r.min.is_finite() {
+            return Err(invalid.at(key("min"), "a finite rate", r.min.to_string()));
+        }
+        if r.last < 2 || r.last > run.spec.levels {
+            return Err(invalid.at(
+                key("last"),
+                &format!("a number of levels in 2..={} (run {} has {} levels)", run.spec.levels, r.run, run.spec.levels),
+                r.last.to_string(),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The largest drift tolerance, `rel` or `floor`: a relative change of 1 already lets a number
