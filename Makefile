@@ -4,7 +4,7 @@ CARGO ?= cargo
 # cargo builds into $(CARGO_TARGET_DIR) when it is set, target/ otherwise
 BIN := $(or $(CARGO_TARGET_DIR),target)/release/signorini
 
-.PHONY: all build test figures reproduce drift crosscheck bench roundoff meshes mesh clean
+.PHONY: all build test cluster-test figures reproduce drift crosscheck bench roundoff meshes mesh clean
 
 all: build
 
@@ -28,6 +28,13 @@ test: build
 	SIGNORINI=$(abspath $(BIN)) CROSSCHECK_OUT=target/crosscheck-report crosscheck/run.sh
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-after-test
 	@diff target/status-before-test target/status-after-test >/dev/null || { echo "make test changed files git sees (before/after below); test outputs belong under target/"; diff target/status-before-test target/status-after-test; exit 1; }
+
+# A one-node Slurm cluster on this machine (as root; installs slurm-wlm and munge with apt-get
+# if missing), a study submitted as an array of shards, a task cancelled mid-run, two arrays at
+# once, each checked against a single-process run; everything under target/cluster/. About two
+# minutes. See the README's Slurm section.
+cluster-test: build
+	SIGNORINI=$(abspath $(BIN)) scripts/slurm/cluster-test.sh
 
 # Redraw figures/ and results/CLAIMS.md from the stored results (no study is rerun).
 figures: build

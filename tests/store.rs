@@ -1,6 +1,6 @@
 //! The results store survives shards, interrupts and concurrent runs: `--fresh --shard K/N`
 //! removes only shard K's runs; a second process running the same study is refused (or waits)
-//! and deletes nothing; an interrupted study keeps its finished runs with summaries that
+//! and deletes nothing, while shards compute side by side and never the same run twice; an interrupted study keeps its finished runs with summaries that
 //! describe exactly them, and `figures` refuses it.
 
 use signorini::records::StudyDir;
@@ -149,4 +149,48 @@ fn an_interrupted_study_keeps_consistent_summaries_and_figures_refuse_it() {
     let (code, err) = signorini(&["run", manifest.to_str().unwrap(), "--results", res.to_str().unwrap()]);
     assert_eq!(code, Some(0), "{err}");
     assert!(check_complete(&m, &res).is_ok());
+}
+
+#[test]
+fn shards_compute_side_by_side_and_a_run_is_computed_once() {
+    let d = tmp("runlock");
+    let res = d.to_str().unwrap();
+    let dir = StudyDir::new(&d, "tiny");
+    // another process computes run a now: it holds a's lock and has a temporary file staged
+    let a = StudyLock::run(&dir, "a", false).unwrap();
+    let staged = dir.root.join("meshes").join(format!(".a_level0.json.tmp{}.0", std::process::id()));
+    std::fs::create_dir_all(staged.parent().unwrap()).unwrap();
+    std::fs::write(&staged, "half written").unwrap();
+    // shard 2/2 (run b) neither waits for a nor removes a's file in progress
+    let (code, err) = signorini(&["run", &fixture(), "--quick", "--shard", "2/2", "--results", res]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(dir.run_file("b").exists() && !dir.run_file("a").exists());
+    assert!(staged.exists(), "removed a file of a run in progress: {err}");
+    // the whole study without --wait: refused at run a, naming the holder
+    let (code, err) = signorini(&["run", &fixture(), "--quick", "--results", res]);
+    assert_ne!(code, Some(0));
+    assert!(
+        err.contains("run a of") && err.contains("is being written by process") && err.contains(&std::process::id().to_string()),
+        "{err}"
+    );
+    // with --wait: waits for a, then computes it once (b is kept)
+    let b_before = std::fs::read(dir.run_file("b")).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["run", &fixture(), "--quick", "--wait", "--results", res])
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    assert!(!dir.run_file("a").exists(), "computed a while its lock was held");
+    std::fs::remove_file(&staged).unwrap(); // the holder's staged file goes with it
+    drop(a);
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("waiting for it to finish") && err.contains("1 run(s) executed"), "{err}");
+    assert_eq!(std::fs::read(dir.run_file("b")).unwrap(), b_before, "b was computed again");
+    let runs = dir.read_runs().unwrap();
+    assert_eq!(runs.iter().map(|r| r.run.id.as_str()).collect::<Vec<_>>(), ["a", "b"]);
+    assert!(drift::check_derived(&dir, "tiny", &runs).is_empty());
 }

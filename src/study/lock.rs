@@ -1,53 +1,108 @@
-//! The lock on a study's results folder (`STUDY/.lock`).
+//! The locks of a study's results folder: the study lock (`STUDY/.lock`), held while the folder's
+//! shared files change (setting up, committing a finished run), and one lock per run
+//! (`STUDY/.locks/RUN.lock`), held while the run is computed. Shards of one study (a Slurm
+//! array) compute their runs side by side and take turns only to commit; two processes never
+//! compute the same run (the second waits or is refused, naming the holder), and neither removes
+//! the other's files of a run in progress.
 
 use super::provenance;
 use crate::records::StudyDir;
 use anyhow::{Context, Result, bail};
+use std::path::{Path, PathBuf};
 
-/// An exclusive lock on a study's results folder (`STUDY/.lock`, holding the owner's process id
-/// and command line), held while a study is written, so that two runs of one study neither
-/// compute everything twice nor delete each other's runs. Released when dropped (or when the
-/// process dies: the operating system drops the lock with the file descriptor).
-pub struct StudyLock {
+/// An exclusive lock on a file holding the owner's process id and command line. Released when
+/// dropped (or when the process dies: the operating system drops the lock with the file
+/// descriptor).
+pub struct Lock {
     _file: std::fs::File,
 }
 
-impl StudyLock {
-    pub fn acquire(dir: &StudyDir, wait: bool) -> Result<StudyLock> {
-        use std::io::{Read, Seek, Write};
-        std::fs::create_dir_all(&dir.root).with_context(|| format!("creating {}", dir.root.display()))?;
+/// The lock on a study's shared files.
+pub type StudyLock = Lock;
+
+impl Lock {
+    /// The study lock of `dir`: refused (naming the holder) if another process holds it, unless
+    /// `wait`, then waits for it.
+    pub fn acquire(dir: &StudyDir, wait: bool) -> Result<Lock> {
         let path = dir.root.join(".lock");
-        let mut file = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&path)
-            .with_context(|| format!("opening the lock file {}", path.display()))?;
-        match file.try_lock() {
-            Ok(()) => {}
-            Err(std::fs::TryLockError::WouldBlock) => {
-                let mut holder = String::new();
-                let _ = file.read_to_string(&mut holder);
-                let holder = if holder.trim().is_empty() { "another process".to_string() } else { holder.trim().to_string() };
-                if !wait {
-                    bail!(
-                        "{} is being written by {holder}; wait for it to finish, or pass --wait to wait for it (the lock is {})",
-                        dir.root.display(),
-                        path.display()
-                    );
-                }
-                eprintln!("{} is being written by {holder}; waiting for it to finish", dir.root.display());
-                file.lock().with_context(|| format!("waiting for the lock {}", path.display()))?;
-            }
-            Err(std::fs::TryLockError::Error(e)) => return Err(e).with_context(|| format!("locking {}", path.display())),
-        }
-        let me =
-            format!("process {} ({}) since {}", std::process::id(), std::env::args().collect::<Vec<_>>().join(" "), provenance::utc_now());
-        file.set_len(0)
-            .and_then(|_| file.rewind())
-            .and_then(|_| file.write_all(me.as_bytes()))
-            .with_context(|| format!("writing {}", path.display()))?;
-        Ok(StudyLock { _file: file })
+        claim(open(&path)?, &path, &dir.root.display().to_string(), wait)
     }
+
+    /// The lock of run `id` of `dir`, held while it is computed. Tried first under the study
+    /// lock, where [`run_in_progress`] looks at it too, so that the look never makes a run's
+    /// owner find its lock taken; if another process computes the run, refused (naming it)
+    /// unless `wait`, then waits for it without holding the study lock.
+    pub fn run(dir: &StudyDir, id: &str, wait: bool) -> Result<Lock> {
+        let path = run_lock_file(dir, id);
+        let file = {
+            let _study = Self::acquire(dir, true)?;
+            let file = open(&path)?;
+            match file.try_lock() {
+                Ok(()) => return own(file, &path),
+                Err(std::fs::TryLockError::WouldBlock) => file,
+                Err(std::fs::TryLockError::Error(e)) => return Err(e).with_context(|| format!("locking {}", path.display())),
+            }
+        };
+        claim(file, &path, &format!("run {id} of {}", dir.root.display()), wait)
+    }
+}
+
+fn open(path: &Path) -> Result<std::fs::File> {
+    if let Some(parent) = path.parent() {
+        std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
+    }
+    std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(path)
+        .with_context(|| format!("opening the lock file {}", path.display()))
+}
+
+/// Take the lock on `file`: at once if free; if held, refused naming the holder, or with `wait`
+/// after waiting for it.
+fn claim(mut file: std::fs::File, path: &Path, what: &str, wait: bool) -> Result<Lock> {
+    use std::io::Read;
+    match file.try_lock() {
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) => {
+            let mut holder = String::new();
+            let _ = file.read_to_string(&mut holder);
+            let holder = if holder.trim().is_empty() { "another process".to_string() } else { holder.trim().to_string() };
+            if !wait {
+                bail!(
+                    "{what} is being written by {holder}; wait for it to finish, or pass --wait to wait for it (the lock is {})",
+                    path.display()
+                );
+            }
+            eprintln!("{what} is being written by {holder}; waiting for it to finish");
+            file.lock().with_context(|| format!("waiting for the lock {}", path.display()))?;
+        }
+        Err(std::fs::TryLockError::Error(e)) => return Err(e).with_context(|| format!("locking {}", path.display())),
+    }
+    own(file, path)
+}
+
+/// A locked file made this process's lock: its text names the process, its command and since when.
+fn own(mut file: std::fs::File, path: &Path) -> Result<Lock> {
+    use std::io::{Seek, Write};
+    let me = format!("process {} ({}) since {}", std::process::id(), std::env::args().collect::<Vec<_>>().join(" "), provenance::utc_now());
+    file.set_len(0)
+        .and_then(|_| file.rewind())
+        .and_then(|_| file.write_all(me.as_bytes()))
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(Lock { _file: file })
+}
+
+fn run_lock_file(dir: &StudyDir, id: &str) -> PathBuf {
+    dir.root.join(".locks").join(format!("{id}.lock"))
+}
+
+/// Whether another process holds the lock of run `id` (computes it now). Ask only under the
+/// study lock (see [`Lock::run`]). A lock this process holds counts too (asked through another
+/// open file); the study's own code never asks about a run it computes.
+pub fn run_in_progress(dir: &StudyDir, id: &str) -> bool {
+    let Ok(file) = std::fs::OpenOptions::new().read(true).write(true).open(run_lock_file(dir, id)) else { return false };
+    matches!(file.try_lock(), Err(std::fs::TryLockError::WouldBlock))
 }

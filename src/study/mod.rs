@@ -11,8 +11,9 @@
 //! and the summaries listing it (`levels.csv`, `provenance.json`) land together or not at all;
 //! what a killed process leaves is removed by the next run; a run that executes nothing changes
 //! no file; a stored run whose spec differs from the manifest's is replaced only when asked
-//! (`replace`). `--fresh` with `--shard K/N` removes only shard K's runs; a lock on the study
-//! folder ([`StudyLock`]) keeps a second process from running the same study at the same time;
+//! (`replace`). `--fresh` with `--shard K/N` removes only shard K's runs; the study lock
+//! ([`StudyLock`], held while shared files change) and one lock per run (held while it is
+//! computed) let shards of one study compute side by side while no run is computed twice;
 //! an interrupt stops after the current level and keeps every finished run ([`Interrupted`]).
 
 pub mod drift;
@@ -149,37 +150,44 @@ pub fn effective_spec(planned: &manifest::PlannedRun, quick: bool) -> RunSpec {
 /// ```
 pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> {
     let dir = StudyDir::new(&opts.results, &manifest.study);
-    let _lock = StudyLock::acquire(&dir, opts.wait_for_lock)?;
     let in_shard = |i: usize| opts.shard.is_none_or(|(k, n)| i % n == k - 1);
     let planned: Vec<RunSpec> =
         manifest.runs.iter().enumerate().filter(|(i, _)| in_shard(*i)).map(|(_, p)| effective_spec(p, opts.quick)).collect();
-    if opts.fresh {
-        start_over(&dir, opts.shard.is_some(), &planned)?;
-    }
-    let mut runs = store::read_runs(&dir)?;
-    store::remove_orphans(&manifest.study, &dir, &runs)?;
-    let stale = store::stale_runs(manifest, &runs, &planned);
-    if !stale.is_empty() && !opts.replace && !opts.fresh {
-        return Err(store::refusal(manifest, &dir, &stale));
-    }
-    for s in &stale {
-        if let store::Stale::Undeclared { id } = s {
-            eprintln!("{}/{id}: removing the stored run, not declared in {}", manifest.study, manifest.file.display());
-            store::remove_run(&dir, id)?;
-        }
-    }
-    runs.retain(|r| manifest.runs.iter().any(|p| p.spec.id == r.run.id));
-    store::sync_summaries(manifest, &dir, &runs, opts.quick)?;
-    run_planned(manifest, &dir, &runs, &planned, opts).map_err(|e| {
+    set_up(manifest, &dir, &planned, opts)?;
+    run_planned(manifest, &dir, &planned, opts).map_err(|e| {
         if e.downcast_ref::<Interrupted>().is_some() {
             return e;
         }
         // a removal or rename may have failed part-way: leave the folder consistent
-        match store::repair(manifest, &dir, opts.quick) {
+        match StudyLock::acquire(&dir, true).and_then(|_lock| store::repair(manifest, &dir, opts.quick)) {
             Ok(()) => e,
             Err(r) => e.context(format!("and bringing {} in line with its runs failed too: {r:#}", dir.root.display())),
         }
     })
+}
+
+/// Under the study lock: `--fresh`, the orphans of unfinished runs removed, stored runs whose
+/// spec differs refused (or with `--replace` undeclared ones removed), the summaries in line
+/// with the runs stored.
+fn set_up(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &RunOptions) -> Result<()> {
+    let _lock = StudyLock::acquire(dir, opts.wait_for_lock)?;
+    if opts.fresh {
+        start_over(dir, opts.shard.is_some(), planned)?;
+    }
+    let mut runs = store::read_runs(dir)?;
+    store::remove_orphans(&manifest.study, dir, &runs)?;
+    let stale = store::stale_runs(manifest, &runs, planned);
+    if !stale.is_empty() && !opts.replace && !opts.fresh {
+        return Err(store::refusal(manifest, dir, &stale));
+    }
+    for s in &stale {
+        if let store::Stale::Undeclared { id } = s {
+            eprintln!("{}/{id}: removing the stored run, not declared in {}", manifest.study, manifest.file.display());
+            store::remove_run(dir, id)?;
+        }
+    }
+    runs.retain(|r| manifest.runs.iter().any(|p| p.spec.id == r.run.id));
+    store::sync_summaries(manifest, dir, &runs, opts.quick)
 }
 
 /// `--fresh`: remove the stored runs this invocation is responsible for (with a shard, only its
@@ -198,11 +206,19 @@ fn start_over(dir: &StudyDir, sharded: bool, planned: &[RunSpec]) -> Result<()> 
     Ok(())
 }
 
-/// Run the planned runs not stored with their spec yet, storing each as it finishes.
-fn run_planned(manifest: &Manifest, dir: &StudyDir, stored: &[RunRecord], planned: &[RunSpec], opts: &RunOptions) -> Result<Vec<String>> {
+/// Run the planned runs not stored with their spec yet, each under its run lock (another process
+/// may compute the others side by side: a shard of the same study), storing each as it finishes
+/// under the study lock.
+fn run_planned(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &RunOptions) -> Result<Vec<String>> {
     let mut executed = Vec::new();
+    let stored = |id: &str| dir.read_run(id).with_context(|| format!("reading the stored run {id}"));
     for spec in planned {
-        match stored.iter().find(|r| r.run.id == spec.id) {
+        // a finished run is final: kept without taking its lock (a run that executes nothing
+        // writes nothing)
+        let done = |r: &Option<RunRecord>| r.as_ref().is_some_and(|r| r.run == *spec);
+        let _run_lock = if done(&stored(&spec.id)?) { None } else { Some(StudyLock::run(dir, &spec.id, opts.wait_for_lock)?) };
+        // read again: another process may have finished the run while this one waited for it
+        match stored(&spec.id)? {
             Some(r) if r.run == *spec => {
                 if opts.progress {
                     eprintln!("{}/{}: finished earlier, kept (use --fresh to start over)", manifest.study, spec.id);
@@ -223,6 +239,7 @@ fn run_planned(manifest: &Manifest, dir: &StudyDir, stored: &[RunRecord], planne
             drop(meshes);
             return Err(interruption(manifest, dir, opts));
         };
+        let _lock = StudyLock::acquire(dir, true)?;
         store::commit_run(manifest, dir, &record, meshes, opts.quick)?;
         executed.push(spec.id.clone());
     }

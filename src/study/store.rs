@@ -127,14 +127,26 @@ fn files_in(dir: &std::path::Path) -> Result<Vec<(String, PathBuf)>> {
 /// The files of the study folder no finished run accounts for: temporary files (of a process
 /// killed while writing) anywhere in it, and mesh snapshots of a run without a record or of a
 /// level its record does not save (a run killed before it finished, an old binary's leftovers).
-/// Files the study never writes are left alone.
+/// Files the study never writes are left alone, and so are the temporary files of a run another
+/// process computes now (its run lock is held; ask under the study lock).
 pub fn orphans(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<PathBuf>> {
     let meshes = dir.root.join("meshes");
     let mut out = Vec::new();
-    for sub in [dir.root.clone(), dir.root.join("runs"), meshes.clone()] {
+    let runs_dir = dir.root.join("runs");
+    for sub in [dir.root.clone(), runs_dir.clone(), meshes.clone()] {
         for (name, path) in files_in(&sub)? {
             let stray_mesh = sub == meshes && StudyDir::parse_mesh_name(&name).is_some_and(|(run, level)| !saved(runs, run, level));
-            if records::is_temporary(&name) || stray_mesh {
+            let temporary = records::is_temporary(&name);
+            // a temporary file of a run another process computes now is not an orphan
+            let of_run = name.strip_prefix('.').and_then(|n| n.rsplit_once(".tmp")).and_then(|(target, _)| {
+                if sub == runs_dir {
+                    target.strip_suffix(".json").map(str::to_string)
+                } else {
+                    StudyDir::parse_mesh_name(target).map(|(run, _)| run.to_string()).filter(|_| sub == meshes)
+                }
+            });
+            let in_progress = temporary && of_run.is_some_and(|id| super::lock::run_in_progress(dir, &id));
+            if (temporary || stray_mesh) && !in_progress {
                 out.push(path);
             }
         }
