@@ -30,6 +30,13 @@ for p in ex71 ex72 fb; do
     "$bin" export --problem "$p" --mesh structured:4 --adapt-levels 10 --out "$dir" || exit 1
     all+=("$dir")
 done
+# the meshes the repaired estimator grades (study estimator_repair: contact_term
+# tensile_on_full_contact), level 10
+for p in ex71 ex72 fb; do
+    dir="$cases/$p-adaptive-repaired-10"
+    "$bin" export --problem "$p" --mesh structured:4 --adapt-levels 10 --contact-term tensile-on-full-contact --out "$dir" || exit 1
+    all+=("$dir")
+done
 dir="$cases/ex72-reference"
 "$bin" export --problem ex72 --mesh structured:4 --adapt-min-ndof 250000 --theta 0.5 \
     --contact-term without-full-contact --out "$dir" || exit 1
