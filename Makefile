@@ -12,8 +12,9 @@ build:
 	$(CARGO) build --release --locked
 
 # What CI runs: formatting and lints (rustfmt.toml, clippy -D warnings), unit and integration tests (release mode: the convergence tests solve real
-# systems), the full drift check (every study rerun and compared with results/ at every level,
-# plus levels.csv, provenance and CLAIMS.md against the records), and the NGSolve cross-check.
+# systems), the drift check (every study rerun and compared with results/ at every level, deep
+# studies in their tiers: quick prefixes plus their `full` runs to the end; plus levels.csv,
+# provenance and CLAIMS.md against the records), and the NGSolve cross-check.
 # Test-time outputs (drift report, cross-check tables with timings) go under target/; the last
 # step fails if the run changed any file git sees.
 test: build
@@ -45,10 +46,11 @@ reproduce: build
 	$(BIN) run --fresh experiments/*.toml
 	$(BIN) figures
 
-# Every study rerun and compared with results/ at every level, field by field; non-zero exit on
-# drift. Report: target/drift/report.json.
+# Every study rerun to the end, deep ones too (`make test` reruns deep studies in their tiers:
+# README, Drift), and compared with results/ at every level, field by field; non-zero exit on
+# drift. Report: target/drift/report.json. The scheduled CI job runs it.
 drift: build
-	$(BIN) drift
+	$(BIN) drift --deep
 
 # NGSolve cross-check: creates crosscheck/.venv from the pinned requirements on first use and
 # stores its tables in results/crosscheck/.
@@ -65,18 +67,18 @@ bench: build
 
 # How far round-off moves the stored numbers: every study rerun three ways that change only the
 # order of floating-point operations (nested dissection forced, minimum degree forced, one thread
-# instead of all) and compared with results/ (automatic ordering, all threads; it must be
-# current: `make drift` first) by `signorini drift --against`, whose report lists per study and
-# float field the largest relative change and the largest change relative to the field's largest
-# value in its run. Reports: results/roundoff/*.json, the basis of the manifests' [drift] tolerances.
+# instead of all) by `signorini drift` (deep studies in their tiers), which compares each with
+# results/ (automatic ordering, all threads; it must be current: `make drift` first); its report
+# lists per study and float field the largest relative change and the largest change relative to
+# the field's largest value in its run. Reports: results/roundoff/*.json, the basis of the
+# manifests' [drift] tolerances.
 ROUNDOFF_VARIANTS := nested-dissection:$(shell nproc) minimum-degree:$(shell nproc) auto:1
 roundoff: build
 	@mkdir -p results/roundoff
 	@set -e; for v in $(ROUNDOFF_VARIANTS); do \
 		ordering=$${v%%:*}; jobs=$${v##*:}; name=$$ordering-$$jobs-threads; \
 		echo "== $$name"; \
-		SIGNORINI_ORDERING=$$ordering $(BIN) run --fresh --jobs $$jobs --results target/roundoff/$$name experiments/*.toml; \
-		$(BIN) drift --against target/roundoff/$$name --report results/roundoff/$$name.json || true; \
+		SIGNORINI_ORDERING=$$ordering RAYON_NUM_THREADS=$$jobs $(BIN) drift --report results/roundoff/$$name.json || true; \
 	done
 
 # Regenerate every experiments/meshes/*.msh from its .geo with gmsh's Python module, installed in

@@ -71,6 +71,10 @@ enum Command {
         /// Rerun the quick forms only (prefixes of the stored full runs: the first levels).
         #[arg(long)]
         quick: bool,
+        /// Rerun deep studies (a [drift.deep] table in their manifest) to the end; without it
+        /// their runs are rerun in their quick forms, the ones the table names in full.
+        #[arg(long, conflicts_with_all = ["quick", "against"])]
+        deep: bool,
         /// Compare the records in this results folder with the stored ones instead of rerunning
         /// (a study rerun into a scratch folder; or every study rerun with another ordering or
         /// thread count, to measure round-off): the studies DIR holds, their provenance
@@ -547,7 +551,18 @@ fn drift_outcome(report: &study::drift::DriftReport, against: Option<&std::path:
     };
     match (report.rows.len(), against) {
         (0, None) => {
-            println!("drift: none ({studies} checked at every level{})", if report.quick { " of the quick forms" } else { "" });
+            let tiered: Vec<&str> = report
+                .studies
+                .iter()
+                .filter(|e| e["quick"].as_bool() == Some(true) && !report.quick)
+                .filter_map(|e| e["study"].as_str())
+                .collect();
+            let tiers = if tiered.is_empty() {
+                String::new()
+            } else {
+                format!("; {} in its tiers: quick prefixes, its `full` runs at every level (all: drift --deep)", tiered.join(", "))
+            };
+            println!("drift: none ({studies} checked at every level{}{tiers})", if report.quick { " of the quick forms" } else { "" });
             Ok(())
         }
         (0, Some(dir)) => {
@@ -566,8 +581,10 @@ fn drift_outcome(report: &study::drift::DriftReport, against: Option<&std::path:
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run_drift(
     quick: bool,
+    deep: bool,
     against: Option<&std::path::Path>,
     report_file: Option<&std::path::Path>,
     accept: &[String],
@@ -583,6 +600,7 @@ fn run_drift(
     let scratch = std::path::PathBuf::from("target/drift").join(if quick { "quick" } else { "full" });
     let options = study::drift::DriftOptions {
         quick,
+        deep,
         against: against.map(|p| p.to_path_buf()),
         scratch,
         results: results.to_path_buf(),
@@ -741,8 +759,8 @@ fn main() -> ExitCode {
         Command::Figures { results, figures, experiments, study } => {
             run_figures(results.as_deref(), figures.as_deref(), experiments, study)
         }
-        Command::Drift { quick, against, report, accept, study, experiments, results } => {
-            run_drift(*quick, against.as_deref(), report.as_deref(), accept, study, experiments, results)
+        Command::Drift { quick, deep, against, report, accept, study, experiments, results } => {
+            run_drift(*quick, *deep, against.as_deref(), report.as_deref(), accept, study, experiments, results)
         }
         Command::Run { manifests, quick, jobs, shard, fresh, replace, results, wait } => {
             let flags = RunFlags { quick: *quick, fresh: *fresh, replace: *replace, wait: *wait };

@@ -246,6 +246,16 @@ fn full_results(results: &Path) {
             repaired(Run { missing: never, ..run("fb_adaptive", "fb", Adaptive) }),
         ],
     );
+    write_study(
+        results,
+        "deep",
+        &[
+            run("ex71_as_written", "ex71", Adaptive),
+            run("ex71_uniform", "ex71", Uniform),
+            fb("fb_as_written", Adaptive),
+            fb("fb_uniform", Uniform),
+        ],
+    );
 }
 
 /// The hertz study: one run of the repository's Hertz problem file (found through the provenance's

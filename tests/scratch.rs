@@ -85,12 +85,15 @@ fn drift_against_a_one_study_folder_compares_that_study_and_names_the_others() {
     assert_eq!(code, 0, "{out}{err}");
     let d = dir.display();
     assert!(out.contains(&format!("drift: none (1 study of {d} compared with results at every level")), "{out}");
-    assert!(out.contains(&format!("not compared (not in {d}): c0_sweep, contact_term_ablation, estimator_repair, ex71, ex72")), "{out}");
+    assert!(
+        out.contains(&format!("not compared (not in {d}): c0_sweep, contact_term_ablation, deep, estimator_repair, ex71, ex72")),
+        "{out}"
+    );
     assert!(!out.contains("--accept") && !err.contains("--accept"), "{out}{err}");
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("drift-report.json")).unwrap()).unwrap();
     assert_eq!(report["studies"].as_array().unwrap().len(), 1, "{report}");
     assert_eq!(report["studies"][0]["study"], "hertz");
-    assert_eq!(report["not_compared"].as_array().unwrap().len(), 9, "{report}");
+    assert_eq!(report["not_compared"].as_array().unwrap().len(), 10, "{report}");
     assert!(report["rows"].as_array().unwrap().is_empty());
     assert_eq!(tracked_state(), before, "drift --against changed results/, figures/ or target/drift/");
 }

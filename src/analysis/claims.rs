@@ -8,6 +8,7 @@
 //! computed twice, with errors sampled at the quadrature points (the paper's way) and on a dense
 //! lattice (`err_dense`); the `sampling` row lists the verdicts that differ.
 
+mod deep;
 mod ex72;
 mod repair;
 
@@ -621,6 +622,7 @@ pub fn claims_with(results: &Path, sampling: ErrorSampling) -> std::io::Result<V
     fb_claims(&ctx, &mut out)?;
     hertz_claims(&ctx, &mut out)?;
     repair::estimator_repair_claim(&ctx, &mut out)?;
+    deep::claims(&ctx, &mut out)?;
     Ok(out)
 }
 

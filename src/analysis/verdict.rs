@@ -107,9 +107,14 @@ impl RateFit {
 /// Levels of the window ending at `end`: end, end - 2, ... back until the window spans
 /// `MIN_DECADES` of NDF and holds `MIN_POINTS` levels (or to the start of the run), in increasing order.
 pub fn window(ndof: &[usize], end: usize) -> Vec<usize> {
+    window_spanning(ndof, end, MIN_DECADES)
+}
+
+/// [`window`] spanning `decades` of NDF instead of `MIN_DECADES` (the deep runs' two decades).
+pub fn window_spanning(ndof: &[usize], end: usize, decades: f64) -> Vec<usize> {
     let mut out = vec![end];
     let mut i = end;
-    while i >= 2 && ((ndof[end] as f64 / ndof[i] as f64).log10() < MIN_DECADES || out.len() < MIN_POINTS) {
+    while i >= 2 && ((ndof[end] as f64 / ndof[i] as f64).log10() < decades || out.len() < MIN_POINTS) {
         i -= 2;
         out.push(i);
     }
@@ -128,8 +133,14 @@ pub fn rate_over(ndof: &[usize], values: &[Option<f64>], end: usize) -> Option<R
 
 /// As [`rate_over`] (the window chosen in NDF), fitted against `x` (one per level, positive).
 pub fn rate_over_x(ndof: &[usize], x: &[f64], abscissa: Abscissa, values: &[Option<f64>], end: usize) -> Option<RateFit> {
+    rate_spanning(ndof, x, abscissa, values, end, MIN_DECADES)
+}
+
+/// [`rate_over_x`] over a window of `decades` of NDF ([`window_spanning`]).
+pub fn rate_spanning(ndof: &[usize], x: &[f64], abscissa: Abscissa, values: &[Option<f64>], end: usize, decades: f64) -> Option<RateFit> {
     let floor = ROUND_OFF * values.iter().flatten().cloned().fold(0.0, f64::max);
-    let levels: Vec<usize> = window(ndof, end).into_iter().rev().take_while(|&l| values[l].is_some_and(|v| v > floor)).collect();
+    let levels: Vec<usize> =
+        window_spanning(ndof, end, decades).into_iter().rev().take_while(|&l| values[l].is_some_and(|v| v > floor)).collect();
     let pts: Vec<(f64, f64)> = levels.iter().map(|&l| (x[l].ln(), -values[l].unwrap().ln())).collect();
     let rate = fit_line(&pts)?;
     let (first, last) = (*levels.last()?, levels[0]);
@@ -157,22 +168,34 @@ impl RateReport {
 
     /// Fitted against `x` ([`rate_over_x`]).
     pub fn from_values_x(ndof: &[usize], x: &[f64], abscissa: Abscissa, values: &[Option<f64>]) -> Option<RateReport> {
+        Self::spanning(ndof, x, abscissa, values, MIN_DECADES)
+    }
+
+    /// [`RateReport::from_values_x`] over windows of `decades` of NDF.
+    pub fn spanning(ndof: &[usize], x: &[f64], abscissa: Abscissa, values: &[Option<f64>], decades: f64) -> Option<RateReport> {
         let end = ndof.len().checked_sub(1)?;
-        let main = rate_over_x(ndof, x, abscissa, values, end)?;
-        let windows =
-            (0..3).filter_map(|k| end.checked_sub(k * WINDOW_SHIFT)).filter_map(|e| rate_over_x(ndof, x, abscissa, values, e)).collect();
+        let main = rate_spanning(ndof, x, abscissa, values, end, decades)?;
+        let windows = (0..3)
+            .filter_map(|k| end.checked_sub(k * WINDOW_SHIFT))
+            .filter_map(|e| rate_spanning(ndof, x, abscissa, values, e, decades))
+            .collect();
         Some(RateReport { main, windows })
     }
 
     /// The rate of `values` (one per level of `run`) against the run's [`abscissa_of`].
     pub fn of_values(run: &RunRecord, values: &[Option<f64>]) -> Option<RateReport> {
+        Self::of_values_spanning(run, values, MIN_DECADES)
+    }
+
+    /// [`RateReport::of_values`] over windows of `decades` of NDF.
+    pub fn of_values_spanning(run: &RunRecord, values: &[Option<f64>], decades: f64) -> Option<RateReport> {
         let ndof: Vec<usize> = run.levels.iter().map(|l| l.ndof).collect();
         let abscissa = abscissa_of(run);
         let x: Vec<f64> = match abscissa {
             Abscissa::Ndof => ndof.iter().map(|&n| n as f64).collect(),
             Abscissa::InverseHMin => run.levels.iter().map(|l| 1.0 / l.h_min).collect(),
         };
-        Self::from_values_x(&ndof, &x, abscissa, values)
+        Self::spanning(&ndof, &x, abscissa, values, decades)
     }
 
     pub fn of(run: &RunRecord, name: &str) -> Option<RateReport> {

@@ -53,6 +53,7 @@
 //! render the PNGs; the SVGs ask the viewer for that CSS font list.
 
 mod axis;
+mod deep;
 mod fb;
 mod font;
 mod glyphs;
@@ -71,7 +72,7 @@ use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// Every figure, in the order drawn.
-pub const FIGURES: [&str; 16] = [
+pub const FIGURES: [&str; 17] = [
     "fig2a",
     "fig2b",
     "fig3a",
@@ -88,6 +89,7 @@ pub const FIGURES: [&str; 16] = [
     "hertz_pressure",
     "hertz_mesh",
     "estimator_repair",
+    "deep_error",
 ];
 
 /// The study a figure is drawn from (the table above).
@@ -102,6 +104,7 @@ pub fn study_of(figure: &str) -> Option<&'static str> {
         "fb_error" | "fb_mesh" => "fb",
         "hertz_pressure" | "hertz_mesh" => "hertz",
         "estimator_repair" => "estimator_repair",
+        "deep_error" => "deep",
         _ => return None,
     })
 }
@@ -246,6 +249,7 @@ fn build(name: &str, results: &Path) -> anyhow::Result<Built> {
         "fb_mesh" => fb::fb_mesh(results),
         "hertz_pressure" => hertz::hertz_pressure(results),
         "hertz_mesh" => hertz::hertz_mesh(results),
+        "deep_error" => deep::deep_error(results),
         other => anyhow::bail!("unknown figure {other}"),
     }
 }

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 
 /// Which study each figure of [`crate::plot::FIGURES`] draws (a test checks that every figure
 /// is listed).
-pub const FIGURE_STUDY: [(&str, &str); 16] = [
+pub const FIGURE_STUDY: [(&str, &str); 17] = [
     ("fig2a", "ex71"),
     ("fig2b", "ex71"),
     ("fig4a", "ex71"),
@@ -32,6 +32,7 @@ pub const FIGURE_STUDY: [(&str, &str); 16] = [
     ("hertz_pressure", "hertz"),
     ("hertz_mesh", "hertz"),
     ("estimator_repair", "estimator_repair"),
+    ("deep_error", "deep"),
 ];
 
 /// The studies a CLAIMS row rests on, from its id (a test checks that every row maps to one).
@@ -41,6 +42,7 @@ pub fn claim_studies(id: &str) -> &'static [&'static str] {
         "sampling" => &["ex71", "ex72", "contact_term_ablation"],
         "hertz" => &["hertz"],
         _ if id.starts_with("7.1-eta5") => &["ex71", "contact_term_ablation"],
+        _ if id.starts_with("7.1-deep") || id.starts_with("fb-deep") => &["deep"],
         _ if id.starts_with("7.1-") => &["ex71"],
         _ if id.starts_with("7.2-") => &["ex72", "ex72_large"],
         _ if id.starts_with("log-factor") => &["log_ablation"],
@@ -57,9 +59,16 @@ fn drift_status(report: Option<&serde_json::Value>, study: &str) -> String {
         return "not checked: no drift report found (run <code>signorini drift --study STUDY</code>)".replace("STUDY", &escape(study));
     };
     let date = r["date"].as_str().unwrap_or("an unknown date");
-    let scope = if r["quick"].as_bool() == Some(true) { "quick prefixes" } else { "every level" };
     let against = r["against"].as_str().map(|a| format!(" against {}", escape(a))).unwrap_or_default();
     let entry = r["studies"].as_array().and_then(|s| s.iter().find(|e| e["study"] == study));
+    // a deep study rerun in its tiers says so in its own entry
+    let scope = if r["quick"].as_bool() == Some(true) {
+        "quick prefixes"
+    } else if entry.is_some_and(|e| e["quick"].as_bool() == Some(true)) {
+        "quick prefixes and, for the runs its manifest names, every level (a deep study's test tier)"
+    } else {
+        "every level"
+    };
     match entry {
         None => format!("not checked in the drift report of {date}{against} (it did not include this study)"),
         Some(e) => match e["drift"].as_u64() {

@@ -376,6 +376,9 @@ pub fn check_derived(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<Dri
 pub struct DriftOptions {
     /// Rerun the quick forms (prefixes of the stored runs) instead of the full studies.
     pub quick: bool,
+    /// Rerun deep studies ([`super::manifest::DeepTier`]) to the end; without it they are rerun
+    /// in their tiers.
+    pub deep: bool,
     /// Compare with the records already in this results folder instead of rerunning (used to
     /// measure round-off: the studies rerun with another ordering or thread count).
     pub against: Option<PathBuf>,
@@ -532,11 +535,18 @@ pub fn run(
         not_compared,
     };
     for m in &manifests {
+        // a deep study in its tiers (unless --deep): quick forms, some runs to the end
+        let (m, quick) = if opts.against.is_some() { (m.clone(), opts.quick) } else { m.for_drift(opts.quick, opts.deep) };
+        let m = &m;
+        if opts.progress && quick && !opts.quick {
+            let full = m.drift.deep.as_ref().map(|t| t.full.join(", ")).unwrap_or_default();
+            eprintln!("{}: a deep study: every run rerun in its quick form, {full} to the end (all to the end: drift --deep)", m.study);
+        }
         let fresh_root = match &opts.against {
             Some(dir) => dir.clone(),
             None => {
                 let options = super::RunOptions {
-                    quick: opts.quick,
+                    quick,
                     shard: None,
                     fresh: true,
                     replace: false,
@@ -553,7 +563,7 @@ pub fn run(
         let fresh = StudyDir::new(&fresh_root, &m.study)
             .read_runs()
             .with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?;
-        let mut c = compare(m, &stored, &fresh, opts.quick);
+        let mut c = compare(m, &stored, &fresh, quick);
         if !stored.is_empty() {
             c.rows.extend(check_derived(&stored_dir, &m.study, &stored));
         }
@@ -568,7 +578,7 @@ pub fn run(
                 if c.rows.is_empty() { "no drift".to_string() } else { format!("{} field(s) moved", c.rows.len()) }
             );
         }
-        report.studies.push(serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": c.rows.len() }));
+        report.studies.push(serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": c.rows.len(), "quick": quick }));
         report.rows.extend(c.rows);
         report.changes.insert(m.study.clone(), c.changes);
     }

@@ -151,6 +151,20 @@ pub struct DriftSpec {
     pub fields: BTreeMap<String, Tolerance>,
     #[serde(default)]
     pub rates: Vec<RateFloor>,
+    /// A deep study (runs too long to rerun in `make test`): see [`DeepTier`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deep: Option<DeepTier>,
+}
+
+/// The drift tiers of a deep study. `signorini drift` (what `make test` runs) reruns each run
+/// in its quick form (the first `quick_levels` levels: an exact prefix, kept to small sizes) and
+/// compares those levels, except the runs in `full`, which it reruns to the end and compares at
+/// every level (a deep level of the study checked in every test run). `signorini drift --deep`
+/// (the scheduled job, `make drift`) reruns every run to the end.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeepTier {
+    pub full: Vec<String>,
 }
 
 fn default_tolerance() -> Tolerance {
@@ -159,7 +173,7 @@ fn default_tolerance() -> Tolerance {
 
 impl Default for DriftSpec {
     fn default() -> Self {
-        DriftSpec { default: default_tolerance(), fields: BTreeMap::new(), rates: Vec::new() }
+        DriftSpec { default: default_tolerance(), fields: BTreeMap::new(), rates: Vec::new(), deep: None }
     }
 }
 
@@ -200,6 +214,22 @@ pub struct Manifest {
 }
 
 impl Manifest {
+    /// The manifest as `signorini drift` reruns it, and whether in quick forms: a deep study
+    /// ([`DeepTier`]) in its quick forms but its `full` runs to the end, unless `deep`; any study
+    /// in its quick forms with `quick`.
+    pub fn for_drift(&self, quick: bool, deep: bool) -> (Manifest, bool) {
+        let mut m = self.clone();
+        match (&self.drift.deep, quick, deep) {
+            (Some(tier), false, false) => {
+                for p in m.runs.iter_mut().filter(|p| tier.full.contains(&p.spec.id)) {
+                    p.quick_levels = p.spec.levels;
+                }
+                (m, true)
+            }
+            _ => (m, quick),
+        }
+    }
+
     pub fn load(path: &Path) -> Result<Self, ManifestError> {
         let bytes = std::fs::read(path).map_err(|error| ManifestError::Read { file: path.to_path_buf(), error })?;
         let text = String::from_utf8_lossy(&bytes);
@@ -360,6 +390,13 @@ fn parse_run(
 /// `[drift]`: tolerances in range for float fields of the records (not the derived ones, which
 /// are checked by definition), and rate checks on declared runs.
 fn check_drift(drift: &DriftSpec, runs: &[PlannedRun], invalid: &Invalid) -> Result<(), ManifestError> {
+    if let Some(deep) = &drift.deep {
+        for (i, id) in deep.full.iter().enumerate() {
+            if !runs.iter().any(|p| &p.spec.id == id) {
+                return Err(invalid.at(format!("drift.deep.full[{i}]"), "the id of a declared run", format!("{id:?}")));
+            }
+        }
+    }
     let floats = crate::records::float_fields();
     for (key, tol) in
         std::iter::once(("default".to_string(), &drift.default)).chain(drift.fields.iter().map(|(k, t)| (format!("fields.{k}"), t)))

@@ -1,0 +1,35 @@
+//! Figures of the `deep` study (Example 7.1 and fb to about 1e7 unknowns), from its records only.
+//!
+//! | figure | study / runs | shows |
+//! |---|---|---|
+//! | `deep_error` | `deep`, all runs | one panel per problem (7.1, fb): `err_quadrature` vs NDF for eta_5 as written, without full-contact nodes, repaired (adaptive) and uniform refinement, a style per run, log-log, NDF^-3/2 below all; the rows `7.1-deep`, `fb-deep` of CLAIMS fit the last two decades |
+
+use super::render::{LineFigure, MARKERS, Panel};
+use super::{Built, ERR, Figure, NDF_DESC, PALETTE, Style, runs, series, slope};
+use std::path::Path;
+
+const STUDY: &str = "deep";
+
+pub(super) fn deep_error(results: &Path) -> anyhow::Result<Built> {
+    let runs = match runs(results, STUDY)? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let mut panels = Vec::new();
+    for (problem, title) in [("ex71", "Example 7.1"), ("fb", "free boundary (fb)")] {
+        let mut p = Panel::new(format!("{title}: error vs NDF to 1e7"), NDF_DESC, format!("error {ERR}"));
+        for (k, r) in runs.iter().filter(|r| r.run.problem == problem).enumerate() {
+            let style = Style { color: PALETTE[k % PALETTE.len()], marker: MARKERS[k % MARKERS.len()], dashed: k % 2 == 1, filled: true };
+            let label = r.run.id.strip_prefix(&format!("{problem}_")).unwrap_or(&r.run.id).replace('_', " ");
+            p.series.push(series(r, label, style, |l| l.err_quadrature));
+        }
+        p.slopes.push(slope());
+        if p.has_data() {
+            panels.push(p);
+        }
+    }
+    if panels.is_empty() {
+        return Ok(Err(format!("study {STUDY} has no levels")));
+    }
+    Ok(Ok(Figure::Lines(LineFigure { title: Some("Deep runs: the error over two decades and more".to_string()), panels })))
+}
