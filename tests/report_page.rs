@@ -28,7 +28,7 @@ fn study_pages_load_in_chromium_with_every_image_and_claim() {
     for page in &pages {
         let study = page.file_stem().unwrap().to_string_lossy().into_owned();
         let seen = common::browser::check_page(&chromium, page);
-        let expected: Vec<&str> = signorini::page::FIGURE_STUDY.iter().filter(|(_, s)| *s == study).map(|(f, _)| *f).collect();
+        let expected: Vec<&str> = signorini::page::figures_of(&study);
         let names: Vec<&str> = seen.images.iter().map(|(n, _)| n.as_str()).collect();
         assert_eq!(names, expected, "{study}: the page's images");
         for (name, loaded) in &seen.images {

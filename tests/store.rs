@@ -24,6 +24,16 @@ fn signorini(args: &[&str]) -> (Option<i32>, String) {
     (out.status.code(), err)
 }
 
+/// `signorini run` of the tiny study with --wait, in the background (stderr captured).
+fn run_waiting(res: &str) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["run", &fixture(), "--quick", "--wait", "--results", res])
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap()
+}
+
 fn fixture() -> String {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny.toml").display().to_string()
 }
@@ -75,12 +85,7 @@ fn a_second_run_of_the_same_study_is_refused_or_waits_and_loses_nothing() {
     assert_eq!(std::fs::read(dir.run_file("b")).unwrap(), before, "the refused run touched the other's run");
     assert!(!dir.run_file("a").exists());
     // with --wait it waits for the lock, then runs
-    let child = Command::new(env!("CARGO_BIN_EXE_signorini"))
-        .args(["run", &fixture(), "--quick", "--wait", "--results", res])
-        .stderr(Stdio::piped())
-        .stdout(Stdio::null())
-        .spawn()
-        .unwrap();
+    let child = run_waiting(res);
     std::thread::sleep(Duration::from_millis(1500));
     assert!(!dir.run_file("a").exists(), "ran while the lock was held");
     drop(lock);
@@ -175,12 +180,7 @@ fn shards_compute_side_by_side_and_a_run_is_computed_once() {
     );
     // with --wait: waits for a, then computes it once (b is kept)
     let b_before = std::fs::read(dir.run_file("b")).unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_signorini"))
-        .args(["run", &fixture(), "--quick", "--wait", "--results", res])
-        .stderr(Stdio::piped())
-        .stdout(Stdio::null())
-        .spawn()
-        .unwrap();
+    let child = run_waiting(res);
     std::thread::sleep(Duration::from_millis(1500));
     assert!(!dir.run_file("a").exists(), "computed a while its lock was held");
     std::fs::remove_file(&staged).unwrap(); // the holder's staged file goes with it

@@ -13,27 +13,11 @@ use base64::Engine;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-/// Which study each figure of [`crate::plot::FIGURES`] draws (a test checks that every figure
-/// is listed).
-pub const FIGURE_STUDY: [(&str, &str); 17] = [
-    ("fig2a", "ex71"),
-    ("fig2b", "ex71"),
-    ("fig4a", "ex71"),
-    ("fig3a", "ex72"),
-    ("fig3b", "ex72"),
-    ("fig4b", "ex72"),
-    ("fig3b_variant", "contact_term_ablation"),
-    ("contact_term_ablation", "contact_term_ablation"),
-    ("c0_sweep", "c0_sweep"),
-    ("log_ablation", "log_ablation"),
-    ("theta_ablation", "theta_ablation"),
-    ("fb_error", "fb"),
-    ("fb_mesh", "fb"),
-    ("hertz_pressure", "hertz"),
-    ("hertz_mesh", "hertz"),
-    ("estimator_repair", "estimator_repair"),
-    ("deep_error", "deep"),
-];
+/// The figures of [`crate::plot::FIGURES`] drawn from `study` ([`crate::plot::study_of`]), in
+/// the order drawn.
+pub fn figures_of(study: &str) -> Vec<&'static str> {
+    crate::plot::FIGURES.into_iter().filter(|f| crate::plot::study_of(f) == Some(study)).collect()
+}
 
 /// The studies a CLAIMS row rests on, from its id (a test checks that every row maps to one).
 pub fn claim_studies(id: &str) -> &'static [&'static str] {
@@ -133,7 +117,7 @@ fn claims_table(claims: &[&Claim]) -> String {
 
 fn figures_html(figures: &Path, study: &str) -> std::io::Result<String> {
     let mut s = String::new();
-    for (name, _) in FIGURE_STUDY.iter().filter(|(_, st)| *st == study) {
+    for name in figures_of(study) {
         let png = figures.join(format!("{name}.png"));
         match std::fs::read(&png) {
             Ok(bytes) => {
@@ -258,7 +242,7 @@ mod tests {
     #[test]
     fn every_figure_has_its_study() {
         for f in crate::plot::FIGURES {
-            assert!(FIGURE_STUDY.iter().any(|(name, _)| *name == f), "figure {f} is not in FIGURE_STUDY");
+            assert!(crate::plot::study_of(f).is_some(), "figure {f} has no study in plot::study_of");
         }
     }
 
