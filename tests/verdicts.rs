@@ -181,7 +181,7 @@ fn record(id: &str, refine: Refine, levels: Vec<LevelRecord>) -> RunRecord {
         save_levels: vec![],
         constants: Default::default(),
     };
-    RunRecord { study: "fb".into(), run, levels, reference_ndof: None }
+    RunRecord { study: "fb".into(), run, levels, reference_ndof: None, history: None }
 }
 
 /// Levels with error C NDF^-rate, estimate 100x the error, l_h = 1, and a contact zone that
