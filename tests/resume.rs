@@ -67,7 +67,7 @@ fn a_killed_run_resumes_after_its_last_finished_level_with_the_same_numbers() {
     child.kill().unwrap(); // SIGKILL: no handler runs
     child.wait().unwrap();
     let kept = checkpoint_levels(&partial);
-    assert!(kept >= 8 && kept < 22, "{kept}");
+    assert!((8..22).contains(&kept), "{kept}");
     assert!(!stopped.join("resumed/runs/long.json").exists());
     let out = run(&stopped, &manifest);
     let stderr = String::from_utf8_lossy(&out.stderr);
