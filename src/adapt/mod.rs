@@ -305,6 +305,7 @@ pub fn solve_level(
         t_estimate,
         t_refine: 0.0,
         t_level: 0.0,
+        t_roundoff: sol.timings.roundoff,
         mem_peak_mib: None,
     };
     Ok(Solved { record, solution: sol, estimate: est, marks })

@@ -214,6 +214,9 @@ pub struct LevelRecord {
     pub t_estimate: f64,
     pub t_refine: f64,
     pub t_level: f64,
+    /// Time of the iterative-refinement step that measures `roundoff_floor` (part of `t_solve`).
+    #[serde(default)]
+    pub t_roundoff: f64,
     /// Peak resident memory of the process during this level, in MiB (Linux: `VmHWM` after
     /// resetting it at the level's start); None where it cannot be measured.
     #[serde(default)]
