@@ -178,10 +178,9 @@ pub fn above_floor<'a>(run: &'a RunRecord, errors: &[Option<f64>]) -> std::borro
 pub fn floor_text(run: &RunRecord, errors: &[Option<f64>]) -> String {
     match floor_hit(run, errors) {
         None => match (run.levels.last(), errors.last().copied().flatten()) {
-            (Some(l), Some(e)) if l.roundoff_floor > 0.0 => format!(
-                "error above {FLOOR_MARGIN}x the round-off floor at every level (last: {e:.1e} vs floor {:.1e})",
-                l.roundoff_floor
-            ),
+            (Some(l), Some(e)) if l.roundoff_floor > 0.0 => {
+                format!("error above {FLOOR_MARGIN}x the round-off floor at every level (last: {e:.1e} vs floor {:.1e})", l.roundoff_floor)
+            }
             _ => "no round-off floor on record".into(),
         },
         Some(h) => format!(
