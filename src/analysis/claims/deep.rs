@@ -36,8 +36,7 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 
 /// The error rate over the last [`DEEP_DECADES`] above the round-off floor.
 fn rate(ctx: &Ctx, r: Option<&RunRecord>) -> Option<RateReport> {
-    let r = ctx.fitted(r?, Q::Error);
-    RateReport::of_values_spanning(&r, &ctx.values(&r, Q::Error), DEEP_DECADES)
+    ctx.rate_spanning(r, Q::Error, DEEP_DECADES)
 }
 
 fn row(ctx: &Ctx, runs: &[RunRecord], problem: &str, id: &'static str, claim: &str) -> Claim {
