@@ -3,11 +3,11 @@
 //! singularity, the error away from the corners, eta_6 and eta_7 at the free boundary, and where
 //! the adaptive mesh refines.
 
+use super::deep::DEEP_DECADES;
 use super::{
     Claim, Ctx, EX72_NU, OPTIMAL, Q, Verdict, estimator_text, fragility, growth_text, halving_exponents, judge, latest_mesh, rate_text, run,
 };
 use crate::records::{RunRecord, StudyDir};
-use super::deep::DEEP_DECADES;
 use crate::verdict::{self, RateReport, RateVerdict, refinement};
 
 /// The claims of Example 7.2.
@@ -18,7 +18,13 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let u72 = run(&ex72, "uniform");
     let wfc = ctx.pick(&ct, "ex72_without_full_contact");
     let aw = run(&ct, "ex72_as_written");
-    let errors = Errors::of(&large).unwrap_or(Errors { study: "ex72", adaptive: a72, uniform: u72, decades: verdict::MIN_DECADES });
+    let errors = Errors::of(&large).unwrap_or(Errors {
+        study: "ex72",
+        adaptive: a72,
+        without_full_contact: None,
+        uniform: u72,
+        decades: verdict::MIN_DECADES,
+    });
     out.push(rates(ctx, a72));
     out.push(error(ctx, &errors, aw, wfc));
     out.push(corners(ctx, a72, &errors));
@@ -34,6 +40,8 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 struct Errors<'a> {
     study: &'static str,
     adaptive: Option<&'a RunRecord>,
+    /// eta_5 without full-contact nodes (only in `ex72_large`)
+    without_full_contact: Option<&'a RunRecord>,
     uniform: Option<&'a RunRecord>,
     decades: f64,
 }
@@ -41,7 +49,13 @@ struct Errors<'a> {
 impl<'a> Errors<'a> {
     fn of(large: &'a [RunRecord]) -> Option<Errors<'a>> {
         let adaptive = run(large, "adaptive").filter(|r| r.levels.iter().any(|l| l.err_quadrature.is_some()))?;
-        Some(Errors { study: "ex72_large", adaptive: Some(adaptive), uniform: run(large, "uniform"), decades: DEEP_DECADES })
+        Some(Errors {
+            study: "ex72_large",
+            adaptive: Some(adaptive),
+            without_full_contact: run(large, "without_full_contact"),
+            uniform: run(large, "uniform"),
+            decades: DEEP_DECADES,
+        })
     }
 
     /// "study ex72_large, reference NDF 4485286, windows of 2 decades"
@@ -91,12 +105,33 @@ fn error(ctx: &Ctx, errors: &Errors, aw: Option<&RunRecord>, wfc: Option<&RunRec
     // the true error against the reference, whose own error is estimated from the measured rate
     let a72 = errors.adaptive;
     let err = ctx.rate_spanning(a72, Q::Error, errors.decades);
-    let reference_error = a72.zip(err.as_ref()).and_then(|(r, e)| {
+    let deep_wfc = errors.without_full_contact.map(|w| {
+        let e = ctx.values(w, Q::Error).last().copied().flatten().unwrap_or(f64::NAN);
+        format!(
+            "{} (to NDF {}, last error {e:.1e})",
+            rate_text(
+                "without full-contact nodes: error rate",
+                ctx.rate_spanning(Some(w), Q::Error, errors.decades).as_ref(),
+                Some(OPTIMAL)
+            ),
+            w.levels.last().map_or(0, |l| l.ndof)
+        )
+    });
+    // The reference marks without full-contact nodes: where a run marked so is on record, its
+    // rate carries the extrapolation (it is the reference's own sequence of meshes, cut short).
+    let (along, along_err, along_name) = match errors.without_full_contact {
+        Some(w) => {
+            (Some(w), ctx.rate_spanning(Some(w), Q::Error, errors.decades), "without full-contact nodes, marked as the reference is")
+        }
+        None => (a72, err.clone(), "eta_5 as written"),
+    };
+    let reference_error = along.zip(along_err.as_ref()).and_then(|(r, e)| {
         let last = r.levels.last()?;
         let e_last = ctx.values(r, Q::Error).last().copied().flatten()?;
         let n_ref = r.reference_ndof? as f64;
         Some((n_ref, e_last * (last.ndof as f64 / n_ref).powf(e.main.rate.slope), e_last))
     });
+    let a_last = a72.and_then(|r| ctx.values(r, Q::Error).last().copied().flatten()).unwrap_or(f64::NAN);
     // same error with and without full-contact nodes although the meshes differ
     let same = aw.zip(wfc).map(|(a, w)| {
         let (ea, ew) = (ctx.values(a, Q::Error), ctx.values(w, Q::Error));
@@ -112,12 +147,13 @@ fn error(ctx: &Ctx, errors: &Errors, aw: Option<&RunRecord>, wfc: Option<&RunRec
         measured: a72
             .map(|_| {
                 format!(
-                    "{}: {}; {}; {}; {}; {}",
+                    "{}: {}; {}{}; {}; {}; {}",
                     errors.source(),
                     rate_text("error rate", err.as_ref(), Some(OPTIMAL)),
+                    deep_wfc.map(|t| format!("{t}; ")).unwrap_or_default(),
                     ctx.floor_text(a72.expect("checked")),
                     reference_error
-                        .map(|(n, e, last)| format!("reference NDF {n:.0}, its own error estimated by extrapolating the fitted rate: {e:.1e} ({:.0}% of the last measured error)", 100.0 * e / last))
+                        .map(|(n, e, last)| format!("reference NDF {n:.0}, its own error estimated by extrapolating the fitted rate of the run {along_name} to the reference's NDF: {e:.1e} ({:.0}% of that run's last measured error, {:.1}% of eta_5 as written's)", 100.0 * e / last, 100.0 * e / a_last))
                         .unwrap_or("no reference".into()),
                     growth_text("efficiency", ctx.growth(a72, Q::Efficiency).as_ref()),
                     same.map(|(rel, ndf, n)| {
