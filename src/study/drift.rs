@@ -619,10 +619,14 @@ pub fn run(
         let m = &m;
         if opts.progress && quick && !opts.quick {
             let (full, replay) = m.drift.deep.as_ref().map(|t| (t.full.join(", "), t.replay.join(", "))).unwrap_or_default();
-            eprintln!(
-                "{}: a deep study: every run rerun in its quick form, {full} to the end, the last level of {replay} replayed from its history (all to the end: drift --deep)",
-                m.study
-            );
+            let mut tiers = vec!["every run rerun in its quick form".to_string()];
+            if !full.is_empty() {
+                tiers.push(format!("{full} to the end"));
+            }
+            if !replay.is_empty() {
+                tiers.push(format!("the last level of {replay} replayed from its history"));
+            }
+            eprintln!("{}: a deep study: {} (all to the end: drift --deep)", m.study, tiers.join(", "));
         }
         let fresh_root = match &opts.against {
             Some(dir) => dir.clone(),
