@@ -13,7 +13,8 @@ build:
 
 # What CI runs: formatting and lints (rustfmt.toml, clippy -D warnings), unit and integration tests (release mode: the convergence tests solve real
 # systems), the drift check (every study rerun and compared with results/ at every level, deep
-# studies in their tiers: quick prefixes plus their `full` runs to the end; plus levels.csv,
+# studies in their tiers: quick prefixes, their `full` runs to the end, the last level of their
+# `replay` runs rebuilt from the stored refinement history and solved again; plus levels.csv,
 # provenance and CLAIMS.md against the records), and the NGSolve cross-check.
 # Test-time outputs (drift report, cross-check tables with timings) go under target/; the last
 # step fails if the run changed any file git sees.

@@ -9,7 +9,7 @@
 //!   plot/             figures and study pages, from records only
 //!   analysis/         rates, verdict rules, the claims of Section 7, Hertz
 //!   study/            manifests, runner, store, references, provenance, drift
-//!   adapt.rs          SOLVE -> ESTIMATE -> MARK -> REFINE
+//!   adapt/            SOLVE -> ESTIMATE -> MARK -> REFINE, replaying a stored history
 //!   records/          level, run and solve records; atomic writes
 //!   estimator/        eta_1 .. eta_7 and their variants
 //!   contact/          active-set method, the SOLVE step, KKT certificate, error norms

@@ -560,7 +560,10 @@ fn drift_outcome(report: &study::drift::DriftReport, against: Option<&std::path:
             let tiers = if tiered.is_empty() {
                 String::new()
             } else {
-                format!("; {} in its tiers: quick prefixes, its `full` runs at every level (all: drift --deep)", tiered.join(", "))
+                format!(
+                    "; {} in its tiers: quick prefixes, its `full` runs at every level, the last level of its `replay` runs (all: drift --deep)",
+                    tiered.join(", ")
+                )
             };
             println!("drift: none ({studies} checked at every level{}{tiers})", if report.quick { " of the quick forms" } else { "" });
             Ok(())

@@ -1,7 +1,10 @@
 //! The drift tiers of a deep study (`[drift.deep]`): `signorini drift` (what `make test` runs)
 //! reruns every run to its quick prefix and the runs named in `full` to the end; `drift --deep`
 //! (the scheduled job) reruns all of them to the end. A change past the prefix of a deep run is
-//! caught by the scheduled tier, a change anywhere in a `full` run by every test run.
+//! caught by the scheduled tier, a change anywhere in a `full` run by every test run. The last
+//! level of a run named in `replay` is rebuilt from its stored refinement history and solved
+//! once more by every test run: a change of that level's numbers, or of the history itself, is
+//! caught without rerunning the levels before it.
 
 use signorini::records::StudyDir;
 use signorini::study::drift::{self, DriftOptions};
@@ -22,8 +25,14 @@ quick_levels = 3
 id = "b"
 levels = 6
 quick_levels = 2
+[[run]]
+id = "c"
+problem = "fb"
+levels = 6
+quick_levels = 2
 [drift.deep]
 full = ["b"]
+replay = ["c"]
 "#;
 
 fn setup(name: &str) -> (PathBuf, Manifest) {
@@ -46,17 +55,24 @@ fn setup(name: &str) -> (PathBuf, Manifest) {
     (root, m)
 }
 
-/// Move the estimate of the last level of run `id` by a relative 1e-5, in its record and in the
-/// summaries (so that only a rerun can see it).
-fn perturb_last_level(root: &Path, m: &Manifest, id: &str) {
+/// Change run `id`'s stored record with `edit` and rewrite the summaries to match.
+fn edit_run(root: &Path, m: &Manifest, id: &str, edit: impl FnOnce(&mut signorini::records::RunRecord)) {
     let dir = StudyDir::new(&root.join("results"), &m.study);
     let mut runs = dir.read_runs().unwrap();
     let r = runs.iter_mut().find(|r| r.run.id == id).unwrap();
-    let last = r.levels.last_mut().unwrap();
-    last.terms.estimate *= 1.0 + 1e-5;
-    last.efficiency = last.err_quadrature.map(|e| last.terms.estimate / e);
+    edit(r);
     signorini::records::write_json(&dir.run_file(id), r).unwrap();
     store::sync_summaries(m, &dir, &runs, false).unwrap();
+}
+
+/// Move the estimate of the last level of run `id` by a relative 1e-5, in its record and in the
+/// summaries (so that only a rerun can see it).
+fn perturb_last_level(root: &Path, m: &Manifest, id: &str) {
+    edit_run(root, m, id, |r| {
+        let last = r.levels.last_mut().unwrap();
+        last.terms.estimate *= 1.0 + 1e-5;
+        last.efficiency = last.err_quadrature.map(|e| last.terms.estimate / e);
+    });
 }
 
 fn drift_rows(root: &Path, m: &Manifest, deep: bool) -> Vec<(String, Option<usize>, String)> {
@@ -99,7 +115,54 @@ fn a_change_at_the_last_level_of_a_full_run_is_caught_by_every_test_run() {
 
 #[test]
 fn a_full_run_the_study_does_not_declare_is_refused() {
-    let text = DEEP.replace(r#"full = ["b"]"#, r#"full = ["c"]"#);
+    let text = DEEP.replace(r#"full = ["b"]"#, r#"full = ["z"]"#);
     let err = Manifest::parse(Path::new("deepish.toml"), &text).unwrap_err().to_string();
     assert!(err.contains("drift.deep.full[0]") && err.contains("the id of a declared run"), "{err}");
+}
+
+#[test]
+fn a_change_at_the_last_level_of_a_replayed_run_is_caught_by_both_tiers() {
+    let (root, m) = setup("replayed");
+    perturb_last_level(&root, &m, "c");
+    // the test tier reruns c to level 1 only, and replays level 5 from the stored history
+    let rows = drift_rows(&root, &m, false);
+    assert_eq!(rows, vec![("c (replayed)".to_string(), Some(5), "estimate".to_string())]);
+    let rows = drift_rows(&root, &m, true);
+    assert!(rows.contains(&("c".to_string(), Some(5), "estimate".to_string())), "{rows:?}");
+}
+
+#[test]
+fn a_change_of_the_stored_history_is_caught_by_every_test_run() {
+    let (root, m) = setup("history");
+    // level 2 (past c's quick prefix) marked everywhere: level 3's mesh is no longer the one stored
+    edit_run(&root, &m, "c", |r| {
+        let h = &mut r.history.as_mut().unwrap().levels[2];
+        h.marks = signorini::records::Flags::encode(&vec![true; h.n_elements]);
+    });
+    let opts = DriftOptions {
+        quick: false,
+        deep: false,
+        against: None,
+        scratch: root.join("scratch"),
+        results: root.join("results"),
+        progress: false,
+    };
+    let report = drift::run(std::slice::from_ref(&m), false, &opts, &|_| Ok(String::new())).unwrap();
+    let rows: Vec<_> = report.rows.iter().map(|r| (r.run.clone(), r.level, r.field.clone())).collect();
+    assert_eq!(rows, vec![("c (replayed)".to_string(), Some(5), "history".to_string())]);
+    assert!(report.rows[0].fresh.contains("level 3: the replayed mesh"), "{:?}", report.rows[0]);
+    // and a change inside the prefix is caught by the rerun itself
+    edit_run(&root, &m, "c", |r| {
+        let h = &mut r.history.as_mut().unwrap().levels[0];
+        h.marks = signorini::records::Flags::encode(&vec![false; h.n_elements]);
+    });
+    let rows = drift_rows(&root, &m, false);
+    assert!(rows.contains(&("c".to_string(), Some(0), "history.marks".to_string())), "{rows:?}");
+}
+
+#[test]
+fn a_replayed_run_the_study_does_not_declare_is_refused() {
+    let text = DEEP.replace(r#"replay = ["c"]"#, r#"replay = ["d"]"#);
+    let err = Manifest::parse(Path::new("deepish.toml"), &text).unwrap_err().to_string();
+    assert!(err.contains("drift.deep.replay[0]") && err.contains("the id of a declared run"), "{err}");
 }

@@ -20,7 +20,7 @@ const FLOORS: &[(&str, &[&str])] = &[
     ("contact", &["contact/"]),
     ("estimator", &["estimator/"]),
     ("records", &["records/"]),
-    ("adapt", &["adapt.rs"]),
+    ("adapt", &["adapt/"]),
     ("study", &["study/"]),
     ("analysis", &["analysis/"]),
     ("plot", &["plot/"]),

@@ -31,7 +31,7 @@ fn fixture() -> String {
 fn numbers(r: &RunRecord) -> serde_json::Value {
     let mut v = serde_json::to_value(r).unwrap();
     for l in v["levels"].as_array_mut().unwrap() {
-        l.as_object_mut().unwrap().retain(|k, _| !k.starts_with("t_"));
+        l.as_object_mut().unwrap().retain(|k, _| !signorini::records::is_measurement(k));
     }
     v
 }

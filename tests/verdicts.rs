@@ -181,7 +181,7 @@ fn record(id: &str, refine: Refine, levels: Vec<LevelRecord>) -> RunRecord {
         save_levels: vec![],
         constants: Default::default(),
     };
-    RunRecord { study: "fb".into(), run, levels, reference_ndof: None }
+    RunRecord { study: "fb".into(), run, levels, reference_ndof: None, history: None }
 }
 
 /// Levels with error C NDF^-rate, estimate 100x the error, l_h = 1, and a contact zone that
@@ -289,4 +289,36 @@ fn fb_rows_on_synthetic_records() {
     let c = claims::claims(&d).unwrap();
     assert_eq!(row(&c, "fb-reliability").verdict, Verdict::Fails);
     let _ = std::fs::remove_dir_all(&d);
+}
+
+/// An error that decays like NDF^-1.5 until it meets a round-off floor growing like NDF: the fit
+/// ends before the first level within 10x the floor, recovers the rate, and says where the floor
+/// was hit; the same fit through the floor levels would not.
+#[test]
+fn rate_fits_end_where_the_error_meets_the_round_off_floor() {
+    let mut levels = synthetic_levels(1.5, 0.0, 40);
+    for l in &mut levels {
+        l.roundoff_floor = 1e-17 * l.ndof as f64;
+        l.err_quadrature = l.err_quadrature.map(|e| e + l.roundoff_floor);
+    }
+    let r = record("deep", Refine::Adaptive, levels);
+    let err = verdict::field(&r, "err_quadrature");
+    let hit = verdict::floor_hit(&r, &err).expect("the error meets the floor");
+    let first_below = r.levels.iter().position(|l| l.err_quadrature.unwrap() < 10.0 * l.roundoff_floor).unwrap();
+    assert_eq!(hit, first_below);
+    assert!(hit > 20 && hit < 40, "{hit}");
+    let cut = verdict::above_floor(&r, &err);
+    assert_eq!(cut.levels.len(), hit);
+    let fit = RateReport::of_values(&cut, &verdict::field(&cut, "err_quadrature")).unwrap();
+    assert_eq!(fit.main.last_level, hit - 1);
+    assert!((fit.main.rate.slope - 1.5).abs() < 0.05, "{}", fit.text());
+    let through = RateReport::of_values(&r, &err).unwrap();
+    assert!(through.main.rate.slope < 1.0, "through the floor: {}", through.text());
+    let text = verdict::floor_text(&r, &err);
+    assert!(text.contains(&format!("from level {hit}")) && text.contains(&format!("fits end at level {}", hit - 1)), "{text}");
+    // a run with no floor on record is never cut
+    let plain = record("plain", Refine::Adaptive, synthetic_levels(1.5, 0.0, 10));
+    let e = verdict::field(&plain, "err_quadrature");
+    assert_eq!(verdict::floor_hit(&plain, &e), None);
+    assert_eq!(verdict::floor_text(&plain, &e), "no round-off floor on record");
 }

@@ -133,15 +133,37 @@ impl Ctx<'_> {
 
     /// The rate of `q` against the variable the theory speaks of for `r`'s refinement
     /// ([`verdict::abscissa_of`]: h_min for uniform, NDF for adaptive).
+    /// Quantities of the error end at the round-off floor ([`verdict::above_floor`]).
     fn rate(&self, r: Option<&RunRecord>, q: Q) -> Option<RateReport> {
-        let r = r?;
-        RateReport::of_values(r, &self.values(r, q))
+        self.rate_spanning(r, q, verdict::MIN_DECADES)
+    }
+
+    /// [`Ctx::rate`] over windows of `decades` of NDF (the deep runs' two decades).
+    fn rate_spanning(&self, r: Option<&RunRecord>, q: Q, decades: f64) -> Option<RateReport> {
+        let r = self.fitted(r?, q);
+        RateReport::of_values_spanning(&r, &self.values(&r, q), decades)
     }
 
     fn growth(&self, r: Option<&RunRecord>, q: Q) -> Option<verdict::RateFit> {
-        let r = r?;
+        let r = self.fitted(r?, q);
         let ndof: Vec<usize> = r.levels.iter().map(|l| l.ndof).collect();
-        verdict::growth(&ndof, &self.values(r, q))
+        verdict::growth(&ndof, &self.values(&r, q))
+    }
+
+    /// The levels of `r` a fit of `q` uses: for an error (any `err_*` field) and the efficiency
+    /// (estimate / error), those before the error reaches [`verdict::FLOOR_MARGIN`] x the
+    /// round-off floor.
+    fn fitted<'a>(&self, r: &'a RunRecord, q: Q) -> std::borrow::Cow<'a, RunRecord> {
+        match q {
+            Q::Field(f) if f.starts_with("err_") => verdict::above_floor(r, &self.values(r, q)),
+            Q::Field(_) => std::borrow::Cow::Borrowed(r),
+            Q::Error | Q::Efficiency | Q::EfficiencyOverLh => verdict::above_floor(r, &self.values(r, Q::Error)),
+        }
+    }
+
+    /// Where `r`'s error meets the round-off floor ([`verdict::floor_text`]).
+    fn floor_text(&self, r: &RunRecord) -> String {
+        verdict::floor_text(r, &self.values(r, Q::Error))
     }
 }
 

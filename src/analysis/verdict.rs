@@ -11,6 +11,10 @@
 //! n points). Stability: the same fit over the decades ending at the last level, two levels
 //! earlier and four levels earlier ([`RateReport::windows`]).
 //!
+//! **Round-off floor.** Deep runs reach errors near 1e-10 where the computed u_h carries round-off
+//! of its own (`LevelRecord::roundoff_floor`). Error fits stop before the first level whose error
+//! is below [`FLOOR_MARGIN`] x that floor ([`floor_hit`], [`above_floor`]), and the rows say where.
+//!
 //! **Abscissa.** Exponents are fitted against the variable the theory speaks of: NDF for
 //! adaptive refinement, the smallest element diameter h_min for uniform refinement ([`Abscissa`];
 //! on coarse uniform meshes NDF = 2(2N + 1)^2 is not proportional to h^-2, which biases an NDF
@@ -47,6 +51,9 @@ pub const MIN_POINTS: usize = 5;
 pub const ROUND_OFF: f64 = 1e-12;
 /// Levels between the ends of the three stability windows.
 pub const WINDOW_SHIFT: usize = 2;
+/// An error counts in a rate fit only while it is at least this many times the level's
+/// round-off floor (`LevelRecord::roundoff_floor`): below, it measures round-off ([`floor_hit`]).
+pub const FLOOR_MARGIN: f64 = 10.0;
 
 pub use crate::base::stats::{LineFit, fit_line, incomplete_beta, t_quantile_975, t_two_sided_tail};
 
@@ -145,6 +152,45 @@ pub fn rate_spanning(ndof: &[usize], x: &[f64], abscissa: Abscissa, values: &[Op
     let rate = fit_line(&pts)?;
     let (first, last) = (*levels.last()?, levels[0]);
     Some(RateFit { rate, abscissa, first_level: first, last_level: last, first_ndof: ndof[first], last_ndof: ndof[last] })
+}
+
+/// The first level of `run` whose error (`errors`, one per level) is below [`FLOOR_MARGIN`] x the
+/// level's round-off floor: from there on the error measures the round-off of u_h, not the
+/// discretisation. None where every error is above (or the run has no floor on record).
+pub fn floor_hit(run: &RunRecord, errors: &[Option<f64>]) -> Option<usize> {
+    run.levels.iter().zip(errors).position(|(l, e)| e.is_some_and(|e| e < FLOOR_MARGIN * l.roundoff_floor))
+}
+
+/// `run` without its levels from [`floor_hit`] on (the run itself where the floor is not hit).
+pub fn above_floor<'a>(run: &'a RunRecord, errors: &[Option<f64>]) -> std::borrow::Cow<'a, RunRecord> {
+    match floor_hit(run, errors) {
+        None => std::borrow::Cow::Borrowed(run),
+        Some(l) => {
+            let mut cut = run.clone();
+            cut.levels.truncate(l);
+            std::borrow::Cow::Owned(cut)
+        }
+    }
+}
+
+/// "error above 10x the round-off floor at every level (last: 7.6e-9 vs floor 4.4e-12)" or
+/// "error within 10x the round-off floor from level 41 (NDF 5.2e6: 3.1e-11 vs floor 4.0e-12); fits end at level 40".
+pub fn floor_text(run: &RunRecord, errors: &[Option<f64>]) -> String {
+    match floor_hit(run, errors) {
+        None => match (run.levels.last(), errors.last().copied().flatten()) {
+            (Some(l), Some(e)) if l.roundoff_floor > 0.0 => {
+                format!("error above {FLOOR_MARGIN}x the round-off floor at every level (last: {e:.1e} vs floor {:.1e})", l.roundoff_floor)
+            }
+            _ => "no round-off floor on record".into(),
+        },
+        Some(h) => format!(
+            "error within {FLOOR_MARGIN}x the round-off floor from level {h} (NDF {:.1e}: {:.1e} vs floor {:.1e}); fits end {}",
+            run.levels[h].ndof as f64,
+            errors[h].unwrap_or(f64::NAN),
+            run.levels[h].roundoff_floor,
+            if h == 0 { "before level 0".to_string() } else { format!("at level {}", h - 1) }
+        ),
+    }
 }
 
 /// The value of a `LevelRecord` field at every level of a run (None where absent or not a number).

@@ -93,3 +93,18 @@ pub fn human_bytes(b: f64) -> String {
     }
     if u == 0 { format!("{v:.0} B") } else { format!("{v:.1} {}", units[u]) }
 }
+
+/// Reset this process's peak resident set (Linux: writing 5 to `/proc/self/clear_refs` sets
+/// `VmHWM` to the current resident set), so that [`peak_resident`] measures from here; false
+/// where that is not possible (then [`peak_resident`] is the peak since the process started).
+pub fn reset_peak_resident() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+/// This process's peak resident set in bytes (`VmHWM` in `/proc/self/status`), or None where it
+/// cannot be read.
+pub fn peak_resident() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    Some(line.split_whitespace().nth(1)?.parse::<f64>().ok()? * 1024.0)
+}

@@ -415,6 +415,36 @@ impl ContactSolver {
         Ok(PdasOutput { u, lambda, active, iterations, termination, c })
     }
 
+    /// One step of iterative refinement of a converged contact solution, in working precision:
+    /// the correction du with du = 0 at the active contact normals and (K du)_i = r_i at every
+    /// other unknown, for the residual r = F - K u (its entries at active normals, the contact
+    /// forces, are ignored). Solved with the factorisation the solution was computed with:
+    /// Refactor's last one imposes the active set already; Schur's (of K) gets the active set
+    /// through one more Schur step with gap 0. Its size measures the round-off the computed u
+    /// carries (the floor below which no error can be measured).
+    pub fn correction(&mut self, residual: &[f64], active: &[bool]) -> Result<Vec<f64>, ContactError> {
+        let (ni, m) = (self.n_interior, self.n_contact());
+        let mut r = residual.to_vec();
+        for k in (0..m).filter(|&k| active[k]) {
+            r[ni + k] = 0.0;
+        }
+        let mut du = match self.strategy {
+            Strategy::Refactor => self.solve(&r),
+            Strategy::Schur => {
+                let y = self.solve(&r);
+                let (_, dlambda) = schur_step(&self.schur, &y[ni..], &vec![0.0; m], active)?;
+                for k in 0..m {
+                    r[ni + k] -= dlambda[k];
+                }
+                self.solve(&r)
+            }
+        };
+        for k in (0..m).filter(|&k| active[k]) {
+            du[ni + k] = 0.0;
+        }
+        Ok(du)
+    }
+
     fn solve_schur(
         &mut self,
         rhs: &[f64],
@@ -428,24 +458,7 @@ impl ContactSolver {
         let s = &self.schur;
         let c = options.c_scale * (0..m).map(|i| s[(i, i)]).sum::<f64>() / m as f64;
         let initial = options.initial_active.clone().filter(|a| a.len() == m).unwrap_or_else(|| (0..m).map(|i| yc[i] > gap[i]).collect());
-        let mut step = |active: &[bool]| -> Result<(Vec<f64>, Vec<f64>), ContactError> {
-            let inact: Vec<usize> = (0..m).filter(|&i| !active[i]).collect();
-            let act: Vec<usize> = (0..m).filter(|&i| active[i]).collect();
-            let mut u: Vec<f64> = (0..m).map(|i| if active[i] { gap[i] } else { 0.0 }).collect();
-            if !inact.is_empty() {
-                // lambda_I = 0:  S_II z = S_IA (y_A - g_A),  u_I = y_I + z
-                let sii = Mat::<f64>::from_fn(inact.len(), inact.len(), |a, b| s[(inact[a], inact[b])]);
-                let r = Mat::<f64>::from_fn(inact.len(), 1, |a, _| act.iter().map(|&j| s[(inact[a], j)] * (yc[j] - gap[j])).sum::<f64>());
-                let llt = sii.llt(Side::Lower).map_err(|e| ContactError::NotPositiveDefinite(format!("Schur block: {e:?}")))?;
-                let z = llt.solve(&r);
-                for (a, &i) in inact.iter().enumerate() {
-                    u[i] = yc[i] + z[(a, 0)];
-                }
-            }
-            // lambda = S (y - u); zero off the active set by construction
-            let lambda = (0..m).map(|i| if active[i] { (0..m).map(|j| s[(i, j)] * (yc[j] - u[j])).sum() } else { 0.0 }).collect();
-            Ok((u, lambda))
-        };
+        let mut step = |active: &[bool]| schur_step(s, yc, gap, active);
         let outcome = pdas(gap, c, initial, options, observe, &mut step)?;
         // u = K^{-1} (F - E lambda)
         let mut b = rhs.to_vec();
@@ -510,6 +523,28 @@ impl ContactSolver {
         }
         Ok((last_u, outcome, c))
     }
+}
+
+/// One active-set step on the Schur complement `s`: u_C and lambda for the active set `active`,
+/// with y_C = (K^{-1} F)_C = `yc` and the gap `gap` (u = g on A, lambda = 0 off A):
+/// S_II z = S_IA (y_A - g_A), u_I = y_I + z, lambda = S (y - u).
+fn schur_step(s: &Mat<f64>, yc: &[f64], gap: &[f64], active: &[bool]) -> Result<Pair, ContactError> {
+    let m = gap.len();
+    let inact: Vec<usize> = (0..m).filter(|&i| !active[i]).collect();
+    let act: Vec<usize> = (0..m).filter(|&i| active[i]).collect();
+    let mut u: Vec<f64> = (0..m).map(|i| if active[i] { gap[i] } else { 0.0 }).collect();
+    if !inact.is_empty() {
+        let sii = Mat::<f64>::from_fn(inact.len(), inact.len(), |a, b| s[(inact[a], inact[b])]);
+        let r = Mat::<f64>::from_fn(inact.len(), 1, |a, _| act.iter().map(|&j| s[(inact[a], j)] * (yc[j] - gap[j])).sum::<f64>());
+        let llt = sii.llt(Side::Lower).map_err(|e| ContactError::NotPositiveDefinite(format!("Schur block: {e:?}")))?;
+        let z = llt.solve(&r);
+        for (a, &i) in inact.iter().enumerate() {
+            u[i] = yc[i] + z[(a, 0)];
+        }
+    }
+    // lambda = S (y - u); zero off the active set by construction
+    let lambda = (0..m).map(|i| if active[i] { (0..m).map(|j| s[(i, j)] * (yc[j] - u[j])).sum() } else { 0.0 }).collect();
+    Ok((u, lambda))
 }
 
 /// All unknowns, the active-set outcome and the complementarity constant c.

@@ -143,6 +143,27 @@ impl fmt::Display for MeshSpec {
 }
 
 impl Mesh {
+    /// The first 16 hex digits of the SHA-256 of the mesh: vertex coordinates (their bits),
+    /// triangles (vertex order included) and boundary edges with their parts. Two meshes with
+    /// the same fingerprint are the same mesh, numbered the same way: what a replayed refinement
+    /// history checks at every level.
+    pub fn fingerprint(&self) -> String {
+        use sha2::Digest;
+        let mut h = sha2::Sha256::new();
+        for v in &self.vertices {
+            h.update(v[0].to_bits().to_le_bytes());
+            h.update(v[1].to_bits().to_le_bytes());
+        }
+        for t in &self.triangles {
+            t.iter().for_each(|i| h.update((*i as u64).to_le_bytes()));
+        }
+        for e in &self.boundary {
+            e.v.iter().for_each(|i| h.update((*i as u64).to_le_bytes()));
+            h.update(e.part.code().to_le_bytes());
+        }
+        h.finalize().iter().take(8).map(|b| format!("{b:02x}")).collect()
+    }
+
     /// The unit square cut into n x n squares. Each square is split by its lower-left to
     /// upper-right diagonal; with `mirror`, squares in the upper half use the other diagonal so
     /// the mesh is symmetric about y = 0.5. Triangles are listed with the diagonal as the edge

@@ -3,9 +3,11 @@
 //! | figure | study / runs | shows |
 //! |---|---|---|
 //! | `deep_error` | `deep`, all runs | one panel per problem (7.1, fb): `err_quadrature` vs NDF for eta_5 as written, without full-contact nodes, repaired (adaptive) and uniform refinement, a style per run, log-log, NDF^-3/2 below all; the rows `7.1-deep`, `fb-deep` of CLAIMS fit the last two decades |
+//! | `deep_floor` | `deep`, `*_as_written` and `*_uniform` | one panel per problem: the error, the estimate C_0 eta_h and the round-off floor of u_h (`roundoff_floor`, dotted: 10x it, below which CLAIMS fits no error) against NDF |
 
 use super::render::{LineFigure, MARKERS, Panel};
-use super::{Built, ERR, Figure, NDF_DESC, PALETTE, Style, runs, series, slope};
+use super::{Built, ERR, ESTIMATE, Figure, NDF_DESC, PALETTE, Style, runs, series, slope};
+use crate::verdict::FLOOR_MARGIN;
 use std::path::Path;
 
 const STUDY: &str = "deep";
@@ -32,4 +34,42 @@ pub(super) fn deep_error(results: &Path) -> anyhow::Result<Built> {
         return Ok(Err(format!("study {STUDY} has no levels")));
     }
     Ok(Ok(Figure::Lines(LineFigure { title: Some("Deep runs: the error over two decades and more".to_string()), panels })))
+}
+
+/// Error, estimate and round-off floor together: where the error of a deep run would meet
+/// [`FLOOR_MARGIN`] x the floor, its fits end.
+pub(super) fn deep_floor(results: &Path) -> anyhow::Result<Built> {
+    let runs = match runs(results, STUDY)? {
+        Ok(r) => r,
+        Err(why) => return Ok(Err(why)),
+    };
+    let mut panels = Vec::new();
+    for (problem, title) in [("ex71", "Example 7.1"), ("fb", "free boundary (fb)")] {
+        let mut p =
+            Panel::new(format!("{title}: error, estimate and round-off floor"), NDF_DESC, "sup-norm of the displacement".to_string());
+        for (k, variant) in ["as_written", "uniform"].into_iter().enumerate() {
+            let Some(r) = runs.iter().find(|r| r.run.id == format!("{problem}_{variant}")) else { continue };
+            let label = variant.replace('_', " ");
+            let style = |i: usize, dashed: bool, filled: bool| Style {
+                color: PALETTE[(3 * k + i) % PALETTE.len()],
+                marker: MARKERS[(3 * k + i) % MARKERS.len()],
+                dashed,
+                filled,
+            };
+            p.series.push(series(r, format!("{label}: error {ERR}"), style(0, false, true), |l| l.err_quadrature));
+            if variant != "uniform" {
+                p.series.push(series(r, format!("{label}: {ESTIMATE}"), style(1, false, false), |l| Some(l.terms.estimate)));
+            }
+            p.series.push(series(r, format!("{label}: {FLOOR_MARGIN} × round-off floor"), style(2, true, false), |l| {
+                Some(FLOOR_MARGIN * l.roundoff_floor).filter(|f| *f > 0.0)
+            }));
+        }
+        if p.has_data() {
+            panels.push(p);
+        }
+    }
+    if panels.is_empty() {
+        return Ok(Err(format!("study {STUDY} has no levels")));
+    }
+    Ok(Ok(Figure::Lines(LineFigure { title: Some("Deep runs: error, estimate and the round-off floor of u_h".to_string()), panels })))
 }

@@ -72,7 +72,7 @@ use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// Every figure, in the order drawn.
-pub const FIGURES: [&str; 17] = [
+pub const FIGURES: [&str; 18] = [
     "fig2a",
     "fig2b",
     "fig3a",
@@ -90,6 +90,7 @@ pub const FIGURES: [&str; 17] = [
     "hertz_mesh",
     "estimator_repair",
     "deep_error",
+    "deep_floor",
 ];
 
 /// The study a figure is drawn from (the table above).
@@ -104,7 +105,7 @@ pub fn study_of(figure: &str) -> Option<&'static str> {
         "fb_error" | "fb_mesh" => "fb",
         "hertz_pressure" | "hertz_mesh" => "hertz",
         "estimator_repair" => "estimator_repair",
-        "deep_error" => "deep",
+        "deep_error" | "deep_floor" => "deep",
         _ => return None,
     })
 }
@@ -250,6 +251,7 @@ fn build(name: &str, results: &Path) -> anyhow::Result<Built> {
         "hertz_pressure" => hertz::hertz_pressure(results),
         "hertz_mesh" => hertz::hertz_mesh(results),
         "deep_error" => deep::deep_error(results),
+        "deep_floor" => deep::deep_floor(results),
         other => anyhow::bail!("unknown figure {other}"),
     }
 }

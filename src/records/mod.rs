@@ -10,10 +10,12 @@
 //! `null` and then refuse to read) is an error naming the field ([`first_non_finite`]).
 
 mod finite;
+pub mod history;
 pub mod report;
 
 pub use crate::contact::solve::ContactSample;
 pub use finite::{NonFinite, first_non_finite};
+pub use history::{BadFlags, Flags, History, LevelHistory};
 
 use std::io::Write;
 use std::path::Path;
@@ -151,8 +153,8 @@ pub enum Refine {
 }
 
 /// Everything a study stores about one level: the one record type behind JSON, CSV, drift and
-/// plots. Flat, so that it is also one CSV row. Fields starting with `t_` are timings (seconds),
-/// never compared by the drift check.
+/// plots. Flat, so that it is also one CSV row. Fields starting with `t_` (timings, seconds) and
+/// `mem_` (memory) are measurements ([`is_measurement`]), never compared by the drift check.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct LevelRecord {
     pub level: usize,
@@ -187,6 +189,11 @@ pub struct LevelRecord {
     /// corners of the clamped side x = 0), where u is known.
     #[serde(default)]
     pub err_right_half: Option<f64>,
+    /// The round-off u_h carries (`DiscreteSolution::roundoff`: the largest nodal component of one
+    /// step of iterative refinement in working precision). An error within a few times it is
+    /// round-off, not discretisation: rate fits use only levels whose error is at least 10x above.
+    #[serde(default)]
+    pub roundoff_floor: f64,
     /// Length of the longest contact edge whose three nodes are neither all active nor all
     /// inactive: the edge straddling a free-boundary point, where eta_6 and eta_7 live. None
     /// without such an edge.
@@ -207,18 +214,26 @@ pub struct LevelRecord {
     pub t_estimate: f64,
     pub t_refine: f64,
     pub t_level: f64,
+    /// Time of the iterative-refinement step that measures `roundoff_floor` (part of `t_solve`).
+    #[serde(default)]
+    pub t_roundoff: f64,
+    /// Peak resident memory of the process during this level, in MiB (Linux: `VmHWM` after
+    /// resetting it at the level's start); None where it cannot be measured.
+    #[serde(default)]
+    pub mem_peak_mib: Option<f64>,
+}
+
+/// Whether a level record's field is a measurement of the machine (timings `t_*`, memory
+/// `mem_*`), which no two runs share and the drift check never compares.
+pub fn is_measurement(field: &str) -> bool {
+    field.starts_with("t_") || field.starts_with("mem_")
 }
 
 /// The float fields of a level record (the ones the drift check compares within tolerances;
-/// integers are compared exactly, timings `t_*` never), in record order.
+/// integers are compared exactly, measurements `t_*`, `mem_*` never), in record order.
 pub fn float_fields() -> Vec<String> {
     let v = serde_json::to_value(LevelRecord::default()).expect("records serialise");
-    v.as_object()
-        .into_iter()
-        .flatten()
-        .filter(|(k, v)| !k.starts_with("t_") && (v.is_f64() || v.is_null()))
-        .map(|(k, _)| k.clone())
-        .collect()
+    v.as_object().into_iter().flatten().filter(|(k, v)| !is_measurement(k) && (v.is_f64() || v.is_null())).map(|(k, _)| k.clone()).collect()
 }
 
 /// One run of a study: a problem, an initial mesh and every choice that affects the numbers.
@@ -264,6 +279,10 @@ pub struct RunRecord {
     pub levels: Vec<LevelRecord>,
     /// NDF of the reference solution, when errors are against one.
     pub reference_ndof: Option<usize>,
+    /// The refinement history (marks and warm starts per level), from which any level can be
+    /// rebuilt and solved again (`adapt::replay`, the drift check's replay tier).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub history: Option<History>,
 }
 
 /// A mesh snapshot for the mesh figure: vertices, triangles, and the contact nodes (active or not,
@@ -426,6 +445,7 @@ mod tests {
             },
             levels: vec![level.clone(), LevelRecord { level: 1, ..level }],
             reference_ndof: None,
+            history: None,
         };
         study.write_csv(&[run]).unwrap();
         let text = std::fs::read_to_string(study.csv_file()).unwrap();

@@ -14,9 +14,12 @@
 //! level where the contact zone happens to be resolved): their round-off is relative to the size
 //! the field has elsewhere in the run, not to its own value. Both are measured, not chosen
 //! (`results/roundoff/`). Observed rates (least-squares slope of -log(field) in log(NDF) over a
-//! run's last levels) are checked against one-sided floors; timings (fields `t_*`) never.
-//! A level, field, run or study missing on either side is drift. In the quick form the fresh
-//! runs are prefixes of the stored full runs and are compared level by level.
+//! run's last levels) are checked against one-sided floors; measurements (timings `t_*`, memory
+//! `mem_*`) never. A level, field, run or study missing on either side is drift. In the quick
+//! form the fresh runs are prefixes of the stored full runs and are compared level by level.
+//! The refinement histories (marks and warm starts per level, mesh fingerprints) must agree
+//! exactly as far as the fresh run went; a deep study in its tiers also replays the last level of
+//! its `replay` runs from the stored history and compares that level ([`replay_tier`]).
 //!
 //! Besides the numbers, the files derived from the records are checked: `levels.csv` and
 //! `provenance.json`'s run list must be exactly what the stored records give
@@ -159,8 +162,8 @@ fn compare_level(
     keys.sort();
     keys.dedup();
     for key in keys {
-        if key.starts_with("t_") {
-            continue; // timings are never compared
+        if crate::records::is_measurement(key) {
+            continue; // timings and memory are never compared
         }
         let (sv, fv) = (s.get(key), f.get(key));
         let drift = |rel: Option<f64>, tol: String| row(study, run, Some(level), key, show(sv), show(fv), rel, tol);
@@ -267,6 +270,7 @@ pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], q
         }
         check_derived_fields(study, id, "stored", &s.levels, &mut out);
         check_derived_fields(study, id, "fresh", &f.levels, &mut out);
+        compare_histories(study, s, f, &mut out);
         let stored_levels: Vec<Value> = s.levels.iter().map(|l| serde_json::to_value(l).expect("records serialise")).collect();
         let scales = field_scales(&stored_levels);
         for l in 0..n_compare {
@@ -313,6 +317,81 @@ pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], q
         }
     }
     Comparison { rows: out, changes }
+}
+
+/// The refinement histories of a stored and a fresh run, exactly, as far as the fresh run went
+/// (a quick form is a prefix): one row at the first level whose mesh, marks or warm start differ.
+fn compare_histories(study: &str, stored: &RunRecord, fresh: &RunRecord, out: &mut Vec<DriftRow>) {
+    let id = &stored.run.id;
+    let (s, f) = match (&stored.history, &fresh.history) {
+        (Some(s), Some(f)) => (s, f),
+        (None, None) => return,
+        (s, f) => {
+            let text = |h: Option<&crate::records::History>| h.map_or("(missing)".to_string(), |h| format!("{} levels", h.levels.len()));
+            out.push(row(study, id, None, "history", text(s.as_ref()), text(f.as_ref()), None, "exact".into()));
+            return;
+        }
+    };
+    for (a, b) in s.levels.iter().zip(&f.levels) {
+        let what = if a.mesh != b.mesh || a.n_elements != b.n_elements {
+            Some(("history.mesh", format!("{} elements, {}", a.n_elements, a.mesh), format!("{} elements, {}", b.n_elements, b.mesh)))
+        } else if a.marks != b.marks {
+            Some(("history.marks", "stored marks".into(), "other marks".into()))
+        } else if a.initial_active != b.initial_active {
+            Some(("history.initial_active", "stored warm start".into(), "another warm start".into()))
+        } else {
+            None
+        };
+        if let Some((field, sv, fv)) = what {
+            out.push(row(study, id, Some(a.level), field, sv, fv, None, "exact".into()));
+            return;
+        }
+    }
+}
+
+/// The replay tier of a deep study in its tiers: the last level of every run in
+/// `[drift.deep] replay`, rebuilt from its stored history and solved once more
+/// ([`super::replay_stored_level`]), against its stored record (rows under run `ID (replayed)`).
+/// A history that does not rebuild its meshes is a row of field `history`.
+fn replay_tier(manifest: &Manifest, stored: &[RunRecord], progress: bool, c: &mut Comparison) -> anyhow::Result<()> {
+    let Some(tier) = &manifest.drift.deep else { return Ok(()) };
+    let study = &manifest.study;
+    for id in &tier.replay {
+        let label = format!("{id} (replayed)");
+        let Some(s) = stored.iter().find(|r| &r.run.id == id) else { continue }; // a missing run is a row already
+        let Some(level) = s.levels.len().checked_sub(1) else { continue };
+        if progress {
+            eprintln!("{study}/{id}: replaying level {level} (NDF {}) from the stored refinement history", s.levels[level].ndof);
+        }
+        match super::replay_stored_level(manifest, s, level, progress) {
+            Ok(solved) => {
+                let stored_levels: Vec<Value> = s.levels.iter().map(|l| serde_json::to_value(l).expect("records serialise")).collect();
+                let scales = field_scales(&stored_levels);
+                let fresh = serde_json::to_value(&solved.record).expect("records serialise");
+                compare_level(study, &label, level, &stored_levels[level], &fresh, &scales, &manifest.drift, &mut c.rows, &mut c.changes);
+            }
+            Err(e) => {
+                let replay = e.chain().find_map(|c| match c.downcast_ref::<crate::adapt::AdaptError>() {
+                    Some(crate::adapt::AdaptError::Replay(r)) => Some(r.to_string()),
+                    _ => c.downcast_ref::<crate::adapt::replay::ReplayError>().map(|r| r.to_string()),
+                });
+                match replay {
+                    Some(why) => c.rows.push(row(
+                        study,
+                        &label,
+                        Some(level),
+                        "history",
+                        "replays the stored meshes".into(),
+                        why,
+                        None,
+                        "exact".into(),
+                    )),
+                    None => return Err(e),
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A readable table of what moved.
@@ -539,8 +618,15 @@ pub fn run(
         let (m, quick) = if opts.against.is_some() { (m.clone(), opts.quick) } else { m.for_drift(opts.quick, opts.deep) };
         let m = &m;
         if opts.progress && quick && !opts.quick {
-            let full = m.drift.deep.as_ref().map(|t| t.full.join(", ")).unwrap_or_default();
-            eprintln!("{}: a deep study: every run rerun in its quick form, {full} to the end (all to the end: drift --deep)", m.study);
+            let (full, replay) = m.drift.deep.as_ref().map(|t| (t.full.join(", "), t.replay.join(", "))).unwrap_or_default();
+            let mut tiers = vec!["every run rerun in its quick form".to_string()];
+            if !full.is_empty() {
+                tiers.push(format!("{full} to the end"));
+            }
+            if !replay.is_empty() {
+                tiers.push(format!("the last level of {replay} replayed from its history"));
+            }
+            eprintln!("{}: a deep study: {} (all to the end: drift --deep)", m.study, tiers.join(", "));
         }
         let fresh_root = match &opts.against {
             Some(dir) => dir.clone(),
@@ -564,6 +650,9 @@ pub fn run(
             .read_runs()
             .with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?;
         let mut c = compare(m, &stored, &fresh, quick);
+        if quick && !opts.quick && opts.against.is_none() {
+            replay_tier(m, &stored, opts.progress, &mut c)?;
+        }
         if !stored.is_empty() {
             c.rows.extend(check_derived(&stored_dir, &m.study, &stored));
         }

@@ -159,12 +159,18 @@ pub struct DriftSpec {
 /// The drift tiers of a deep study. `signorini drift` (what `make test` runs) reruns each run
 /// in its quick form (the first `quick_levels` levels: an exact prefix, kept to small sizes) and
 /// compares those levels, except the runs in `full`, which it reruns to the end and compares at
-/// every level (a deep level of the study checked in every test run). `signorini drift --deep`
-/// (the scheduled job, `make drift`) reruns every run to the end.
+/// every level (a deep level of the study checked in every test run). The last level of each
+/// run in `replay` is rebuilt from its stored refinement history and solved once more
+/// (`adapt::replay`), without the levels before it, and compared with its stored record; every
+/// run's history is compared exactly with the stored one as far as it was rerun.
+/// `signorini drift --deep` (the scheduled job, `make drift`) reruns every run to the end.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DeepTier {
+    #[serde(default)]
     pub full: Vec<String>,
+    #[serde(default)]
+    pub replay: Vec<String>,
 }
 
 fn default_tolerance() -> Tolerance {
@@ -391,9 +397,11 @@ fn parse_run(
 /// are checked by definition), and rate checks on declared runs.
 fn check_drift(drift: &DriftSpec, runs: &[PlannedRun], invalid: &Invalid) -> Result<(), ManifestError> {
     if let Some(deep) = &drift.deep {
-        for (i, id) in deep.full.iter().enumerate() {
-            if !runs.iter().any(|p| &p.spec.id == id) {
-                return Err(invalid.at(format!("drift.deep.full[{i}]"), "the id of a declared run", format!("{id:?}")));
+        for (tier, ids) in [("full", &deep.full), ("replay", &deep.replay)] {
+            for (i, id) in ids.iter().enumerate() {
+                if !runs.iter().any(|p| &p.spec.id == id) {
+                    return Err(invalid.at(format!("drift.deep.{tier}[{i}]"), "the id of a declared run", format!("{id:?}")));
+                }
             }
         }
     }

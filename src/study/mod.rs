@@ -16,6 +16,7 @@
 //! computed) let shards of one study compute side by side while no run is computed twice;
 //! an interrupt stops after the current level and keeps every finished run ([`Interrupted`]).
 
+pub mod checkpoint;
 pub mod drift;
 mod lock;
 pub mod manifest;
@@ -197,7 +198,7 @@ fn start_over(dir: &StudyDir, sharded: bool, planned: &[RunSpec]) -> Result<()> 
     if sharded {
         return planned.iter().try_for_each(|spec| store::remove_run(dir, &spec.id));
     }
-    for sub in ["runs", "meshes"] {
+    for sub in ["runs", "meshes", ".partial"] {
         let p = dir.root.join(sub);
         if p.exists() {
             std::fs::remove_dir_all(&p).with_context(|| format!("removing {}", p.display()))?;
@@ -241,6 +242,7 @@ fn run_planned(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &
         };
         let _lock = StudyLock::acquire(dir, true)?;
         store::commit_run(manifest, dir, &record, meshes, opts.quick)?;
+        checkpoint::remove(dir, &spec.id)?;
         executed.push(spec.id.clone());
     }
     Ok(executed)
@@ -326,17 +328,36 @@ fn reference_key(spec: &RunSpec, problem: &str, mesh: &str) -> Option<String> {
     spec.reference.as_ref().map(|r| format!("{}|{:?}|{}|{}|{}|{:?}", problem, spec.constants, mesh, r.theta, r.min_ndof, r.contact_term))
 }
 
-/// One run of the manifest at `manifest_file` (its problem and mesh files are relative to it): the
-/// adaptive loop with a progress bar, adding the declared levels' mesh snapshots to `meshes`.
-/// `None` when interrupted.
-fn run_one(
-    study: &str,
-    spec: &RunSpec,
-    manifest_file: &std::path::Path,
-    dir: &StudyDir,
-    meshes: &mut Batch,
-    progress: bool,
-) -> Result<Option<RunRecord>> {
+/// What a run solves besides its spec: the problem, the initial mesh and, for a problem without
+/// an exact solution, the reference solution errors are measured against.
+pub struct Prepared {
+    pub problem: Box<dyn problems::Problem>,
+    pub mesh_spec: MeshSpec,
+    pub reference: Option<Arc<ReferenceField>>,
+}
+
+impl Prepared {
+    /// Call `f` with what errors are measured against: the exact solution, else the reference
+    /// solution, else nothing.
+    pub fn with_error_against<R>(&self, f: impl FnOnce(Option<crate::norms::Reference>) -> R) -> R {
+        let exact = self.problem.exact();
+        let exact_fn = exact.map(|e| move |x: [f64; 2]| e.u(x));
+        let reference_fn = self.reference.as_ref().map(|r| move |x: [f64; 2]| r.eval(x));
+        match (&exact_fn, &reference_fn) {
+            (Some(e), _) => f(Some(e)),
+            (None, Some(r)) => f(Some(r)),
+            (None, None) => f(None),
+        }
+    }
+
+    pub fn initial_mesh(&self) -> Result<crate::mesh::Mesh> {
+        Ok(self.mesh_spec.build(self.problem.as_ref())?)
+    }
+}
+
+/// Load a run's problem and initial mesh (relative to `manifest_file`) and compute (or take from
+/// this process's cache) its reference solution. `None` when interrupted.
+pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, progress: bool) -> Result<Option<Prepared>> {
     let problem_path = manifest::resolve_problem(manifest_file, &spec.problem);
     let mesh_path = manifest::resolve_mesh(manifest_file, &spec.mesh);
     let problem = problems::load(&problem_path, &spec.constants)?;
@@ -371,53 +392,144 @@ fn run_one(
         }
         _ => None,
     };
-    let exact = problem.exact();
-    let exact_fn = exact.map(|e| move |x: [f64; 2]| e.u(x));
-    let reference_fn = reference.as_ref().map(|r| move |x: [f64; 2]| r.eval(x));
-    let error_against: Option<crate::norms::Reference> = match (&exact_fn, &reference_fn) {
-        (Some(f), _) => Some(f),
-        (None, Some(f)) => Some(f),
-        (None, None) => None,
-    };
+    Ok(Some(Prepared { problem, mesh_spec, reference }))
+}
+
+/// One run of the manifest at `manifest_file` (its problem and mesh files are relative to it): the
+/// adaptive loop with a progress bar, adding the declared levels' mesh snapshots to `meshes`, a
+/// checkpoint after every level that is not the last ([`checkpoint`]), resumed from the
+/// checkpoint of an earlier, stopped process if there is one. `None` when interrupted.
+fn run_one(
+    study: &str,
+    spec: &RunSpec,
+    manifest_file: &std::path::Path,
+    dir: &StudyDir,
+    meshes: &mut Batch,
+    progress: bool,
+) -> Result<Option<RunRecord>> {
+    let Some(prepared) = prepare(study, spec, manifest_file, progress)? else { return Ok(None) };
     let config = AdaptConfig::for_run(spec);
-    let pb = bar(progress, spec.levels as u64, &format!("{study}/{}", spec.id));
-    let mut level_error: Option<anyhow::Error> = None;
-    let mut stopped = false;
-    let mesh = mesh_spec.build(problem.as_ref())?;
-    let levels = adapt::run(problem.as_ref(), mesh, &config, error_against, &mut |level: Level| {
-        let r = level.record;
-        pb.set_message(format!(
-            "level {} NDF {} estimate {:.3e}{}",
-            r.level,
-            r.ndof,
-            r.terms.estimate,
-            r.err_quadrature.map(|e| format!(" error {e:.3e}")).unwrap_or_default()
-        ));
-        pb.inc(1);
-        if let Err(e) = keep_level(study, spec, dir, meshes, &level, problem.as_ref()) {
-            level_error = Some(e);
-            return ControlFlow::Break(());
-        }
-        if interrupted() {
-            stopped = true;
-            return ControlFlow::Break(());
-        }
-        ControlFlow::Continue(())
-    })
-    .with_context(|| format!("{study}/{}", spec.id))?
-    .records;
-    pb.finish_and_clear();
-    if let Some(e) = level_error {
-        return Err(e);
-    }
-    if stopped {
-        return Ok(None);
-    }
+    let start = start_of(study, spec, dir, meshes, &prepared, &config, progress)?;
+    let Some(result) = loop_of(study, spec, dir, meshes, &prepared, &config, start, progress)? else { return Ok(None) };
+    let (levels, history) = (result.records, result.history);
     if progress {
         let last = levels.last().expect("at least one level");
         eprintln!("{study}/{}: {} levels, final NDF {}, estimate {:.3e}", spec.id, levels.len(), last.ndof, last.terms.estimate);
     }
-    Ok(Some(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof: reference.as_ref().map(|r| r.ndof) }))
+    let reference_ndof = prepared.reference.as_ref().map(|r| r.ndof);
+    Ok(Some(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof, history: Some(history) }))
+}
+
+/// Where the run starts: level 0, or after the last level of its checkpoint (the mesh snapshots
+/// of the levels before it are made again by replaying those levels).
+fn start_of(
+    study: &str,
+    spec: &RunSpec,
+    dir: &StudyDir,
+    meshes: &mut Batch,
+    prepared: &Prepared,
+    config: &AdaptConfig,
+    progress: bool,
+) -> Result<adapt::Start> {
+    let mesh0 = prepared.initial_mesh()?;
+    let Some(c) = checkpoint::read(dir, spec) else { return Ok(adapt::Start::new(mesh0)) };
+    let done = c.levels.len();
+    eprintln!("{study}/{}: resuming after level {} (from {})", spec.id, done - 1, checkpoint::file(dir, &spec.id).display());
+    let problem = prepared.problem.as_ref();
+    for &l in spec.save_levels.iter().filter(|&&l| l < done) {
+        let (mesh, solved) = prepared
+            .with_error_against(|r| adapt::replay::solve_stored_level(problem, mesh0.clone(), config, &c.history, l, r))
+            .with_context(|| format!("{study}/{}: replaying level {l} for its mesh snapshot", spec.id))?;
+        let level = Level {
+            record: &c.levels[l],
+            mesh: &mesh,
+            solution: &solved.solution,
+            estimate: &solved.estimate,
+            history: &c.history.levels[l],
+            continues: true,
+            next_active: None,
+        };
+        save_level(study, spec, dir, meshes, &level, problem)?;
+    }
+    let next_active =
+        c.next_active.as_ref().map(|f| f.decode()).transpose().with_context(|| format!("{study}/{}: the checkpoint", spec.id))?;
+    let start = adapt::replay::resume(mesh0, c.levels, c.history, next_active).with_context(|| format!("{study}/{}: resuming", spec.id))?;
+    if progress {
+        eprintln!("{study}/{}: level {} rebuilt from the stored marks", spec.id, start.level);
+    }
+    Ok(start)
+}
+
+/// The adaptive loop of a run from `start`, with its progress bar, snapshots and checkpoints.
+/// `None` when interrupted.
+#[allow(clippy::too_many_arguments)]
+fn loop_of(
+    study: &str,
+    spec: &RunSpec,
+    dir: &StudyDir,
+    meshes: &mut Batch,
+    prepared: &Prepared,
+    config: &AdaptConfig,
+    start: adapt::Start,
+    progress: bool,
+) -> Result<Option<adapt::AdaptResult>> {
+    let problem = prepared.problem.as_ref();
+    let pb = bar(progress, spec.levels as u64, &format!("{study}/{}", spec.id));
+    pb.inc(start.level as u64);
+    let mut level_error: Option<anyhow::Error> = None;
+    let mut stopped = false;
+    let mut kept =
+        checkpoint::Checkpoint { run: spec.clone(), levels: start.records.clone(), history: start.history.clone(), next_active: None };
+    let result = prepared.with_error_against(|error_against| {
+        adapt::run_from(problem, start, config, error_against, &mut |level: Level| {
+            let r = level.record;
+            pb.set_message(format!(
+                "level {} NDF {} estimate {:.3e}{}",
+                r.level,
+                r.ndof,
+                r.terms.estimate,
+                r.err_quadrature.map(|e| format!(" error {e:.3e}")).unwrap_or_default()
+            ));
+            pb.inc(1);
+            let kept_level = keep_level(study, spec, dir, meshes, &level, problem).and_then(|()| {
+                kept.levels.push(r.clone());
+                kept.history.levels.push(level.history.clone());
+                kept.next_active = level.next_active.map(adapt::Flags::encode);
+                if level.continues { checkpoint::write(dir, &kept) } else { Ok(()) }
+            });
+            if let Err(e) = kept_level {
+                level_error = Some(e);
+                return ControlFlow::Break(());
+            }
+            if interrupted() {
+                stopped = true;
+                return ControlFlow::Break(());
+            }
+            ControlFlow::Continue(())
+        })
+    });
+    let result = result.with_context(|| format!("{study}/{}", spec.id))?;
+    pb.finish_and_clear();
+    if let Some(e) = level_error {
+        return Err(e);
+    }
+    Ok((!stopped).then_some(result))
+}
+
+/// Rebuild level `level` of a stored run from its refinement history and solve it again
+/// ([`adapt::replay::solve_stored_level`]): the drift check's replay tier. The run's problem,
+/// mesh and reference are those of `manifest`.
+pub fn replay_stored_level(manifest: &Manifest, stored: &RunRecord, level: usize, progress: bool) -> Result<adapt::Solved> {
+    let spec = &stored.run;
+    let what = format!("{}/{}: replaying level {level}", manifest.study, spec.id);
+    let history = stored.history.as_ref().ok_or_else(|| anyhow::anyhow!("{what}: the stored run has no refinement history"))?;
+    let prepared = prepare(&manifest.study, spec, &manifest.file, progress)?.ok_or_else(|| anyhow::anyhow!("{what}: interrupted"))?;
+    let mesh0 = prepared.initial_mesh()?;
+    let config = AdaptConfig::for_run(spec);
+    let problem = prepared.problem.as_ref();
+    let (_, solved) =
+        prepared.with_error_against(|r| adapt::replay::solve_stored_level(problem, mesh0, &config, history, level, r)).context(what)?;
+    Ok(solved)
 }
 
 fn bar(progress: bool, len: u64, prefix: &str) -> ProgressBar {

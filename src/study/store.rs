@@ -172,8 +172,9 @@ pub fn remove_orphans(study: &str, dir: &StudyDir, runs: &[RunRecord]) -> Result
     Ok(())
 }
 
-/// Remove a run's record and its mesh snapshots (`meshes/RUN_levelL.*`).
+/// Remove a run's record, its mesh snapshots (`meshes/RUN_levelL.*`) and its checkpoint.
 pub fn remove_run(dir: &StudyDir, id: &str) -> Result<()> {
+    super::checkpoint::remove(dir, id)?;
     let file = dir.run_file(id);
     match std::fs::remove_file(&file) {
         Ok(()) => {}

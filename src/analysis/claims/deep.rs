@@ -34,9 +34,9 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     Ok(())
 }
 
+/// The error rate over the last [`DEEP_DECADES`] above the round-off floor.
 fn rate(ctx: &Ctx, r: Option<&RunRecord>) -> Option<RateReport> {
-    let r = r?;
-    RateReport::of_values_spanning(r, &ctx.values(r, Q::Error), DEEP_DECADES)
+    ctx.rate_spanning(r, Q::Error, DEEP_DECADES)
 }
 
 fn row(ctx: &Ctx, runs: &[RunRecord], problem: &str, id: &'static str, claim: &str) -> Claim {
@@ -67,7 +67,8 @@ fn row(ctx: &Ctx, runs: &[RunRecord], problem: &str, id: &'static str, claim: &s
                 } else {
                     format!("; {}", growth_text("efficiency", ctx.growth(get(v), Q::Efficiency).as_ref()))
                 };
-                format!("{v} (to NDF {final_ndof}): error rate {text}{eff}")
+                let floor = get(v).map(|r| ctx.floor_text(r)).unwrap_or_default();
+                format!("{v} (to NDF {final_ndof}): error rate {text}{eff}; {floor}")
             })
             .collect();
         parts.join(". ")

@@ -1,5 +1,10 @@
 //! The adaptive loop of Section 7: SOLVE -> ESTIMATE -> MARK -> REFINE, one level per turn,
-//! with an observer that sees every level (what the study runner records).
+//! with an observer that sees every level (what the study runner records). The loop keeps a
+//! refinement [`History`] (marks and warm starts per level) from which [`replay`] rebuilds and
+//! solves any level again, and it can start from a later level ([`run_from`], [`Start`]): how an
+//! interrupted deep run resumes.
+
+pub mod replay;
 
 use crate::contact::PdasOptions;
 use crate::estimate::{self, Estimate, EstimatorConfig};
@@ -7,7 +12,7 @@ use crate::mesh::Mesh;
 use crate::mesh::refine::{self, Refinement};
 use crate::norms::{self, Reference};
 use crate::problems::Problem;
-pub use crate::records::{LevelRecord, Refine};
+pub use crate::records::{Flags, History, LevelHistory, LevelRecord, Refine};
 use crate::solve::{self, DiscreteSolution, SolveError};
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -49,6 +54,11 @@ pub enum AdaptError {
     /// observer), level `level` was not.
     #[error("stopped before level {level} ({}): {error}", if *level == 0 { "no level was solved".to_string() } else { format!("levels 0 to {} were solved", level - 1) })]
     Memory { level: usize, error: solve::MemoryError },
+    /// A start at or beyond the last level: nothing is left to solve.
+    #[error("nothing to solve: the loop starts at level {start} and has {levels} levels")]
+    NothingToSolve { start: usize, levels: usize },
+    #[error(transparent)]
+    Replay(#[from] replay::ReplayError),
 }
 
 impl AdaptConfig {
@@ -108,6 +118,12 @@ pub struct Level<'a> {
     pub mesh: &'a Mesh,
     pub solution: &'a DiscreteSolution,
     pub estimate: &'a Estimate,
+    /// The level's entry of the refinement history.
+    pub history: &'a LevelHistory,
+    /// The loop goes on to a next level (false at the last level, which is not refined).
+    pub continues: bool,
+    /// The active set the next level starts from, if it continues with warm starts.
+    pub next_active: Option<&'a [bool]>,
 }
 
 /// Mark by the maximum strategy: eta_T >= theta max eta_T.
@@ -186,7 +202,113 @@ pub struct AdaptResult {
     pub estimate: Estimate,
     /// One record per level solved, in order; the last one describes `mesh`.
     pub records: Vec<LevelRecord>,
+    /// The refinement history of every level in `records`.
+    pub history: History,
     pub termination: Termination,
+}
+
+/// Where the loop starts: the mesh of level `level`, the active set its solve starts from, and
+/// the records and history of the levels before it (empty from level 0).
+pub struct Start {
+    pub mesh: Mesh,
+    pub level: usize,
+    pub initial_active: Option<Vec<bool>>,
+    pub records: Vec<LevelRecord>,
+    pub history: History,
+}
+
+impl Start {
+    /// Level 0 on `mesh`.
+    pub fn new(mesh: Mesh) -> Self {
+        Start { mesh, level: 0, initial_active: None, records: Vec::new(), history: History::default() }
+    }
+}
+
+/// One level solved, estimated and marked (not yet refined).
+pub struct Solved {
+    pub record: LevelRecord,
+    pub solution: DiscreteSolution,
+    pub estimate: Estimate,
+    pub marks: Vec<bool>,
+}
+
+/// SOLVE, ESTIMATE and MARK on the mesh of level `level`, the contact solve started from
+/// `initial_active` (if `config.warm_start`): everything of a level but the refinement. Its
+/// record's `t_refine` and `t_level` are zero (the loop sets them).
+pub fn solve_level(
+    problem: &dyn Problem,
+    mesh: &Mesh,
+    level: usize,
+    config: &AdaptConfig,
+    reference: Option<Reference>,
+    initial_active: Option<Vec<bool>>,
+) -> Result<Solved, AdaptError> {
+    let ndof = mesh.p2_ndof();
+    // before every level, not only the first: an adaptive loop grows until it does not fit
+    solve::check_memory(&format!("level {level} of the adaptive loop"), ndof as f64)
+        .map_err(|error| AdaptError::Memory { level, error })?;
+    let mut options = config.pdas.clone();
+    if config.warm_start {
+        options.initial_active = initial_active;
+    }
+    let t0 = Instant::now();
+    let sol = solve::solve(mesh, problem, &options, &mut |_| {})?;
+    let t_solve = t0.elapsed().as_secs_f64();
+    let t0 = Instant::now();
+    let est = estimate::estimate(mesh, problem, &sol, &config.estimator);
+    // the estimator samples the data at points of its own (a dense lattice, edge points)
+    if let Some(bad) = problem.bad_datum() {
+        return Err(SolveError::Data(bad).into());
+    }
+    let t_estimate = t0.elapsed().as_secs_f64();
+    let error = reference.map(|r| norms::linf_error(mesh, &sol, r));
+    let marks = match config.refine {
+        Refine::Adaptive => mark_maximum(&est.element, config.theta),
+        Refine::Uniform => vec![true; mesh.n_triangles()],
+    };
+    let (h_min, h_max) = mesh.h_range();
+    let peak = largest_indicator_centroid(mesh, &est.element);
+    let zone = sol.contact_zone();
+    let t = &est.terms;
+    let ct = &sol.timings.contact;
+    let record = LevelRecord {
+        level,
+        ndof: 2 * sol.nodes.len(),
+        ndof_free: sol.dofs.n_free,
+        n_elements: mesh.n_triangles(),
+        h_min,
+        h_max,
+        min_angle: mesh.min_angle_degrees(),
+        contact_nodes: sol.dofs.contact.len(),
+        active_nodes: sol.active_count(),
+        full_contact_nodes: est.full_contact_nodes,
+        pdas_iterations: sol.pdas.len(),
+        zone_min: zone.map(|z| z[0]),
+        zone_max: zone.map(|z| z[1]),
+        terms: *t,
+        err_quadrature: error.map(|e| e.linf_quadrature),
+        err_dense: error.map(|e| e.linf_dense),
+        err_nodal: error.map(|e| e.linf_nodal),
+        efficiency: error.map(|e| t.estimate / e.linf_quadrature),
+        err_contact: reference.and_then(|r| norms::linf_error_contact(mesh, &sol, r)),
+        err_right_half: reference.and_then(|r| norms::linf_error_where(mesh, &sol, r, norms::Sampling::Dense, &|x| x[0] >= 0.5)),
+        roundoff_floor: sol.roundoff,
+        h_free_boundary: free_boundary_edge(mesh, &sol),
+        max_indicator_x: peak[0],
+        max_indicator_y: peak[1],
+        // counted on the last level too, so a shorter run is an exact prefix of a longer one
+        marked: marks.iter().filter(|m| **m).count(),
+        t_assembly: sol.timings.assembly,
+        t_factorisation: ct.symbolic + ct.numeric + ct.schur,
+        t_active_set: ct.active_set,
+        t_solve,
+        t_estimate,
+        t_refine: 0.0,
+        t_level: 0.0,
+        t_roundoff: sol.timings.roundoff,
+        mem_peak_mib: None,
+    };
+    Ok(Solved { record, solution: sol, estimate: est, marks })
 }
 
 /// Run the loop from `mesh`. `reference` gives the displacement errors are measured against
@@ -210,95 +332,58 @@ pub struct AdaptResult {
 /// let result = adapt::run(problem.as_ref(), mesh, &config, Some(&u), &mut |_| ControlFlow::Continue(())).unwrap();
 /// assert_eq!(result.termination, Termination::LevelsReached);
 /// assert_eq!(result.records.len(), 3);
+/// assert_eq!(result.history.levels.len(), 3);
 /// assert_eq!(result.records[2].ndof, 2 * result.solution.nodes.len());
 /// assert!(result.records[2].err_quadrature.unwrap() < result.records[0].err_quadrature.unwrap());
 /// ```
 pub fn run(
     problem: &dyn Problem,
-    mut mesh: Mesh,
+    mesh: Mesh,
+    config: &AdaptConfig,
+    reference: Option<Reference>,
+    observer: &mut dyn FnMut(Level) -> ControlFlow<()>,
+) -> Result<AdaptResult, AdaptError> {
+    run_from(problem, Start::new(mesh), config, reference, observer)
+}
+
+/// [`run`] from a later level: `start` holds the mesh of level `start.level`, the active set its
+/// solve starts from and the records and history of the levels before (a resumed run:
+/// [`replay::resume`]). The same numbers as the uninterrupted loop, level for level.
+pub fn run_from(
+    problem: &dyn Problem,
+    start: Start,
     config: &AdaptConfig,
     reference: Option<Reference>,
     observer: &mut dyn FnMut(Level) -> ControlFlow<()>,
 ) -> Result<AdaptResult, AdaptError> {
     config.validate()?;
-    let mut records = Vec::new();
+    if start.level >= config.levels {
+        return Err(AdaptError::NothingToSolve { start: start.level, levels: config.levels });
+    }
+    let Start { mut mesh, level: first, mut initial_active, mut records, mut history } = start;
     let mut state: Option<(Mesh, DiscreteSolution, Estimate)> = None;
     let mut termination = Termination::LevelsReached;
-    let mut initial_active: Option<Vec<bool>> = None;
-    for level in 0..config.levels {
-        let ndof = mesh.p2_ndof();
+    for level in first..config.levels {
         if let Some(max) = config.max_ndof
             && level > 0
-            && ndof > max
+            && mesh.p2_ndof() > max
         {
             termination = Termination::MaxNdofReached;
             break;
         }
-        // before every level, not only the first: an adaptive loop grows until it does not fit
-        solve::check_memory(&format!("level {level} of the adaptive loop"), ndof as f64)
-            .map_err(|error| AdaptError::Memory { level, error })?;
         let t_level = Instant::now();
-        let mut options = config.pdas.clone();
-        if config.warm_start {
-            options.initial_active = initial_active.take();
-        }
-        let t0 = Instant::now();
-        let sol = solve::solve(&mesh, problem, &options, &mut |_| {})?;
-        let t_solve = t0.elapsed().as_secs_f64();
-        let t0 = Instant::now();
-        let est = estimate::estimate(&mesh, problem, &sol, &config.estimator);
-        // the estimator samples the data at points of its own (a dense lattice, edge points)
-        if let Some(bad) = problem.bad_datum() {
-            return Err(SolveError::Data(bad).into());
-        }
-        let t_estimate = t0.elapsed().as_secs_f64();
-        let error = reference.map(|r| norms::linf_error(&mesh, &sol, r));
-        let last = level + 1 == config.levels;
-        let marks = match config.refine {
-            Refine::Adaptive => mark_maximum(&est.element, config.theta),
-            Refine::Uniform => vec![true; mesh.n_triangles()],
-        };
-        // counted on the last level too, so a shorter run is an exact prefix of a longer one
-        let marked = marks.iter().filter(|m| **m).count();
-        let (h_min, h_max) = mesh.h_range();
-        let peak = largest_indicator_centroid(&mesh, &est.element);
-        let zone = sol.contact_zone();
-        let t = &est.terms;
-        let ct = &sol.timings.contact;
-        let mut record = LevelRecord {
+        let measured = crate::memory::reset_peak_resident();
+        let started_from = initial_active.take().filter(|_| config.warm_start);
+        let Solved { mut record, solution: sol, estimate: est, marks } =
+            solve_level(problem, &mesh, level, config, reference, started_from.clone())?;
+        let entry = LevelHistory {
             level,
-            ndof: 2 * sol.nodes.len(),
-            ndof_free: sol.dofs.n_free,
             n_elements: mesh.n_triangles(),
-            h_min,
-            h_max,
-            min_angle: mesh.min_angle_degrees(),
-            contact_nodes: sol.dofs.contact.len(),
-            active_nodes: sol.active_count(),
-            full_contact_nodes: est.full_contact_nodes,
-            pdas_iterations: sol.pdas.len(),
-            zone_min: zone.map(|z| z[0]),
-            zone_max: zone.map(|z| z[1]),
-            terms: *t,
-            err_quadrature: error.map(|e| e.linf_quadrature),
-            err_dense: error.map(|e| e.linf_dense),
-            err_nodal: error.map(|e| e.linf_nodal),
-            efficiency: error.map(|e| t.estimate / e.linf_quadrature),
-            err_contact: reference.and_then(|r| norms::linf_error_contact(&mesh, &sol, r)),
-            err_right_half: reference.and_then(|r| norms::linf_error_where(&mesh, &sol, r, norms::Sampling::Dense, &|x| x[0] >= 0.5)),
-            h_free_boundary: free_boundary_edge(&mesh, &sol),
-            max_indicator_x: peak[0],
-            max_indicator_y: peak[1],
-            marked,
-            t_assembly: sol.timings.assembly,
-            t_factorisation: ct.symbolic + ct.numeric + ct.schur,
-            t_active_set: ct.active_set,
-            t_solve,
-            t_estimate,
-            t_refine: 0.0,
-            t_level: 0.0,
+            mesh: mesh.fingerprint(),
+            initial_active: started_from.as_deref().map(Flags::encode),
+            marks: Flags::encode(&marks),
         };
-        let next = if last {
+        let next = if level + 1 == config.levels {
             None
         } else {
             let t0 = Instant::now();
@@ -308,8 +393,18 @@ pub fn run(
             Some((refinement.mesh, active))
         };
         record.t_level = t_level.elapsed().as_secs_f64();
-        let flow = observer(Level { record: &record, mesh: &mesh, solution: &sol, estimate: &est });
+        record.mem_peak_mib = crate::memory::peak_resident().filter(|_| measured).map(|b| b / (1024.0 * 1024.0));
+        let flow = observer(Level {
+            record: &record,
+            mesh: &mesh,
+            solution: &sol,
+            estimate: &est,
+            history: &entry,
+            continues: next.is_some(),
+            next_active: next.as_ref().and_then(|(_, a)| a.as_deref()),
+        });
         records.push(record);
+        history.levels.push(entry);
         state = Some((mesh, sol, est));
         if flow.is_break() {
             termination = Termination::StoppedByObserver;
@@ -323,6 +418,6 @@ pub fn run(
             None => break,
         }
     }
-    let (mesh, solution, estimate) = state.expect("level 0 is always solved");
-    Ok(AdaptResult { mesh, solution, estimate, records, termination })
+    let (mesh, solution, estimate) = state.expect("the first level is always solved");
+    Ok(AdaptResult { mesh, solution, estimate, records, history, termination })
 }

@@ -1,0 +1,86 @@
+//! A run stopped mid-way (the process killed, as a cluster's time limit does) resumes after its
+//! last finished level, not from level 0, and ends with the same numbers and history as a run
+//! that was never stopped; the checkpoint it resumed from is gone once the run has landed.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+const MANIFEST: &str = r#"description = "one run long enough to be stopped"
+[defaults]
+problem = "ex71"
+mesh = "structured:4"
+theta = 0.5
+[[run]]
+id = "long"
+levels = 22
+save_levels = [3, 21]
+"#;
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_signorini")
+}
+
+fn run(results: &Path, manifest: &Path) -> std::process::Output {
+    Command::new(bin()).args(["run", manifest.to_str().unwrap(), "--results", results.to_str().unwrap()]).output().unwrap()
+}
+
+fn checkpoint_levels(file: &Path) -> usize {
+    let Ok(text) = std::fs::read_to_string(file) else { return 0 };
+    let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else { return 0 };
+    v["levels"].as_array().map_or(0, |l| l.len())
+}
+
+fn without_measurements(file: PathBuf) -> serde_json::Value {
+    let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(file).unwrap()).unwrap();
+    for l in v["levels"].as_array_mut().unwrap() {
+        l.as_object_mut().unwrap().retain(|k, _| !signorini::records::is_measurement(k));
+    }
+    v
+}
+
+#[test]
+fn a_killed_run_resumes_after_its_last_finished_level_with_the_same_numbers() {
+    let root = std::env::temp_dir().join(format!("signorini-resume-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    let manifest = root.join("resumed.toml");
+    std::fs::write(&manifest, MANIFEST).unwrap();
+    // the reference: never stopped
+    let whole = root.join("whole");
+    assert!(run(&whole, &manifest).status.success());
+    // killed once 8 levels are kept
+    let stopped = root.join("stopped");
+    let partial = stopped.join("resumed/.partial/long.json");
+    let mut child = Command::new(bin())
+        .args(["run", manifest.to_str().unwrap(), "--results", stopped.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    while checkpoint_levels(&partial) < 8 {
+        assert!(child.try_wait().unwrap().is_none(), "the run finished before it could be stopped");
+        assert!(started.elapsed() < Duration::from_secs(300), "no checkpoint of 8 levels after 300 s");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.kill().unwrap(); // SIGKILL: no handler runs
+    child.wait().unwrap();
+    let kept = checkpoint_levels(&partial);
+    assert!((8..22).contains(&kept), "{kept}");
+    assert!(!stopped.join("resumed/runs/long.json").exists());
+    let out = run(&stopped, &manifest);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains(&format!("resuming after level {}", kept - 1)), "{stderr}");
+    let file = |r: &Path| r.join("resumed/runs/long.json");
+    assert_eq!(without_measurements(file(&stopped)), without_measurements(file(&whole)));
+    for l in [3, 21] {
+        for ext in ["vtu", "json"] {
+            let name = format!("resumed/meshes/long_level{l}.{ext}");
+            assert_eq!(std::fs::read(stopped.join(&name)).unwrap(), std::fs::read(whole.join(&name)).unwrap(), "{name}");
+        }
+    }
+    assert!(!stopped.join("resumed/.partial").exists(), "the checkpoint stays after the run landed");
+    std::fs::remove_dir_all(&root).unwrap();
+}
