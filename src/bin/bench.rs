@@ -53,6 +53,13 @@ struct Args {
     /// Run one whole contact solve of the first size in this process and print its JSON row.
     #[arg(long, hide = true)]
     cold_child: bool,
+    /// Only the rate of the numeric factorisation on these sizes beside faer's dense LL^T on
+    /// every core (each size in a process of its own), printed and not written.
+    #[arg(long, value_delimiter = ',')]
+    factor_rate: Vec<usize>,
+    /// Run the factor-rate measurement of the first size in this process.
+    #[arg(long, hide = true)]
+    rate_child: bool,
 }
 
 /// One whole contact solve in a fresh process: Example 7.2 on structured:N from nothing to the
@@ -426,6 +433,22 @@ fn main() -> Result<()> {
         println!("ROW {}", serde_json::to_string(&cold_solve(n)?)?);
         return Ok(());
     }
+    if args.rate_child {
+        let n = *args.sizes.first().ok_or_else(|| anyhow::anyhow!("--rate-child needs a size"))?;
+        println!("ROW {}", serde_json::to_string(&factor_rate(n, args.repeats)?)?);
+        return Ok(());
+    }
+    if !args.factor_rate.is_empty() {
+        let exe = std::env::current_exe()?;
+        println!("{RATE_HEADER}");
+        for &n in &args.factor_rate {
+            let mut cmd = std::process::Command::new(&exe);
+            cmd.args(["--rate-child", "--sizes", &n.to_string(), "--repeats", &args.repeats.to_string()]);
+            let r: FactorRate = run_child(&mut cmd, &format!("the factor rate of structured:{n}"))?;
+            println!("{}", r.row());
+        }
+        return Ok(());
+    }
     if args.child {
         for &n in &args.sizes {
             println!("ROW {}", serde_json::to_string(&bench_size(n, args.repeats)?)?);
@@ -484,6 +507,109 @@ fn main() -> Result<()> {
     records::write_json(&args.out, &doc)?;
     println!("wrote {}", args.out.display());
     Ok(())
+}
+
+/// The numeric factorisation of one size against the machine's dense rate, in one process.
+/// Rates count two flops per multiply-add of the ordering's count (the fill of L, without the
+/// explicit zeros that relaxed supernodes add), and n^3 / 3 flops for a dense LL^T of order n.
+#[derive(serde::Serialize, serde::Deserialize, Clone)]
+struct FactorRate {
+    n: usize,
+    unknowns: usize,
+    supernodes: usize,
+    /// share of the executed multiply-adds in supernodes of at least 64 columns
+    wide_share: f64,
+    /// multiply-adds of the fill (the ordering's count) and executed (explicit zeros included)
+    multiply_adds: f64,
+    executed_multiply_adds: f64,
+    /// the first factorisation in the process (first touch of L), and the median of the others
+    numeric_first_s: f64,
+    numeric_warm_s: f64,
+    /// GFlop/s of the warm factorisation ...
+    sparse_gflops: f64,
+    /// ... and of faer's dense LL^T of order DENSE_N on every core (median of five, same process)
+    dense_gflops: f64,
+    ratio: f64,
+}
+
+const RATE_HEADER: &str = "    N   unknowns supernodes wide64 |  madds  executed   first    warm  GFlop/s | dense GFlop/s  ratio";
+
+impl FactorRate {
+    fn row(&self) -> String {
+        format!(
+            "{:>5} {:>10} {:>10} {:>6.2} | {:>8.2e} {:>8.2e} {:>7.3} {:>7.3} {:>8.1} | {:>13.1} {:>6.2}",
+            self.n,
+            self.unknowns,
+            self.supernodes,
+            self.wide_share,
+            self.multiply_adds,
+            self.executed_multiply_adds,
+            self.numeric_first_s,
+            self.numeric_warm_s,
+            self.sparse_gflops,
+            self.dense_gflops,
+            self.ratio
+        )
+    }
+}
+
+/// The order of the dense LL^T the sparse rate is held against.
+const DENSE_N: usize = 2048;
+
+fn factor_rate(n: usize, repeats: usize) -> Result<FactorRate> {
+    use signorini::{cholesky, symbolic};
+    let problem = Ex72;
+    let mesh = MeshSpec::Structured(n).build(&problem)?;
+    let nodes = P2Nodes::new(&mesh);
+    let dofs = DofMap::new(&nodes, &problem);
+    let sys = assembly::assemble(&mesh, &nodes, &dofs, &problem);
+    let (sn, placement, ordering) = symbolic::analyse(&sys.matrix, dofs.n_interior, &dofs.unknown_coords(&nodes));
+    let plan = cholesky::Plan::new(&sn);
+    let mut l = vec![0.0; sn.len_val()];
+    let mut times = Vec::new();
+    for r in 0..=repeats.max(1) {
+        cholesky::load(&sn, &placement, sys.matrix.values(), &mut l, r == 0);
+        let t0 = Instant::now();
+        cholesky::factorize(&sn, &plan, &mut l)?;
+        times.push(t0.elapsed().as_secs_f64());
+    }
+    let (numeric_first_s, numeric_warm_s) = (times[0], median(times[1..].to_vec()));
+    // the dense rate: a warm-up, then the median of five (one factorisation takes about 0.2 s)
+    dense_rate(DENSE_N);
+    let dense_gflops = median((0..5).map(|_| dense_rate(DENSE_N)).collect());
+    // the ordering counts the leading block (all but the contact unknowns, whose trailing
+    // dense block is factorised too: m^3 / 6 more)
+    let m = (sn.n() - dofs.n_interior) as f64;
+    let multiply_adds = ordering.multiply_adds() + m * m * m / 6.0;
+    let (supernodes, wide_share) = plan.shape(&sn, 64);
+    let sparse_gflops = 2.0 * multiply_adds / numeric_warm_s / 1e9;
+    Ok(FactorRate {
+        n,
+        unknowns: sn.n(),
+        supernodes,
+        wide_share,
+        multiply_adds,
+        executed_multiply_adds: plan.multiply_adds(),
+        numeric_first_s,
+        numeric_warm_s,
+        sparse_gflops,
+        dense_gflops,
+        ratio: sparse_gflops / dense_gflops,
+    })
+}
+
+/// GFlop/s of faer's dense LL^T of an n x n SPD matrix on every core.
+fn dense_rate(n: usize) -> f64 {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::linalg::cholesky::llt::factor::{LltParams, LltRegularization, cholesky_in_place, cholesky_in_place_scratch};
+    let mut a = faer::Mat::<f64>::from_fn(n, n, |i, j| if i == j { n as f64 } else { 1.0 / (1.0 + i.abs_diff(j) as f64) });
+    let par = faer::Par::rayon(0);
+    let mut stack = MemBuffer::new(cholesky_in_place_scratch::<f64>(n, par, faer::Spec::<LltParams, f64>::default()));
+    let t0 = Instant::now();
+    cholesky_in_place(a.as_mut(), LltRegularization::default(), par, MemStack::new(&mut stack), faer::Spec::<LltParams, f64>::default())
+        .expect("the test matrix is diagonally dominant");
+    let t = t0.elapsed().as_secs_f64();
+    (n as f64).powi(3) / 3.0 / t / 1e9
 }
 
 /// All repeats of one size, in this process.
