@@ -107,7 +107,8 @@ struct ColdSize {
     ngsolve: Vec<NgRun>,
     /// why NGSolve has no runs, if it has none
     ngsolve_missing: Option<String>,
-    /// NGSolve with MKL PARDISO (`inverse="pardiso"`, the bench venv), and why it has no runs
+    /// NGSolve with MKL PARDISO's LL^T (`inverse="pardisospd"` on the matrix stored as symmetric,
+    /// in the bench venv), and why it has no runs
     #[serde(default)]
     pardiso: Vec<NgRun>,
     #[serde(default)]
@@ -209,7 +210,7 @@ fn cold_comparison(sizes: &[usize], repeats: usize, python: &std::path::Path, pa
                 size.ngsolve.push(ng);
             }
             if have_pardiso {
-                let ng = ngsolve_cold(pardiso, n, "pardiso")?;
+                let ng = ngsolve_cold(pardiso, n, "pardisospd")?;
                 print_ng(n, r, "NGSolve + PARDISO", &ng);
                 size.pardiso.push(ng);
             }
@@ -357,7 +358,7 @@ fn targets(phases: &[SizeResult], rates: &[FactorRate], cold: &[ColdSize], scale
                 pardiso,
                 pardiso.map(|p| ours / p),
                 Bound::AtMost(0.5),
-                c.pardiso_missing.clone().unwrap_or_else(|| "NGSolve's inverse=\"pardiso\" (MKL)".into()),
+                c.pardiso_missing.clone().unwrap_or_else(|| "NGSolve's inverse=\"pardisospd\" (MKL 2026.2)".into()),
             ));
         }
         if c.n >= 256 {
