@@ -171,27 +171,6 @@ impl Plan {
                 pulled + c * c * c / 6.0 + p * c * c / 2.0
             })
             .collect();
-        if std::env::var("SIG_HIST").is_ok() {
-            let mut h = [0.0f64; 8];
-            let mut hs = [0.0f64; 8];
-            for s in 0..ns {
-                for u in &upd[upd_ptr[s]..upd_ptr[s + 1]] {
-                    let dn = supernode(sn, u.d as usize);
-                    let (rows, mid) = ((dn.pattern.len() - u.first as usize) as f64, u.mid as f64);
-                    let w = (rows - mid / 2.0) * mid * dn.ncols as f64;
-                    let b = (dn.ncols as f64).log2().floor().min(7.0) as usize;
-                    h[b] += w;
-                    let b2 = (mid).log2().floor().min(7.0) as usize;
-                    hs[b2] += w;
-                }
-            }
-            let tot: f64 = work.iter().sum();
-            eprintln!("total {tot:.3e}; update madds by log2(k=ncols_d): {:?}", h.iter().map(|x| format!("{:.3}", x / tot)).collect::<Vec<_>>());
-            eprintln!("by log2(mid): {:?}", hs.iter().map(|x| format!("{:.3}", x / tot)).collect::<Vec<_>>());
-            let mut nb = [0usize; 8];
-            for s in 0..ns { nb[((begin[s+1]-begin[s]) as f64).log2().floor().min(7.0) as usize] += 1; }
-            eprintln!("supernodes by log2(ncols): {nb:?}; updates {}", upd.len());
-        }
         let own = work.clone();
         for s in 0..ns {
             let w: f64 = kids[kid_ptr[s]..kid_ptr[s + 1]].iter().map(|&k| work[k as usize]).sum();
