@@ -59,11 +59,14 @@ crosscheck: build
 	SIGNORINI=$(abspath $(BIN)) crosscheck/run.sh
 
 # NGSolve's phase timings first (warm, medians over repeats in one process per size), then ours
-# side by side; then whole solves in fresh processes, ours and NGSolve's interleaved (medians of
-# 3 at N = 256 and 512), the structured:1024 scale point, and the table of the targets with
-# met / not met. About 15 minutes; results/bench/{ngsolve_bench,solver}.json.
+# side by side; the numeric factorisation's rate against faer's dense LL^T (N = 256, 512, 1024);
+# then whole solves in fresh processes, ours, NGSolve's (sparsecholesky) and NGSolve's with MKL
+# PARDISO interleaved (medians of 3 at N = 256 and 512; PARDISO from crosscheck/.venv-bench, the
+# bench's own venv with pinned MKL), the structured:1024 scale point, and the table of the targets
+# with met / not met. About 30 minutes; results/bench/{ngsolve_bench,solver}.json.
 bench: build
-	crosscheck/setup.sh && crosscheck/.venv/bin/python crosscheck/crosscheck.py --out-dir results/bench bench --sizes 32,64,128,256,512
+	crosscheck/setup.sh && crosscheck/setup.sh bench
+	crosscheck/.venv/bin/python crosscheck/crosscheck.py --out-dir results/bench bench --sizes 32,64,128,256,512
 	$(CARGO) run --release --locked --bin bench
 
 # How far round-off moves the stored numbers: every study rerun three ways that change only the

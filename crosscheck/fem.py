@@ -108,10 +108,14 @@ def build_ngmesh(vertices, triangles, segments, seg_parts):
     return mesh
 
 
-def stiffness_form(fes, p):
+def stiffness_form(fes, p, symmetric=False):
+    """The elasticity form; `symmetric=True` stores the matrix as symmetric, which tells a solver
+    that can exploit it (MKL PARDISO: LL^T / LDL^T instead of LU) that it may."""
     u, v = fes.TnT()
     eu, ev = Sym(ng.Grad(u)), Sym(ng.Grad(v))
-    return BilinearForm(2 * p.mu * InnerProduct(eu, ev) * dx + p.zeta * Trace(eu) * Trace(ev) * dx)
+    a = BilinearForm(fes, symmetric=symmetric)
+    a += 2 * p.mu * InnerProduct(eu, ev) * dx + p.zeta * Trace(eu) * Trace(ev) * dx
+    return a
 
 
 def load_form(fes, p, skip=None):

@@ -168,7 +168,7 @@ impl Plan {
                         (rows - mid / 2.0) * mid * dn.ncols as f64
                     })
                     .sum();
-                pulled + c * c * c / 3.0 + p * c * c / 2.0
+                pulled + c * c * c / 6.0 + p * c * c / 2.0
             })
             .collect();
         let own = work.clone();
@@ -249,6 +249,20 @@ impl Plan {
         }
     }
 
+    /// The multiply-adds the factorisation executes: every supernode's updates from its
+    /// descendants, dense Cholesky and triangular solve, explicit zeros of the relaxed
+    /// supernodes included (the work the schedule balances).
+    pub fn multiply_adds(&self) -> f64 {
+        self.own.iter().sum()
+    }
+
+    /// Supernodes, and the share of the multiply-adds in supernodes of at least `cols` columns.
+    pub fn shape(&self, sn: &Symbolic, cols: usize) -> (usize, f64) {
+        let begin = sn.supernode_begin();
+        let wide: f64 = (0..self.own.len()).filter(|&s| begin[s + 1] - begin[s] >= cols).map(|s| self.own[s]).sum();
+        (self.own.len(), wide / self.multiply_adds())
+    }
+
     fn kids(&self, s: usize) -> impl Iterator<Item = usize> + '_ {
         self.kids[self.kid_ptr[s]..self.kid_ptr[s + 1]].iter().map(|&k| k as usize)
     }
@@ -271,6 +285,8 @@ impl Plan {
 /// workspace.
 struct Scratch {
     update: Vec<f64>,
+    /// the rows of the current update product in the target's block
+    rel: Vec<usize>,
     stack: MemBuffer,
     stack_bytes: usize,
 }
@@ -380,6 +396,7 @@ impl Context<'_> {
         SCRATCH.with_borrow_mut(|scratch| {
             let scratch = scratch.get_or_insert_with(|| Scratch {
                 update: Vec::new(),
+                rel: Vec::new(),
                 stack: MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
                 stack_bytes: 0,
             });
@@ -395,7 +412,6 @@ impl Context<'_> {
                 scratch.stack = MemBuffer::new(need);
                 scratch.stack_bytes = need.unaligned_bytes_required();
             }
-            let mut ls = MatMut::from_column_major_slice_mut(block, nrows, ncols);
             with_local_map(sn.n(), |local| {
                 for (i, &r) in node.pattern.iter().enumerate() {
                     local[r as usize] = (ncols + i) as u32;
@@ -409,7 +425,8 @@ impl Context<'_> {
                     let rows = dn.pattern.len() - first;
                     let below = ld.subrows(dn.ncols + first, rows);
                     let (ld_mid, ld_bot) = below.split_at_row(mid);
-                    let mut upd = MatMut::from_column_major_slice_mut(&mut scratch.update[..rows * mid], rows, mid);
+                    let product = &mut scratch.update[..rows * mid];
+                    let mut upd = MatMut::from_column_major_slice_mut(&mut *product, rows, mid);
                     {
                         let (top, bot) = upd.rb_mut().split_at_row_mut(mid);
                         faer::linalg::matmul::triangular::matmul(
@@ -425,17 +442,18 @@ impl Context<'_> {
                         );
                         faer::linalg::matmul::matmul(bot, Accum::Replace, ld_bot, ld_mid.transpose(), 1.0, par);
                     }
-                    let rows_of = &dn.pattern[first..];
-                    for jj in 0..mid {
-                        let col = rows_of[jj] as usize - node.begin;
-                        for ii in jj..rows {
-                            let r = rows_of[ii] as usize;
-                            let at = if ii < mid { r - node.begin } else { local[r] as usize };
-                            ls[(at, col)] -= upd[(ii, jj)];
-                        }
-                    }
+                    // where the product's rows go in s's block: its own columns by subtraction,
+                    // its pattern rows through the row map
+                    let rel = &mut scratch.rel;
+                    rel.clear();
+                    rel.extend(dn.pattern[first..].iter().enumerate().map(|(ii, &r)| {
+                        let r = r as usize;
+                        if ii < mid { r - node.begin } else { local[r] as usize }
+                    }));
+                    scatter_subtract(block, nrows, product, rows, mid, rel);
                 }
             });
+            let ls = MatMut::from_column_major_slice_mut(block, nrows, ncols);
             let (mut top, bot) = ls.split_at_row_mut(ncols);
             faer::linalg::cholesky::llt::factor::cholesky_in_place(
                 top.rb_mut(),
@@ -452,6 +470,24 @@ impl Context<'_> {
             faer::linalg::triangular_solve::solve_lower_triangular_in_place(top.rb(), bot.transpose_mut(), par);
             Ok(())
         })
+    }
+}
+
+/// `block[rel[i], rel[j]] -= product[i, j]` for the lower triangle `i >= j` of the `rows x mid`
+/// product (column-major), `block` column-major with `nrows` rows; `rel[j]` for `j < mid` is
+/// also the column of the block. Entry by entry in the same order as an indexed loop (the
+/// same bits), without bounds checks in the inner loop: it runs once per entry of every update,
+/// and with faer's checked indexing it was a seventh of the factorisation.
+fn scatter_subtract(block: &mut [f64], nrows: usize, product: &[f64], rows: usize, mid: usize, rel: &[usize]) {
+    assert!(product.len() >= rows * mid && rel.len() == rows && mid <= rows);
+    assert!(rel.iter().all(|&r| r < nrows) && rel[..mid].iter().all(|&c| (c + 1) * nrows <= block.len()));
+    for jj in 0..mid {
+        let column = &mut block[rel[jj] * nrows..][..nrows];
+        let source = &product[jj * rows..][..rows];
+        for ii in jj..rows {
+            // SAFETY: rel[ii] < nrows = column.len() and ii < rows = source.len(), checked above
+            unsafe { *column.get_unchecked_mut(*rel.get_unchecked(ii)) -= *source.get_unchecked(ii) };
+        }
     }
 }
 

@@ -155,6 +155,17 @@ pub struct OrderingChoice {
     pub grading: f64,
 }
 
+impl OrderingChoice {
+    /// The multiply-subtract pairs (and divisions) of the kept ordering: the work of the
+    /// factorisation without the explicit zeros that supernodes add.
+    pub fn multiply_adds(&self) -> f64 {
+        match self.method {
+            Method::NestedDissection => self.flops_nested_dissection,
+            Method::MinimumDegree => self.flops_minimum_degree.expect("a kept minimum-degree ordering has its flops"),
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
