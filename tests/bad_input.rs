@@ -117,6 +117,28 @@ fn memory_estimate_covers_the_measured_peaks() {
     assert_eq!(signorini::mesh::MeshSpec::Structured(512).ndof().unwrap(), 2101250.0);
 }
 
+/// The next level of an adaptive loop is estimated from the previous level's measured peak where
+/// that is smaller than the per-unknown estimate and the bound is the machine's memory: Example
+/// 7.1's deep run peaked at 8.1 GiB with 8.46e6 unknowns, and the estimate alone (23 GiB) refused
+/// its next level of 1.22e7 unknowns on a 24 GiB machine.
+#[test]
+fn a_level_after_a_measured_one_is_estimated_from_its_peak_where_that_is_smaller() {
+    use signorini::memory::level_estimate;
+    use signorini::solve::memory_estimate;
+    const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+    let (n, previous) = (1.22e7, (8.46e6, 8.1 * GIB));
+    // without a measurement, or against an address-space limit: the per-unknown estimate
+    assert_eq!(level_estimate(n, None, true).0, memory_estimate(n));
+    assert_eq!(level_estimate(n, Some(previous), false).0, memory_estimate(n));
+    let (need, basis) = level_estimate(n, Some(previous), true);
+    assert!((need - 1.25 * 8.1 * GIB * n / 8.46e6).abs() < 1.0, "{need}");
+    assert!(need < 0.65 * memory_estimate(n) && basis.contains("previous level's peak"), "{basis}");
+    // a measured peak above the per-unknown estimate never raises it, nor does a level with
+    // fewer unknowns scale it down
+    assert_eq!(level_estimate(1.0e6, Some((5e5, 4.0 * GIB)), true).0, memory_estimate(1.0e6));
+    assert_eq!(level_estimate(1.0e6, Some((2e6, 1.0 * GIB)), true).0, 1.25 * GIB);
+}
+
 #[test]
 fn bad_probe_outside_the_domain_or_not_finite_is_an_error() {
     for p in ["2,0.5", "0.5,-0.1", "1.0000001,0.5", "-0.1,0.5"] {

@@ -242,10 +242,12 @@ pub fn solve_level(
     config: &AdaptConfig,
     reference: Option<Reference>,
     initial_active: Option<Vec<bool>>,
+    measured: Option<(f64, f64)>,
 ) -> Result<Solved, AdaptError> {
     let ndof = mesh.p2_ndof();
-    // before every level, not only the first: an adaptive loop grows until it does not fit
-    solve::check_memory(&format!("level {level} of the adaptive loop"), ndof as f64)
+    // before every level, not only the first: an adaptive loop grows until it does not fit;
+    // `measured`: the previous level's unknowns and peak resident bytes, if known
+    solve::check_memory_measured(&format!("level {level} of the adaptive loop"), ndof as f64, measured)
         .map_err(|error| AdaptError::Memory { level, error })?;
     let mut options = config.pdas.clone();
     if config.warm_start {
@@ -372,10 +374,11 @@ pub fn run_from(
             break;
         }
         let t_level = Instant::now();
+        let previous = records.last().and_then(|r: &LevelRecord| Some((r.ndof as f64, r.mem_peak_mib? * 1024.0 * 1024.0)));
         let measured = crate::memory::reset_peak_resident();
         let started_from = initial_active.take().filter(|_| config.warm_start);
         let Solved { mut record, solution: sol, estimate: est, marks } =
-            solve_level(problem, &mesh, level, config, reference, started_from.clone())?;
+            solve_level(problem, &mesh, level, config, reference, started_from.clone(), previous)?;
         let entry = LevelHistory {
             level,
             n_elements: mesh.n_triangles(),

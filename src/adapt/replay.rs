@@ -69,7 +69,7 @@ pub fn solve_stored_level(
 ) -> Result<(Mesh, Solved), AdaptError> {
     let mesh = mesh_at(mesh0, history, level)?;
     let start = initial_active(history, level)?;
-    let solved = super::solve_level(problem, &mesh, level, config, reference, start)?;
+    let solved = super::solve_level(problem, &mesh, level, config, reference, start, None)?;
     Ok((mesh, solved))
 }
 

@@ -10,7 +10,9 @@ use crate::mesh::{Mesh, MeshError, P2Nodes};
 use crate::problems::Problem;
 use std::time::Instant;
 
-pub use crate::memory::{Available, MemoryError, UNKNOWN_MEMORY_LIMIT, available_memory, check_memory, human_bytes, memory_estimate};
+pub use crate::memory::{
+    Available, MemoryError, UNKNOWN_MEMORY_LIMIT, available_memory, check_memory, check_memory_measured, human_bytes, memory_estimate,
+};
 
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {
