@@ -108,7 +108,10 @@ pub fn level_estimate(ndof: f64, measured: Option<(f64, f64)>, resident_bound: b
         Some((n0, peak)) if resident_bound && n0 > 0.0 && peak > 0.0 => {
             let scaled = MEASURED_MARGIN * peak * (ndof / n0).max(1.0);
             if scaled < coarse.0 {
-                (scaled, format!("1.25 x the previous level's peak {} at {n0:.0} unknowns, scaled to these", human_bytes(peak)))
+                (
+                    scaled,
+                    format!("{MEASURED_MARGIN} x the previous level's peak {} at {n0:.0} unknowns, scaled to these", human_bytes(peak)),
+                )
             } else {
                 coarse
             }
