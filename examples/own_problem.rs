@@ -58,6 +58,7 @@ fn main() -> anyhow::Result<()> {
     let why = match result.termination {
         Termination::LevelsReached => "all levels solved",
         Termination::MaxNdofReached => "the next level would exceed max_ndof",
+        Termination::StopNdofReached => "a level reached stop_ndof",
         Termination::StoppedByObserver => "stopped by the observer",
     };
     let kkt = result.solution.kkt();

@@ -231,6 +231,9 @@ struct AdaptArgs {
     /// Stop before a level with more unknowns than this.
     #[arg(long, allow_negative_numbers = true)]
     max_ndof: Option<usize>,
+    /// Stop after the first level with at least this many unknowns.
+    #[arg(long, allow_negative_numbers = true)]
+    stop_ndof: Option<usize>,
     /// Write the last level's mesh and solution to this VTU file (ParaView, meshio: displacement,
     /// contact force, active set, element indicators).
     #[arg(long, value_name = "PATH.vtu")]
@@ -279,6 +282,7 @@ fn flag_of(key: &str) -> &'static str {
     match key {
         "levels" => "--levels",
         "max_ndof" => "--max-ndof",
+        "stop_ndof" => "--stop-ndof",
         "theta" => "--theta",
         "estimator.c0" => "--c0",
         "pdas.max_iterations" => "--max-pdas-iterations",
@@ -352,6 +356,7 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
     let config = AdaptConfig {
         levels: args.levels,
         max_ndof: args.max_ndof,
+        stop_ndof: args.stop_ndof,
         refine: if args.uniform { Refine::Uniform } else { Refine::Adaptive },
         theta: args.theta,
         estimator: args.estimator.config()?,

@@ -427,6 +427,16 @@ fn run_reports_termination_and_final_state() {
     assert_eq!(r.termination, adapt::Termination::MaxNdofReached);
     assert!(r.records.last().unwrap().ndof <= 200 && r.records.len() < 10);
     assert_eq!(r.records.last().unwrap().n_elements, r.mesh.n_triangles());
+    // stop_ndof: the first level at or beyond it is the last, the one before is below it
+    let r = go(AdaptConfig { levels: 10, stop_ndof: Some(1000), ..Default::default() }, usize::MAX);
+    assert_eq!(r.termination, adapt::Termination::StopNdofReached);
+    let n = r.records.len();
+    assert!(
+        n < 10 && r.records[n - 1].ndof >= 1000 && r.records[n - 2].ndof < 1000,
+        "{:?}",
+        r.records.iter().map(|l| l.ndof).collect::<Vec<_>>()
+    );
+    assert_eq!(r.records[n - 1].n_elements, r.mesh.n_triangles());
 }
 
 /// Settings out of range are an error of the loop, before anything is solved (never a panic).

@@ -27,6 +27,7 @@ fn repaired_eta5_sees_tension_on_full_contact_patches() {
     let config = AdaptConfig {
         levels: 12,
         max_ndof: None,
+        stop_ndof: None,
         refine: Refine::Adaptive,
         theta: 0.5,
         estimator: EstimatorConfig { contact_term: ContactTerm::TensileOnFullContact, ..Default::default() },

@@ -87,6 +87,7 @@ impl Run<'_> {
                 theta: self.theta,
                 levels,
                 max_ndof: None,
+                stop_ndof: None,
                 estimator: self.estimator,
                 reference: None,
                 save_levels: vec![20],

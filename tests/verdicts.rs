@@ -176,6 +176,7 @@ fn record(id: &str, refine: Refine, levels: Vec<LevelRecord>) -> RunRecord {
         theta: 0.5,
         levels: levels.len(),
         max_ndof: None,
+        stop_ndof: None,
         estimator: EstimatorConfig::default(),
         reference: None,
         save_levels: vec![],

@@ -24,6 +24,8 @@ pub struct AdaptConfig {
     pub levels: usize,
     /// Stop before solving a level with more unknowns than this.
     pub max_ndof: Option<usize>,
+    /// Stop after solving the first level with at least this many unknowns (it is not refined).
+    pub stop_ndof: Option<usize>,
     pub refine: Refine,
     pub theta: f64,
     pub estimator: EstimatorConfig,
@@ -67,6 +69,7 @@ impl AdaptConfig {
         AdaptConfig {
             levels: spec.levels,
             max_ndof: spec.max_ndof,
+            stop_ndof: spec.stop_ndof,
             refine: spec.refine,
             theta: spec.theta,
             estimator: spec.estimator,
@@ -84,6 +87,9 @@ impl AdaptConfig {
         }
         if self.max_ndof == Some(0) {
             return bad("max_ndof", "a number of unknowns >= 1", "0".into());
+        }
+        if self.stop_ndof == Some(0) {
+            return bad("stop_ndof", "a number of unknowns >= 1", "0".into());
         }
         if !(self.theta > 0.0 && self.theta <= 1.0) {
             return bad("theta", "a number in (0, 1]", self.theta.to_string());
@@ -103,6 +109,7 @@ impl Default for AdaptConfig {
         AdaptConfig {
             levels: 20,
             max_ndof: None,
+            stop_ndof: None,
             refine: Refine::Adaptive,
             theta: 0.5,
             estimator: EstimatorConfig::default(),
@@ -186,6 +193,8 @@ pub enum Termination {
     LevelsReached,
     /// The next level would have had more unknowns than `AdaptConfig::max_ndof` (it was not solved).
     MaxNdofReached,
+    /// The last level solved has at least `AdaptConfig::stop_ndof` unknowns.
+    StopNdofReached,
     /// The observer returned `ControlFlow::Break` (checked before the other two: an observer that
     /// stops at the last level is reported here).
     StoppedByObserver,
@@ -386,7 +395,8 @@ pub fn run_from(
             initial_active: started_from.as_deref().map(Flags::encode),
             marks: Flags::encode(&marks),
         };
-        let next = if level + 1 == config.levels {
+        let reached = config.stop_ndof.is_some_and(|s| mesh.p2_ndof() >= s);
+        let next = if level + 1 == config.levels || reached {
             None
         } else {
             let t0 = Instant::now();
@@ -412,6 +422,9 @@ pub fn run_from(
         if flow.is_break() {
             termination = Termination::StoppedByObserver;
             break;
+        }
+        if reached {
+            termination = Termination::StopNdofReached;
         }
         match next {
             Some((m, active)) => {

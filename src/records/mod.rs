@@ -247,6 +247,10 @@ pub struct RunSpec {
     pub theta: f64,
     pub levels: usize,
     pub max_ndof: Option<usize>,
+    /// Stop after the first level with at least this many unknowns (a deep run "to at least
+    /// 1e7 NDF", whatever the marking makes of the last step); absent in runs without it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stop_ndof: Option<usize>,
     pub estimator: EstimatorConfig,
     /// Example 7.2 has no exact solution: errors are measured against a reference solution
     /// computed on a finer mesh (see `study::reference`), if this is set.
@@ -438,6 +442,7 @@ mod tests {
                 theta: 0.5,
                 levels: 2,
                 max_ndof: None,
+                stop_ndof: None,
                 estimator: EstimatorConfig::default(),
                 reference: None,
                 save_levels: vec![],

@@ -11,7 +11,8 @@
 //! quick_levels = 8           # the --quick form: the first levels of the same runs
 //! theta = 0.5
 //! refine = "adaptive"        # or "uniform"
-//! max_ndof = 2000000         # optional
+//! max_ndof = 2000000         # optional: no level with more unknowns is solved
+//! stop_ndof = 10000000       # optional: the first level with at least this many is the last
 //! save_levels = []           # levels written as VTU (and mesh JSON)
 //! [defaults.estimator]
 //! c0 = 0.45
@@ -109,6 +110,7 @@ struct RunToml {
     theta: Option<f64>,
     refine: Option<Refine>,
     max_ndof: Option<usize>,
+    stop_ndof: Option<usize>,
     save_levels: Option<Vec<usize>>,
     estimator: Option<EstimatorOverrides>,
     reference: Option<ReferenceToml>,
@@ -359,6 +361,7 @@ fn parse_run(
         theta,
         levels,
         max_ndof: r.max_ndof.or(d.max_ndof),
+        stop_ndof: r.stop_ndof.or(d.stop_ndof),
         estimator,
         reference: reference.map(|rf| ReferenceSpec {
             theta: rf.theta,
