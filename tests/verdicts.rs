@@ -66,13 +66,28 @@ fn verdicts_on_synthetic_rates() {
 }
 
 #[test]
-fn less_than_a_decade_is_inconclusive() {
-    // 6 levels growing by 1.3: 0.57 decades in all
+fn less_than_two_decades_is_inconclusive() {
+    // 6 levels growing by 1.35: 0.65 decades in all
     let ndof = ndofs(6);
     let mut rng = Lcg(3);
     let r = RateReport::from_values(&ndof, &values(&ndof, 1.5, 0.0, &mut rng)).unwrap();
     assert!(r.main.decades() < 1.0);
     assert_eq!(verdict::judge_rate(&r.main, 1.5), RateVerdict::Inconclusive);
+    // 13 levels: 1.56 decades, a clearly slow rate with a tight interval: still no verdict,
+    // and the range says why (one pre-asymptotic decade and a half is not a verdict)
+    let ndof = ndofs(13);
+    let r = RateReport::from_values(&ndof, &values(&ndof, 1.0, 0.0, &mut rng)).unwrap();
+    assert!((1.0..verdict::MIN_DECADES).contains(&r.main.decades()) && r.main.rate.half_width < 0.01);
+    assert_eq!(verdict::judge_rate(&r.main, 1.5), RateVerdict::Inconclusive);
+    assert!(r.main.range().contains("only 1.6 decade(s): no verdict"), "{}", r.main.range());
+    let g = verdict::growth(&ndof, &values(&ndof, -0.3, 0.0, &mut rng)).unwrap();
+    assert_eq!(verdict::judge_trend(&g), verdict::Trend::Short, "a growing trend over 1.6 decades is no verdict either");
+    // the same over 17 levels (2.2 decades) decides
+    let ndof = ndofs(17);
+    let r = RateReport::from_values(&ndof, &values(&ndof, 1.0, 0.0, &mut rng)).unwrap();
+    assert!(r.main.decades() >= verdict::MIN_DECADES);
+    assert_eq!(verdict::judge_rate(&r.main, 1.5), RateVerdict::NotReproduced);
+    assert!(!r.main.range().contains("no verdict"));
 }
 
 #[test]
@@ -248,12 +263,13 @@ fn fb_rows_on_synthetic_records() {
     let e = row(&c, "fb-error-rate");
     assert_eq!(e.verdict, Verdict::NotReproduced, "judged on eta_5 as written (rate 1.0): {}", e.measured);
     assert!(
-        e.measured.contains("adaptive (eta_5 as written) 1.00 ± 0.00") && e.measured.contains("without full-contact nodes 1.50 ± 0.00"),
+        e.measured.contains("eta_5 as written (fb/adaptive) 1.00 ± 0.00")
+            && e.measured.contains("without full-contact nodes (fb/adaptive_wfc) 1.50 ± 0.00"),
         "{}",
         e.measured
     );
     // the uniform run is fitted against h_min = NDF^-1/2: NDF^-1.25 is h^2.5
-    assert!(e.measured.contains("uniform 2.50 ± 0.00 (in h_min"), "{}", e.measured);
+    assert!(e.measured.contains("uniform (fb/uniform) 2.50 ± 0.00 (in h_min"), "{}", e.measured);
     let r = row(&c, "fb-reliability");
     assert_eq!(r.verdict, Verdict::Holds, "{}", r.measured);
     assert!(r.measured.contains("smallest reliable C_0 4.5e-3"), "{}", r.measured);
@@ -289,6 +305,18 @@ fn fb_rows_on_synthetic_records() {
     write_json(&dir.run_file("uniform"), &record("uniform", Refine::Uniform, bad)).unwrap();
     let c = claims::claims(&d).unwrap();
     assert_eq!(row(&c, "fb-reliability").verdict, Verdict::Fails);
+
+    // a deep study's runs, where stored, are the ones judged (and named)
+    let deep = StudyDir::new(&d, "deep");
+    std::fs::create_dir_all(deep.root.join("runs")).unwrap();
+    let mut as_written = record("fb_as_written", Refine::Adaptive, synthetic_levels(1.5, 0.0, 26));
+    as_written.study = "deep".into();
+    write_json(&deep.run_file("fb_as_written"), &as_written).unwrap();
+    let c = claims::claims(&d).unwrap();
+    let e = row(&c, "fb-error-rate");
+    assert_eq!(e.verdict, Verdict::Reproduced, "{}", e.measured);
+    assert!(e.measured.contains("eta_5 as written (deep/fb_as_written) 1.50 ± 0.00"), "{}", e.measured);
+    assert!(e.measured.contains("(fb/adaptive_wfc)"), "the variants the deep study lacks come from fb: {}", e.measured);
     let _ = std::fs::remove_dir_all(&d);
 }
 

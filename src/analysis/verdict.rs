@@ -6,10 +6,12 @@
 //! bisection refines in two-level staircases (one bisection halves an element's area, two halve
 //! its diameter), so a fit over consecutive levels depends on where the window starts; the fit
 //! therefore takes every other level (levels of the same parity as the window's last level). The
-//! window ends at a given level and reaches back until it spans at least one decade of NDF
+//! window ends at a given level and reaches back until it spans at least two decades of NDF
 //! ([`MIN_DECADES`]) and holds at least [`MIN_POINTS`] levels. The 95% interval is slope ± t_{0.975, n-2} x standard error (Student's t,
-//! n points). Stability: the same fit over the decades ending at the last level, two levels
-//! earlier and four levels earlier ([`RateReport::windows`]).
+//! n points). Stability: the same fit over the windows ending at the last level, two levels
+//! earlier and four levels earlier ([`RateReport::windows`]). A window shorter than two decades
+//! (a run that ends early) decides nothing: one decade of small meshes is pre-asymptotic more
+//! often than not, and a rate read there is not a verdict (its `range` says how short it is).
 //!
 //! **Round-off floor.** Deep runs reach errors near 1e-10 where the computed u_h carries round-off
 //! of its own (`LevelRecord::roundoff_floor`). Error fits stop before the first level whose error
@@ -22,19 +24,20 @@
 //! (2c for a claim of NDF^-c) with the band doubled (± 0.2 in h is ± 0.1 in NDF).
 //!
 //! **Rules** ([`judge_rate`]), for a claimed rate c and interval [lo, hi]:
+//! 0. a window spanning less than two decades of NDF: *inconclusive*, whatever the interval;
 //! 1. the interval lies below c - 0.1: *not reproduced*; above c + 0.1: *different (faster)*;
-//! 2. the whole interval lies inside [c - 0.1, c + 0.1] and the window spans at least one decade
-//!    of NDF: *reproduced*;
-//! 3. anything else (an interval that reaches outside the band, however close its centre is to c,
-//!    or a window of less than a decade): *inconclusive*.
+//! 2. the whole interval lies inside [c - 0.1, c + 0.1]: *reproduced*;
+//! 3. anything else (an interval that reaches outside the band, however close its centre is to
+//!    c): *inconclusive*.
 //!
 //! A verdict is *fragile* ([`window_fragility`]) when the windows ending two and four levels
 //! earlier give another verdict; `claims` also marks a row fragile when the dense sampling of the
 //! error gives another verdict.
 //!
-//! **Bounded** ([`judge_trend`]): the slope of log(quantity) against log(NDF) has an interval
-//! containing 0 and no wider than 0.3; an interval containing 0 but wider than 0.3 is
-//! inconclusive, whatever its centre (a flat centre is no evidence with a wide interval).
+//! **Bounded** ([`judge_trend`]): the slope of log(quantity) against log(NDF), over the same
+//! two-decade window, has an interval containing 0 and no wider than 0.3; an interval containing 0
+//! but wider than 0.3 is inconclusive, whatever its centre (a flat centre is no evidence with a
+//! wide interval), and so is a window shorter than two decades.
 
 use crate::records::RunRecord;
 
@@ -42,8 +45,9 @@ use crate::records::RunRecord;
 pub const RATE_BAND: f64 = 0.1;
 /// An interval wider than this decides nothing.
 pub const MAX_WIDTH: f64 = 0.3;
-/// The fit window spans at least this many decades of NDF.
-pub const MIN_DECADES: f64 = 1.0;
+/// The fit window spans at least this many decades of NDF; a shorter one (the run ends
+/// early) decides nothing ([`judge_rate`], [`judge_trend`]).
+pub const MIN_DECADES: f64 = 2.0;
 /// The fit window holds at least this many levels (where the run has them): with fewer, the t
 /// factor of the interval is large (t_{0.975, 3} = 3.18).
 pub const MIN_POINTS: usize = 5;
@@ -91,15 +95,21 @@ impl RateFit {
             if self.rate.half_width.is_finite() { format!("{:.2}", self.rate.half_width) } else { "inf".into() }
         )
     }
-    /// "levels 14–24 every other, NDF 3.1e4–3.1e5", with "in h_min, " first for a fit against h_min
+    /// Whether the window is long enough for a verdict ([`MIN_DECADES`]).
+    pub fn spans_enough(&self) -> bool {
+        self.decades() >= MIN_DECADES
+    }
+    /// "levels 14–24 every other, NDF 3.1e4–3.1e6", with "in h_min, " first for a fit against
+    /// h_min and ", only 1.0 decade(s): no verdict" last for a window shorter than [`MIN_DECADES`]
     pub fn range(&self) -> String {
         format!(
-            "{}levels {}–{} every other, NDF {:.1e}–{:.1e}",
+            "{}levels {}–{} every other, NDF {:.1e}–{:.1e}{}",
             if self.abscissa == Abscissa::InverseHMin { "in h_min, " } else { "" },
             self.first_level,
             self.last_level,
             self.first_ndof as f64,
-            self.last_ndof as f64
+            self.last_ndof as f64,
+            if self.spans_enough() { String::new() } else { format!(", only {:.1} decade(s): no verdict", self.decades()) }
         )
     }
     /// A claim of NDF^-c and its band in this fit's variable: (2c, 2 band) in h_min (NDF ~ h^-2).
@@ -114,14 +124,9 @@ impl RateFit {
 /// Levels of the window ending at `end`: end, end - 2, ... back until the window spans
 /// `MIN_DECADES` of NDF and holds `MIN_POINTS` levels (or to the start of the run), in increasing order.
 pub fn window(ndof: &[usize], end: usize) -> Vec<usize> {
-    window_spanning(ndof, end, MIN_DECADES)
-}
-
-/// [`window`] spanning `decades` of NDF instead of `MIN_DECADES` (the deep runs' two decades).
-pub fn window_spanning(ndof: &[usize], end: usize, decades: f64) -> Vec<usize> {
     let mut out = vec![end];
     let mut i = end;
-    while i >= 2 && ((ndof[end] as f64 / ndof[i] as f64).log10() < decades || out.len() < MIN_POINTS) {
+    while i >= 2 && ((ndof[end] as f64 / ndof[i] as f64).log10() < MIN_DECADES || out.len() < MIN_POINTS) {
         i -= 2;
         out.push(i);
     }
@@ -140,14 +145,8 @@ pub fn rate_over(ndof: &[usize], values: &[Option<f64>], end: usize) -> Option<R
 
 /// As [`rate_over`] (the window chosen in NDF), fitted against `x` (one per level, positive).
 pub fn rate_over_x(ndof: &[usize], x: &[f64], abscissa: Abscissa, values: &[Option<f64>], end: usize) -> Option<RateFit> {
-    rate_spanning(ndof, x, abscissa, values, end, MIN_DECADES)
-}
-
-/// [`rate_over_x`] over a window of `decades` of NDF ([`window_spanning`]).
-pub fn rate_spanning(ndof: &[usize], x: &[f64], abscissa: Abscissa, values: &[Option<f64>], end: usize, decades: f64) -> Option<RateFit> {
     let floor = ROUND_OFF * values.iter().flatten().cloned().fold(0.0, f64::max);
-    let levels: Vec<usize> =
-        window_spanning(ndof, end, decades).into_iter().rev().take_while(|&l| values[l].is_some_and(|v| v > floor)).collect();
+    let levels: Vec<usize> = window(ndof, end).into_iter().rev().take_while(|&l| values[l].is_some_and(|v| v > floor)).collect();
     let pts: Vec<(f64, f64)> = levels.iter().map(|&l| (x[l].ln(), -values[l].unwrap().ln())).collect();
     let rate = fit_line(&pts)?;
     let (first, last) = (*levels.last()?, levels[0]);
@@ -214,34 +213,22 @@ impl RateReport {
 
     /// Fitted against `x` ([`rate_over_x`]).
     pub fn from_values_x(ndof: &[usize], x: &[f64], abscissa: Abscissa, values: &[Option<f64>]) -> Option<RateReport> {
-        Self::spanning(ndof, x, abscissa, values, MIN_DECADES)
-    }
-
-    /// [`RateReport::from_values_x`] over windows of `decades` of NDF.
-    pub fn spanning(ndof: &[usize], x: &[f64], abscissa: Abscissa, values: &[Option<f64>], decades: f64) -> Option<RateReport> {
         let end = ndof.len().checked_sub(1)?;
-        let main = rate_spanning(ndof, x, abscissa, values, end, decades)?;
-        let windows = (0..3)
-            .filter_map(|k| end.checked_sub(k * WINDOW_SHIFT))
-            .filter_map(|e| rate_spanning(ndof, x, abscissa, values, e, decades))
-            .collect();
+        let main = rate_over_x(ndof, x, abscissa, values, end)?;
+        let windows =
+            (0..3).filter_map(|k| end.checked_sub(k * WINDOW_SHIFT)).filter_map(|e| rate_over_x(ndof, x, abscissa, values, e)).collect();
         Some(RateReport { main, windows })
     }
 
     /// The rate of `values` (one per level of `run`) against the run's [`abscissa_of`].
     pub fn of_values(run: &RunRecord, values: &[Option<f64>]) -> Option<RateReport> {
-        Self::of_values_spanning(run, values, MIN_DECADES)
-    }
-
-    /// [`RateReport::of_values`] over windows of `decades` of NDF.
-    pub fn of_values_spanning(run: &RunRecord, values: &[Option<f64>], decades: f64) -> Option<RateReport> {
         let ndof: Vec<usize> = run.levels.iter().map(|l| l.ndof).collect();
         let abscissa = abscissa_of(run);
         let x: Vec<f64> = match abscissa {
             Abscissa::Ndof => ndof.iter().map(|&n| n as f64).collect(),
             Abscissa::InverseHMin => run.levels.iter().map(|l| 1.0 / l.h_min).collect(),
         };
-        Self::spanning(&ndof, &x, abscissa, values, decades)
+        Self::from_values_x(&ndof, &x, abscissa, values)
     }
 
     pub fn of(run: &RunRecord, name: &str) -> Option<RateReport> {
@@ -300,11 +287,13 @@ pub fn abscissa_of(run: &RunRecord) -> Abscissa {
 pub fn judge_rate(fit: &RateFit, claim: f64) -> RateVerdict {
     let (lo, hi) = (fit.rate.lo(), fit.rate.hi());
     let (c, band) = fit.claim_in_abscissa(claim);
-    if hi < c - band {
+    if !fit.spans_enough() {
+        RateVerdict::Inconclusive
+    } else if hi < c - band {
         RateVerdict::NotReproduced
     } else if lo > c + band {
         RateVerdict::Different
-    } else if lo >= c - band && hi <= c + band && fit.decades() >= MIN_DECADES {
+    } else if lo >= c - band && hi <= c + band {
         RateVerdict::Reproduced
     } else {
         RateVerdict::Inconclusive
@@ -327,7 +316,8 @@ pub fn window_fragility(rep: &RateReport, claim: f64) -> Option<String> {
     })
 }
 
-/// Trend of a quantity: slope of log(value) against log(NDF) over the last decade (positive: growing).
+/// Trend of a quantity: slope of log(value) against log(NDF) over the last two decades
+/// ([`window`]; positive: growing).
 pub fn growth(ndof: &[usize], values: &[Option<f64>]) -> Option<RateFit> {
     let mut f = rate_over(ndof, values, ndof.len().checked_sub(1)?)?;
     f.rate.slope = -f.rate.slope;
@@ -342,6 +332,8 @@ pub enum Trend {
     Falling,
     /// The interval contains 0 but is wider than `MAX_WIDTH`: it cannot tell bounded from growing.
     Inconclusive,
+    /// The window spans less than [`MIN_DECADES`]: no verdict, whatever the interval.
+    Short,
 }
 
 impl Trend {
@@ -351,6 +343,7 @@ impl Trend {
             Trend::Growing => "growing",
             Trend::Falling => "falling",
             Trend::Inconclusive => "inconclusive (interval wider than 0.3)",
+            Trend::Short => "inconclusive (window shorter than two decades)",
         }
     }
 }
@@ -359,7 +352,9 @@ impl Trend {
 /// containing 0 is inconclusive, whatever its centre).
 pub fn judge_trend(growth: &RateFit) -> Trend {
     let contains_zero = growth.rate.lo() <= 0.0 && 0.0 <= growth.rate.hi();
-    if contains_zero && growth.rate.width() <= MAX_WIDTH {
+    if !growth.spans_enough() {
+        Trend::Short
+    } else if contains_zero && growth.rate.width() <= MAX_WIDTH {
         Trend::Bounded
     } else if contains_zero {
         Trend::Inconclusive

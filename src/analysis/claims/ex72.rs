@@ -3,9 +3,9 @@
 //! singularity, the error away from the corners, eta_6 and eta_7 at the free boundary, and where
 //! the adaptive mesh refines.
 
-use super::deep::DEEP_DECADES;
 use super::{
-    Claim, Ctx, EX72_NU, OPTIMAL, Q, Verdict, estimator_text, fragility, growth_text, halving_exponents, judge, latest_mesh, rate_text, run,
+    Claim, Ctx, EX72_NU, OPTIMAL, Q, Verdict, estimator_text, fragility, growth_text, halving_exponents, judge, latest_mesh, rate_text,
+    run, source,
 };
 use crate::records::{RunRecord, StudyDir};
 use crate::verdict::{self, RateReport, RateVerdict, refinement};
@@ -18,14 +18,8 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let u72 = run(&ex72, "uniform");
     let wfc = ctx.pick(&ct, "ex72_without_full_contact");
     let aw = run(&ct, "ex72_as_written");
-    let errors = Errors::of(&large).unwrap_or(Errors {
-        study: "ex72",
-        adaptive: a72,
-        without_full_contact: None,
-        uniform: u72,
-        decades: verdict::MIN_DECADES,
-    });
-    out.push(rates(ctx, a72));
+    let errors = Errors::of(&large).unwrap_or(Errors { study: "ex72", adaptive: a72, without_full_contact: None, uniform: u72 });
+    out.push(rates(ctx, errors.adaptive));
     out.push(error(ctx, &errors, aw, wfc));
     out.push(corners(ctx, a72, &errors));
     out.push(away(ctx, &errors));
@@ -34,16 +28,15 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     Ok(())
 }
 
-/// The runs the true-error rows fit: the deep study `ex72_large` (reference of at least 4e6
-/// unknowns, runs to about 1e6, windows of [`DEEP_DECADES`]) where it holds errors, else `ex72`
-/// (reference 2.5e5, one decade).
+/// The runs the true-error rows (and the estimator's rates) fit: the deep study `ex72_large`
+/// (reference of at least 4e6 unknowns, runs to about 1e6) where it holds errors, else `ex72`
+/// (reference 2.5e5).
 struct Errors<'a> {
     study: &'static str,
     adaptive: Option<&'a RunRecord>,
     /// eta_5 without full-contact nodes (only in `ex72_large`)
     without_full_contact: Option<&'a RunRecord>,
     uniform: Option<&'a RunRecord>,
-    decades: f64,
 }
 
 impl<'a> Errors<'a> {
@@ -54,17 +47,15 @@ impl<'a> Errors<'a> {
             adaptive: Some(adaptive),
             without_full_contact: run(large, "without_full_contact"),
             uniform: run(large, "uniform"),
-            decades: DEEP_DECADES,
         })
     }
 
-    /// "study ex72_large, reference NDF 4485286, windows of 2 decades"
+    /// "study ex72_large, reference NDF 4485286"
     fn source(&self) -> String {
         format!(
-            "study {}, reference NDF {}, windows of at least {} decade(s)",
+            "study {}, reference NDF {}",
             self.study,
             self.adaptive.and_then(|r| r.reference_ndof).map(|n| n.to_string()).unwrap_or("none".into()),
-            self.decades
         )
     }
 }
@@ -83,7 +74,8 @@ fn rates(ctx: &Ctx, a72: Option<&RunRecord>) -> Claim {
             String::new()
         } else {
             format!(
-                "{}; {}",
+                "{}: {}; {}",
+                source(a72),
                 estimator_text(ctx, a72),
                 names[1..].iter().zip(&reps[1..]).map(|(n, r)| rate_text(n, r.as_ref(), Some(OPTIMAL))).collect::<Vec<_>>().join("; ")
             )
@@ -104,25 +96,19 @@ fn rates(ctx: &Ctx, a72: Option<&RunRecord>) -> Claim {
 fn error(ctx: &Ctx, errors: &Errors, aw: Option<&RunRecord>, wfc: Option<&RunRecord>) -> Claim {
     // the true error against the reference, whose own error is estimated from the measured rate
     let a72 = errors.adaptive;
-    let err = ctx.rate_spanning(a72, Q::Error, errors.decades);
+    let err = ctx.rate(a72, Q::Error);
     let deep_wfc = errors.without_full_contact.map(|w| {
         let e = ctx.values(w, Q::Error).last().copied().flatten().unwrap_or(f64::NAN);
         format!(
             "{} (to NDF {}, last error {e:.1e})",
-            rate_text(
-                "without full-contact nodes: error rate",
-                ctx.rate_spanning(Some(w), Q::Error, errors.decades).as_ref(),
-                Some(OPTIMAL)
-            ),
+            rate_text("without full-contact nodes: error rate", ctx.rate(Some(w), Q::Error).as_ref(), Some(OPTIMAL)),
             w.levels.last().map_or(0, |l| l.ndof)
         )
     });
     // The reference marks without full-contact nodes: where a run marked so is on record, its
     // rate carries the extrapolation (it is the reference's own sequence of meshes, cut short).
     let (along, along_err, along_name) = match errors.without_full_contact {
-        Some(w) => {
-            (Some(w), ctx.rate_spanning(Some(w), Q::Error, errors.decades), "without full-contact nodes, marked as the reference is")
-        }
+        Some(w) => (Some(w), ctx.rate(Some(w), Q::Error), "without full-contact nodes, marked as the reference is"),
         None => (a72, err.clone(), "eta_5 as written"),
     };
     let reference_error = along.zip(along_err.as_ref()).and_then(|(r, e)| {
@@ -195,7 +181,7 @@ fn corners(ctx: &Ctx, a72: Option<&RunRecord>, errors: &Errors) -> Claim {
             )
         })
         .unwrap_or_default();
-    let eu = ctx.rate_spanning(u72, Q::Error, errors.decades);
+    let eu = ctx.rate(u72, Q::Error);
     Claim {
         fragile: fragility(eu.as_ref(), lambda / 2.0),
         id: "7.2-corners (beyond the paper)",
@@ -231,12 +217,12 @@ fn corners(ctx: &Ctx, a72: Option<&RunRecord>, errors: &Errors) -> Claim {
 /// Row of Example 7.2: the error away from the corners: on Gamma_C and on x >= 1/2.
 fn away(ctx: &Ctx, errors: &Errors) -> Claim {
     // the error away from the corners: on Gamma_C and on x >= 1/2
-    let (a72, u72, d) = (errors.adaptive, errors.uniform, errors.decades);
+    let (a72, u72) = (errors.adaptive, errors.uniform);
     let away: Vec<(&str, Option<RateReport>)> = vec![
-        ("adaptive, on Gamma_C", ctx.rate_spanning(a72, Q::Field("err_contact"), d)),
-        ("adaptive, on x >= 1/2", ctx.rate_spanning(a72, Q::Field("err_right_half"), d)),
-        ("uniform, on Gamma_C", ctx.rate_spanning(u72, Q::Field("err_contact"), d)),
-        ("uniform, on x >= 1/2", ctx.rate_spanning(u72, Q::Field("err_right_half"), d)),
+        ("adaptive, on Gamma_C", ctx.rate(a72, Q::Field("err_contact"))),
+        ("adaptive, on x >= 1/2", ctx.rate(a72, Q::Field("err_right_half"))),
+        ("uniform, on Gamma_C", ctx.rate(u72, Q::Field("err_contact"))),
+        ("uniform, on x >= 1/2", ctx.rate(u72, Q::Field("err_right_half"))),
     ];
     let have = away.iter().any(|a| a.1.is_some());
     Claim {
