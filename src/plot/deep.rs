@@ -2,7 +2,7 @@
 //!
 //! | figure | study / runs | shows |
 //! |---|---|---|
-//! | `deep_error` | `deep`, all runs | one panel per problem (7.1, fb): `err_quadrature` vs NDF for eta_5 as written, without full-contact nodes, repaired (adaptive) and uniform refinement, a style per run, log-log, NDF^-3/2 below all; the rows `7.1-deep`, `fb-deep` of CLAIMS fit the last two decades |
+//! | `deep_error` | `deep`, all runs | one panel per problem (7.1, fb): `err_quadrature` vs NDF for eta_5 as written, without full-contact nodes, repaired (adaptive) and uniform refinement, a style per run, log-log, NDF^-3/2 below all; the rows `7.1-error-rate`, `fb-error-rate` of CLAIMS fit the last two decades |
 //! | `deep_floor` | `deep`, `*_as_written` and `*_uniform` | one panel per problem: the error, the estimate C_0 eta_h and the round-off floor of u_h (`roundoff_floor`, dotted: 10x it, below which CLAIMS fits no error) against NDF |
 
 use super::render::{LineFigure, MARKERS, Panel};
