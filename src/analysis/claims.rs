@@ -160,11 +160,12 @@ impl Ctx<'_> {
 
     /// The levels of `r` a fit of `q` uses: for an error (any `err_*` field) and the efficiency
     /// (estimate / error), those before the error reaches [`verdict::FLOOR_MARGIN`] x the
-    /// round-off floor.
+    /// round-off floor; for another field, those up to its last value above round-off
+    /// ([`verdict::above_round_off`]).
     fn fitted<'a>(&self, r: &'a RunRecord, q: Q) -> std::borrow::Cow<'a, RunRecord> {
         match q {
             Q::Field(f) if f.starts_with("err_") => verdict::above_floor(r, &self.values(r, q)),
-            Q::Field(_) => std::borrow::Cow::Borrowed(r),
+            Q::Field(_) => verdict::above_round_off(r, &self.values(r, q)),
             Q::Error | Q::Efficiency | Q::EfficiencyOverLh | Q::EfficiencyL1 => verdict::above_floor(r, &self.values(r, Q::Error)),
         }
     }

@@ -153,6 +153,21 @@ pub fn rate_over_x(ndof: &[usize], x: &[f64], abscissa: Abscissa, values: &[Opti
     Some(RateFit { rate, abscissa, first_level: first, last_level: last, first_ndof: ndof[first], last_ndof: ndof[last] })
 }
 
+/// `run` without its trailing levels whose value is round-off (at or below [`ROUND_OFF`] x the
+/// largest value of the run: a quantity that is zero for the exact solution, like Example 7.1's
+/// eta_4, decays to 1e-17): the fit of such a quantity ends where it was last above round-off
+/// (its range says where) instead of finding no level at all.
+pub fn above_round_off<'a>(run: &'a RunRecord, values: &[Option<f64>]) -> std::borrow::Cow<'a, RunRecord> {
+    let floor = ROUND_OFF * values.iter().flatten().cloned().fold(0.0, f64::max);
+    let keep = values.iter().rposition(|v| v.is_some_and(|v| v > floor)).map_or(0, |l| l + 1);
+    if keep == run.levels.len() {
+        return std::borrow::Cow::Borrowed(run);
+    }
+    let mut cut = run.clone();
+    cut.levels.truncate(keep);
+    std::borrow::Cow::Owned(cut)
+}
+
 /// The first level of `run` whose error (`errors`, one per level) is below [`FLOOR_MARGIN`] x the
 /// level's round-off floor: from there on the error measures the round-off of u_h, not the
 /// discretisation. None where every error is above (or the run has no floor on record).

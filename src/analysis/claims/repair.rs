@@ -20,13 +20,20 @@ use super::{Claim, Ctx, OPTIMAL, Q, Verdict, c0_text, deep_or, growth_text, rate
 use crate::records::{RunRecord, StudyDir};
 use crate::verdict::{self, RateVerdict, Trend};
 
-/// The NDF a uniform run needs for the error `err` (same interpolation), None outside its range.
-pub(super) fn uniform_ndof_for(uniform: &RunRecord, err_field: &str, err: f64) -> Option<f64> {
+/// The NDF a uniform run needs for the error `err`, log-log interpolated between its levels of
+/// one parity, or extrapolated along its last two such levels for an error below its last
+/// (`true` then); None above its first error.
+pub(super) fn uniform_ndof_for(uniform: &RunRecord, err_field: &str, err: f64) -> Option<(f64, bool)> {
     let pts = same_parity(uniform, err_field);
-    pts.windows(2).find(|w| w[1].1 <= err && err <= w[0].1).map(|w| {
+    let along = |w: &[(f64, f64)]| {
         let t = (err / w[0].1).ln() / (w[1].1 / w[0].1).ln();
         (w[0].0.ln() + t * (w[1].0 / w[0].0).ln()).exp()
-    })
+    };
+    if let Some(w) = pts.windows(2).find(|w| w[1].1 <= err && err <= w[0].1) {
+        return Some((along(w), false));
+    }
+    let last = pts.len().checked_sub(2).map(|i| &pts[i..])?;
+    (err < last[1].1 && last[1].1 < last[0].1).then(|| (along(last), true))
 }
 
 /// (NDF, error) of the levels with the parity of the last one, increasing NDF.
@@ -50,10 +57,19 @@ pub(super) fn unknowns_text(adaptive: &RunRecord, uniform: &RunRecord, err_field
     };
     let n = l.ndof as f64;
     match uniform_ndof_for(uniform, err_field, e) {
-        Some(nu) => (
+        Some((nu, extrapolated)) => (
             format!(
-                "at NDF {n:.2e} (level {}) the adaptive error is {e:.3e}; uniform refinement reaches it at NDF {nu:.2e}, interpolated on its levels of one parity: adaptive / uniform unknowns {:.2}",
+                "at NDF {n:.2e} (level {}) the adaptive error is {e:.3e}; uniform refinement reaches it at NDF {nu:.2e}, {}: adaptive / uniform unknowns {:.2}",
                 l.level,
+                if extrapolated {
+                    format!(
+                        "extrapolated along its last two levels of one parity (its last error {:.3e} at NDF {:.2e})",
+                        same_parity(uniform, err_field).last().map_or(f64::NAN, |p| p.1),
+                        same_parity(uniform, err_field).last().map_or(f64::NAN, |p| p.0)
+                    )
+                } else {
+                    "interpolated on its levels of one parity".to_string()
+                },
                 n / nu
             ),
             Some(n < nu),
