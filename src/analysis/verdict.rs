@@ -436,24 +436,28 @@ mod tests {
 
     #[test]
     fn reproduced_only_when_the_whole_interval_lies_in_the_band() {
-        assert_eq!(judge_rate(&fit(1.52, 0.05, 1.5), 1.5), RateVerdict::Reproduced);
-        assert_eq!(judge_rate(&fit(1.42, 0.02, 1.5), 1.5), RateVerdict::Reproduced, "inside the band without containing c");
+        assert_eq!(judge_rate(&fit(1.52, 0.05, 2.5), 1.5), RateVerdict::Reproduced);
+        assert_eq!(judge_rate(&fit(1.42, 0.02, 2.5), 1.5), RateVerdict::Reproduced, "inside the band without containing c");
         // touches c, 0.29 wide: it reaches outside the band, however central
-        assert_eq!(judge_rate(&fit(1.355, 0.146, 1.5), 1.5), RateVerdict::Inconclusive);
-        assert_eq!(judge_rate(&fit(1.5, 0.145, 1.5), 1.5), RateVerdict::Inconclusive, "centred on c, wider than the band");
-        assert_eq!(judge_rate(&fit(1.2, 0.05, 1.5), 1.5), RateVerdict::NotReproduced);
-        assert_eq!(judge_rate(&fit(1.8, 0.05, 1.5), 1.5), RateVerdict::Different);
-        assert_eq!(judge_rate(&fit(1.5, 0.01, 0.8), 1.5), RateVerdict::Inconclusive, "less than a decade");
+        assert_eq!(judge_rate(&fit(1.355, 0.146, 2.5), 1.5), RateVerdict::Inconclusive);
+        assert_eq!(judge_rate(&fit(1.5, 0.145, 2.5), 1.5), RateVerdict::Inconclusive, "centred on c, wider than the band");
+        assert_eq!(judge_rate(&fit(1.2, 0.05, 2.5), 1.5), RateVerdict::NotReproduced);
+        assert_eq!(judge_rate(&fit(1.8, 0.05, 2.5), 1.5), RateVerdict::Different);
+        // a window shorter than two decades decides nothing, however clear the interval
+        assert_eq!(judge_rate(&fit(1.5, 0.01, 1.9), 1.5), RateVerdict::Inconclusive, "less than two decades");
+        assert_eq!(judge_rate(&fit(1.0, 0.01, 1.5), 1.5), RateVerdict::Inconclusive, "a slow rate over a decade and a half");
+        assert_eq!(judge_rate(&fit(2.0, 0.01, 1.5), 1.5), RateVerdict::Inconclusive, "a fast rate over a decade and a half");
     }
 
     #[test]
     fn bounded_only_with_a_narrow_interval_around_zero() {
-        assert_eq!(judge_trend(&fit(0.02, 0.12, 1.0)), Trend::Bounded);
+        assert_eq!(judge_trend(&fit(0.02, 0.12, 2.0)), Trend::Bounded);
         // contains 0 but 0.43 wide: no verdict, even with a flat centre (the old |slope| < 0.05 escape)
-        assert_eq!(judge_trend(&fit(0.02, 0.215, 1.0)), Trend::Inconclusive);
-        assert_eq!(judge_trend(&fit(-0.02, 0.37, 1.0)), Trend::Inconclusive);
-        assert_eq!(judge_trend(&fit(0.04, 0.01, 1.0)), Trend::Growing, "a small slope known precisely is a trend");
-        assert_eq!(judge_trend(&fit(-0.14, 0.11, 1.0)), Trend::Falling);
+        assert_eq!(judge_trend(&fit(0.02, 0.215, 2.0)), Trend::Inconclusive);
+        assert_eq!(judge_trend(&fit(-0.02, 0.37, 2.0)), Trend::Inconclusive);
+        assert_eq!(judge_trend(&fit(0.04, 0.01, 2.0)), Trend::Growing, "a small slope known precisely is a trend");
+        assert_eq!(judge_trend(&fit(-0.14, 0.11, 2.0)), Trend::Falling);
+        assert_eq!(judge_trend(&fit(0.3, 0.01, 1.5)), Trend::Short, "a clear growth over a decade and a half is no verdict");
     }
 
     #[test]
@@ -490,15 +494,18 @@ mod tests {
     }
 
     #[test]
-    fn window_reaches_back_one_decade_on_every_other_level() {
-        let ndof: Vec<usize> = (0..12).map(|l| 100 * 2usize.pow(l)).collect();
-        // one decade is reached at level 7 (2^4 >= 10), five points at level 3
-        assert_eq!(window(&ndof, 11), vec![3, 5, 7, 9, 11]);
+    fn window_reaches_back_two_decades_on_every_other_level() {
+        let ndof: Vec<usize> = (0..14).map(|l| 100 * 2usize.pow(l)).collect();
+        // two decades are reached at level 5 (2^8 >= 100), five points at level 5 too
+        assert_eq!(window(&ndof, 13), vec![5, 7, 9, 11, 13]);
         assert_eq!(window(&ndof, 2), vec![0, 2]);
-        // slow growth: the decade decides
-        let slow: Vec<usize> = (0..30).map(|l| (100.0 * 1.2f64.powi(l)) as usize).collect();
-        let w = window(&slow, 29);
-        assert!((slow[29] as f64 / slow[w[0]] as f64) >= 10.0 && (slow[29] as f64 / slow[w[1]] as f64) < 10.0, "{w:?}");
+        // fast growth: the five points decide (level 3 spans 2^10)
+        let fast: Vec<usize> = (0..14).map(|l| 100 * 4usize.pow(l)).collect();
+        assert_eq!(window(&fast, 13), vec![5, 7, 9, 11, 13]);
+        // slow growth: the two decades decide
+        let slow: Vec<usize> = (0..60).map(|l| (100.0 * 1.2f64.powi(l)) as usize).collect();
+        let w = window(&slow, 59);
+        assert!((slow[59] as f64 / slow[w[0]] as f64) >= 100.0 && (slow[59] as f64 / slow[w[1]] as f64) < 100.0, "{w:?}");
     }
 }
 
