@@ -383,7 +383,7 @@ pub fn run_from(
             break;
         }
         let t_level = Instant::now();
-        let previous = records.last().and_then(|r: &LevelRecord| r.mem_peak_mib.map(|mib| (r.ndof as f64, mib * 1024.0 * 1024.0)));
+        let previous = records.last().and_then(LevelRecord::measured_peak);
         let measured = crate::memory::reset_peak_resident();
         let started_from = initial_active.take().filter(|_| config.warm_start);
         let Solved { mut record, solution: sol, estimate: est, marks } =

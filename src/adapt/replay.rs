@@ -58,18 +58,23 @@ fn initial_active(history: &History, level: usize) -> Result<Option<Vec<bool>>, 
 }
 
 /// Rebuild level `level` of a run from its initial mesh and history and solve it again, as the
-/// loop did: the same mesh, the same warm start, so the same record (timings aside).
+/// loop did: the same mesh, the same warm start, so the same record (timings aside). `stored`
+/// is the level's stored record, if there is one: its measured peak is what the memory check
+/// scales from (a 1.2e7-unknown level that peaked at 11.7 GiB is not refused by the 23 GiB of
+/// the per-unknown estimate).
 pub fn solve_stored_level(
     problem: &dyn Problem,
     mesh0: Mesh,
     config: &AdaptConfig,
     history: &History,
     level: usize,
+    stored: Option<&LevelRecord>,
     reference: Option<Reference>,
 ) -> Result<(Mesh, Solved), AdaptError> {
     let mesh = mesh_at(mesh0, history, level)?;
     let start = initial_active(history, level)?;
-    let solved = super::solve_level(problem, &mesh, level, config, reference, start, None)?;
+    let measured = stored.and_then(LevelRecord::measured_peak);
+    let solved = super::solve_level(problem, &mesh, level, config, reference, start, measured)?;
     Ok((mesh, solved))
 }
 

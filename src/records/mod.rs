@@ -223,6 +223,15 @@ pub struct LevelRecord {
     pub mem_peak_mib: Option<f64>,
 }
 
+impl LevelRecord {
+    /// (unknowns, peak resident bytes) of this level where its peak was measured: what the
+    /// memory check of a later level, or of the same level solved again, is scaled from
+    /// (`solve::check_memory_measured`).
+    pub fn measured_peak(&self) -> Option<(f64, f64)> {
+        self.mem_peak_mib.map(|mib| (self.ndof as f64, mib * 1024.0 * 1024.0))
+    }
+}
+
 /// Whether a level record's field is a measurement of the machine (timings `t_*`, memory
 /// `mem_*`), which no two runs share and the drift check never compares.
 pub fn is_measurement(field: &str) -> bool {

@@ -438,7 +438,7 @@ fn start_of(
     let problem = prepared.problem.as_ref();
     for &l in spec.save_levels.iter().filter(|&&l| l < done) {
         let (mesh, solved) = prepared
-            .with_error_against(|r| adapt::replay::solve_stored_level(problem, mesh0.clone(), config, &c.history, l, r))
+            .with_error_against(|r| adapt::replay::solve_stored_level(problem, mesh0.clone(), config, &c.history, l, c.levels.get(l), r))
             .with_context(|| format!("{study}/{}: replaying level {l} for its mesh snapshot", spec.id))?;
         let level = Level {
             record: &c.levels[l],
@@ -527,8 +527,9 @@ pub fn replay_stored_level(manifest: &Manifest, stored: &RunRecord, level: usize
     let mesh0 = prepared.initial_mesh()?;
     let config = AdaptConfig::for_run(spec);
     let problem = prepared.problem.as_ref();
-    let (_, solved) =
-        prepared.with_error_against(|r| adapt::replay::solve_stored_level(problem, mesh0, &config, history, level, r)).context(what)?;
+    let (_, solved) = prepared
+        .with_error_against(|r| adapt::replay::solve_stored_level(problem, mesh0, &config, history, level, stored.levels.get(level), r))
+        .context(what)?;
     Ok(solved)
 }
 
