@@ -255,7 +255,8 @@ pub fn solve_level(
 ) -> Result<Solved, AdaptError> {
     let ndof = mesh.p2_ndof();
     // before every level, not only the first: an adaptive loop grows until it does not fit;
-    // `measured`: the previous level's unknowns and peak resident bytes, if known
+    // `measured`: unknowns and peak resident bytes of a measured solve, if known (the previous
+    // level's in the loop, the level's own stored one in a replay)
     solve::check_memory_measured(&format!("level {level} of the adaptive loop"), ndof as f64, measured)
         .map_err(|error| AdaptError::Memory { level, error })?;
     let mut options = config.pdas.clone();

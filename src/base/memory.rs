@@ -79,9 +79,9 @@ pub fn check_memory(what: &str, ndof: f64) -> Result<(), MemoryError> {
     check_memory_measured(what, ndof, None)
 }
 
-/// [`check_memory`] for a solve that follows a measured one (the next level of an adaptive
-/// loop): `measured` is (unknowns, peak resident bytes) of the previous solve. See
-/// [`level_estimate`].
+/// [`check_memory`] for a solve whose size a measured one predicts (the next level of an
+/// adaptive loop, or a stored level solved again): `measured` is (unknowns, peak resident bytes)
+/// of that solve. See [`level_estimate`].
 pub fn check_memory_measured(what: &str, ndof: f64, measured: Option<(f64, f64)>) -> Result<(), MemoryError> {
     let available = available();
     let (needed, basis) = level_estimate(ndof, measured, available.is_some_and(|a| !a.by_address_space));
