@@ -228,3 +228,48 @@ fn the_symbolic_analysis_is_the_same_on_any_number_of_threads() {
         }
     }
 }
+
+/// The partial substitutions the contact solver reuses (the contact normals are the trailing
+/// block): the rows of the trailing block from the forward substitution alone, and the solve of a
+/// right-hand side that differs only there from the forward substitution kept, are bit for bit
+/// what the whole solve gives, on one and two threads, also where the trailing block begins
+/// inside a supernode.
+#[test]
+fn solves_finished_from_a_kept_forward_substitution_are_the_whole_solves() {
+    for (name, m) in meshes() {
+        let (matrix, coords, ni) = stiffness_and_contact(&m);
+        let symbolic = symbolic(&matrix, ni, &coords);
+        let plan = Plan::new(&symbolic);
+        let l = ours(&matrix, &symbolic, matrix.values(), 2).unwrap();
+        let n = matrix.n();
+        let b: Vec<f64> = (0..n).map(|i| ((i * 37 % 101) as f64 - 50.0) / 7.0).collect();
+        let mut b2 = b.clone();
+        for (k, v) in b2[ni..].iter_mut().enumerate() {
+            *v -= 0.3 + k as f64 * 1e-3; // contact forces, say
+        }
+        let whole = |b: &[f64]| {
+            let mut x = b.to_vec();
+            cholesky::solve_in_place(&symbolic, &plan, &l, &mut x);
+            x
+        };
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        // the contact normals keep their places (the ordering orders 0..ni only), so b needs no permutation here
+        assert!((ni..n).all(|i| symbolic.inv()[i] == i), "{name}");
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let mut z = b.clone();
+                cholesky::forward_in_place(&symbolic, &plan, &l, &mut z);
+                let mut tail = z.clone();
+                cholesky::backward_tail(&symbolic, &plan, &l, &mut tail, ni);
+                assert_eq!(bits(&tail[ni..]), bits(&whole(&b)[ni..]), "{name}, {threads} thread(s): trailing rows");
+                for from in [ni, ni - 1, ni - 7] {
+                    let mut x = z.clone();
+                    cholesky::forward_tail(&symbolic, &plan, &l, &mut x, &b2, from);
+                    cholesky::backward_in_place(&symbolic, &plan, &l, &mut x);
+                    assert_eq!(bits(&x), bits(&whole(&b2)), "{name}, {threads} thread(s), from {from}: the solve of b2");
+                }
+            });
+        }
+    }
+}

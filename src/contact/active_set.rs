@@ -15,7 +15,12 @@
 //! where lambda_p = L(phi_p n) - a(u_h, phi_p n) is the discrete nodal contact force
 //! (eq. 4.5, Lemma 5.2). Each active-set iteration is a dense solve on the inactive nodes;
 //! one more sparse solve recovers the whole displacement. The sparse matrix is factorised once
-//! per mesh, whatever the number of iterations ([`Strategy::Schur`]).
+//! per mesh, whatever the number of iterations ([`Strategy::Schur`]). Since F - E lambda differs
+//! from F only in the trailing block, the forward substitution of F is computed once and kept:
+//! y_C needs only the trailing block's backward substitution, and u only the trailing block's
+//! forward substitution again before the whole backward one, bit for bit the full solves
+//! ([`cholesky::forward_tail`], [`cholesky::backward_tail`]); the round-off measurement's two
+//! solves ([`ContactSolver::correction`]) share one forward substitution the same way.
 //!
 //! The dense trailing block costs O(m^3): when adaptivity puts thousands of nodes on Gamma_C
 //! (Example 7.1 refines along it) the solver switches to [`Strategy::Refactor`]: the
@@ -374,6 +379,54 @@ impl ContactSolver {
         u
     }
 
+    /// The forward substitution z = L^{-1} P b (permuted numbering): the first half of
+    /// [`Self::solve`], kept to finish solves whose right-hand sides differ from b only at the
+    /// contact normals ([`Self::contact_rows`], [`Self::solve_from`]).
+    fn forward(&mut self, b: &[f64]) -> Vec<f64> {
+        let t0 = Instant::now();
+        let inv = self.symbolic.inv();
+        let mut z = vec![0.0; self.n];
+        for (i, &v) in b.iter().enumerate() {
+            z[inv[i]] = v;
+        }
+        cholesky::forward_in_place(&self.symbolic, &self.plan, &self.l_values, &mut z);
+        self.timings.solves += t0.elapsed().as_secs_f64();
+        z
+    }
+
+    /// (K^{-1} b)_C, the contact normals' rows of the solution, from the forward substitution z
+    /// of b: the backward substitution of the trailing block only (Schur strategy, where C keeps
+    /// its place at the end). Bit for bit the rows of [`Self::solve`]`(b)`.
+    fn contact_rows(&mut self, z: &[f64]) -> Vec<f64> {
+        debug_assert_eq!(self.strategy, Strategy::Schur);
+        let t0 = Instant::now();
+        let ni = self.n_interior;
+        let mut x = z.to_vec();
+        cholesky::backward_tail(&self.symbolic, &self.plan, &self.l_values, &mut x, ni);
+        self.timings.solves += t0.elapsed().as_secs_f64();
+        x.split_off(ni)
+    }
+
+    /// K^{-1} b for a b that differs only at the contact normals from the right-hand side whose
+    /// forward substitution is z (Schur strategy): the forward substitution of the trailing
+    /// block again, then the backward one. Bit for bit [`Self::solve`]`(b)`, for a forward
+    /// substitution of the trailing block's share of L instead of all of it.
+    fn solve_from(&mut self, z: Vec<f64>, b: &[f64]) -> Vec<f64> {
+        debug_assert_eq!(self.strategy, Strategy::Schur);
+        let t0 = Instant::now();
+        let inv = self.symbolic.inv();
+        let mut bp = vec![0.0; self.n];
+        for (i, &v) in b.iter().enumerate() {
+            bp[inv[i]] = v;
+        }
+        let mut x = z;
+        cholesky::forward_tail(&self.symbolic, &self.plan, &self.l_values, &mut x, &bp, self.n_interior);
+        cholesky::backward_in_place(&self.symbolic, &self.plan, &self.l_values, &mut x);
+        let u = inv.iter().map(|&k| x[k]).collect();
+        self.timings.solves += t0.elapsed().as_secs_f64();
+        u
+    }
+
     /// Solve the discrete Signorini problem K u = F - E lambda with u_C <= gap, lambda >= 0,
     /// complementarity (E places lambda on the contact normal unknowns), K the matrix the solver
     /// was last factorised with. `observe` sees every iteration as it ends. An iteration that does
@@ -431,12 +484,13 @@ impl ContactSolver {
         let mut du = match self.strategy {
             Strategy::Refactor => self.solve(&r),
             Strategy::Schur => {
-                let y = self.solve(&r);
-                let (_, dlambda) = schur_step(&self.schur, &y[ni..], &vec![0.0; m], active)?;
+                let z = self.forward(&r);
+                let yc = self.contact_rows(&z);
+                let (_, dlambda) = schur_step(&self.schur, &yc, &vec![0.0; m], active)?;
                 for k in 0..m {
                     r[ni + k] -= dlambda[k];
                 }
-                self.solve(&r)
+                self.solve_from(z, &r)
             }
         };
         for k in (0..m).filter(|&k| active[k]) {
@@ -453,8 +507,9 @@ impl ContactSolver {
         observe: &mut dyn FnMut(&PdasIteration),
     ) -> Result<PdasResult, ContactError> {
         let (ni, m) = (self.n_interior, self.n_contact());
-        let y = self.solve(rhs);
-        let yc = &y[ni..];
+        // y_C = (K^{-1} F)_C; the forward substitution of F is kept for u below
+        let z = self.forward(rhs);
+        let yc = &self.contact_rows(&z);
         let s = &self.schur;
         let c = options.c_scale * (0..m).map(|i| s[(i, i)]).sum::<f64>() / m as f64;
         let initial = options.initial_active.clone().filter(|a| a.len() == m).unwrap_or_else(|| (0..m).map(|i| yc[i] > gap[i]).collect());
@@ -465,7 +520,7 @@ impl ContactSolver {
         for k in 0..m {
             b[ni + k] -= outcome.lambda[k];
         }
-        let u = self.solve(&b);
+        let u = self.solve_from(z, &b);
         Ok((u, outcome, c))
     }
 

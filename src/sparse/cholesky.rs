@@ -496,77 +496,145 @@ thread_local! {
 }
 
 /// Solve L L^T x = b in place for the factor `l` of [`factorize`], with b and x in the permuted
-/// numbering (row `inv[i]` holds unknown i). Forward substitution up the tree (each supernode
-/// pulls the products of its descendants, in the order faer pushes them), backward substitution
-/// down it, independent subtrees in parallel; the same bits on any number of threads.
+/// numbering (row `inv[i]` holds unknown i): [`forward_in_place`], then [`backward_in_place`].
 pub fn solve_in_place(sn: &Symbolic, plan: &Plan, l: &[f64], x: &mut [f64]) {
+    forward_in_place(sn, plan, l, x);
+    backward_in_place(sn, plan, l, x);
+}
+
+/// Forward substitution L y = b in place, up the tree (each supernode pulls the products of its
+/// descendants, in the order faer pushes them), independent subtrees in parallel; the same bits
+/// on any number of threads.
+pub fn forward_in_place(sn: &Symbolic, plan: &Plan, l: &[f64], x: &mut [f64]) {
     assert_eq!((l.len(), x.len()), (sn.len_val(), sn.n()));
     let x = Shared::new(x);
+    // SAFETY: a task writes only its supernode's rows of x, and reads rows of descendants, which
+    // the schedule has finished
+    let _ = plan.upward(&|s, _| -> Result<(), std::convert::Infallible> {
+        unsafe { forward_supernode(sn, plan, l, x, s) };
+        Ok(())
+    });
+}
+
+/// Backward substitution L^T x = y in place, down the tree, independent subtrees in parallel;
+/// the same bits on any number of threads.
+pub fn backward_in_place(sn: &Symbolic, plan: &Plan, l: &[f64], x: &mut [f64]) {
+    assert_eq!((l.len(), x.len()), (sn.len_val(), sn.n()));
+    let x = Shared::new(x);
+    // SAFETY: a task writes only its supernode's rows of x, and reads rows of ancestors, which
+    // the schedule has finished
+    plan.downward(&|s| unsafe { backward_supernode(sn, plan, l, x, s) });
+}
+
+/// The supernodes holding the rows `from..n`: every supernode that ends after `from` (the first
+/// may begin before it). Supernodes are numbered in a postorder, so these are the last ones, each
+/// an ancestor of none of the others before it.
+fn tail(sn: &Symbolic, from: usize) -> std::ops::Range<usize> {
+    let begin = sn.supernode_begin();
+    let first = begin.partition_point(|&b| b <= from).saturating_sub(1);
+    first..sn.n_supernodes()
+}
+
+/// [`forward_in_place`] again for a right-hand side `b` that differs only in rows `from..n` from
+/// the one `x` holds the forward substitution of: the supernodes of those rows are recomputed
+/// from `b` (in order, one thread), the others are kept. Bit for bit what [`forward_in_place`]
+/// gives for `b`: rows before `from` do not depend on rows after it, and every supernode is
+/// computed by the same kernel from the same values. Work: the trailing block's share of L.
+pub fn forward_tail(sn: &Symbolic, plan: &Plan, l: &[f64], x: &mut [f64], b: &[f64], from: usize) {
+    assert_eq!((l.len(), x.len(), b.len()), (sn.len_val(), sn.n(), sn.n()));
+    let tail = tail(sn, from);
+    let start = sn.supernode_begin()[tail.start];
+    x[start..].copy_from_slice(&b[start..]);
+    let x = Shared::new(x);
+    for s in tail {
+        // SAFETY: one thread; the kernel's slices of x are dropped before it returns
+        unsafe { forward_supernode(sn, plan, l, x, s) };
+    }
+}
+
+/// The rows `from..n` of [`backward_in_place`] of the forward substitution `x`, without the
+/// other rows (left as they are: not a solution there): the supernodes of those rows, from the
+/// last, one thread. Bit for bit the rows a full backward substitution gives, since they depend
+/// on no row before `from`. Work: the trailing block's share of L.
+pub fn backward_tail(sn: &Symbolic, plan: &Plan, l: &[f64], x: &mut [f64], from: usize) {
+    assert_eq!((l.len(), x.len()), (sn.len_val(), sn.n()));
+    let tail = tail(sn, from);
+    let x = Shared::new(x);
+    for s in tail.rev() {
+        // SAFETY: as in forward_tail
+        unsafe { backward_supernode(sn, plan, l, x, s) };
+    }
+}
+
+/// One supernode of the forward substitution: x_s -= L_{s,d} x_d for every descendant d that
+/// updates it (in the order faer pushes them), then x_s = L_ss^{-1} x_s.
+/// # Safety
+/// Nothing else may access the rows of `s` in `x` meanwhile, nor write those of its descendants.
+unsafe fn forward_supernode(sn: &Symbolic, plan: &Plan, l: &[f64], x: Shared, s: usize) {
     let block = |node: &Supernode| -> MatRef<'_, f64> {
         MatRef::from_column_major_slice(&l[node.offset..node.offset + node.nrows() * node.ncols], node.nrows(), node.ncols)
     };
-    // SAFETY (both kernels): a task writes only its supernode's rows of x, and reads rows of
-    // descendants (forward) or ancestors (backward), which the schedule has finished
     let rows = |begin: usize, len: usize| unsafe { x.slice(begin, len) };
-    let forward = |s: usize, _: bool| -> Result<(), std::convert::Infallible> {
-        let node = supernode(sn, s);
-        let xs = rows(node.begin, node.ncols);
-        SOLVE_SCRATCH.with_borrow_mut(|tmp| {
-            tmp.resize(plan.max_pattern.max(plan.max_cols), 0.0);
-            for u in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
-                let dn = supernode(sn, u.d as usize);
-                let (first, mid) = (u.first as usize, u.mid as usize);
-                // t = L_{d, rows in s} x_d: the rows of faer's product L_{d, below} x_d that fall
-                // in s, computed by the same kernel (a loop of our own here would round differently)
-                let xd = MatRef::from_column_major_slice(rows(dn.begin, dn.ncols), dn.ncols, 1);
-                let t = &mut tmp[..mid];
-                faer::linalg::matmul::matmul(
-                    MatMut::from_column_major_slice_mut(&mut *t, mid, 1),
-                    Accum::Replace,
-                    block(&dn).subrows(dn.ncols + first, mid),
-                    xd,
-                    1.0,
-                    Par::Seq,
-                );
-                for (&tj, &r) in t.iter().zip(&dn.pattern[first..first + mid]) {
-                    xs[r as usize - node.begin] -= tj;
-                }
-            }
-        });
-        let ls = block(&node);
-        faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-            ls.subrows(0, node.ncols),
-            MatMut::from_column_major_slice_mut(xs, node.ncols, 1),
-            Par::Seq,
-        );
-        Ok(())
-    };
-    let backward = |s: usize| {
-        let node = supernode(sn, s);
-        let xs = rows(node.begin, node.ncols);
-        let ls = block(&node);
-        SOLVE_SCRATCH.with_borrow_mut(|tmp| {
-            tmp.resize(plan.max_pattern.max(plan.max_cols), 0.0);
-            let p = node.pattern.len();
-            for (t, &r) in tmp[..p].iter_mut().zip(node.pattern) {
-                *t = rows(r as usize, 1)[0];
-            }
-            let t = MatRef::from_column_major_slice(&tmp[..p], p, 1);
+    let node = supernode(sn, s);
+    let xs = rows(node.begin, node.ncols);
+    SOLVE_SCRATCH.with_borrow_mut(|tmp| {
+        tmp.resize(plan.max_pattern.max(plan.max_cols), 0.0);
+        for u in &plan.upd[plan.upd_ptr[s]..plan.upd_ptr[s + 1]] {
+            let dn = supernode(sn, u.d as usize);
+            let (first, mid) = (u.first as usize, u.mid as usize);
+            // t = L_{d, rows in s} x_d: the rows of faer's product L_{d, below} x_d that fall
+            // in s, computed by the same kernel (a loop of our own here would round differently)
+            let xd = MatRef::from_column_major_slice(rows(dn.begin, dn.ncols), dn.ncols, 1);
+            let t = &mut tmp[..mid];
             faer::linalg::matmul::matmul(
-                MatMut::from_column_major_slice_mut(&mut *xs, node.ncols, 1),
-                Accum::Add,
-                ls.subrows(node.ncols, p).transpose(),
-                t,
-                -1.0,
+                MatMut::from_column_major_slice_mut(&mut *t, mid, 1),
+                Accum::Replace,
+                block(&dn).subrows(dn.ncols + first, mid),
+                xd,
+                1.0,
                 Par::Seq,
             );
-        });
-        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
-            ls.subrows(0, node.ncols).transpose(),
-            MatMut::from_column_major_slice_mut(xs, node.ncols, 1),
+            for (&tj, &r) in t.iter().zip(&dn.pattern[first..first + mid]) {
+                xs[r as usize - node.begin] -= tj;
+            }
+        }
+    });
+    let ls = block(&node);
+    faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+        ls.subrows(0, node.ncols),
+        MatMut::from_column_major_slice_mut(xs, node.ncols, 1),
+        Par::Seq,
+    );
+}
+
+/// One supernode of the backward substitution: x_s -= L_{below,s}^T x_below, then
+/// x_s = L_ss^{-T} x_s.
+/// # Safety
+/// Nothing else may access the rows of `s` in `x` meanwhile, nor write those of its ancestors.
+unsafe fn backward_supernode(sn: &Symbolic, plan: &Plan, l: &[f64], x: Shared, s: usize) {
+    let rows = |begin: usize, len: usize| unsafe { x.slice(begin, len) };
+    let node = supernode(sn, s);
+    let xs = rows(node.begin, node.ncols);
+    let ls = MatRef::from_column_major_slice(&l[node.offset..node.offset + node.nrows() * node.ncols], node.nrows(), node.ncols);
+    SOLVE_SCRATCH.with_borrow_mut(|tmp| {
+        tmp.resize(plan.max_pattern.max(plan.max_cols), 0.0);
+        let p = node.pattern.len();
+        for (t, &r) in tmp[..p].iter_mut().zip(node.pattern) {
+            *t = rows(r as usize, 1)[0];
+        }
+        let t = MatRef::from_column_major_slice(&tmp[..p], p, 1);
+        faer::linalg::matmul::matmul(
+            MatMut::from_column_major_slice_mut(&mut *xs, node.ncols, 1),
+            Accum::Add,
+            ls.subrows(node.ncols, p).transpose(),
+            t,
+            -1.0,
             Par::Seq,
         );
-    };
-    let _ = plan.upward(&forward);
-    plan.downward(&backward);
+    });
+    faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+        ls.subrows(0, node.ncols).transpose(),
+        MatMut::from_column_major_slice_mut(xs, node.ncols, 1),
+        Par::Seq,
+    );
 }
