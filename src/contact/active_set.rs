@@ -368,15 +368,25 @@ impl ContactSolver {
     /// Solve with the current factorisation ([`cholesky::solve_in_place`]).
     pub fn solve(&mut self, b: &[f64]) -> Vec<f64> {
         let t0 = Instant::now();
-        let inv = self.symbolic.inv();
-        let mut x = vec![0.0; self.n];
-        for (i, &v) in b.iter().enumerate() {
-            x[inv[i]] = v;
-        }
+        let mut x = self.permuted(b);
         cholesky::solve_in_place(&self.symbolic, &self.plan, &self.l_values, &mut x);
-        let u = inv.iter().map(|&k| x[k]).collect();
+        let u = self.unpermuted(&x);
         self.timings.solves += t0.elapsed().as_secs_f64();
         u
+    }
+
+    /// b in the numbering of L (row `inv[i]` holds unknown i).
+    fn permuted(&self, b: &[f64]) -> Vec<f64> {
+        let mut x = vec![0.0; self.n];
+        for (&k, &v) in self.symbolic.inv().iter().zip(b) {
+            x[k] = v;
+        }
+        x
+    }
+
+    /// x from the numbering of L back to the unknowns'.
+    fn unpermuted(&self, x: &[f64]) -> Vec<f64> {
+        self.symbolic.inv().iter().map(|&k| x[k]).collect()
     }
 
     /// The forward substitution z = L^{-1} P b (permuted numbering): the first half of
@@ -384,11 +394,7 @@ impl ContactSolver {
     /// contact normals ([`Self::contact_rows`], [`Self::solve_from`]).
     fn forward(&mut self, b: &[f64]) -> Vec<f64> {
         let t0 = Instant::now();
-        let inv = self.symbolic.inv();
-        let mut z = vec![0.0; self.n];
-        for (i, &v) in b.iter().enumerate() {
-            z[inv[i]] = v;
-        }
+        let mut z = self.permuted(b);
         cholesky::forward_in_place(&self.symbolic, &self.plan, &self.l_values, &mut z);
         self.timings.solves += t0.elapsed().as_secs_f64();
         z
@@ -414,15 +420,11 @@ impl ContactSolver {
     fn solve_from(&mut self, z: Vec<f64>, b: &[f64]) -> Vec<f64> {
         debug_assert_eq!(self.strategy, Strategy::Schur);
         let t0 = Instant::now();
-        let inv = self.symbolic.inv();
-        let mut bp = vec![0.0; self.n];
-        for (i, &v) in b.iter().enumerate() {
-            bp[inv[i]] = v;
-        }
+        let bp = self.permuted(b);
         let mut x = z;
         cholesky::forward_tail(&self.symbolic, &self.plan, &self.l_values, &mut x, &bp, self.n_interior);
         cholesky::backward_in_place(&self.symbolic, &self.plan, &self.l_values, &mut x);
-        let u = inv.iter().map(|&k| x[k]).collect();
+        let u = self.unpermuted(&x);
         self.timings.solves += t0.elapsed().as_secs_f64();
         u
     }
