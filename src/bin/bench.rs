@@ -329,6 +329,18 @@ fn targets(phases: &[SizeResult], rates: &[FactorRate], cold: &[ColdSize], scale
                 Bound::AtMost(g),
                 missing.clone(),
             ));
+            if let Some(r) = rates.iter().find(|r| r.n == c.n && r.gemm_gflops > 0.0) {
+                let best = at_gemm_rate(&c.ours, r);
+                t.push(Target::bounded(
+                    "bound: the same, numeric phase at faer's GEMM rate",
+                    c.n,
+                    best,
+                    ng,
+                    ng.map(|ng| best / ng),
+                    Bound::AtMost(g),
+                    format!("{:.2e} multiply-adds at {:.1} GFlop/s, the other phases as measured", r.multiply_adds, r.gemm_gflops),
+                ));
+            }
         }
         if c.n == 512 {
             let ours = median(c.ours.iter().map(|r| r.peak_rss_mb).collect());
@@ -411,6 +423,20 @@ fn targets(phases: &[SizeResult], rates: &[FactorRate], cold: &[ColdSize], scale
             &goal(mem_goal, "MB"),
             ours.peak_rss_mb <= mem_goal,
         ));
+        // what no faster factorisation changes: the numeric phase at faer's GEMM rate, and the
+        // values of L alone
+        if let Some(r) = rates.iter().find(|r| r.n == s.n && r.gemm_gflops > 0.0) {
+            let best = at_gemm_rate(&s.ours, r);
+            t.push(row(
+                "bound: the same solve, numeric phase at faer's GEMM rate [s]",
+                best,
+                None,
+                &goal(time_goal, "s"),
+                best <= time_goal,
+            ));
+            let l_mb = r.values_of_l as f64 * 8.0 / (1024.0 * 1024.0);
+            t.push(row("bound: the values of L alone [MB]", l_mb, None, &goal(mem_goal, "MB"), l_mb <= mem_goal));
+        }
     }
     let opt = |v: Option<f64>, p: usize| v.map_or("-".to_string(), |v| format!("{v:.p$}"));
     println!("\ntargets (issues 15 and 25; our cold contact solve against NGSolve's cold linear solve, fresh processes, medians):");
@@ -460,6 +486,14 @@ struct SizeResult {
     median: Phases,
     runs: Vec<Phases>,
     peak_rss_mb: f64,
+}
+
+/// The median cold whole solve of `runs` had its numeric phase run at faer's GEMM rate (the
+/// ordering's multiply-adds, the same run's rate) and the other phases taken as measured: a
+/// bound on what a faster numeric factorisation alone can give.
+fn at_gemm_rate(runs: &[ColdRun], rate: &FactorRate) -> f64 {
+    let rest = median(runs.iter().map(|r| r.whole_s - r.numeric_s).collect());
+    rest + 2.0 * rate.multiply_adds / (rate.gemm_gflops * 1e9)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -596,15 +630,18 @@ struct FactorRate {
     /// ... and of faer's dense LL^T of order DENSE_N on every core (median of five, same process)
     dense_gflops: f64,
     ratio: f64,
+    /// faer's square product of order DENSE_N on every core (median of five, same process): the
+    /// fastest dense kernel the factorisation is built from, so no phase of it runs faster
+    #[serde(default)]
+    gemm_gflops: f64,
 }
 
-const RATE_HEADER: &str =
-    "    N   unknowns supernodes wide64 |  madds  executed   first    warm  GFlop/s | dense GFlop/s  ratio | values of L  solve";
+const RATE_HEADER: &str = "    N   unknowns supernodes wide64 |  madds  executed   first    warm  GFlop/s | dense GFlop/s  ratio | GEMM GFlop/s | values of L  solve";
 
 impl FactorRate {
     fn row(&self) -> String {
         format!(
-            "{:>5} {:>10} {:>10} {:>6.2} | {:>8.2e} {:>8.2e} {:>7.3} {:>7.3} {:>8.1} | {:>13.1} {:>6.2} | {:>11.3e} {:>6.3}",
+            "{:>5} {:>10} {:>10} {:>6.2} | {:>8.2e} {:>8.2e} {:>7.3} {:>7.3} {:>8.1} | {:>13.1} {:>6.2} | {:>12.1} | {:>11.3e} {:>6.3}",
             self.n,
             self.unknowns,
             self.supernodes,
@@ -616,6 +653,7 @@ impl FactorRate {
             self.sparse_gflops,
             self.dense_gflops,
             self.ratio,
+            self.gemm_gflops,
             self.values_of_l as f64,
             self.solve_warm_s
         )
@@ -672,6 +710,8 @@ fn factor_rate(n: usize, repeats: usize) -> Result<FactorRate> {
     // the dense rate: a warm-up, then the median of five (one factorisation takes about 0.2 s)
     dense_rate(DENSE_N);
     let dense_gflops = median((0..5).map(|_| dense_rate(DENSE_N)).collect());
+    gemm_rate(DENSE_N);
+    let gemm_gflops = median((0..5).map(|_| gemm_rate(DENSE_N)).collect());
     // the ordering counts the leading block (all but the contact unknowns, whose trailing
     // dense block is factorised too: m^3 / 6 more)
     let m = (sn.n() - dofs.n_interior) as f64;
@@ -692,7 +732,19 @@ fn factor_rate(n: usize, repeats: usize) -> Result<FactorRate> {
         sparse_gflops,
         dense_gflops,
         ratio: sparse_gflops / dense_gflops,
+        gemm_gflops,
     })
+}
+
+/// GFlop/s of faer's product of two n x n matrices on every core (2 n^3 flops).
+fn gemm_rate(n: usize) -> f64 {
+    let a = faer::Mat::<f64>::from_fn(n, n, |i, j| 1.0 / (1.0 + i.abs_diff(j) as f64));
+    let mut c = faer::Mat::<f64>::zeros(n, n);
+    let t0 = Instant::now();
+    faer::linalg::matmul::matmul(c.as_mut(), faer::Accum::Replace, a.as_ref(), a.as_ref(), 1.0, faer::Par::rayon(0));
+    let t = t0.elapsed().as_secs_f64();
+    std::hint::black_box(&c);
+    2.0 * (n as f64).powi(3) / t / 1e9
 }
 
 /// GFlop/s of faer's dense LL^T of an n x n SPD matrix on every core.
