@@ -393,6 +393,11 @@ impl Target {
         };
         Target { target: target.into(), n, ours, reference, value, goal, met, note }
     }
+
+    /// A target whose value is ours / reference.
+    fn ratio(target: &str, n: usize, ours: f64, reference: Option<f64>, bound: Bound, note: String) -> Self {
+        Self::bounded(target, n, ours, reference, reference.map(|r| ours / r), bound, note)
+    }
 }
 
 /// The performance targets (issues 15 and 25), each with the measured value and whether it is met.
@@ -416,24 +421,14 @@ fn targets(phases: &[SizeResult], rates: &[FactorRate], cold: &[ColdSize], scale
         let ng = med(c.ngsolve.iter().map(|r| r.whole_s).collect());
         let missing = c.ngsolve_missing.clone().unwrap_or_default();
         if let Some(&(_, g)) = goal_max.iter().find(|(n, _)| *n == c.n) {
-            let value = ng.map(|ng| ours / ng);
-            t.push(Target::bounded(
-                "cold whole solve / NGSolve's whole linear solve [s]",
-                c.n,
-                ours,
-                ng,
-                value,
-                Bound::AtMost(g),
-                missing.clone(),
-            ));
+            t.push(Target::ratio("cold whole solve / NGSolve's whole linear solve [s]", c.n, ours, ng, Bound::AtMost(g), missing.clone()));
             if let Some(r) = rates.iter().find(|r| r.n == c.n && r.gemm_gflops > 0.0) {
                 let best = at_gemm_rate(&c.ours, r);
-                t.push(Target::bounded(
+                t.push(Target::ratio(
                     "bound: the same, numeric phase at faer's GEMM rate",
                     c.n,
                     best,
                     ng,
-                    ng.map(|ng| best / ng),
                     Bound::AtMost(g),
                     format!("{:.2e} multiply-adds at {:.1} GFlop/s, the other phases as measured", r.multiply_adds, r.gemm_gflops),
                 ));
@@ -442,8 +437,7 @@ fn targets(phases: &[SizeResult], rates: &[FactorRate], cold: &[ColdSize], scale
         if c.n == 512 {
             let ours = median(c.ours.iter().map(|r| r.peak_rss_mb).collect());
             let ng = med(c.ngsolve.iter().map(|r| r.peak_rss_mb).collect());
-            let value = ng.map(|ng| ours / ng);
-            t.push(Target::bounded("peak memory / NGSolve's [MB]", c.n, ours, ng, value, Bound::AtMost(0.6), missing.clone()));
+            t.push(Target::ratio("peak memory / NGSolve's [MB]", c.n, ours, ng, Bound::AtMost(0.6), missing.clone()));
             let sym = median(c.ours.iter().map(|r| r.symbolic_s / r.whole_s).collect());
             let (symbolic, whole) =
                 (median(c.ours.iter().map(|r| r.symbolic_s).collect()), median(c.ours.iter().map(|r| r.whole_s).collect()));
@@ -460,12 +454,11 @@ fn targets(phases: &[SizeResult], rates: &[FactorRate], cold: &[ColdSize], scale
         if c.n == 512 {
             let ours = median(c.ours.iter().map(|r| r.whole_s).collect());
             let pardiso = med(c.pardiso.iter().map(|r| r.factorisation_s + r.solve_s).collect());
-            t.push(Target::bounded(
+            t.push(Target::ratio(
                 "cold whole solve / PARDISO's factorisation + solve [s]",
                 c.n,
                 ours,
                 pardiso,
-                pardiso.map(|p| ours / p),
                 Bound::AtMost(0.5),
                 c.pardiso_missing.clone().unwrap_or_else(|| "NGSolve's inverse=\"pardisospd\" (MKL 2026.2)".into()),
             ));
