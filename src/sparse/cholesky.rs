@@ -566,14 +566,16 @@ pub fn backward_tail(sn: &Symbolic, plan: &Plan, l: &[f64], x: &mut [f64], from:
     }
 }
 
+/// Supernode `node`'s block of the factor `l` (its columns, own rows then pattern rows).
+fn block_of<'a>(l: &'a [f64], node: &Supernode) -> MatRef<'a, f64> {
+    MatRef::from_column_major_slice(&l[node.offset..node.offset + node.nrows() * node.ncols], node.nrows(), node.ncols)
+}
+
 /// One supernode of the forward substitution: x_s -= L_{s,d} x_d for every descendant d that
 /// updates it (in the order faer pushes them), then x_s = L_ss^{-1} x_s.
 /// # Safety
 /// Nothing else may access the rows of `s` in `x` meanwhile, nor write those of its descendants.
 unsafe fn forward_supernode(sn: &Symbolic, plan: &Plan, l: &[f64], x: Shared, s: usize) {
-    let block = |node: &Supernode| -> MatRef<'_, f64> {
-        MatRef::from_column_major_slice(&l[node.offset..node.offset + node.nrows() * node.ncols], node.nrows(), node.ncols)
-    };
     let rows = |begin: usize, len: usize| unsafe { x.slice(begin, len) };
     let node = supernode(sn, s);
     let xs = rows(node.begin, node.ncols);
@@ -589,7 +591,7 @@ unsafe fn forward_supernode(sn: &Symbolic, plan: &Plan, l: &[f64], x: Shared, s:
             faer::linalg::matmul::matmul(
                 MatMut::from_column_major_slice_mut(&mut *t, mid, 1),
                 Accum::Replace,
-                block(&dn).subrows(dn.ncols + first, mid),
+                block_of(l, &dn).subrows(dn.ncols + first, mid),
                 xd,
                 1.0,
                 Par::Seq,
@@ -599,7 +601,7 @@ unsafe fn forward_supernode(sn: &Symbolic, plan: &Plan, l: &[f64], x: Shared, s:
             }
         }
     });
-    let ls = block(&node);
+    let ls = block_of(l, &node);
     faer::linalg::triangular_solve::solve_lower_triangular_in_place(
         ls.subrows(0, node.ncols),
         MatMut::from_column_major_slice_mut(xs, node.ncols, 1),
@@ -615,7 +617,7 @@ unsafe fn backward_supernode(sn: &Symbolic, plan: &Plan, l: &[f64], x: Shared, s
     let rows = |begin: usize, len: usize| unsafe { x.slice(begin, len) };
     let node = supernode(sn, s);
     let xs = rows(node.begin, node.ncols);
-    let ls = MatRef::from_column_major_slice(&l[node.offset..node.offset + node.nrows() * node.ncols], node.nrows(), node.ncols);
+    let ls = block_of(l, &node);
     SOLVE_SCRATCH.with_borrow_mut(|tmp| {
         tmp.resize(plan.max_pattern.max(plan.max_cols), 0.0);
         let p = node.pattern.len();

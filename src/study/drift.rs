@@ -204,15 +204,14 @@ fn compare_level(
                     c.max_rel = diff / a.abs();
                     c.at = format!("{run} {level}");
                 }
+                let rel = if a != 0.0 { Some(diff / a.abs()) } else { None };
                 if ORDER_OF_MAGNITUDE.contains(&key.as_str()) {
                     let decades = decades_apart(a, b, REL_RANGE * scale);
                     c.max_decades = c.max_decades.max(decades);
                     if !(decades <= DECADES) {
-                        let rel = if a != 0.0 { Some(diff / a.abs()) } else { None };
                         out.push(drift(rel, format!("within {DECADES} decade(s), both raised to {:.3e}", REL_RANGE * scale)));
                     }
                 } else if !is_derived(key) && !(diff <= tol.rel * a.abs() + tol.floor * scale) {
-                    let rel = if a != 0.0 { Some(diff / a.abs()) } else { None };
                     out.push(drift(rel, format!("rel {:e} + floor {:e} x {scale:.3e}", tol.rel, tol.floor)));
                 }
             }
