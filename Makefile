@@ -13,7 +13,7 @@ build:
 
 # What CI runs: formatting and lints (rustfmt.toml, clippy -D warnings), unit and integration tests (release mode: the convergence tests solve real
 # systems), the drift check (every study rerun and compared with results/ at every level, deep
-# studies in their tiers: quick prefixes, their `full` runs to the end, the last level of their
+# studies in their tiers (docs/drift.md): quick prefixes, their `full` runs to the end, the last level of their
 # `replay` runs rebuilt from the stored refinement history and solved again; plus levels.csv,
 # provenance and CLAIMS.md against the records), and the NGSolve cross-check.
 # Test-time outputs (drift report, cross-check tables with timings) go under target/; the last
@@ -34,7 +34,7 @@ test: build
 # A one-node Slurm cluster on this machine (as root; installs slurm-wlm and munge with apt-get
 # if missing), a study submitted as an array of shards, a task cancelled mid-run, two arrays at
 # once, each checked against a single-process run; everything under target/cluster/. About two
-# minutes. See the README's Slurm section.
+# minutes. See docs/studies.md, On a Slurm cluster.
 cluster-test: build
 	SIGNORINI=$(abspath $(BIN)) scripts/slurm/cluster-test.sh
 
@@ -48,7 +48,7 @@ reproduce: build
 	$(BIN) figures
 
 # Every study rerun to the end, deep ones too (`make test` reruns deep studies in their tiers:
-# README, Drift), and compared with results/ at every level, field by field; non-zero exit on
+# docs/drift.md), and compared with results/ at every level, field by field; non-zero exit on
 # drift. Report: target/drift/report.json. The scheduled CI job runs it.
 drift: build
 	$(BIN) drift --deep
