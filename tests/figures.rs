@@ -258,6 +258,12 @@ fn full_results(results: &Path) {
             fb("fb_uniform", Uniform),
         ],
     );
+    let ex72 = |id, refine| Run { missing: never, ..run(id, "ex72", refine) };
+    write_study(
+        results,
+        "ex72_large",
+        &[ex72("adaptive", Adaptive), without(ex72("without_full_contact", Adaptive)), ex72("uniform", Uniform)],
+    );
 }
 
 /// The hertz study: one run of the repository's Hertz problem file (found through the provenance's

@@ -17,7 +17,9 @@ fn study_pages_load_in_chromium_with_every_image_and_claim() {
     let out = std::env::temp_dir().join(format!("signorini-pages-{}", std::process::id()));
     let pages =
         signorini::page::write_pages(Path::new("results"), Path::new("figures"), &out, &[], Path::new("target/drift/report.json")).unwrap();
-    assert!(pages.len() >= 9, "one page per stored study: {pages:?}");
+    assert!(pages.len() >= 10, "one page per stored study and the index: {pages:?}");
+    let (index, pages) = pages.split_last().unwrap();
+    assert_eq!(index.file_name().unwrap(), "index.html");
     let claims = signorini::claims::claims(Path::new("results")).unwrap();
     let Some(chromium) = common::browser::chromium() else {
         // never a silent pass: `make test` prints the same note, and CI installs chromium
@@ -25,12 +27,18 @@ fn study_pages_load_in_chromium_with_every_image_and_claim() {
         std::fs::remove_dir_all(&out).unwrap();
         return;
     };
-    for page in &pages {
+    let seen = common::browser::check_page(&chromium, index);
+    for c in &claims {
+        assert!(seen.text.contains(&format!("{}: {}", c.id, c.summary.topic)), "index: the summary line of {} missing", c.id);
+    }
+    assert!(seen.errors.is_empty(), "index: console errors {:?}", seen.errors);
+    for page in pages {
         let study = page.file_stem().unwrap().to_string_lossy().into_owned();
         let seen = common::browser::check_page(&chromium, page);
         let expected: Vec<&str> = signorini::page::figures_of(&study);
         let names: Vec<&str> = seen.images.iter().map(|(n, _)| n.as_str()).collect();
         assert_eq!(names, expected, "{study}: the page's images");
+        assert!(!expected.is_empty(), "{study}: a study page without figures");
         for (name, loaded) in &seen.images {
             assert!(loaded, "{study}: image {name} did not load");
         }

@@ -72,8 +72,18 @@ impl From<RateVerdict> for Verdict {
     }
 }
 
+/// A claim's line in the summary that opens CLAIMS.md: the claim in a few words, what the paper
+/// says, and the headline measurement (one number with its interval, window and run).
+#[derive(Clone, Debug, Default)]
+pub struct Summary {
+    pub topic: &'static str,
+    pub paper: &'static str,
+    pub headline: String,
+}
+
 pub struct Claim {
     pub id: &'static str,
+    pub summary: Summary,
     pub claim: String,
     pub measured: String,
     pub verdict: Verdict,
@@ -210,6 +220,44 @@ fn rate_text(name: &str, rep: Option<&RateReport>, claim: Option<f64>) -> String
     }
 }
 
+/// "NDF 1.2e5–1.2e7" of a fit, "h_min, NDF …" for a fit against h_min, with "only 1.0
+/// decade(s): no verdict" for a window too short.
+fn short_range(fit: &verdict::RateFit) -> String {
+    format!(
+        "{}NDF {:.1e}–{:.1e}{}",
+        if fit.abscissa == verdict::Abscissa::InverseHMin { "in h_min, " } else { "" },
+        fit.first_ndof as f64,
+        fit.last_ndof as f64,
+        if fit.spans_enough() { String::new() } else { format!(", only {:.1} decade(s): no verdict", fit.decades()) }
+    )
+}
+
+/// A summary's headline for a rate: "1.04 ± 0.03 (NDF 1.2e5–1.2e7, deep/ex71_as_written)".
+fn rate_headline(name: &str, rep: Option<&RateReport>, r: Option<&RunRecord>) -> String {
+    match rep {
+        Some(rep) => format!("{name}{} ({}, {})", rep.main.text(), short_range(&rep.main), source(r)),
+        None => format!("{name}n/a"),
+    }
+}
+
+/// A summary's headline for a trend: "slope 0.21 ± 0.04 (NDF 1.2e5–1.2e7, deep/ex71_as_written)".
+fn growth_headline(name: &str, g: Option<&verdict::RateFit>, r: Option<&RunRecord>) -> String {
+    match g {
+        Some(g) => format!("{name}slope {} ({}, {})", g.text(), short_range(g), source(r)),
+        None => format!("{name}n/a"),
+    }
+}
+
+/// The slowest of `names`' rates for `r`: "eta4 0.50 ± 0.01 (…)" (None without a fit).
+fn slowest_headline(ctx: &Ctx, r: Option<&RunRecord>, names: &[&str]) -> String {
+    names
+        .iter()
+        .filter_map(|n| Some((*n, ctx.rate(r, Q::Field(n))?)))
+        .min_by(|a, b| a.1.main.rate.slope.total_cmp(&b.1.main.rate.slope))
+        .map(|(n, rep)| rate_headline(&format!("slowest {n} "), Some(&rep), r))
+        .unwrap_or("n/a".into())
+}
+
 fn judge(rep: Option<&RateReport>, claim: f64) -> Verdict {
     rep.map_or(Verdict::NoData, |r| verdict::judge_rate(&r.main, claim).into())
 }
@@ -313,6 +361,11 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: fragility(err.as_ref(), OPTIMAL),
         id: "7.1-error-rate",
+        summary: Summary {
+            topic: "Ex. 7.1: error rate, adaptive",
+            paper: "NDF^-1.5 (Fig. 2a)",
+            headline: rate_headline("", err.as_ref(), a71),
+        },
         claim: "Ex. 7.1: the error ||u - u_h||_Linf converges at the optimal rate NDF^(-3/2) under adaptive refinement (Fig. 2a)".into(),
         measured: format!(
             "{}. {}. {}",
@@ -327,6 +380,11 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: fragility(est.as_ref(), OPTIMAL),
         id: "7.1-estimator-rate",
+        summary: Summary {
+            topic: "Ex. 7.1: estimator rate",
+            paper: "eta_h at NDF^-1.5 (Fig. 2a)",
+            headline: rate_headline("eta_h ", est.as_ref(), a71),
+        },
         claim: "Ex. 7.1: the estimator eta_h converges at NDF^(-3/2) (Fig. 2a)".into(),
         measured: format!(
             "as written ({}): {}. Without full-contact nodes ({}): {}",
@@ -348,6 +406,11 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: None,
         id: "7.1-eta5",
+        summary: Summary {
+            topic: "Ex. 7.1: eta_1..eta_5",
+            paper: "each at NDF^-1.5 (Fig. 4a)",
+            headline: slowest_headline(ctx, a71, &["eta1", "eta2", "eta3", "eta4", "eta5"]),
+        },
         claim: "Ex. 7.1: the individual estimators eta_1..eta_5 decay optimally (Fig. 4a); in particular eta_5 = max_p h_p |sigma-hat_1(u_h)|".into(),
         measured: format!(
             "adaptive ({}): {}. Reading of sigma-hat (sigma n in a frame whose e_1 is the normal), the rows above: sigma-hat_1 = n . sigma n (normal stress, eta_5), sigma-hat_2 = t . sigma n (eta_4); \
@@ -381,6 +444,7 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: None,
         id: "7.1-efficiency",
+        summary: Summary { topic: "Ex. 7.1: efficiency index", paper: "bounded (Fig. 2b)", headline: growth_headline("log efficiency: ", g.as_ref(), a71) },
         claim: format!(
             "Ex. 7.1: the efficiency index estimate/error stays bounded (Fig. 2b), C_0 = 0.45; bounded = the slope of log(efficiency) against log(NDF) has a 95% interval containing 0 no wider than {}",
             verdict::MAX_WIDTH,
@@ -407,6 +471,11 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: None,
         id: "7.1-eta6-eta7",
+        summary: Summary {
+            topic: "Ex. 7.1: eta_6, eta_7",
+            paper: "vanish",
+            headline: eta67.map(|v| format!("largest {v:.1e} ({})", source(a71))).unwrap_or("n/a".into()),
+        },
         claim: "Ex. 7.1: ||(chi + u_h2)^+||_Linf(Lambda) and ||(-u_h2 - chi)^+||_Linf(Gamma_C) vanish".into(),
         measured: eta67.map(|v| format!("max over levels of eta6, eta7: {v:.3e}")).unwrap_or_default(),
         verdict: match eta67 {
@@ -432,6 +501,15 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: None,
         id: "c0",
+        summary: Summary {
+            topic: "Reliability with C_0 = 0.45",
+            paper: "C_0 eta_h >= error (6.1)",
+            headline: if rows.is_empty() {
+                "n/a".into()
+            } else {
+                format!("smallest reliable C_0 {worst:.1e} over {} runs: 0.45 is {:.1} decades above it", rows.len(), (0.45 / worst).log10())
+            },
+        },
         claim: "Section 7: C_0 = 0.45 is consistent with the reliability bound (6.1): C_0 eta_h >= ||u - u_h||_Linf at every level, in all experiments".into(),
         measured: if rows.is_empty() {
             String::new()
@@ -454,6 +532,15 @@ fn log_factor_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: None,
         id: "log-factor (ablation)",
+        summary: Summary {
+            topic: "The log factor l_h (ablation)",
+            paper: "l_h = 1 + |log h_min|^2 (6.3); no claim",
+            headline: la
+                .iter()
+                .map(|r| format!("{} {}", r.run.id, ctx.growth(Some(r), Q::Efficiency).map_or("n/a".into(), |g| g.text())))
+                .collect::<Vec<_>>()
+                .join(", "),
+        },
         claim: "Eq. 6.3's factor l_h = 1 + |log h_min|^2 against 1 + |log h_min| and 1: the trend of the efficiency index (no claim of the paper; for reading the rows above)".into(),
         measured: rows.join("; "),
         verdict: if rows.is_empty() { Verdict::NoData } else { Verdict::NoClaim },
@@ -476,6 +563,7 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: fragility(e_ad.as_ref(), OPTIMAL),
         id: "fb-error-rate",
+        summary: Summary { topic: "fb: error rate, adaptive", paper: "NDF^-1.5, carried over (beyond the paper)", headline: rate_headline("", e_ad.as_ref(), ad) },
         claim: "fb (beyond the paper): with a free boundary at x = a = sqrt(2) - 1 and a known solution, adaptive refinement with the paper's estimator (eta_5 as written) converges at NDF^(-3/2); the variant without full-contact nodes and uniform refinement for comparison".into(),
         measured: if none {
             "no data".into()
@@ -504,6 +592,15 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: None,
         id: "fb-reliability",
+        summary: Summary {
+            topic: "fb: reliability",
+            paper: "C_0 = 0.45 reliable, carried over",
+            headline: rows
+                .iter()
+                .map(|r| r.1)
+                .reduce(f64::max)
+                .map_or("n/a".into(), |c| format!("smallest reliable C_0 {c:.1e} over {} runs", rows.len())),
+        },
         claim: "fb: C_0 = 0.45 is reliable, C_0 eta_h >= ||u - u_h||_Linf at every level; the smallest reliable C_0".into(),
         measured: if rows.is_empty() { "no data".into() } else { rows.iter().map(|r| r.0.clone()).collect::<Vec<_>>().join("; ") },
         verdict: if rows.is_empty() {
@@ -520,6 +617,11 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: None,
         id: "fb-efficiency",
+        summary: Summary {
+            topic: "fb: efficiency index",
+            paper: "bounded, carried over",
+            headline: growth_headline("log efficiency: ", g.as_ref(), ad),
+        },
         claim: "fb: the efficiency index of the paper's estimator (eta_5 as written) stays bounded (same rule as 7.1-efficiency)".into(),
         measured: if none {
             "no data".into()
@@ -567,6 +669,11 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: None,
         id: "fb-refinement",
+        summary: Summary {
+            topic: "fb: refinement at the free boundary",
+            paper: "the mesh concentrates at free boundaries (beyond the paper)",
+            headline: parts.first().cloned().unwrap_or("n/a".into()),
+        },
         claim: "fb: the adaptive mesh concentrates at the free boundary x = a: a local minimum (or plateau of its own) of the edge length along Gamma_C within 0.15 of a".into(),
         measured: if parts.is_empty() { "no data".into() } else { parts.join("; ") },
         verdict,
@@ -597,9 +704,20 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         ))
     };
     let zs: Vec<(String, bool)> = [ad, wfc, un].into_iter().filter_map(zone).collect();
+    let zone_decay = ad.and_then(|r| {
+        let ndof: Vec<usize> = r.levels.iter().map(|l| l.ndof).collect();
+        let d0: Vec<Option<f64>> = r.levels.iter().map(|l| l.zone_min.map(|z| (z - a).abs())).collect();
+        let fit = verdict::rate_over(&ndof, &d0, ndof.len() - 1)?;
+        Some(format!("|zone start - a| at NDF^-({}) ({}, {})", fit.text(), short_range(&fit), source(Some(r))))
+    });
     out.push(Claim {
         fragile: None,
         id: "fb-contact-zone",
+        summary: Summary {
+            topic: "fb: the discrete contact zone",
+            paper: "tends to [a, 1] (beyond the paper)",
+            headline: zone_decay.unwrap_or("n/a".into()),
+        },
         claim: "fb: the discrete contact zone tends to [a, 1]: |zone start - a| decays (rate interval above 0) and the zone ends at x = 1"
             .into(),
         measured: if zs.is_empty() { "no data".into() } else { zs.iter().map(|z| z.0.clone()).collect::<Vec<_>>().join("; ") },
@@ -625,6 +743,7 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let runs = StudyDir::new(ctx.results, "hertz").read_runs()?;
     let mut rows = Vec::new();
     let mut judged = None;
+    let mut headline = None;
     for r in &runs {
         let Some(snap) = latest_mesh(ctx.results, "hertz", &r.run.id) else { continue };
         let problem = crate::study::stored_problem(ctx.results, "hertz", &r.run).map_err(|e| std::io::Error::other(format!("{e:#}")))?;
@@ -658,6 +777,13 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             let a_dev = c.half_width_deviation();
             let (lo, hi) = (a_dev.abs() - res, a_dev.abs() + res);
             let p_dev = c.peak_deviation().abs();
+            headline = Some(format!(
+                "a_h - a {:+.2}% to {:+.2}%, p0 {:+.2}% (NDF {}, hertz/adaptive)",
+                100.0 * (c.half_width_deviation() - res),
+                100.0 * (c.half_width_deviation() + res),
+                100.0 * c.peak_deviation(),
+                snap.ndof
+            ));
             judged = Some(if hi <= HERTZ_TOLERANCE && p_dev <= HERTZ_TOLERANCE {
                 Verdict::Holds
             } else if lo > HERTZ_TOLERANCE || p_dev > HERTZ_TOLERANCE {
@@ -670,6 +796,7 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(Claim {
         fragile: None,
         id: "hertz",
+        summary: Summary { topic: "Hertz: cylinder on a flat", paper: "Hertz's a and p0 within 2% (beyond the paper)", headline: headline.unwrap_or("n/a".into()) },
         claim: format!(
             "Hertz (beyond the paper): an elastic cylinder (plane strain) on a rigid flat, adaptive with the paper's estimator: on the finest mesh the contact half-width a (± half the node spacing at the zone's ends) and the peak pressure p0 within {:.0}% of Hertz's a = sqrt(4FR(1 - nu^2)/(pi E)), p0 = 2F/(pi a) at the computed force F; the run with the smaller load measures the finite-size deviation",
             100.0 * HERTZ_TOLERANCE
@@ -725,6 +852,11 @@ pub fn claims(results: &Path) -> std::io::Result<Vec<Claim>> {
     out.push(Claim {
         fragile: None,
         id: "sampling",
+        summary: Summary {
+            topic: "Dense sampling of the error",
+            paper: "maxima at quadrature points (the paper's choice)",
+            headline: format!("{} of {} verdicts flip", flips.len(), out.len()),
+        },
         claim: "Gauss-point maxima underestimate the L-infinity norm: every verdict above recomputed with the error maxima over the order-6 barycentric lattice of every element (err_dense) instead of the quadrature points, and with the runs RUN_dense (estimator maxima on the dense lattice and dense edge points too, `estimator.sampling = \"dense\"`) in place of RUN where a study has them".into(),
         measured: format!(
             "{} ({} verdicts recomputed; dense-estimator runs used: {})",
@@ -743,6 +875,15 @@ pub fn claims(results: &Path) -> std::io::Result<Vec<Claim>> {
     Ok(out)
 }
 
+/// The anchor GitHub gives the heading `### ID` of a claim: lower case, spaces to hyphens, every
+/// other character but letters, digits, `-` and `_` dropped.
+pub fn anchor(id: &str) -> String {
+    id.to_lowercase()
+        .chars()
+        .filter_map(|c| if c == ' ' { Some('-') } else { (c.is_alphanumeric() || c == '-' || c == '_').then_some(c) })
+        .collect()
+}
+
 /// The markdown document, generated from the records in `results/`.
 pub fn markdown(claims: &[Claim]) -> String {
     markdown_for(claims, Path::new("results"))
@@ -754,9 +895,27 @@ pub fn markdown_for(claims: &[Claim], results: &Path) -> String {
     s += "# Claims of Section 7, measured\n\n";
     let _ = write!(
         s,
-        "Generated by `signorini figures` from the records in `{}/` (never edited by hand). ",
+        "Generated by `signorini figures` from the records in `{}/` (never edited by hand). One line per claim: what it says in a few words, what the paper says, \
+         the headline measurement (rate ± 95% half-width over the window of NDF named, on the run named) and the verdict; the claim's name links to its evidence below.\n\n",
         results.display().to_string().trim_end_matches('/')
     );
+    s += "| claim | the paper | measured | verdict |\n|---|---|---|---|\n";
+    let cell = |t: &str| t.replace('|', "\\|");
+    for c in claims {
+        let fragile = if c.fragile.is_some() { ", *fragile*" } else { "" };
+        let _ = writeln!(
+            s,
+            "| [**{}**](#{}): {} | {} | {} | {}{} |",
+            c.id,
+            anchor(c.id),
+            cell(c.summary.topic),
+            cell(c.summary.paper),
+            cell(&c.summary.headline),
+            c.verdict.text(),
+            fragile
+        );
+    }
+    s += "\n## How the rows are judged\n\n";
     let _ = write!(
         s,
         "Rates are least-squares slopes of -log(quantity) against log(NDF) with 95% Student-t intervals (rate ± half-width), fitted on every other level \
@@ -778,12 +937,18 @@ pub fn markdown_for(claims: &[Claim], results: &Path) -> String {
         d = verdict::MIN_DECADES,
         t = TARGET_HALF_WIDTH,
     );
-    s += "| claim | measured | verdict |\n|---|---|---|\n";
+    s += "## Evidence\n";
     for c in claims {
-        // a literal | inside a cell is escaped (GitHub tables), so norms like ||u - u_h|| survive
-        let cell = |t: &str| t.replace('|', "\\|");
         let fragile = c.fragile.as_ref().map(|f| format!(", *fragile*: {f}")).unwrap_or_default();
-        let _ = writeln!(s, "| **{}**: {} | {} | {}{} |", c.id, cell(&c.claim), cell(&c.measured), c.verdict.text(), cell(&fragile));
+        let _ = write!(
+            s,
+            "\n### {}\n\n**Claim.** {}\n\n**Measured.** {}\n\n**Verdict.** {}{}\n",
+            c.id,
+            c.claim,
+            c.measured,
+            c.verdict.text(),
+            fragile
+        );
     }
     s
 }

@@ -28,6 +28,8 @@
 //! | `theta_ablation` | `theta_ablation`, a panel per problem | `err_quadrature` vs NDF for each theta and uniform, with NDF^-3/2; where some run of a problem has fewer than two errors, the estimate for all runs of that problem instead (the y label says which) |
 //! | `fb_error`, `fb_mesh` | `fb` | see `plot/fb.rs`: error and estimate vs NDF of the free-boundary problem, and its late adaptive mesh with x = a marked |
 //! | `hertz_pressure`, `hertz_mesh` | `hertz` | see `plot/hertz.rs`: the contact pressure against Hertz's, and the mesh near the contact |
+//! | `deep_error`, `deep_floor` | `deep` | see `plot/deep.rs`: the error of the deep runs to 1e7 unknowns, and error, estimate and round-off floor together |
+//! | `ex72_large_error` | `ex72_large` | see `plot/ex72_large.rs`: Example 7.2's error on the square and on Gamma_C against the reference, every run |
 //! | `estimator_repair` | `estimator_repair`, a panel per problem | `err_quadrature` (solid) and `estimate` (dashed) vs NDF for each run (adaptive or uniform, and its l_h) of the repaired estimator |
 //!
 //! Style: log axes labelled at the decades (`10⁻⁴`; also 2x and 5x when less than two decades
@@ -54,6 +56,7 @@
 
 mod axis;
 mod deep;
+mod ex72_large;
 mod fb;
 mod font;
 mod glyphs;
@@ -72,7 +75,7 @@ use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// Every figure, in the order drawn.
-pub const FIGURES: [&str; 18] = [
+pub const FIGURES: [&str; 19] = [
     "fig2a",
     "fig2b",
     "fig3a",
@@ -91,6 +94,7 @@ pub const FIGURES: [&str; 18] = [
     "estimator_repair",
     "deep_error",
     "deep_floor",
+    "ex72_large_error",
 ];
 
 /// The study a figure is drawn from (the table above).
@@ -106,6 +110,7 @@ pub fn study_of(figure: &str) -> Option<&'static str> {
         "hertz_pressure" | "hertz_mesh" => "hertz",
         "estimator_repair" => "estimator_repair",
         "deep_error" | "deep_floor" => "deep",
+        "ex72_large_error" => "ex72_large",
         _ => return None,
     })
 }
@@ -252,6 +257,7 @@ fn build(name: &str, results: &Path) -> anyhow::Result<Built> {
         "hertz_mesh" => hertz::hertz_mesh(results),
         "deep_error" => deep::deep_error(results),
         "deep_floor" => deep::deep_floor(results),
+        "ex72_large_error" => ex72_large::ex72_large_error(results),
         other => anyhow::bail!("unknown figure {other}"),
     }
 }

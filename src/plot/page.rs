@@ -98,19 +98,62 @@ fn claims_table(claims: &[&Claim]) -> String {
     if claims.is_empty() {
         return "<p>No CLAIMS row rests on this study.</p>\n".into();
     }
-    let mut s = String::from("<table class=\"claims\"><tr><th>claim</th><th>measured</th><th>verdict</th></tr>\n");
+    let mut s = String::from("<table class=\"claims\"><tr><th>claim</th><th>the paper</th><th>measured</th><th>verdict</th></tr>\n");
     for c in claims {
-        // the verdict text marks failures in markdown bold; render it as HTML
-        let verdict = escape(&c.verdict.text().replace("**", ""));
+        // the summary line shows; the claim's full wording and its evidence fold behind it
         let _ = writeln!(
             s,
-            "<tr class=\"claim\" id=\"claim-{id}\"><td><b>{id}</b>: {}</td><td>{}</td><td>{verdict}</td></tr>",
+            "<tr class=\"claim\" id=\"claim-{id}\"><td><b>{id}</b>: {}<details><summary>the claim in full</summary>{}</details></td><td>{}</td><td>{}<details><summary>evidence</summary>{}</details></td><td>{}</td></tr>",
+            escape(c.summary.topic),
             escape(&c.claim),
+            escape(c.summary.paper),
+            escape(&c.summary.headline),
             escape(&c.measured),
+            verdict_html(c),
             id = escape(c.id)
         );
     }
     s + "</table>\n"
+}
+
+/// The verdict as HTML (the markdown bold of failures dropped), with "fragile" where it is.
+fn verdict_html(c: &Claim) -> String {
+    let fragile = c.fragile.as_ref().map(|f| format!(", <i>fragile</i>: {}", escape(f))).unwrap_or_default();
+    format!("{}{fragile}", escape(&c.verdict.text().replace("**", "")))
+}
+
+/// The index of the study pages: the summary line of every CLAIMS row, each linked to the pages
+/// of the studies it rests on, then the list of studies.
+pub fn index_page(results: &Path, studies: &[String], claims: &[Claim]) -> String {
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>signorini: studies</title><style>{STYLE}</style></head><body>\n<h1>The claims of Section 7, measured</h1>\n<p>From the records in <code>{}</code>. One line per claim; its studies' pages hold the evidence.</p>\n",
+        escape(&results.display().to_string())
+    );
+    s += "<table class=\"claims\"><tr><th>claim</th><th>the paper</th><th>measured</th><th>verdict</th><th>studies</th></tr>\n";
+    for c in claims {
+        let links: Vec<String> = claim_studies(c.id)
+            .iter()
+            .filter(|st| studies.iter().any(|p| p == *st))
+            .map(|st| format!("<a href=\"{st}.html#claim-{id}\">{st}</a>", id = escape(c.id)))
+            .collect();
+        let _ = writeln!(
+            s,
+            "<tr><td><b>{}</b>: {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            escape(c.id),
+            escape(c.summary.topic),
+            escape(c.summary.paper),
+            escape(&c.summary.headline),
+            verdict_html(c),
+            links.join(", ")
+        );
+    }
+    s += "</table>\n<h2>Studies</h2>\n<ul>\n";
+    for st in studies {
+        let _ = writeln!(s, "<li><a href=\"{0}.html\">{0}</a></li>", escape(st));
+    }
+    s + "</ul>\n</body></html>\n"
 }
 
 fn figures_html(figures: &Path, study: &str) -> std::io::Result<String> {
@@ -156,7 +199,8 @@ fn provenance_html(study: &StudyDir) -> String {
 
 const STYLE: &str = "body{font-family:'DejaVu Sans',sans-serif;max-width:1100px;margin:2em auto;color:#222}\
 table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:4px 8px;text-align:left;vertical-align:top}\
-th{background:#f4f4f4}figure{margin:1em 0}img{max-width:100%}.bad{color:#b00}code{font-size:90%}";
+th{background:#f4f4f4}figure{margin:1em 0}img{max-width:100%}.bad{color:#b00}code{font-size:90%}\
+details{margin-top:4px;color:#444}summary{cursor:pointer;color:#06c}";
 
 /// The page of `study`: `results` holds its records, `figures` its PNGs, `claims` every CLAIMS
 /// row (those of the study are shown), `drift` the drift report if one was found.
@@ -204,8 +248,9 @@ pub fn studies_in(results: &Path) -> std::io::Result<Vec<String>> {
     Ok(out)
 }
 
-/// Write `out/STUDY.html` for each of `studies` (every study under `results` if empty), atomically;
-/// returns the pages written. A named study without records is an error.
+/// Write `out/STUDY.html` for each of `studies` (every study under `results` if empty), and with
+/// every study also `out/index.html` ([`index_page`]), atomically; returns the pages written,
+/// the index last. A named study without records is an error.
 pub fn write_pages(results: &Path, figures: &Path, out: &Path, studies: &[String], drift_report: &Path) -> anyhow::Result<Vec<PathBuf>> {
     use anyhow::Context;
     let present = studies_in(results)?;
@@ -228,6 +273,12 @@ pub fn write_pages(results: &Path, figures: &Path, out: &Path, studies: &[String
         let page = study_page(results, figures, study, &claims, drift.as_ref())?;
         let path = out.join(format!("{study}.html"));
         crate::records::write_atomic(&path, page.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+        written.push(path);
+    }
+    if studies.is_empty() {
+        let path = out.join("index.html");
+        crate::records::write_atomic(&path, index_page(results, &chosen, &claims).as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
         written.push(path);
     }
     Ok(written)
