@@ -378,7 +378,7 @@ fn compare_histories(study: &str, stored: &RunRecord, fresh: &RunRecord, out: &m
 }
 
 /// The replay tier of a deep study in its tiers: the last level of every run in
-/// `[drift.deep] replay`, rebuilt from its stored history and solved once more
+/// `[drift.deep] replay` (the last with at most `replay_max_ndof` unknowns where that is given), rebuilt from its stored history and solved once more
 /// ([`super::replay_stored_level`]), against its stored record (rows under run `ID (replayed)`).
 /// A history that does not rebuild its meshes is a row of field `history`.
 fn replay_tier(manifest: &Manifest, stored: &[RunRecord], progress: bool, c: &mut Comparison) -> anyhow::Result<()> {
@@ -387,7 +387,7 @@ fn replay_tier(manifest: &Manifest, stored: &[RunRecord], progress: bool, c: &mu
     for id in &tier.replay {
         let label = format!("{id} (replayed)");
         let Some(s) = stored.iter().find(|r| &r.run.id == id) else { continue }; // a missing run is a row already
-        let Some(level) = s.levels.len().checked_sub(1) else { continue };
+        let Some(level) = s.levels.iter().rposition(|l| tier.replay_max_ndof.is_none_or(|m| l.ndof <= m)) else { continue };
         if progress {
             eprintln!("{study}/{id}: replaying level {level} (NDF {}) from the stored refinement history", s.levels[level].ndof);
         }

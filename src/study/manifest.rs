@@ -162,8 +162,10 @@ pub struct DriftSpec {
 /// in its quick form (the first `quick_levels` levels: an exact prefix, kept to small sizes) and
 /// compares those levels, except the runs in `full`, which it reruns to the end and compares at
 /// every level (a deep level of the study checked in every test run). The last level of each
-/// run in `replay` is rebuilt from its stored refinement history and solved once more
-/// (`adapt::replay`), without the levels before it, and compared with its stored record; every
+/// run in `replay` (the last with at most `replay_max_ndof` unknowns, where that is given: a
+/// level whose solve fits the memory of the machines `make test` runs on) is rebuilt from its
+/// stored refinement history and solved once more (`adapt::replay`), without the levels before
+/// it, and compared with its stored record; every
 /// run's history is compared exactly with the stored one as far as it was rerun.
 /// `signorini drift --deep` (the scheduled job, `make drift`) reruns every run to the end.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -173,6 +175,9 @@ pub struct DeepTier {
     pub full: Vec<String>,
     #[serde(default)]
     pub replay: Vec<String>,
+    /// The replayed level is the last with at most this many unknowns (all levels: the last).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replay_max_ndof: Option<usize>,
 }
 
 fn default_tolerance() -> Tolerance {
@@ -400,6 +405,9 @@ fn parse_run(
 /// are checked by definition), and rate checks on declared runs.
 fn check_drift(drift: &DriftSpec, runs: &[PlannedRun], invalid: &Invalid) -> Result<(), ManifestError> {
     if let Some(deep) = &drift.deep {
+        if deep.replay_max_ndof == Some(0) {
+            return Err(invalid.at("drift.deep.replay_max_ndof".into(), "a positive number of unknowns", "0".into()));
+        }
         for (tier, ids) in [("full", &deep.full), ("replay", &deep.replay)] {
             for (i, id) in ids.iter().enumerate() {
                 if !runs.iter().any(|p| &p.spec.id == id) {
