@@ -60,6 +60,7 @@ fn main() -> anyhow::Result<()> {
         Termination::MaxNdofReached => "the next level would exceed max_ndof",
         Termination::StopNdofReached => "a level reached stop_ndof",
         Termination::StoppedByObserver => "stopped by the observer",
+        Termination::NothingMarked => "the estimate is zero: nothing to mark",
     };
     let kkt = result.solution.kkt();
     println!("stopped: {why}; final mesh {} triangles, max penetration {:.1e}", result.mesh.n_triangles(), kkt.max_penetration);

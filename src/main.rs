@@ -10,6 +10,15 @@ use signorini::norms::Sampling;
 use signorini::{norms, problems, report, solve, study};
 use std::process::ExitCode;
 
+/// `eprintln!` that cannot panic: a message whose write to stderr fails (a full device, a
+/// file-size limit, a closed stderr) is dropped, and the exit status still says what happened.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stderr(), $($arg)*);
+    }};
+}
+
 #[derive(Parser)]
 #[command(name = "signorini", version, about = "P2 finite elements for the Signorini problem and its supremum-norm a posteriori estimator")]
 struct Cli {
@@ -290,9 +299,12 @@ fn flag_of(key: &str) -> &'static str {
     }
 }
 
-/// Validate the loop's settings as manifests do, naming the flag.
-fn validate(config: &AdaptConfig) -> Result<()> {
-    config.validate().map_err(|e| anyhow::anyhow!("{}: expected {}, got {}", flag_of(e.key), e.expected, e.got))
+/// Validate the loop's settings as manifests do (the same functions), naming the flag: every
+/// setting, and `max_ndof` against the initial mesh `spec`.
+fn validate(config: &AdaptConfig, spec: &MeshSpec) -> Result<()> {
+    let flag = |e: adapt::ConfigError| anyhow::anyhow!("{}: expected {}, got {}", flag_of(e.key), e.expected, e.got);
+    config.validate().map_err(flag)?;
+    config.check_initial(spec.ndof()?, &spec.to_string()).map_err(flag)
 }
 
 /// A solve's mesh, solution, element indicators and report.
@@ -308,7 +320,7 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
     let theta = args.theta.unwrap_or(0.5);
     let config =
         AdaptConfig { levels: args.adapt_levels.map_or(200, |l| l + 1), theta, estimator, pdas: pdas.clone(), ..Default::default() };
-    validate(&config)?;
+    validate(&config, &spec)?;
     solve::check_memory(&spec.to_string(), spec.ndof()?)?;
     if let Some(n) = args.adapt_min_ndof {
         solve::check_memory(&format!("an adaptive level reaching --adapt-min-ndof {n}"), n as f64)?;
@@ -336,7 +348,7 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
     let verbose = args.verbose;
     let mut log = |it: &signorini::contact::PdasIteration| {
         if verbose {
-            eprintln!("pdas {:>3}: active {:>6} (+{} -{}), residual {:.3e}", it.iteration, it.active, it.added, it.removed, it.residual);
+            say!("pdas {:>3}: active {:>6} (+{} -{}), residual {:.3e}", it.iteration, it.active, it.added, it.removed, it.residual);
         }
     };
     let sol =
@@ -346,6 +358,7 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
     if let Some(bad) = problem.bad_datum() {
         return Err(solve::SolveError::Data(bad)).with_context(|| format!("estimating on {mesh_name}"));
     }
+    est.terms.check_finite().with_context(|| format!("estimating on {mesh_name}"))?;
     let report = report::SolveReport::new(problem.name(), &mesh_name, &mesh, &sol, error, &est, &probes)?;
     Ok((mesh, sol, est.element, report))
 }
@@ -362,7 +375,7 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
         estimator: args.estimator.config()?,
         ..Default::default()
     };
-    validate(&config)?;
+    validate(&config, &spec)?;
     if let Some(path) = &args.save {
         check_writable(path)?;
     }
@@ -402,16 +415,43 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
             r.pdas_iterations,
             r.t_level
         );
-        std::ops::ControlFlow::Continue(())
+        // an interrupt (SIGINT) stops after the level just printed, as `run` does
+        if study::interrupted() { std::ops::ControlFlow::Break(()) } else { std::ops::ControlFlow::Continue(()) }
     })?;
+    if let Some(note) = result.termination.note(&config) {
+        println!("# {note}");
+    }
+    let level = result.records.last().map_or(0, |r| r.level);
     if let Some(path) = &args.save {
-        let level = result.records.last().map_or(0, |r| r.level);
         let doc = report::solution_vtu(&result.mesh, &result.solution, &result.estimate.element);
         signorini::records::write_atomic(path, doc.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
         println!("# wrote {} (level {level}, NDF {})", path.display(), result.mesh.p2_ndof());
     }
+    if study::interrupted() {
+        bail!(AdaptInterrupted { level, saved: args.save.clone() });
+    }
     Ok(())
 }
+
+/// `adapt` stopped by an interrupt after level `level` (exit status 130): the rows above are
+/// the levels kept.
+#[derive(Debug)]
+struct AdaptInterrupted {
+    level: usize,
+    saved: Option<std::path::PathBuf>,
+}
+
+impl std::fmt::Display for AdaptInterrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "adapt: interrupted after level {}; the table above holds levels 0 to {}", self.level, self.level)?;
+        match &self.saved {
+            Some(p) => write!(f, ", and {} the last of them", p.display()),
+            None => Ok(()),
+        }
+    }
+}
+
+impl std::error::Error for AdaptInterrupted {}
 
 /// Refuse an output path whose folder does not exist before hours of work are spent, not after.
 fn check_writable(path: &std::path::Path) -> Result<()> {
@@ -455,7 +495,7 @@ fn run_studies(
     for manifest in &parsed {
         let options = study::RunOptions { quick, shard, fresh, replace, results: results.clone(), progress: true, wait_for_lock: wait };
         let executed = study::run_study(manifest, &options)?;
-        eprintln!("{}: {} run(s) executed, results in {}", manifest.study, executed.len(), results.join(&manifest.study).display());
+        say!("{}: {} run(s) executed, results in {}", manifest.study, executed.len(), results.join(&manifest.study).display());
     }
     Ok(())
 }
@@ -470,7 +510,7 @@ fn threads(jobs: usize) -> Result<usize> {
     }
     let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     if jobs > cores {
-        eprintln!(
+        say!(
             "note: --jobs {jobs} is more than the {cores} core(s) available to this process; using {cores} (the results do not depend on the thread count; more threads than cores only add overhead)"
         );
     }
@@ -490,7 +530,7 @@ fn check_shard(manifests: &[study::manifest::Manifest], (k, n): (usize, usize)) 
         );
     }
     for (s, r, _) in counts.iter().filter(|c| c.2 == 0) {
-        eprintln!("note: --shard {k}/{n} holds no run of {s} ({r} run(s)); other shards run them");
+        say!("note: --shard {k}/{n} holds no run of {s} ({r} run(s)); other shards run them");
     }
     Ok(())
 }
@@ -519,7 +559,7 @@ fn accept_studies(accept: &[String], experiments: &std::path::Path, results: &st
             wait_for_lock: false,
         };
         study::run_study(m, &options)?;
-        eprintln!(
+        say!(
             "accepted: {} rewritten from a full rerun of {}; run `signorini figures`, review and commit the change",
             results.join(&m.study).display(),
             m.file.display()
@@ -662,7 +702,7 @@ fn figure_studies(
         );
     }
     if !held.absent.is_empty() {
-        eprintln!("figures: {dir} does not hold {}: their figures and claims are not drawn", held.absent.join(", "));
+        say!("figures: {dir} does not hold {}: their figures and claims are not drawn", held.absent.join(", "));
     }
     Ok((held.present, Some(named.unwrap_or(present))))
 }
@@ -720,19 +760,19 @@ fn run_export(args: &SolveArgs, out: &std::path::Path) -> Result<()> {
     Ok(())
 }
 
-/// SIGINT: the first stops a study after its current level (keeping every finished run), a
-/// second one stops at once.
+/// SIGINT: the first stops a study (or `adapt`) after its current level (keeping every
+/// finished run, or the levels printed), a second one stops at once.
 fn install_interrupt_handler() {
     let result = ctrlc::set_handler(|| {
         if study::interrupted() {
-            eprintln!("\ninterrupted again: stopping now (finished runs are on disk)");
+            say!("\ninterrupted again: stopping now (finished runs are on disk)");
             std::process::exit(130);
         }
-        eprintln!("\ninterrupt: finishing the current level, then stopping (Ctrl-C again stops at once)");
+        say!("\ninterrupt: finishing the current level, then stopping (Ctrl-C again stops at once)");
         study::interrupt();
     });
     if let Err(e) = result {
-        eprintln!("warning: cannot install the interrupt handler: {e}");
+        say!("warning: cannot install the interrupt handler: {e}");
     }
 }
 
@@ -749,10 +789,10 @@ fn main() -> ExitCode {
     }
     let cli = Cli::parse();
     if let Err(e) = signorini::ordering::forced() {
-        eprintln!("error: {e}");
+        say!("error: {e}");
         return ExitCode::from(2);
     }
-    if matches!(cli.command, Command::Run { .. } | Command::Drift { .. }) {
+    if matches!(cli.command, Command::Run { .. } | Command::Drift { .. } | Command::Adapt(_)) {
         install_interrupt_handler();
     }
     let result = match &cli.command {
@@ -781,12 +821,12 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) if e.downcast_ref::<study::Interrupted>().is_some() => {
-            eprintln!("{e:#}");
+        Err(e) if e.downcast_ref::<study::Interrupted>().is_some() || e.downcast_ref::<AdaptInterrupted>().is_some() => {
+            say!("{e:#}");
             ExitCode::from(130)
         }
         Err(e) => {
-            eprintln!("error: {e:#}");
+            say!("error: {e:#}");
             ExitCode::FAILURE
         }
     }

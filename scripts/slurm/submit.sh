@@ -13,23 +13,36 @@
 #   --logs DIR        where the jobs' output goes [DIR/slurm-logs, DIR the results folder]
 #   --bin PATH        the signorini binary [target/release/signorini, built with make build]
 set -euo pipefail
+usage="usage: submit.sh [options] MANIFEST (options first; see the comment at the top of $0)"
+fail() { echo "submit.sh: $*" >&2; exit 2; }
 tasks=4 results=results partition= time= cpus=1 logs= bin=target/release/signorini
-while [ $# -gt 1 ]; do
+# every argument is checked before anything is created or submitted
+while [ $# -gt 0 ]; do
     case $1 in
-        --tasks) tasks=$2 ;;
-        --results) results=$2 ;;
-        --partition) partition=$2 ;;
-        --time) time=$2 ;;
-        --cpus) cpus=$2 ;;
-        --logs) logs=$2 ;;
-        --bin) bin=$2 ;;
-        *) echo "submit.sh: unknown option $1 (see the comment at the top of $0)" >&2; exit 2 ;;
+        --tasks|--results|--partition|--time|--cpus|--logs|--bin)
+            [ $# -ge 2 ] && [ -n "$2" ] && [ "${2#--}" = "$2" ] || fail "$1 needs a value; $usage"
+            case $1 in
+                --tasks) tasks=$2 ;;
+                --results) results=$2 ;;
+                --partition) partition=$2 ;;
+                --time) time=$2 ;;
+                --cpus) cpus=$2 ;;
+                --logs) logs=$2 ;;
+                --bin) bin=$2 ;;
+            esac
+            shift 2 ;;
+        --*) fail "unknown option $1; $usage" ;;
+        *) [ $# -eq 1 ] || fail "the manifest comes last, after the options (got $1 before: ${*:2}); $usage"
+           break ;;
     esac
-    shift 2
 done
-manifest=${1:?usage: submit.sh [options] MANIFEST}
-[ -f "$manifest" ] || { echo "submit.sh: no manifest $manifest" >&2; exit 2; }
-[ -x "$bin" ] || { echo "submit.sh: no binary $bin (make build)" >&2; exit 2; }
+[ $# -eq 1 ] || fail "no manifest given; $usage"
+manifest=$1
+for n in tasks cpus; do
+    [[ ${!n} =~ ^[1-9][0-9]*$ ]] || fail "--$n ${!n}: expected a whole number >= 1"
+done
+[ -f "$manifest" ] || fail "no manifest $manifest"
+[ -x "$bin" ] || fail "no binary $bin (make build)"
 logs=${logs:-$results/slurm-logs}
 mkdir -p "$logs"
 here=$(cd "$(dirname "$0")" && pwd)

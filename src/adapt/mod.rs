@@ -34,15 +34,8 @@ pub struct AdaptConfig {
     pub warm_start: bool,
 }
 
-/// A setting of the loop outside its range: `key` is the field (as manifests spell it), `expected`
-/// the admissible values, `got` the value given.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{key}: expected {expected}, got {got}")]
-pub struct ConfigError {
-    pub key: &'static str,
-    pub expected: &'static str,
-    pub got: String,
-}
+/// A setting of the loop outside its range (the estimator's error type: one for all settings).
+pub use crate::estimate::ConfigError;
 
 /// Why the loop could not run: settings out of range (checked before anything is solved) or a
 /// level whose solve failed.
@@ -52,6 +45,9 @@ pub enum AdaptError {
     Config(#[from] ConfigError),
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// The estimate of level `level` is not a finite number (nothing of that level is kept).
+    #[error("level {level}: {error}")]
+    Estimate { level: usize, error: estimate::NotFinite },
     /// The next level would not fit in memory: levels `0..level` were solved (and seen by the
     /// observer), level `level` was not.
     #[error("stopped before level {level} ({}): {error}", if *level == 0 { "no level was solved".to_string() } else { format!("levels 0 to {} were solved", level - 1) })]
@@ -81,7 +77,7 @@ impl AdaptConfig {
     /// With theta > 1 the maximum strategy marks nothing and the loop solves one mesh over and
     /// over; with `levels = 0` or `max_ndof = 0` it solves nothing.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        let bad = |key, expected, got: String| Err(ConfigError { key, expected, got });
+        let bad = |key, expected: &str, got: String| Err(ConfigError { key, expected: expected.into(), got });
         if self.levels == 0 {
             return bad("levels", "a number of levels >= 1", "0".into());
         }
@@ -94,13 +90,26 @@ impl AdaptConfig {
         if !(self.theta > 0.0 && self.theta <= 1.0) {
             return bad("theta", "a number in (0, 1]", self.theta.to_string());
         }
-        if !(self.estimator.c0 > 0.0 && self.estimator.c0.is_finite()) {
-            return bad("estimator.c0", "a positive number", self.estimator.c0.to_string());
-        }
+        self.estimator.validate()?;
         if self.pdas.max_iterations == 0 {
             return bad("pdas.max_iterations", "a number of iterations >= 1", "0".into());
         }
         Ok(())
+    }
+
+    /// Check `max_ndof` against the initial mesh `mesh` of `ndof` unknowns: level 0 is always
+    /// solved, so a `max_ndof` below it would contradict itself (refused, not a silent level 0).
+    pub fn check_initial(&self, ndof: f64, mesh: &str) -> Result<(), ConfigError> {
+        match self.max_ndof {
+            Some(max) if (max as f64) < ndof => Err(ConfigError {
+                key: "max_ndof",
+                expected: format!(
+                    "a number of unknowns >= {ndof:.0} (the initial mesh {mesh} has {ndof:.0}, and level 0 is always solved)"
+                ),
+                got: max.to_string(),
+            }),
+            _ => Ok(()),
+        }
     }
 }
 
@@ -198,6 +207,28 @@ pub enum Termination {
     /// The observer returned `ControlFlow::Break` (checked before the other two: an observer that
     /// stops at the last level is reported here).
     StoppedByObserver,
+    /// The estimate of the last level solved is zero on every element: the maximum strategy
+    /// marks nothing, so the next level would be the same mesh again (not solved).
+    NothingMarked,
+}
+
+impl Termination {
+    /// Why the loop stopped before its last level, in a sentence (None: all levels were solved,
+    /// or the caller stopped it and knows why).
+    pub fn note(self, config: &AdaptConfig) -> Option<String> {
+        match self {
+            Termination::LevelsReached | Termination::StoppedByObserver => None,
+            Termination::MaxNdofReached => {
+                Some(format!("stopped: the next level would have more than max_ndof = {} unknowns", config.max_ndof.unwrap_or(0)))
+            }
+            Termination::StopNdofReached => {
+                Some(format!("stopped: the last level has at least stop_ndof = {} unknowns", config.stop_ndof.unwrap_or(0)))
+            }
+            Termination::NothingMarked => Some(
+                "stopped: the estimate is zero on every element, so nothing is marked and the next level would be the same mesh".into(),
+            ),
+        }
+    }
 }
 
 /// What [`run`] returns: the state of the last level solved and why the loop stopped (in the
@@ -272,6 +303,7 @@ pub fn solve_level(
     if let Some(bad) = problem.bad_datum() {
         return Err(SolveError::Data(bad).into());
     }
+    est.terms.check_finite().map_err(|error| AdaptError::Estimate { level, error })?;
     let t_estimate = t0.elapsed().as_secs_f64();
     let error = reference.map(|r| norms::linf_error(mesh, &sol, r));
     let marks = match config.refine {
@@ -372,6 +404,9 @@ pub fn run_from(
     if start.level >= config.levels {
         return Err(AdaptError::NothingToSolve { start: start.level, levels: config.levels });
     }
+    if start.level == 0 {
+        config.check_initial(start.mesh.p2_ndof() as f64, "of level 0")?;
+    }
     let Start { mut mesh, level: first, mut initial_active, mut records, mut history } = start;
     let mut state: Option<(Mesh, DiscreteSolution, Estimate)> = None;
     let mut termination = Termination::LevelsReached;
@@ -397,7 +432,8 @@ pub fn run_from(
             marks: Flags::encode(&marks),
         };
         let reached = config.stop_ndof.is_some_and(|s| mesh.p2_ndof() >= s);
-        let next = if level + 1 == config.levels || reached {
+        let unmarked = config.refine == Refine::Adaptive && !marks.contains(&true);
+        let next = if level + 1 == config.levels || reached || unmarked {
             None
         } else {
             let t0 = Instant::now();
@@ -426,6 +462,8 @@ pub fn run_from(
         }
         if reached {
             termination = Termination::StopNdofReached;
+        } else if next.is_none() && unmarked && level + 1 < config.levels {
+            termination = Termination::NothingMarked;
         }
         match next {
             Some((m, active)) => {

@@ -42,15 +42,56 @@ pub fn available() -> Option<Available> {
     })
 }
 
-/// The address-space limit's soft value minus the current virtual size (pages of 4 KiB, as on
-/// x86-64 Linux), if there is a limit.
+/// The address-space limit's soft value (RLIMIT_AS, `getrlimit`) minus the current virtual size
+/// (`/proc/self/statm`, in pages), if there is a limit.
 fn address_space_left() -> Option<f64> {
-    let limits = std::fs::read_to_string("/proc/self/limits").ok()?;
-    let line = limits.lines().find(|l| l.starts_with("Max address space"))?;
-    let limit: f64 = line["Max address space".len()..].split_whitespace().next()?.parse().ok()?; // "unlimited" fails here
+    let mut lim = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+    // SAFETY: getrlimit writes the struct it is given, nothing else
+    if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) } != 0 || lim.rlim_cur == libc::RLIM_INFINITY {
+        return None;
+    }
     let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
     let pages: f64 = statm.split_whitespace().next()?.parse().ok()?;
-    Some((limit - pages * 4096.0).max(0.0))
+    // SAFETY: sysconf only reads a constant of the system
+    let page = match unsafe { libc::sysconf(libc::_SC_PAGESIZE) } {
+        p if p > 0 => p as f64,
+        _ => 4096.0,
+    };
+    Some((lim.rlim_cur as f64 - pages * page).max(0.0))
+}
+
+/// Address space the solver's threads reserve beyond what [`memory_estimate`] counts (which is
+/// resident memory), in bytes: an address-space limit counts it all, whether touched or not.
+/// Per worker thread of the pool (`rayon::current_num_threads`): a glibc malloc arena (64 MiB
+/// reserved on 64-bit Linux) and the thread's stack (2 MiB, Rust's default); per worker and the
+/// main thread: the packing buffer of the dense products (faer through private-gemm-x86:
+/// twice the largest CPU cache, allocated on a thread's first product, kept, and allocated
+/// infallibly, so a failure there aborts the process). Counted in full at every check,
+/// although threads that already ran hold theirs inside the current virtual size: an
+/// overestimate of up to this amount, which refuses a level that might just have fit rather
+/// than let the process abort. Measured (`prlimit --as`, ex71 on structured:4, 32 MiB L3): the
+/// solve needs 220, 356 and 603 MB of address space with 1, 2 and 4 threads.
+pub fn thread_reserve() -> f64 {
+    let workers = rayon::current_num_threads() as f64;
+    workers * (64.0 + 2.0) * MIB + (workers + 1.0) * 2.0 * largest_cache()
+}
+
+/// The largest cache of CPU 0 in bytes (`/sys/devices/system/cpu/cpu0/cache/index*/size`), or
+/// 32 MiB where that cannot be read.
+fn largest_cache() -> f64 {
+    let sizes = (0..8).filter_map(|i| std::fs::read_to_string(format!("/sys/devices/system/cpu/cpu0/cache/index{i}/size")).ok());
+    let bytes = sizes.filter_map(|s| {
+        let s = s.trim();
+        let (digits, unit) = s.split_at(s.find(|c: char| !c.is_ascii_digit()).unwrap_or(s.len()));
+        let scale = match unit {
+            "" => 1.0,
+            "K" => 1024.0,
+            "M" => MIB,
+            _ => return None,
+        };
+        digits.parse::<f64>().ok().map(|d| d * scale)
+    });
+    bytes.fold(None, |a: Option<f64>, b| Some(a.map_or(b, |a| a.max(b)))).unwrap_or(32.0 * MIB)
 }
 
 /// Where the machine's available memory is unknown (no `/proc/meminfo`), solves whose estimate
@@ -84,7 +125,13 @@ pub fn check_memory(what: &str, ndof: f64) -> Result<(), MemoryError> {
 /// of that solve. See [`level_estimate`].
 pub fn check_memory_measured(what: &str, ndof: f64, measured: Option<(f64, f64)>) -> Result<(), MemoryError> {
     let available = available();
-    let (needed, basis) = level_estimate(ndof, measured, available.is_some_and(|a| !a.by_address_space));
+    let (mut needed, mut basis) = level_estimate(ndof, measured, available.is_some_and(|a| !a.by_address_space));
+    if available.is_some_and(|a| a.by_address_space) {
+        let reserve = thread_reserve();
+        needed += reserve;
+        basis +=
+            &format!(", + {} of address space the threads reserve: stacks, malloc arenas, dense-product buffers", human_bytes(reserve));
+    }
     if needed > available.map_or(UNKNOWN_MEMORY_LIMIT, |a| a.bytes) {
         return Err(MemoryError { what: what.to_string(), ndof, needed, basis, available });
     }

@@ -123,6 +123,42 @@ impl Default for EstimatorConfig {
     }
 }
 
+/// A setting outside its range: `key` is the field (as manifests spell it: `estimator.c0`,
+/// `theta`), `expected` the admissible values, `got` the value given. The one error of the
+/// settings' validation, whether they come from a manifest or the command line (which names
+/// the flag of `key` instead).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{key}: expected {expected}, got {got}")]
+pub struct ConfigError {
+    pub key: &'static str,
+    pub expected: String,
+    pub got: String,
+}
+
+impl EstimatorConfig {
+    /// Check the settings: C_0 must be a positive normal number (not zero, NaN, infinite or
+    /// subnormal, where C_0 eta_h loses its digits). Whether C_0 eta_h is finite depends on
+    /// eta_h too: [`Terms::check_finite`] checks that once the estimate is computed.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        if !(self.c0 > 0.0 && self.c0.is_normal()) {
+            return Err(ConfigError { key: "estimator.c0", expected: "a positive number".into(), got: self.c0.to_string() });
+        }
+        Ok(())
+    }
+}
+
+/// An estimate that is not a finite number: C_0 eta_h overflowed (a C_0 too large for this
+/// eta_h) or eta_h itself is not finite. Nothing can be compared with it or stored.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "the estimate C_0 eta_h = {c0:e} x {eta_h:e} is {estimate}, not a finite number (estimator.c0, --c0: a C_0 for which it is finite)"
+)]
+pub struct NotFinite {
+    pub c0: f64,
+    pub eta_h: f64,
+    pub estimate: f64,
+}
+
 /// The estimator's terms (the `estimator` object of `signorini solve --json`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Terms {
@@ -145,6 +181,15 @@ pub struct Terms {
 impl Terms {
     pub fn eta(&self) -> [f64; 7] {
         [self.eta1, self.eta2, self.eta3, self.eta4, self.eta5, self.eta6, self.eta7]
+    }
+
+    /// The estimate is a finite number: what every path that reports or stores one checks
+    /// (the adaptive loop at every level, `signorini solve`).
+    pub fn check_finite(&self) -> Result<(), NotFinite> {
+        if self.estimate.is_finite() {
+            return Ok(());
+        }
+        Err(NotFinite { c0: self.c0, eta_h: self.eta_h, estimate: self.estimate })
     }
 }
 

@@ -376,7 +376,7 @@ fn parse_run(
         save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
         constants,
     };
-    AdaptConfig::for_run(&spec).validate().map_err(|e| invalid.at(key(e.key), e.expected, e.got))?;
+    AdaptConfig::for_run(&spec).validate().map_err(|e| invalid.at(key(e.key), &e.expected, e.got))?;
     let quick_levels = r.quick_levels.or(d.quick_levels).unwrap_or(levels.min(6));
     if quick_levels == 0 || quick_levels > levels {
         return Err(invalid.at(key("quick_levels"), &format!("a number in 1..={levels} (levels)"), quick_levels.to_string()));
@@ -578,15 +578,7 @@ impl Manifest {
         mesh_spec
             .build(problem.as_ref())
             .map_err(|e| invalid("mesh", format!("a mesh problem {} can be solved on", spec.problem), format!("{:?}: {e}", spec.mesh)))?;
-        if let Some(max) = spec.max_ndof
-            && (max as f64) < ndof
-        {
-            return Err(invalid(
-                "max_ndof",
-                format!("a number of unknowns >= {ndof} (the initial mesh {} has {ndof}, and level 0 is always solved)", spec.mesh),
-                max.to_string(),
-            ));
-        }
+        AdaptConfig::for_run(spec).check_initial(ndof, &spec.mesh).map_err(|e| invalid(e.key, e.expected, e.got))?;
         if let Some(rf) = &spec.reference {
             if problem.exact().is_some() {
                 return Err(invalid(

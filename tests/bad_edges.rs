@@ -1,0 +1,134 @@
+//! No crash at the edges of the machine: an address-space limit gives a certified answer or the
+//! named memory error, never an abort; a stderr that cannot be written gives the error's exit
+//! status, not a panic's; an interrupted `adapt` stops after the current level and says what
+//! it kept.
+
+use std::io::BufRead;
+use std::os::unix::process::CommandExt;
+use std::process::{Command, Stdio};
+
+/// The binary with `args`, under an address-space limit of `bytes` (RLIMIT_AS, as
+/// `prlimit --as` sets it): (exit code or None for a signal, stdout, stderr).
+fn limited(bytes: u64, args: &[&str]) -> (Option<i32>, String, String) {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_signorini"));
+    cmd.args(args);
+    // SAFETY: setrlimit only, between fork and exec
+    unsafe {
+        cmd.pre_exec(move || {
+            let lim = libc::rlimit { rlim_cur: bytes, rlim_max: bytes };
+            if libc::setrlimit(libc::RLIMIT_AS, &lim) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    let o = cmd.output().unwrap();
+    (o.status.code(), String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
+}
+
+/// From 50 MB to 1 GB of address space: `solve` either certifies its answer or refuses with the
+/// named memory error before solving; `adapt` either finishes or stops before the level that
+/// would not fit. Before, faer's dense kernels aborted (SIGABRT) between 100 and 300 MB: the
+/// check counted resident memory only, not the address space each thread reserves.
+#[test]
+fn bad_address_space_limit_gives_an_answer_or_the_memory_error_never_a_signal() {
+    let (mut solved, mut refused) = (0, 0);
+    for mb in (50..=1000).step_by(50) {
+        let bytes = mb * 1_000_000;
+        let (code, out, err) = limited(bytes, &["solve", "--problem", "ex71", "--mesh", "structured:4"]);
+        match code {
+            Some(0) => {
+                assert!(out.contains("certified:"), "{mb} MB: {out}");
+                solved += 1;
+            }
+            Some(1) => {
+                assert!(err.contains("address-space limit") && err.contains("162 unknowns"), "{mb} MB: {err}");
+                refused += 1;
+            }
+            _ => panic!("{mb} MB: solve ended with {code:?} (a signal or a panic):\n{err}"),
+        }
+        let (code, _, err) = limited(bytes, &["adapt", "--problem", "ex71", "--levels", "4"]);
+        match code {
+            Some(0) => {}
+            Some(1) => assert!(err.contains("address-space limit"), "{mb} MB: {err}"),
+            _ => panic!("{mb} MB: adapt ended with {code:?} (a signal or a panic):\n{err}"),
+        }
+    }
+    assert!(solved > 0 && refused > 0, "solved {solved}, refused {refused}: the range should hold both");
+}
+
+/// The exit code of `solve --problem nope` (an error) run by a shell that first applies
+/// `redirect` to its stderr and then execs the binary.
+fn unwritable_stderr(redirect: &str) -> Option<i32> {
+    let bin = env!("CARGO_BIN_EXE_signorini");
+    let script = format!("exec {redirect}; exec {bin} solve --problem nope --mesh structured:4");
+    Command::new("bash").args(["-c", &script]).output().unwrap().status.code()
+}
+
+/// The error message cannot be written (stderr to a file under a file-size limit of 40 bytes,
+/// as `prlimit --fsize=40` sets it; a full device; a closed stderr): the exit status is still
+/// the error's, 1, not a panic's 101 nor death by SIGXFSZ.
+#[test]
+fn bad_unwritable_stderr_exits_with_the_error_status() {
+    let dir = std::env::temp_dir().join(format!("signorini-edges-stderr-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("err.txt");
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_signorini"));
+    cmd.args(["solve", "--problem", "nope", "--mesh", "structured:4"]).stderr(std::fs::File::create(&file).unwrap());
+    // SAFETY: setrlimit only, between fork and exec
+    unsafe {
+        cmd.pre_exec(|| {
+            let lim = libc::rlimit { rlim_cur: 40, rlim_max: 40 };
+            if libc::setrlimit(libc::RLIMIT_FSIZE, &lim) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    let status = cmd.status().unwrap();
+    assert_eq!(status.code(), Some(1), "file-size limit: {status:?}");
+    let written = std::fs::read_to_string(&file).unwrap();
+    assert!(written.len() <= 40 && written.starts_with("error: "), "{written:?}");
+    assert_eq!(unwritable_stderr("2>/dev/full"), Some(1), "/dev/full");
+    assert_eq!(unwritable_stderr("2>&-"), Some(1), "closed stderr");
+}
+
+/// SIGINT to a running `adapt` (sent after its first level row): it finishes the level it is
+/// on, prints it, writes `--save`'s file of the last level kept and exits with 130, naming the
+/// level it stopped after; it does not die by the signal.
+#[test]
+fn interrupted_adapt_stops_after_the_current_level_and_says_what_it_kept() {
+    let dir = std::env::temp_dir().join(format!("signorini-edges-sigint-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let save = dir.join("last.vtu");
+    let _ = std::fs::remove_file(&save);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["adapt", "--problem", "ex72", "--mesh", "structured:8", "--levels", "40", "--save"])
+        .arg(&save)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = std::io::BufReader::new(child.stdout.take().unwrap()).lines();
+    let mut rows = Vec::new();
+    for line in lines.by_ref() {
+        let line = line.unwrap();
+        if line.trim_start().starts_with(|c: char| c.is_ascii_digit()) {
+            rows.push(line);
+            break;
+        }
+    }
+    assert_eq!(rows.len(), 1, "no level row before the process ended");
+    // SAFETY: a signal to the child this test started
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) }, 0);
+    let rest: Vec<String> = lines.map(|l| l.unwrap()).collect();
+    let status = child.wait().unwrap();
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    assert_eq!(status.code(), Some(130), "{status:?}: {err}");
+    rows.extend(rest.iter().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).cloned());
+    let last: usize = rows.last().unwrap().split_whitespace().next().unwrap().parse().unwrap();
+    assert!(last < 39, "the loop was not stopped: {rows:?}");
+    assert!(err.contains(&format!("interrupted after level {last}; the table above holds levels 0 to {last}")), "{err}");
+    assert!(save.exists() && rest.iter().any(|l| l.contains(&format!("(level {last},"))), "{rest:?}");
+}

@@ -1,0 +1,125 @@
+//! One validation for the command line and the manifests: every bad setting of the adaptive
+//! loop is refused by the same library function (`AdaptConfig::validate`,
+//! `AdaptConfig::check_initial`, `Terms::check_finite`) whichever way it comes, with the same
+//! expected values and the same value named; and a loop with nothing to mark says so instead of
+//! solving the same mesh again.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("signorini-settings-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// (exit code, stdout, stderr) of the binary run in `dir`.
+fn signorini_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).current_dir(dir).output().unwrap();
+    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned());
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    (out.status.code().unwrap_or(-1), stdout, stderr)
+}
+
+/// The part of an error from `marker` to the end of its line, the run's name dropped.
+fn tail<'a>(err: &'a str, marker: &str) -> &'a str {
+    let at = err.find(marker).unwrap_or_else(|| panic!("no {marker:?} in: {err}"));
+    let line = err[at..].lines().next().unwrap();
+    line.strip_suffix(" (run r0)").unwrap_or(line)
+}
+
+/// Each bad value as flags of `adapt` and as manifest lines (`[defaults]`, `[defaults.estimator]`),
+/// with the key the manifest names and the flag the command line names.
+const CASES: [(&[&str], &str, &str, &str, &str); 14] = [
+    (&["--c0", "0"], "", "c0 = 0.0", "estimator.c0", "--c0"),
+    (&["--c0", "-1"], "", "c0 = -1.0", "estimator.c0", "--c0"),
+    (&["--c0", "nan"], "", "c0 = nan", "estimator.c0", "--c0"),
+    (&["--c0", "inf"], "", "c0 = inf", "estimator.c0", "--c0"),
+    (&["--c0", "1e-310"], "", "c0 = 1e-310", "estimator.c0", "--c0"),
+    (&["--theta", "0"], "theta = 0.0", "", "theta", "--theta"),
+    (&["--theta", "1.5"], "theta = 1.5", "", "theta", "--theta"),
+    (&["--theta", "-0.5"], "theta = -0.5", "", "theta", "--theta"),
+    (&["--theta", "nan"], "theta = nan", "", "theta", "--theta"),
+    (&["--levels", "0"], "levels = 0", "", "levels", "--levels"),
+    (&["--max-ndof", "0"], "max_ndof = 0", "", "max_ndof", "--max-ndof"),
+    (&["--max-ndof", "5"], "max_ndof = 5", "", "max_ndof", "--max-ndof"),
+    (&["--max-ndof", "161"], "max_ndof = 161", "", "max_ndof", "--max-ndof"),
+    (&["--stop-ndof", "0"], "stop_ndof = 0", "", "stop_ndof", "--stop-ndof"),
+];
+
+fn manifest(defaults: &str, estimator: &str) -> String {
+    let levels = if defaults.starts_with("levels") { "" } else { "levels = 2\n" };
+    format!(
+        "[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\n{levels}{defaults}\n[defaults.estimator]\n{estimator}\n[[run]]\nid = \"r0\"\n"
+    )
+}
+
+#[test]
+fn bad_settings_get_the_same_refusal_from_the_command_line_and_a_manifest() {
+    for (flags, defaults, estimator, key, flag) in CASES {
+        let d = tmp("both");
+        let mut args = vec!["adapt", "--problem", "ex71", "--mesh", "structured:4"];
+        if flags[0] != "--levels" {
+            args.extend(["--levels", "2"]);
+        }
+        args.extend_from_slice(flags);
+        let (code, out, cli) = signorini_in(&d, &args);
+        assert_eq!(code, 1, "{flags:?}: {cli}");
+        assert!(out.is_empty(), "{flags:?}: solved before refusing:\n{out}");
+        assert!(cli.contains(&format!("error: {flag}: expected ")), "{flags:?}: {cli}");
+        std::fs::write(d.join("m.toml"), manifest(defaults, estimator)).unwrap();
+        let (code, _, man) = signorini_in(&d, &["run", "m.toml", "--results", "res"]);
+        assert_eq!(code, 1, "{flags:?}: {man}");
+        assert!(man.contains(&format!("m.toml: key `run[0].{key}`: expected ")), "{flags:?}: {man}");
+        assert!(!d.join("res").exists(), "{flags:?}: the manifest's run was started");
+        assert_eq!(tail(&cli, ": expected "), tail(&man, ": expected "), "{flags:?}");
+        if key == "max_ndof" && flags[1] != "0" {
+            assert!(cli.contains("expected a number of unknowns >= 162 (the initial mesh structured:4 has 162"), "{cli}");
+        }
+    }
+}
+
+/// A C_0 so large that C_0 eta_h overflows cannot be known bad before eta_h is: both paths stop
+/// at level 0 with the same named error (the command line printed `inf` and exited 0).
+#[test]
+fn bad_estimate_that_overflows_is_refused_by_both_paths_at_level_0() {
+    let d = tmp("overflow");
+    let (code, out, cli) = signorini_in(&d, &["adapt", "--problem", "ex71", "--levels", "2", "--c0", "1e308"]);
+    assert_eq!(code, 1, "{cli}");
+    assert!(!out.contains("inf"), "{out}");
+    std::fs::write(d.join("m.toml"), manifest("", "c0 = 1e308")).unwrap();
+    let (code, _, man) = signorini_in(&d, &["run", "m.toml", "--results", "res"]);
+    assert_eq!(code, 1, "{man}");
+    let marker = "level 0: the estimate C_0 eta_h = 1e308 x ";
+    assert_eq!(tail(&cli, marker), tail(&man, marker));
+    assert!(cli.contains("is inf, not a finite number"), "{cli}");
+    // `solve` refuses it too
+    let (code, out, err) = signorini_in(&d, &["solve", "--problem", "ex71", "--mesh", "structured:4", "--c0", "1e308"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(out.is_empty() && err.contains("is inf, not a finite number"), "{out}{err}");
+    // a large C_0 whose estimate is finite stays accepted
+    let (code, _, err) = signorini_in(&d, &["adapt", "--problem", "ex71", "--levels", "1", "--c0", "1e300"]);
+    assert_eq!(code, 0, "{err}");
+}
+
+/// A problem whose estimate is zero everywhere (no load, no contact) has nothing to mark: the
+/// loop stops after level 0 and says why, instead of solving the same mesh `levels` times.
+#[test]
+fn nothing_to_mark_stops_the_loop_and_says_so() {
+    let d = tmp("unmarked");
+    std::fs::write(
+        d.join("still.toml"),
+        "[material]\nmu = 1\nlambda = 1\n[parts]\ncontact = \"y < 1e-12\"\ndirichlet = \"x < 1e-12\"\n[contact]\nchi = \"1\"\nnormal = [0, -1]\n",
+    )
+    .unwrap();
+    let (code, out, err) = signorini_in(&d, &["adapt", "--problem", "still.toml", "--levels", "4"]);
+    assert_eq!(code, 0, "{err}");
+    let rows: Vec<&str> = out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).collect();
+    assert_eq!(rows.len(), 1, "{out}");
+    assert!(out.contains("# stopped: the estimate is zero on every element, so nothing is marked"), "{out}");
+    // uniform refinement marks everything: all levels are solved
+    let (code, out, err) = signorini_in(&d, &["adapt", "--problem", "still.toml", "--levels", "3", "--uniform"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).count(), 3, "{out}");
+}
