@@ -569,7 +569,7 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             "no data".into()
         } else {
             let against_uniform = |r: Option<&RunRecord>| match (r, un) {
-                (Some(r), Some(u)) => format!("{}: {}", r.run.id, repair::unknowns_text(r, u, ctx.err_field()).0),
+                (Some(r), Some(u)) => format!("{}: {}", r.run.id, repair::unknowns(ctx, r, u).0),
                 _ => String::new(),
             };
             let floor = |r: Option<&RunRecord>| r.map(|r| format!("; {}", ctx.floor_text(r))).unwrap_or_default();

@@ -106,6 +106,26 @@ impl LineFit {
     }
 }
 
+/// The least-squares line through (x, y) evaluated at `x`, with the 95% half-width of that value
+/// (the interval of the mean response: t_{0.975, n-2} s sqrt(1/n + (x - mean x)^2 / Sxx));
+/// None with fewer than 3 points or no spread in x.
+pub fn line_value_at(pts: &[(f64, f64)], x: f64) -> Option<(f64, f64)> {
+    let n = pts.len();
+    if n < 3 {
+        return None;
+    }
+    let nf = n as f64;
+    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / nf, pts.iter().map(|p| p.1).sum::<f64>() / nf);
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    if sxx <= 0.0 {
+        return None;
+    }
+    let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx;
+    let rss: f64 = pts.iter().map(|p| (p.1 - my - slope * (p.0 - mx)).powi(2)).sum();
+    let s = (rss / (nf - 2.0)).sqrt();
+    Some((my + slope * (x - mx), t_quantile_975(n - 2) * s * (1.0 / nf + (x - mx).powi(2) / sxx).sqrt()))
+}
+
 /// Least-squares line through (x, y) with a 95% interval on the slope; None with fewer than 2
 /// points or no spread in x.
 pub fn fit_line(pts: &[(f64, f64)]) -> Option<LineFit> {
@@ -127,4 +147,24 @@ pub fn fit_line(pts: &[(f64, f64)]) -> Option<LineFit> {
         f64::INFINITY
     };
     Some(LineFit { slope, half_width, points: n })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On points of an exact line the value is the line's and its interval has no width; with
+    /// noise, the interval widens away from the points' centre and holds the true value.
+    #[test]
+    fn line_value_at_follows_the_line_and_its_uncertainty() {
+        let exact: Vec<(f64, f64)> = (0..6).map(|i| (i as f64, 2.0 - 0.5 * i as f64)).collect();
+        let (y, w) = line_value_at(&exact, 10.0).unwrap();
+        assert!((y - (2.0 - 5.0)).abs() < 1e-12 && w < 1e-12, "{y} ± {w}");
+        let noisy: Vec<(f64, f64)> = (0..8).map(|i| (i as f64, 1.0 + i as f64 + if i % 2 == 0 { 0.1 } else { -0.1 })).collect();
+        let (mid, w_mid) = line_value_at(&noisy, 3.5).unwrap();
+        let (end, w_end) = line_value_at(&noisy, 7.0).unwrap();
+        assert!((mid - 4.5).abs() <= w_mid && (end - 8.0).abs() <= w_end, "{mid} ± {w_mid}, {end} ± {w_end}");
+        assert!(w_end > w_mid, "the interval is narrowest at the centre: {w_mid} vs {w_end}");
+        assert!(line_value_at(&noisy[..2], 1.0).is_none(), "two points give no interval");
+    }
 }
