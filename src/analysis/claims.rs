@@ -524,6 +524,92 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     Ok(())
 }
 
+/// The size of the efficiency index per problem and variant (beside the paper's C_0): its range
+/// and spread over the levels of the error-rate fit, and how far the smallest reliable C_0 of
+/// one problem is from another's.
+fn efficiency_size_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
+    let (deep, large) = (StudyDir::new(ctx.results, "deep").read_runs()?, StudyDir::new(ctx.results, "ex72_large").read_runs()?);
+    let mut rows = Vec::new();
+    let mut per_problem: Vec<(&str, f64)> = Vec::new();
+    for (problem, runs, ids) in [
+        ("ex71", &deep, ["ex71_as_written", "ex71_without_full_contact", "ex71_repaired"]),
+        ("fb", &deep, ["fb_as_written", "fb_without_full_contact", "fb_repaired"]),
+        ("ex72", &large, ["adaptive", "without_full_contact", "repaired"]),
+    ] {
+        for id in ids {
+            let Some(r) = run(runs, id) else { continue };
+            let Some(rep) = ctx.rate(Some(r), Q::Error) else { continue };
+            let eff = ctx.values(r, Q::Efficiency);
+            let window: Vec<f64> = (rep.main.first_level..=rep.main.last_level).filter_map(|l| eff.get(l).copied().flatten()).collect();
+            let (lo, hi) = (window.iter().cloned().fold(f64::INFINITY, f64::min), window.iter().cloned().fold(0.0, f64::max));
+            if window.is_empty() {
+                continue;
+            }
+            rows.push(format!("{}: {lo:.1e} to {hi:.1e} (spread {:.0}x; {})", source(Some(r)), hi / lo, short_range(&rep.main)));
+            if let Some(c0) = min_reliable_c0(r) {
+                match per_problem.iter_mut().find(|p| p.0 == problem) {
+                    Some(p) => p.1 = p.1.max(c0),
+                    None => per_problem.push((problem, c0)),
+                }
+            }
+        }
+    }
+    let (lo, hi) = (per_problem.iter().map(|p| p.1).fold(f64::INFINITY, f64::min), per_problem.iter().map(|p| p.1).fold(0.0, f64::max));
+    let c0s = per_problem.iter().map(|(p, c)| format!("{p} {c:.1e}")).collect::<Vec<_>>().join(", ");
+    out.push(Claim {
+        fragile: None,
+        id: "efficiency-size",
+        summary: Summary {
+            topic: "Size of the efficiency index",
+            paper: "C_0 = 0.45 for both examples (Section 7)",
+            headline: if per_problem.len() < 2 {
+                "n/a".into()
+            } else {
+                format!("smallest reliable C_0 per problem {c0s}: one problem's C_0 is {:.0}x another's", hi / lo)
+            },
+        },
+        claim: "How large the efficiency index C_0 eta_h / error is, per problem and contact term, over the levels of each run's error-rate fit (the paper plots it in Fig. 2b and uses one C_0 = 0.45 for both examples; no claim on its size), and the smallest reliable C_0 per problem (the largest over its runs of max error / eta_h)".into(),
+        measured: if rows.is_empty() { "no data".into() } else { format!("estimate / error: {}. Smallest reliable C_0: {c0s}", rows.join("; ")) },
+        verdict: if rows.is_empty() { Verdict::NoData } else { Verdict::NoClaim },
+    });
+    Ok(())
+}
+
+/// The marking parameter theta (the paper does not give it): the error rate per theta.
+fn theta_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
+    let runs = StudyDir::new(ctx.results, "theta_ablation").read_runs()?;
+    let mut rows = Vec::new();
+    let mut headline = Vec::new();
+    for r in &runs {
+        let rep = ctx.rate(Some(r), Q::Error);
+        let last = r.levels.last();
+        rows.push(format!(
+            "{}: {}; last level NDF {}, error {}",
+            r.run.id,
+            rate_text("error rate", rep.as_ref(), None),
+            last.map_or(0, |l| l.ndof),
+            ctx.values(r, Q::Error).last().copied().flatten().map_or("n/a".into(), |e| format!("{e:.2e}"))
+        ));
+        if r.run.problem == "ex71" && r.run.refine == crate::records::Refine::Adaptive {
+            let short = |p: &RateReport| if p.main.spans_enough() { String::new() } else { " (under two decades: no verdict)".into() };
+            headline.push(format!("θ = {}: {}", r.run.theta, rep.map_or("n/a".into(), |p| format!("{}{}", p.main.text(), short(&p)))));
+        }
+    }
+    out.push(Claim {
+        fragile: None,
+        id: "theta (ablation)",
+        summary: Summary {
+            topic: "The marking parameter theta (ablation)",
+            paper: "maximum strategy; theta not given",
+            headline: if headline.is_empty() { "n/a".into() } else { format!("Ex. 7.1 error rates {} (theta_ablation)", headline.join(", ")) },
+        },
+        claim: "The maximum strategy's theta (the paper does not give it): the error rate per theta in 0.3, 0.5, 0.7 and under uniform refinement (study theta_ablation, small runs: windows shorter than two decades are no verdict, and their ranges say so)".into(),
+        measured: if rows.is_empty() { "no data".into() } else { rows.join("; ") },
+        verdict: if rows.is_empty() { Verdict::NoData } else { Verdict::NoClaim },
+    });
+    Ok(())
+}
+
 /// The log-factor ablation: the efficiency trend per l_h.
 fn log_factor_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let la = StudyDir::new(ctx.results, "log_ablation").read_runs()?;
@@ -814,7 +900,9 @@ pub fn claims_with(results: &Path, sampling: ErrorSampling) -> std::io::Result<V
     ex71_claims(&ctx, &mut out)?;
     c0_claim(&ctx, &mut out)?;
     ex72::claims(&ctx, &mut out)?;
+    efficiency_size_claim(&ctx, &mut out)?;
     log_factor_claim(&ctx, &mut out)?;
+    theta_claim(&ctx, &mut out)?;
     fb_claims(&ctx, &mut out)?;
     hertz_claims(&ctx, &mut out)?;
     repair::estimator_repair_claim(&ctx, &mut out)?;

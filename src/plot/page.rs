@@ -25,6 +25,8 @@ pub fn claim_studies(id: &str) -> &'static [&'static str] {
         "c0" => &["c0_sweep"],
         "sampling" => &["ex71", "ex72", "contact_term_ablation"],
         "hertz" => &["hertz"],
+        "efficiency-size" => &["deep", "ex72_large"],
+        _ if id.starts_with("theta") => &["theta_ablation"],
         _ if id.starts_with("7.1-") => &["deep", "ex71", "contact_term_ablation"],
         _ if id.starts_with("7.2-") => &["ex72", "ex72_large"],
         _ if id.starts_with("log-factor") => &["log_ablation"],
