@@ -11,7 +11,12 @@
 //!   that executes nothing leaves every file as it was.
 //! - A stored run is never replaced silently: a manifest whose run differs from the stored one, or
 //!   a stored run the manifest does not declare, is refused unless told to replace it
-//!   ([`stale_runs`], [`refusal`]).
+//!   ([`stale_runs`], [`refusal`]); the runner repeats the check under the run's lock, and
+//!   `--fresh` holds every run lock of the study before it removes anything.
+//! - `run`, `drift`, `figures` and `report` check the folder with [`Store::check`] first: each
+//!   record's run id is its file name, every snapshot it saves exists and parses, the summaries
+//!   match the records; a folder at fault is refused naming the file (`run --replace` replaces
+//!   the records at fault).
 
 use super::manifest::Manifest;
 use super::provenance::{self, Provenance};
