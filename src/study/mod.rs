@@ -209,6 +209,11 @@ fn set_up(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &RunOp
 /// study lock, and then everything is let go and taken again. Held by another process: refused
 /// naming it, or with `--wait` waited for.
 fn hold_every_run(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &RunOptions) -> Result<(StudyLock, Vec<lock::Lock>)> {
+    if !opts.wait_for_lock {
+        // refused at once if another process sets up or stores (taking the run locks below
+        // waits for the study lock briefly, as every run does)
+        drop(StudyLock::acquire(dir, false)?);
+    }
     loop {
         let ids = if opts.shard.is_some() {
             planned.iter().map(|s| s.id.clone()).collect()
