@@ -219,3 +219,240 @@ fn a_run_that_executes_nothing_changes_no_file() {
     assert!(out.contains("0 run(s) executed"), "{out}");
     assert_eq!(state(&results_of(&dir)), before, "a run that executed nothing rewrote a file");
 }
+
+// ---- issue 38, item 4: a results folder that checks itself (Store::check, used by run, drift,
+// figures and report)
+
+/// A study stored in `dir/results/study` from [`STUDY`].
+fn stored(name: &str) -> (PathBuf, &'static str) {
+    let dir = tmp(name);
+    let m = manifest(&dir, STUDY);
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_eq!(code, 0, "{out}");
+    (dir, m)
+}
+
+/// `drift --against results` (the folder against itself: every number agrees) and `figures`.
+fn drift_and_figures(dir: &Path) -> [(i32, String); 2] {
+    [
+        signorini(dir, &["drift", "--against", "results", "--experiments", ".", "--study", "study"]),
+        signorini(dir, &["figures", "--results", "results", "--experiments", ".", "--figures", "figs"]),
+    ]
+}
+
+#[test]
+fn a_copied_record_fails_drift_figures_and_run_naming_it_and_replace_removes_it() {
+    let (dir, m) = stored("copy");
+    let study = results_of(&dir);
+    std::fs::copy(study.join("runs/a.json"), study.join("runs/copy.json")).unwrap();
+    for (code, out) in drift_and_figures(&dir) {
+        assert_ne!(code, 0, "{out}");
+        assert!(out.contains("runs/copy.json") && out.contains("holds run a, not copy"), "{out}");
+    }
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(out.contains("runs/copy.json") && out.contains("Nothing was run or changed"), "{out}");
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results", "--replace"]);
+    assert_eq!(code, 0, "{out}");
+    assert_eq!(consistent(&study), ["a", "b"]);
+    for (code, out) in drift_and_figures(&dir) {
+        assert_eq!(code, 0, "{out}");
+    }
+}
+
+#[test]
+fn a_missing_or_truncated_mesh_snapshot_fails_drift_and_figures_naming_it() {
+    let (dir, m) = stored("snapshot");
+    let study = results_of(&dir);
+    let (json, vtu) = (study.join("meshes/b_level3.json"), study.join("meshes/b_level3.vtu"));
+    let (json_bytes, vtu_bytes) = (std::fs::read(&json).unwrap(), std::fs::read(&vtu).unwrap());
+    std::fs::remove_file(&json).unwrap();
+    for (code, out) in drift_and_figures(&dir) {
+        assert_ne!(code, 0, "{out}");
+        assert!(out.contains("meshes/b_level3.json") && out.contains("missing: run b saves level 3"), "{out}");
+    }
+    std::fs::write(&json, &json_bytes).unwrap();
+    std::fs::write(&vtu, &vtu_bytes[..vtu_bytes.len() / 2]).unwrap();
+    for (code, out) in drift_and_figures(&dir) {
+        assert_ne!(code, 0, "{out}");
+        assert!(out.contains("meshes/b_level3.vtu") && out.contains("not a whole VTK file"), "{out}");
+    }
+    // run refuses too, and --replace computes run b again
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert!(code != 0 && out.contains("b_level3.vtu"), "{out}");
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results", "--replace"]);
+    assert!(code == 0 && out.contains("1 run(s) executed"), "{out}");
+    assert_eq!(std::fs::read(&vtu).unwrap(), vtu_bytes, "run b computed again gives the same snapshot");
+}
+
+#[test]
+fn a_truncated_levels_csv_in_the_folder_compared_is_an_error_not_no_drift() {
+    let (dir, m) = stored("against");
+    let (code, out) = signorini(&dir, &["run", m, "--results", "other"]);
+    assert_eq!(code, 0, "{out}");
+    let csv = dir.join("other/study/levels.csv");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    std::fs::write(&csv, &text[..text.len() / 2]).unwrap();
+    let (code, out) = signorini(&dir, &["drift", "--against", "other", "--experiments", ".", "--study", "study"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(out.contains("--against other") && out.contains("levels.csv") && out.contains("not what runs/*.json render"), "{out}");
+    assert!(!out.contains("no drift"), "{out}");
+    // a provenance listing other runs is named the same way
+    std::fs::write(&csv, &text).unwrap();
+    let prov = dir.join("other/study/provenance.json");
+    let p = std::fs::read_to_string(&prov).unwrap().replace("\"b\"", "\"c\"");
+    std::fs::write(&prov, p).unwrap();
+    let (code, out) = signorini(&dir, &["drift", "--against", "other", "--experiments", ".", "--study", "study"]);
+    assert!(code != 0 && out.contains("provenance.json") && out.contains("lists the runs a c"), "{out}");
+}
+
+#[test]
+fn report_refuses_an_image_that_is_not_a_png() {
+    let figs = tmp("png");
+    let study = "c0_sweep";
+    let name = signorini::page::figures_of(study)[0];
+    std::fs::write(figs.join(format!("{name}.png")), "<html>not an image</html>").unwrap();
+    let out = figs.join("out");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let e = signorini::page::write_pages(&root.join("results"), &figs, &out, &[study.into()], &figs.join("none.json")).unwrap_err();
+    assert!(format!("{e:#}").contains(&format!("{name}.png is not a PNG image")), "{e:#}");
+}
+
+// ---- issue 38, item 3: the inputs a run reads are part of its spec
+
+#[test]
+fn a_run_whose_problem_file_changed_is_a_changed_spec_naming_the_file() {
+    let dir = tmp("inputs");
+    let problems = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/problems/ex71.toml");
+    let text = std::fs::read_to_string(&problems).unwrap();
+    std::fs::create_dir_all(dir.join("problems")).unwrap();
+    std::fs::write(dir.join("problems/p.toml"), &text).unwrap();
+    let m = manifest(&dir, &STUDY.replace("problem = \"ex71\"", "problem = \"problems/p.toml\""));
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_eq!(code, 0, "{out}");
+    let a: serde_json::Value = serde_json::from_slice(&std::fs::read(results_of(&dir).join("runs/a.json")).unwrap()).unwrap();
+    assert_eq!(a["run"]["inputs"]["problems/p.toml"].as_str().map(str::len), Some(64), "{}", a["run"]);
+    // the same file, one byte more: refused naming it, nothing changed, never "finished earlier, kept"
+    std::fs::write(dir.join("problems/p.toml"), format!("{text}\n")).unwrap();
+    let before = std::fs::read(results_of(&dir).join("runs/a.json")).unwrap();
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(out.contains("the input file problems/p.toml changed") && !out.contains("finished earlier, kept"), "{out}");
+    assert_eq!(std::fs::read(results_of(&dir).join("runs/a.json")).unwrap(), before);
+    // figures refuse the study as computed with another spec
+    let (code, out) = signorini(&dir, &["figures", "--results", "results", "--experiments", ".", "--figures", "figs"]);
+    assert!(code != 0 && out.contains("the input file problems/p.toml changed"), "{out}");
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results", "--replace"]);
+    assert!(code == 0 && out.contains("2 run(s) executed"), "{out}");
+}
+
+// ---- issue 38, item 2: no concurrent process undoes a run (real processes, both orders)
+
+/// A study whose one run takes a second or two (Example 7.1, 19 adaptive levels from
+/// structured:8), so that a second process reliably starts while it computes.
+const LONG: &str = r#"description = "store test: one run of a few seconds"
+[defaults]
+problem = "ex71"
+mesh = "structured:8"
+[[run]]
+id = "a"
+levels = 19
+theta = 0.5
+"#;
+
+fn spawn(dir: &Path, args: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(dir)
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+fn finish(child: std::process::Child) -> (i32, String) {
+    let o = child.wait_with_output().unwrap();
+    (o.status.code().unwrap_or(-1), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
+}
+
+/// Wait until run a's checkpoint exists: its process holds the run's lock and computes it.
+fn computing(study: &Path) {
+    let file = study.join(".partial/a.json");
+    let start = std::time::Instant::now();
+    while !file.exists() {
+        assert!(start.elapsed().as_secs() < 120, "{} never appeared", file.display());
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
+fn theta_of(study: &Path) -> f64 {
+    let a: serde_json::Value = serde_json::from_slice(&std::fs::read(study.join("runs/a.json")).unwrap()).unwrap();
+    a["run"]["theta"].as_f64().unwrap()
+}
+
+#[test]
+fn a_second_manifest_waiting_for_a_run_never_replaces_it_without_replace_in_either_order() {
+    let dir = tmp("two-manifests");
+    for (sub, theta) in [("one", "0.5"), ("two", "0.6")] {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+        std::fs::write(dir.join(sub).join("s.toml"), LONG.replace("theta = 0.5", &format!("theta = {theta}"))).unwrap();
+    }
+    for (first, second, theta) in [("one", "two", 0.5), ("two", "one", 0.6)] {
+        let results = format!("results-{first}");
+        let study = dir.join(&results).join("s");
+        let p1 = spawn(&dir, &["run", &format!("{first}/s.toml"), "--results", &results]);
+        computing(&study);
+        let p2 = spawn(&dir, &["run", &format!("{second}/s.toml"), "--results", &results, "--wait"]);
+        let ((c1, o1), (c2, o2)) = (finish(p1), finish(p2));
+        assert_eq!(c1, 0, "{o1}");
+        assert!(o2.contains("waiting for it to finish"), "the second process did not wait for the first: {o2}");
+        assert_ne!(c2, 0, "{o2}");
+        assert!(o2.contains("another process stored run a") && o2.contains("theta") && o2.contains("--replace"), "{o2}");
+        assert_eq!(theta_of(&study), theta, "the first process's run was replaced");
+        assert_eq!(consistent(&study), ["a"]);
+    }
+}
+
+#[test]
+fn fresh_never_removes_a_run_in_progress_in_either_order() {
+    let dir = tmp("fresh");
+    let m = manifest(&dir, LONG);
+    let study = results_of(&dir).with_file_name("study");
+    // a run computes; --fresh without --wait is refused naming it, and the run lands
+    let p1 = spawn(&dir, &["run", m, "--results", "results"]);
+    computing(&study);
+    let (c2, o2) = signorini(&dir, &["run", m, "--results", "results", "--fresh"]);
+    assert_ne!(c2, 0, "{o2}");
+    assert!(o2.contains(&format!("is being written by process {}", p1.id())) && o2.contains("--wait"), "{o2}");
+    let (c1, o1) = finish(p1);
+    assert!(c1 == 0 && o1.contains("1 run(s) executed"), "{o1}");
+    assert_eq!(consistent(&study), ["a"]);
+    let stored = std::fs::read(study.join("runs/a.json")).unwrap();
+    // a run computes; --fresh --wait waits for it, then starts over: the first run is not lost
+    std::fs::remove_dir_all(&study).unwrap();
+    let p1 = spawn(&dir, &["run", m, "--results", "results"]);
+    computing(&study);
+    let p2 = spawn(&dir, &["run", m, "--results", "results", "--fresh", "--wait"]);
+    let ((c1, o1), (c2, o2)) = (finish(p1), finish(p2));
+    assert!(c1 == 0 && o1.contains("1 run(s) executed"), "the run computing when --fresh started was lost: {o1}");
+    assert!(c2 == 0 && o2.contains("waiting for it to finish") && o2.contains("1 run(s) executed"), "{o2}");
+    assert_eq!(consistent(&study), ["a"]);
+    // the other order: --fresh computes, a plain run waits and keeps what --fresh stored
+    let p1 = spawn(&dir, &["run", m, "--results", "results", "--fresh"]);
+    std::thread::sleep(std::time::Duration::from_millis(200)); // past --fresh's removal of the old checkpoint
+    computing(&study);
+    let p2 = spawn(&dir, &["run", m, "--results", "results", "--wait"]);
+    let ((c1, o1), (c2, o2)) = (finish(p1), finish(p2));
+    assert!(c1 == 0 && o1.contains("1 run(s) executed"), "{o1}");
+    assert!(c2 == 0 && o2.contains("waiting for it to finish") && o2.contains("finished earlier, kept"), "{o2}");
+    assert_eq!(consistent(&study), ["a"]);
+    // every number the same however the processes met (timings aside)
+    let numbers = |b: &[u8]| {
+        let mut v: serde_json::Value = serde_json::from_slice(b).unwrap();
+        for l in v["levels"].as_array_mut().unwrap() {
+            l.as_object_mut().unwrap().retain(|k, _| !k.starts_with("t_") && !k.starts_with("mem_"));
+        }
+        v
+    };
+    assert_eq!(numbers(&std::fs::read(study.join("runs/a.json")).unwrap()), numbers(&stored));
+}

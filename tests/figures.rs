@@ -92,6 +92,7 @@ impl Run<'_> {
                 reference: None,
                 save_levels: vec![20],
                 constants: Default::default(),
+                inputs: Default::default(),
             },
             levels: lv,
             reference_ndof: (self.problem == "ex72").then_some(2_000_000),

@@ -196,6 +196,7 @@ fn record(id: &str, refine: Refine, levels: Vec<LevelRecord>) -> RunRecord {
         reference: None,
         save_levels: vec![],
         constants: Default::default(),
+        inputs: Default::default(),
     };
     RunRecord { study: "fb".into(), run, levels, reference_ndof: None, history: None }
 }

@@ -157,12 +157,23 @@ pub fn index_page(results: &Path, studies: &[String], claims: &[Claim]) -> Strin
     }
     s + "</ul>\n</body></html>\n"
 }
+/// The eight bytes every PNG file starts with.
+const PNG_SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
 
 fn figures_html(figures: &Path, study: &str) -> std::io::Result<String> {
     let mut s = String::new();
     for name in figures_of(study) {
         let png = figures.join(format!("{name}.png"));
         match std::fs::read(&png) {
+            Ok(bytes) if !bytes.starts_with(PNG_SIGNATURE) => {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    format!(
+                        "{} is not a PNG image (it does not start with the PNG signature); redraw it with `signorini figures`",
+                        png.display()
+                    ),
+                ));
+            }
             Ok(bytes) => {
                 let data = base64::engine::general_purpose::STANDARD.encode(bytes);
                 let _ = writeln!(
@@ -262,6 +273,10 @@ pub fn write_pages(results: &Path, figures: &Path, out: &Path, studies: &[String
     }
     if let Some(missing) = chosen.iter().find(|s| !present.contains(s)) {
         anyhow::bail!("study {missing} has no records in {} (studies there: {})", results.display(), present.join(", "));
+    }
+    // every study shown is read through the store's integrity check first
+    for study in &chosen {
+        crate::study::store::Store::new(results, study).read()?;
     }
     let claims = crate::claims::claims(results).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
     let drift = match std::fs::read_to_string(drift_report) {

@@ -270,6 +270,11 @@ pub struct RunSpec {
     /// empty for the file's own values and for built-in problems.
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub constants: std::collections::BTreeMap<String, f64>,
+    /// The SHA-256 of every file the run reads (problem file, Gmsh mesh), by its path as the
+    /// manifest writes it: part of what the run is, so a run whose input changed is not the
+    /// stored one. Empty for built-in problems and meshes.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub inputs: std::collections::BTreeMap<String, String>,
 }
 
 /// How a reference solution is computed: adaptive refinement (maximum strategy with `theta`,
@@ -354,6 +359,12 @@ impl StudyDir {
 
     /// Every finished run of the study, in file-name order.
     pub fn read_runs(&self) -> std::io::Result<Vec<RunRecord>> {
+        Ok(self.read_run_files()?.into_iter().map(|(_, r)| r).collect())
+    }
+
+    /// Every record file `runs/*.json` with the run it holds, in file-name order (what the
+    /// store's integrity check reads: a record's run id must be its file name).
+    pub fn read_run_files(&self) -> std::io::Result<Vec<(PathBuf, RunRecord)>> {
         let dir = self.root.join("runs");
         let mut files: Vec<PathBuf> = match std::fs::read_dir(&dir) {
             Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|e| e == "json")).collect(),
@@ -362,10 +373,11 @@ impl StudyDir {
         };
         files.sort();
         files
-            .iter()
+            .into_iter()
             .map(|f| {
-                let text = read_text(f)?;
-                serde_json::from_str(&text).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display())))
+                let text = read_text(&f)?;
+                let record = serde_json::from_str(&text).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display())))?;
+                Ok((f, record))
             })
             .collect()
     }
@@ -456,6 +468,7 @@ mod tests {
                 reference: None,
                 save_levels: vec![],
                 constants: Default::default(),
+                inputs: Default::default(),
             },
             levels: vec![level.clone(), LevelRecord { level: 1, ..level }],
             reference_ndof: None,

@@ -444,38 +444,31 @@ pub fn table(rows: &[DriftRow]) -> String {
     s
 }
 
-/// The first line where two texts differ, shortened, as it reads in each.
-fn first_difference(a: &str, b: &str) -> (String, String) {
-    let (al, bl): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
-    let i = (0..al.len().max(bl.len())).find(|&i| al.get(i) != bl.get(i)).unwrap_or(al.len().min(bl.len()));
-    let cut =
-        |s: Option<&&str>| format!("line {}: {}", i + 1, s.map(|s| s.chars().take(60).collect::<String>()).unwrap_or("(none)".into()));
-    (cut(al.get(i)), cut(bl.get(i)))
+use super::store::first_difference;
+
+/// The views of a study's stored records, checked against what the records render
+/// ([`super::store::summary_faults`]): `levels.csv` byte for byte and `provenance.json`'s list of
+/// runs. A hand edit, a bad merge or a study interrupted before its summaries were rewritten is
+/// drift.
+pub fn check_derived(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<DriftRow> {
+    super::store::summary_faults(dir, study, runs).iter().map(|f| fault_row(dir, study, f)).collect()
 }
 
-/// The views of a study's stored records, checked against what the records render:
-/// `levels.csv` byte for byte and `provenance.json`'s list of runs. A hand edit, a bad merge or
-/// a study interrupted before its summaries were rewritten is drift.
-pub fn check_derived(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<DriftRow> {
-    let mut out = Vec::new();
-    let file_row = |field: &str, stored: String, fresh: String| {
-        row(study, "*", None, field, stored, fresh, None, "exact (rendered from runs/*.json)".into())
-    };
-    match (std::fs::read(dir.csv_file()), dir.csv_bytes(runs)) {
-        (Ok(on_disk), Ok(rendered)) if on_disk == rendered => {}
-        (Ok(on_disk), Ok(rendered)) => {
-            let (a, b) = first_difference(&String::from_utf8_lossy(&on_disk), &String::from_utf8_lossy(&rendered));
-            out.push(file_row("levels.csv", a, b));
-        }
-        (Err(e), _) => out.push(file_row("levels.csv", format!("(cannot read: {e})"), "rendered".into())),
-        (_, Err(e)) => out.push(file_row("levels.csv", "present".into(), format!("(cannot render: {e})"))),
-    }
-    let ids: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
-    let listed = super::store::listed_runs(dir);
-    if listed.as_ref() != Some(&ids) {
-        out.push(file_row("provenance.json runs", listed.map(|l| l.join(" ")).unwrap_or("(unreadable)".into()), ids.join(" ")));
-    }
-    out
+/// A fault of the stored folder ([`super::store::Store::check`]) as a row of drift: the file
+/// (relative to the study folder) and what is wrong with it.
+fn fault_row(dir: &StudyDir, study: &str, f: &super::store::Fault) -> DriftRow {
+    let file = f.file.strip_prefix(&dir.root).unwrap_or(&f.file).display().to_string();
+    let field = if f.record.is_some() { "store".to_string() } else { file.clone() };
+    row(
+        study,
+        f.record.as_deref().unwrap_or("*"),
+        None,
+        &field,
+        format!("{file} {}", f.what),
+        "a folder that holds together".into(),
+        None,
+        "exact (the store's integrity check)".into(),
+    )
 }
 
 /// What a drift run compares the stored results with.
@@ -672,22 +665,28 @@ pub fn run(
                 opts.scratch.clone()
             }
         };
-        let stored_dir = StudyDir::new(&opts.results, &m.study);
-        let stored = stored_dir.read_runs().with_context(|| format!("reading the stored runs of {}", m.study))?;
-        let fresh = StudyDir::new(&fresh_root, &m.study)
-            .read_runs()
-            .with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?;
+        let stored_store = super::store::Store::new(&opts.results, &m.study);
+        let stored_dir = stored_store.dir.clone();
+        let checked = stored_store.check().with_context(|| format!("reading the stored runs of {}", m.study))?;
+        stored_store.note_leftovers(&checked.leftovers);
+        let stored = checked.runs;
+        let fresh = match &opts.against {
+            // another folder's records are read through the same check; a fault there is an error
+            Some(_) => super::store::Store::new(&fresh_root, &m.study)
+                .read()
+                .with_context(|| format!("--against {}: the study {}", fresh_root.display(), m.study))?,
+            None => StudyDir::new(&fresh_root, &m.study)
+                .read_runs()
+                .with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?,
+        };
         let mut c = compare(m, &stored, &fresh, quick);
         if quick && !opts.quick && opts.against.is_none() {
             replay_tier(m, &stored, opts.progress, &mut c)?;
         }
-        if !stored.is_empty() {
-            c.rows.extend(check_derived(&stored_dir, &m.study, &stored));
-        }
+        c.rows.extend(checked.faults.iter().map(|f| fault_row(&stored_dir, &m.study, f)));
         if opts.against.is_some() {
             c.rows.extend(compare_provenance(&m.study, &stored_dir, &StudyDir::new(&fresh_root, &m.study)));
         }
-        note_orphans(&stored_dir, &m.study, &stored)?;
         if opts.progress {
             eprintln!(
                 "{}: {}",
@@ -709,22 +708,6 @@ pub fn run(
         }
     }
     Ok(report)
-}
-
-/// The drift check reads the stored results and never changes them: files of an unfinished run
-/// there (see [`super::store::orphans`]) are ignored, and named in one line so that the next
-/// `signorini run` of the study (which removes them) is not a surprise.
-fn note_orphans(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> anyhow::Result<()> {
-    let found = super::store::orphans(dir, runs)?;
-    if !found.is_empty() {
-        eprintln!(
-            "{study}: ignoring {} file(s) of an unfinished run in {} (`signorini run` removes them): {}",
-            found.len(),
-            dir.root.display(),
-            super::store::names(dir, &found)
-        );
-    }
-    Ok(())
 }
 
 /// The largest change of every float field over the studies of a report, as a table.

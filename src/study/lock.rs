@@ -106,3 +106,21 @@ pub fn run_in_progress(dir: &StudyDir, id: &str) -> bool {
     let Ok(file) = std::fs::OpenOptions::new().read(true).write(true).open(run_lock_file(dir, id)) else { return false };
     matches!(file.try_lock(), Err(std::fs::TryLockError::WouldBlock))
 }
+
+/// Every run of the study a process may compute or have left: `declared`, the stored records
+/// (`runs/RUN.json`), the run locks (`.locks/RUN.lock`) and the checkpoints
+/// (`.partial/RUN.json`), sorted, each once. What `--fresh` holds before it removes anything.
+pub fn runs_of(dir: &StudyDir, declared: impl Iterator<Item = String>) -> Vec<String> {
+    let mut ids: Vec<String> = declared.collect();
+    for (sub, ext) in [("runs", "json"), (".locks", "lock"), (".partial", "json")] {
+        for e in std::fs::read_dir(dir.root.join(sub)).into_iter().flatten().flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if let Some(id) = name.strip_suffix(&format!(".{ext}")).filter(|id| !id.is_empty() && !id.starts_with('.')) {
+                ids.push(id.to_string());
+            }
+        }
+    }
+    ids.sort();
+    ids.dedup();
+    ids
+}

@@ -358,6 +358,7 @@ fn parse_run(
     {
         return Err(invalid.at(key("reference.theta"), "a number in (0, 1]", rf.theta.to_string()));
     }
+    let inputs = input_hashes(path, &problem, &mesh).map_err(|(k, e)| invalid.at(key(k), "a readable file", e))?;
     let spec = RunSpec {
         id,
         problem,
@@ -375,6 +376,7 @@ fn parse_run(
         }),
         save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
         constants,
+        inputs,
     };
     AdaptConfig::for_run(&spec).validate().map_err(|e| invalid.at(key(e.key), &e.expected, e.got))?;
     let quick_levels = r.quick_levels.or(d.quick_levels).unwrap_or(levels.min(6));
@@ -518,6 +520,27 @@ pub fn resolve_mesh(manifest: &Path, mesh: &str) -> String {
         }
         _ => mesh.to_string(),
     }
+}
+
+/// The SHA-256 of every file a run with `problem` and `mesh` reads (a problem file, a Gmsh
+/// mesh), keyed by the path as the manifest writes it ([`RunSpec::inputs`]). A file that cannot
+/// be read is an error for the key naming it: (`problem` or `mesh`, the path and why).
+pub fn input_hashes(manifest: &Path, problem: &str, mesh: &str) -> Result<BTreeMap<String, String>, (&'static str, String)> {
+    let mut out = BTreeMap::new();
+    let mut add = |key: &'static str, written: &str, resolved: &Path| {
+        let bytes = std::fs::read(resolved).map_err(|e| (key, format!("{}: {e}", resolved.display())))?;
+        out.insert(written.to_string(), super::provenance::sha256_hex(&bytes));
+        Ok(())
+    };
+    if crate::problems::is_file(problem) {
+        add("problem", problem, Path::new(&resolve_problem(manifest, problem)))?;
+    }
+    if let Ok(spec) = MeshSpec::parse(&resolve_mesh(manifest, mesh))
+        && let Some(file) = spec.file()
+    {
+        add("mesh", mesh.strip_prefix("gmsh:").unwrap_or(mesh).trim(), file)?;
+    }
+    Ok(out)
 }
 
 impl Manifest {

@@ -171,24 +171,75 @@ pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> 
 /// spec differs refused (or with `--replace` undeclared ones removed), the summaries in line
 /// with the runs stored.
 fn set_up(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &RunOptions) -> Result<()> {
-    let _lock = StudyLock::acquire(dir, opts.wait_for_lock)?;
+    let (_lock, _run_locks) =
+        if opts.fresh { hold_every_run(manifest, dir, planned, opts)? } else { (StudyLock::acquire(dir, opts.wait_for_lock)?, Vec::new()) };
     if opts.fresh {
         start_over(dir, opts.shard.is_some(), planned)?;
     }
-    let mut runs = store::read_runs(dir)?;
+    let checked = store::Store { dir: dir.clone(), study: manifest.study.clone() }.check()?;
+    let mut runs = checked.runs;
     store::remove_orphans(&manifest.study, dir, &runs)?;
-    let stale = store::stale_runs(manifest, &runs, planned);
+    let mut stale = store::damaged(&checked.faults);
+    stale.extend(store::stale_runs(manifest, &runs, planned));
     if !stale.is_empty() && !opts.replace && !opts.fresh {
         return Err(store::refusal(manifest, dir, &stale));
     }
     for s in &stale {
-        if let store::Stale::Undeclared { id } = s {
-            eprintln!("{}/{id}: removing the stored run, not declared in {}", manifest.study, manifest.file.display());
-            store::remove_run(dir, id)?;
+        match s {
+            store::Stale::Undeclared { id } => {
+                eprintln!("{}/{id}: removing the stored run, not declared in {}", manifest.study, manifest.file.display());
+                store::remove_run(dir, id)?;
+            }
+            store::Stale::Damaged { file, what } => {
+                eprintln!("{}/{file}: removing the damaged record and its snapshots ({})", manifest.study, what.join("; "));
+                store::remove_run(dir, file)?;
+                runs = store::read_runs(dir)?;
+            }
+            store::Stale::Differs { .. } => {}
         }
     }
     runs.retain(|r| manifest.runs.iter().any(|p| p.spec.id == r.run.id));
     store::sync_summaries(manifest, dir, &runs, opts.quick)
+}
+
+/// `--fresh`: the lock of every run this invocation would remove (any run of the study, or with
+/// a shard only its runs), then the study lock, so that no file of a run another process
+/// computes is removed. The run locks are taken one by one without the study lock (the owner of
+/// one takes the study lock to store its run); a run that started meanwhile is found under the
+/// study lock, and then everything is let go and taken again. Held by another process: refused
+/// naming it, or with `--wait` waited for.
+fn hold_every_run(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &RunOptions) -> Result<(StudyLock, Vec<lock::Lock>)> {
+    if !opts.wait_for_lock {
+        // refused at once if another process sets up or stores (taking the run locks below
+        // waits for the study lock briefly, as every run does)
+        drop(StudyLock::acquire(dir, false)?);
+    }
+    loop {
+        let ids = if opts.shard.is_some() {
+            planned.iter().map(|s| s.id.clone()).collect()
+        } else {
+            lock::runs_of(dir, manifest.runs.iter().map(|p| p.spec.id.clone()))
+        };
+        let mut held = Vec::new();
+        for id in &ids {
+            held.push(
+                StudyLock::run(dir, id, opts.wait_for_lock)
+                    .context("--fresh removes every run of the study; it waits for none without --wait")?,
+            );
+        }
+        let study = StudyLock::acquire(dir, opts.wait_for_lock)?;
+        if opts.shard.is_some() {
+            return Ok((study, held));
+        }
+        let started: Vec<String> =
+            lock::runs_of(dir, std::iter::empty()).into_iter().filter(|id| !ids.contains(id) && lock::run_in_progress(dir, id)).collect();
+        if started.is_empty() {
+            return Ok((study, held));
+        }
+        if !opts.wait_for_lock {
+            bail!("--fresh: run(s) {} of {} started meanwhile; pass --wait to wait for them", started.join(", "), dir.root.display());
+        }
+    }
 }
 
 /// `--fresh`: remove the stored runs this invocation is responsible for (with a shard, only its
@@ -226,6 +277,16 @@ fn run_planned(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &
                 }
                 continue;
             }
+            // stored by another process while this one waited for the run: the same check as
+            // at the start, under the run's lock
+            Some(r) if !opts.replace => bail!(
+                "{}: another process stored run {} of {} with another spec while this one waited for it ({}); not replacing it. \
+                 The runs this process finished before it are kept. Pass --replace to replace it",
+                manifest.file.display(),
+                spec.id,
+                dir.root.display(),
+                store::spec_differences(&r.run, spec).join("; ")
+            ),
             Some(r) => eprintln!(
                 "{}/{}: replacing the stored run when the new one has finished ({})",
                 manifest.study,
@@ -272,8 +333,9 @@ fn interruption(manifest: &Manifest, dir: &StudyDir, opts: &RunOptions) -> anyho
 /// what figures and claims need before they draw from a study. The error names what is missing
 /// or different and how to complete the study.
 pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<()> {
-    let dir = StudyDir::new(results, &manifest.study);
-    let runs = store::read_runs(&dir)?;
+    let store = store::Store::new(results, &manifest.study);
+    let runs = store.read()?;
+    let dir = store.dir;
     let mut problems = Vec::new();
     for planned in &manifest.runs {
         match runs.iter().find(|r| r.run.id == planned.spec.id) {

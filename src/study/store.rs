@@ -11,7 +11,12 @@
 //!   that executes nothing leaves every file as it was.
 //! - A stored run is never replaced silently: a manifest whose run differs from the stored one, or
 //!   a stored run the manifest does not declare, is refused unless told to replace it
-//!   ([`stale_runs`], [`refusal`]).
+//!   ([`stale_runs`], [`refusal`]); the runner repeats the check under the run's lock, and
+//!   `--fresh` holds every run lock of the study before it removes anything.
+//! - `run`, `drift`, `figures` and `report` check the folder with [`Store::check`] first: each
+//!   record's run id is its file name, every snapshot it saves exists and parses, the summaries
+//!   match the records; a folder at fault is refused naming the file (`run --replace` replaces
+//!   the records at fault).
 
 use super::manifest::Manifest;
 use super::provenance::{self, Provenance};
@@ -51,9 +56,17 @@ pub fn spec_differences(stored: &RunSpec, declared: &RunSpec) -> Vec<String> {
     let mut keys: Vec<&String> = a.iter().map(|(k, _)| k).collect();
     keys.extend(b.iter().map(|(k, _)| k).filter(|k| !a.iter().any(|(ka, _)| ka == *k)));
     let show = |v: Option<Value>| v.map_or("(absent)".to_string(), |v| v.to_string());
+    let hash = |v: Option<Value>| v.and_then(|v| v.as_str().map(|h| format!("sha256 {}", &h[..h.len().min(12)]))).unwrap_or("none".into());
     keys.into_iter()
         .filter(|k| get(&a, k) != get(&b, k))
-        .map(|k| format!("{k}: {} stored, {} declared", show(get(&a, k)), show(get(&b, k))))
+        .map(|k| match k.strip_prefix("inputs.") {
+            // an input file is named as such: the run read other bytes than the file holds now
+            Some(file) => match get(&a, k) {
+                None => format!("the input file {file} is not in the stored spec ({} now)", hash(get(&b, k))),
+                stored => format!("the input file {file} changed ({} stored, {} now)", hash(stored), hash(get(&b, k))),
+            },
+            None => format!("{k}: {} stored, {} declared", show(get(&a, k)), show(get(&b, k))),
+        })
         .collect()
 }
 
@@ -64,6 +77,23 @@ pub enum Stale {
     Differs { id: String, differences: Vec<String> },
     /// Not declared by the manifest at all.
     Undeclared { id: String },
+    /// A record file (`runs/FILE.json`) at fault in the store's integrity check ([`Store::check`]):
+    /// what is wrong with it and its snapshots.
+    Damaged { file: String, what: Vec<String> },
+}
+
+/// The record files at fault among `faults` ([`Store::check`]), each once with all it has.
+pub fn damaged(faults: &[Fault]) -> Vec<Stale> {
+    let mut out: Vec<Stale> = Vec::new();
+    for f in faults {
+        let Some(stem) = &f.record else { continue };
+        let text = f.to_string();
+        match out.iter_mut().find(|s| matches!(s, Stale::Damaged { file, .. } if file == stem)) {
+            Some(Stale::Damaged { what, .. }) => what.push(text),
+            _ => out.push(Stale::Damaged { file: stem.clone(), what: vec![text] }),
+        }
+    }
+    out
 }
 
 /// The stored runs that are stale: among `planned` (the runs this invocation is responsible
@@ -92,6 +122,7 @@ pub fn refusal(manifest: &Manifest, dir: &StudyDir, stale: &[Stale]) -> anyhow::
         .map(|s| match s {
             Stale::Differs { id, differences } => format!("run {id} is stored with another spec ({})", differences.join("; ")),
             Stale::Undeclared { id } => format!("run {id} is stored but not declared in {}", manifest.file.display()),
+            Stale::Damaged { file, what } => format!("the record runs/{file}.json does not hold together ({})", what.join("; ")),
         })
         .collect();
     anyhow::anyhow!(
@@ -249,4 +280,190 @@ pub fn repair(manifest: &Manifest, dir: &StudyDir, quick: bool) -> Result<()> {
     let runs = read_runs(dir)?;
     remove_orphans(&manifest.study, dir, &runs)?;
     sync_summaries(manifest, dir, &runs, quick)
+}
+
+/// The one door to a study's results folder for readers: the folder read and checked as a
+/// whole ([`Store::check`]). `run`, `drift` (both sides of `--against`), `figures` and `report`
+/// read a study through it, so a folder that does not hold together is named, never drawn or
+/// compared as if it did.
+#[derive(Clone, Debug)]
+pub struct Store {
+    pub dir: StudyDir,
+    pub study: String,
+}
+
+/// Something in a study folder that does not hold together: the file and what is wrong with it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fault {
+    pub file: PathBuf,
+    pub what: String,
+    /// The stem of the record file at fault (`runs/STEM.json`, and its snapshots); `None` for a
+    /// summary (`levels.csv`, `provenance.json`), which is rendered from the records.
+    pub record: Option<String>,
+}
+
+impl std::fmt::Display for Fault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.file.display(), self.what)
+    }
+}
+
+/// A study folder as read by [`Store::check`].
+#[derive(Clone, Debug, Default)]
+pub struct Checked {
+    /// The records, in file-name order.
+    pub runs: Vec<RunRecord>,
+    /// What does not hold together (empty for a sound folder).
+    pub faults: Vec<Fault>,
+    /// Files of an unfinished run no record accounts for ([`orphans`]): `run` removes them,
+    /// every reader names and ignores them.
+    pub leftovers: Vec<PathBuf>,
+}
+
+impl Checked {
+    /// The faults, one per line, for an error message.
+    pub fn faults_text(&self) -> String {
+        self.faults.iter().map(|f| format!("\n  {f}")).collect()
+    }
+}
+
+impl Store {
+    pub fn new(results: &std::path::Path, study: &str) -> Self {
+        Store { dir: StudyDir::new(results, study), study: study.to_string() }
+    }
+
+    /// Read the folder and check that it holds together: every record's run id is its file
+    /// name (so each run is stored once) and its study is this one; every mesh snapshot a record
+    /// saves exists and parses, as the level it names; `levels.csv` and `provenance.json` are
+    /// what the records render ([`summary_faults`]). A record that does not parse is an error
+    /// naming it.
+    pub fn check(&self) -> Result<Checked> {
+        let files = self.dir.read_run_files().with_context(|| format!("reading the runs in {}", self.dir.root.join("runs").display()))?;
+        let mut faults = Vec::new();
+        for (file, record) in &files {
+            let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            let mut fault =
+                |file: &std::path::Path, what: String| faults.push(Fault { file: file.to_path_buf(), what, record: Some(stem.clone()) });
+            if record.run.id != stem {
+                fault(
+                    file,
+                    format!("holds run {}, not {stem} (a record's run id is its file name: a copy or a renamed file?)", record.run.id),
+                );
+                continue;
+            }
+            if record.study != self.study {
+                fault(file, format!("is a record of study {}, not {}", record.study, self.study));
+            }
+            for (path, what) in snapshot_faults(&self.dir, record) {
+                fault(&path, what);
+            }
+        }
+        let runs: Vec<RunRecord> = files.into_iter().map(|(_, r)| r).collect();
+        faults.extend(summary_faults(&self.dir, &self.study, &runs));
+        let leftovers = orphans(&self.dir, &runs)?;
+        Ok(Checked { runs, faults, leftovers })
+    }
+
+    /// [`Store::check`] for a reader: the records of a sound folder (its leftovers named on
+    /// stderr and ignored); a fault is an error naming every one.
+    pub fn read(&self) -> Result<Vec<RunRecord>> {
+        let checked = self.check()?;
+        if !checked.faults.is_empty() {
+            anyhow::bail!(
+                "{} does not hold together:{}\nRerun the runs at fault with `signorini run experiments/{}.toml --replace` (or restore the files)",
+                self.dir.root.display(),
+                checked.faults_text(),
+                self.study
+            );
+        }
+        self.note_leftovers(&checked.leftovers);
+        Ok(checked.runs)
+    }
+
+    /// Name the leftovers of an unfinished run a reader ignores, in one line.
+    pub fn note_leftovers(&self, leftovers: &[PathBuf]) {
+        if !leftovers.is_empty() {
+            eprintln!(
+                "{}: ignoring {} file(s) of an unfinished run in {} (`signorini run` removes them): {}",
+                self.study,
+                leftovers.len(),
+                self.dir.root.display(),
+                names(&self.dir, leftovers)
+            );
+        }
+    }
+}
+
+/// The mesh snapshots `record` saves that are missing or do not parse as its level, each with
+/// what is wrong: the JSON (what the mesh figures read) must be the run's level with the level's
+/// NDF, the VTU a whole VTK file.
+fn snapshot_faults(dir: &StudyDir, record: &RunRecord) -> Vec<(PathBuf, String)> {
+    let id = &record.run.id;
+    let mut out = Vec::new();
+    for &l in record.run.save_levels.iter().filter(|&&l| l < record.levels.len()) {
+        let json = dir.mesh_file(id, l, "json");
+        match dir.read_mesh(id, l) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => out.push((json, format!("missing: run {id} saves level {l}"))),
+            Err(e) => out.push((json, format!("does not parse as a mesh snapshot ({e})"))),
+            Ok(s) if s.run != *id || s.level != l || s.ndof != record.levels[l].ndof => out.push((
+                json,
+                format!(
+                    "is run {} level {} with {} unknowns, not run {id} level {l} with {}",
+                    s.run, s.level, s.ndof, record.levels[l].ndof
+                ),
+            )),
+            Ok(_) => {}
+        }
+        let vtu = dir.mesh_file(id, l, "vtu");
+        match std::fs::read(&vtu) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => out.push((vtu, format!("missing: run {id} saves level {l}"))),
+            Err(e) => out.push((vtu, format!("cannot be read ({e})"))),
+            Ok(b) if !(b.starts_with(b"<?xml") && b.trim_ascii_end().ends_with(b"</VTKFile>")) => {
+                out.push((vtu, "is not a whole VTK file (no XML header or no closing </VTKFile>)".into()))
+            }
+            Ok(_) => {}
+        }
+    }
+    out
+}
+
+/// The first line where two texts differ, shortened, as it reads in each.
+pub fn first_difference(a: &str, b: &str) -> (String, String) {
+    let (al, bl): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
+    let i = (0..al.len().max(bl.len())).find(|&i| al.get(i) != bl.get(i)).unwrap_or(al.len().min(bl.len()));
+    let cut =
+        |s: Option<&&str>| format!("line {}: {}", i + 1, s.map(|s| s.chars().take(60).collect::<String>()).unwrap_or("(none)".into()));
+    (cut(al.get(i)), cut(bl.get(i)))
+}
+
+/// The summaries of a study against what its records render: `levels.csv` byte for byte,
+/// `provenance.json` readable, of this study and listing exactly these runs. A folder with no
+/// record and no summary has nothing to disagree.
+pub fn summary_faults(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<Fault> {
+    let (csv, prov) = (dir.csv_file(), dir.provenance_file());
+    if runs.is_empty() && !csv.exists() && !prov.exists() {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    let mut fault = |file: &std::path::Path, what: String| out.push(Fault { file: file.to_path_buf(), what, record: None });
+    match (std::fs::read(&csv), dir.csv_bytes(runs)) {
+        (Ok(on_disk), Ok(rendered)) if on_disk == rendered => {}
+        (Ok(on_disk), Ok(rendered)) => {
+            let (a, b) = first_difference(&String::from_utf8_lossy(&on_disk), &String::from_utf8_lossy(&rendered));
+            fault(&csv, format!("is not what runs/*.json render: {a}, rendered {b}"));
+        }
+        (Err(e), _) => fault(&csv, format!("cannot be read ({e})")),
+        (_, Err(e)) => fault(&csv, format!("cannot be rendered from the records ({e})")),
+    }
+    let ids: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
+    match std::fs::read_to_string(&prov)
+        .map_err(|e| e.to_string())
+        .and_then(|t| serde_json::from_str::<Provenance>(&t).map_err(|e| e.to_string()))
+    {
+        Err(e) => fault(&prov, format!("cannot be read ({e})")),
+        Ok(p) if p.runs != ids => fault(&prov, format!("lists the runs {}, the records are {}", p.runs.join(" "), ids.join(" "))),
+        Ok(p) if p.study != study => fault(&prov, format!("is the provenance of study {}, not {study}", p.study)),
+        Ok(_) => {}
+    }
+    out
 }
