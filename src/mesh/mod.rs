@@ -10,6 +10,7 @@
 pub mod gmsh;
 pub mod io;
 pub mod locate;
+mod msh_nodes;
 pub mod refine;
 
 use crate::problems::Problem;
