@@ -50,8 +50,11 @@ mod property {
     use signorini::mesh::gmsh::{GmshFile, read};
     use std::collections::BTreeMap;
 
+    /// Nodes, triangles and boundary edges (by node index).
+    type Square = (Vec<[f64; 2]>, Vec<[usize; 3]>, Vec<[usize; 2]>);
+
     /// The 2 x 2 squares on [0, 1]^2 (9 nodes, 8 triangles) and its 8 boundary edges, by node index.
-    fn square() -> (Vec<[f64; 2]>, Vec<[usize; 3]>, Vec<[usize; 2]>) {
+    fn square() -> Square {
         let nodes = (0..9).map(|k| [0.5 * (k % 3) as f64, 0.5 * (k / 3) as f64]).collect();
         let mut tris = Vec::new();
         for j in 0..2 {

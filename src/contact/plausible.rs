@@ -89,7 +89,7 @@ fn outward_normals(mesh: &Mesh, nodes: &P2Nodes) -> Vec<Option<[f64; 2]>> {
 /// Check the problem's contact data at every contact node of the mesh (see the module docs).
 /// Data that are not finite numbers are left to the data watch, which names their key: when
 /// the gap or normal `dofs` holds already tripped it, nothing is checked here.
-pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem) -> Result<(), ContactDataError> {
+pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem) -> Result<(), Box<ContactDataError>> {
     if problem.bad_datum().is_some() {
         return Ok(());
     }
@@ -120,11 +120,11 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
             let edge = mesh.boundary[b].v.map(|v| mesh.vertices[v]);
             let outward = outward[b].expect("a contact edge");
             let (problem, part) = (problem_name(problem), contact_part(problem));
-            return Err(ContactDataError::Normal { problem, part, at, edge, normal: c.normal, outward, dot });
+            return Err(Box::new(ContactDataError::Normal { problem, part, at, edge, normal: c.normal, outward, dot }));
         }
         if c.gap < -diameter {
             let (problem, part) = (problem_name(problem), contact_part(problem));
-            return Err(ContactDataError::Gap { problem, part, at, chi: c.gap, diameter });
+            return Err(Box::new(ContactDataError::Gap { problem, part, at, chi: c.gap, diameter }));
         }
     }
     Ok(())

@@ -27,7 +27,7 @@ pub enum SolveError {
     #[error(transparent)]
     Data(#[from] crate::problems::BadDatum),
     #[error(transparent)]
-    ContactData(#[from] super::plausible::ContactDataError),
+    ContactData(#[from] Box<super::plausible::ContactDataError>),
     /// No boundary edge of the mesh is in the contact part.
     #[error("the problem's contact part matches no boundary edge of the mesh: there is nothing to be in contact (the problem declares: {})", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") })]
     NoContact { declared: Vec<String> },
