@@ -26,6 +26,17 @@ fn bad_mesh_string_says_what_is_expected() {
 }
 
 #[test]
+fn bad_odd_symmetric_mesh_says_n_must_be_even() {
+    for (spec, suggest) in
+        [("symmetric:5", "use symmetric:4 or symmetric:6"), ("symmetric:1", "use symmetric:2"), ("symmetric:0", "use symmetric:2")]
+    {
+        let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", spec]);
+        assert_eq!(code, 1, "{spec}: {err}");
+        assert!(err.contains(&format!("'{spec}'")) && err.contains("symmetric:N needs N even") && err.contains(suggest), "{spec}: {err}");
+    }
+}
+
+#[test]
 fn bad_odd_mesh_for_the_wedge_names_the_missing_kink() {
     let (code, err) = run(&["solve", "--problem", "ex72", "--mesh", "structured:5"]);
     assert_ne!(code, 0);

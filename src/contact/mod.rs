@@ -1,12 +1,14 @@
 //! Floor 5: the SOLVE step. The primal–dual active set method on the assembled system
 //! ([`active_set`], whose items are re-exported here), one discrete Signorini solution with its
-//! contact force ([`solve`]), the certificate of its KKT conditions ([`certify`]) and the
+//! contact force ([`solve`]), the checks that its contact data make physical sense
+//! ([`plausible`]), the certificate of its KKT conditions ([`certify`]) and the
 //! L-infinity norms of its error ([`norms`]). May import: `base`, `problems`, `mesh`, `sparse`,
 //! `fem`.
 
 pub mod active_set;
 pub mod certify;
 pub mod norms;
+pub mod plausible;
 pub mod solve;
 
 pub use active_set::*;

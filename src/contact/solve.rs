@@ -26,6 +26,8 @@ pub enum SolveError {
     NotCertified(#[from] KktError),
     #[error(transparent)]
     Data(#[from] crate::problems::BadDatum),
+    #[error(transparent)]
+    ContactData(#[from] Box<super::plausible::ContactDataError>),
     /// No boundary edge of the mesh is in the contact part.
     #[error("the problem's contact part matches no boundary edge of the mesh: there is nothing to be in contact (the problem declares: {})", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") })]
     NoContact { declared: Vec<String> },
@@ -119,6 +121,7 @@ pub fn solve(
     let nodes = P2Nodes::new(mesh);
     let dofs = DofMap::new(&nodes, problem);
     certify::check_held(mesh, &nodes, &dofs, problem)?;
+    super::plausible::check_contact_data(mesh, &nodes, &dofs, problem)?;
     if dofs.contact.is_empty() {
         return Err(SolveError::NoContact { declared: problem.declared_parts() });
     }

@@ -13,16 +13,18 @@
 //!   naming a node the file does not have are errors naming the file and the line.
 //! * Points (type 15) are ignored, and so is every physical group of dimension 0 or 2; any other
 //!   element type (quadrangles, second-order triangles or lines, 3D elements) is an error.
-//! * Nodes must lie in the plane z = 0. Nodes not used by any triangle are dropped; the others
-//!   become the mesh's vertices in the file's order.
+//! * Nodes are placed by their tags, whatever the order of the blocks and of the tags within a
+//!   block (sparse tags too); a tag listed twice is an error. Nodes must lie in the plane z = 0.
+//!   Nodes not used by any triangle are dropped; the others become the mesh's vertices in
+//!   ascending tag order (for a file Gmsh wrote without renumbering, the file's order).
 //!
 //! `mshio` parses the `$MeshFormat`, `$Entities`, `$Nodes` and `$Elements` sections but not
 //! `$PhysicalNames`, so that small section (`dim tag "name"` per line, ASCII in binary files too)
-//! is read here. `mshio` also drops the node tags of a node section whose tags are contiguous;
-//! they are then `min_node_tag, min_node_tag + 1, ...` in block order (as Gmsh writes them). Its
+//! is read here. `mshio` also drops the node tags of a node section whose tags are contiguous (in
+//! any order), so the tags are read by `mesh::msh_nodes` in every case. `mshio`'s
 //! errors carry the position in the file, turned into a line number here.
 
-use super::{BoundaryEdge, Mesh, MeshError, Part, key};
+use super::{BoundaryEdge, Mesh, MeshError, Part, key, msh_nodes};
 use crate::problems::Problem;
 use mshio::ElementType;
 use std::collections::{BTreeMap, HashMap};
@@ -75,10 +77,12 @@ fn physical_names(path: &Path, bytes: &[u8]) -> Result<PhysicalNames, MeshError>
         let (i, l) =
             lines.next().ok_or_else(|| error(path, Some(n_line), format!("$PhysicalNames: the file ends before its {n} names")))?;
         let bad = || error(path, Some(i), format!("$PhysicalNames: expected `dimension tag \"name\"`, got {l:?}"));
-        let mut parts = l.splitn(3, char::is_whitespace);
-        let dim: i32 = parts.next().and_then(|s| s.parse().ok()).ok_or_else(bad)?;
-        let tag: i32 = parts.next().and_then(|s| s.parse().ok()).ok_or_else(bad)?;
-        let name = parts.next().map(str::trim).and_then(|s| s.strip_prefix('"')).and_then(|s| s.strip_suffix('"')).ok_or_else(bad)?;
+        // fields separated by any run of spaces or tabs; the name is the rest of the line
+        let field = |s: &str| s.split_once(char::is_whitespace).map(|(f, rest)| (f.to_string(), rest.trim_start().to_string()));
+        let (dim, rest) = field(l).ok_or_else(bad)?;
+        let (tag, rest) = field(&rest).ok_or_else(bad)?;
+        let (dim, tag): (i32, i32) = (dim.parse().map_err(|_| bad())?, tag.parse().map_err(|_| bad())?);
+        let name = rest.trim().strip_prefix('"').and_then(|s| s.strip_suffix('"')).ok_or_else(bad)?;
         names.insert((dim, tag), (name.to_string(), i));
     }
     match lines.next() {
@@ -174,6 +178,60 @@ fn check_folds(
     Ok(())
 }
 
+/// Every node of the `$Nodes` section by its tag (ascending: the order the vertices take). The
+/// tags are the file's own, read by [`msh_nodes`] (`mshio` drops them when they look contiguous,
+/// whatever their order), after checking that it and `mshio` read the same section; the
+/// coordinates are `mshio`'s. A tag listed twice, a tag outside the header's range or a
+/// coordinate that is not finite is an error naming the node (and its line in an ASCII file).
+fn nodes_by_tag(
+    path: &Path,
+    bytes: &[u8],
+    binary: bool,
+    nodes: &mshio::Nodes<u64, i32, f64>,
+) -> Result<BTreeMap<u64, [f64; 3]>, MeshError> {
+    let fail = |m: String| error(path, None, m);
+    let encoding = msh_nodes::Encoding::of(bytes)
+        .filter(|e| e.binary == binary)
+        .ok_or_else(|| fail("cannot read the encoding of the $MeshFormat header".into()))?;
+    let section = msh_nodes::read(bytes, encoding)
+        .map_err(fail)?
+        .ok_or_else(|| fail("the $Nodes section is not where the file's sections lead".into()))?;
+    section.check_against(nodes).map_err(fail)?;
+    // more nodes than tags between the smallest and the largest: some tag is listed twice
+    let (min, max) = (nodes.min_node_tag, nodes.max_node_tag);
+    if nodes.num_nodes > max.saturating_sub(min) + 1 {
+        return Err(fail(format!(
+            "the $Nodes section has {} nodes but only {} tags between {min} and {max}: some node tag is listed twice",
+            nodes.num_nodes,
+            max.saturating_sub(min) + 1,
+        )));
+    }
+    let listed: usize = nodes.node_blocks.iter().map(|b| b.nodes.len()).sum();
+    if listed as u64 != nodes.num_nodes {
+        return Err(fail(format!("the $Nodes header declares {} nodes, its blocks hold {listed}", nodes.num_nodes)));
+    }
+    let mut node_at: BTreeMap<u64, [f64; 3]> = BTreeMap::new();
+    for (mine, theirs) in section.blocks.iter().zip(&nodes.node_blocks) {
+        for ((&tag, &offset), n) in mine.tags.iter().zip(&mine.offsets).zip(&theirs.nodes) {
+            let here = |message: String| error(path, (!binary).then(|| line_at(bytes, offset)), message);
+            let at = [n.x, n.y, n.z];
+            if let Some(c) = at.iter().find(|c| !c.is_finite()) {
+                return Err(here(format!("node {tag} has the coordinate {c}: every coordinate must be a finite number")));
+            }
+            if !(min..=max).contains(&tag) {
+                return Err(here(format!("node tag {tag} is outside the range {min} to {max} that the $Nodes header declares")));
+            }
+            if let Some(before) = node_at.insert(tag, at) {
+                return Err(here(format!(
+                    "node tag {tag} is listed twice, at ({}, {}, {}) and at ({}, {}, {})",
+                    before[0], before[1], before[2], at[0], at[1], at[2]
+                )));
+            }
+        }
+    }
+    Ok(node_at)
+}
+
 /// Read and check a Gmsh file (everything that does not depend on the problem).
 pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     check_size(path)?;
@@ -210,76 +268,7 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     let line_of = |tag: u64| lines.get(&tag).copied();
     let nodes = msh.data.nodes.as_ref().ok_or_else(|| error(path, None, "the file has no $Nodes section"))?;
     let elements = msh.data.elements.as_ref().ok_or_else(|| error(path, None, "the file has no $Elements section"))?;
-    // nodes by tag
-    let mut node_at: HashMap<u64, [f64; 3]> = HashMap::new();
-    let mut node_order: Vec<u64> = Vec::new();
-    let mut next_tag = nodes.min_node_tag;
-    for block in &nodes.node_blocks {
-        let mut tags: Vec<u64> = vec![0; block.nodes.len()];
-        match &block.node_tags {
-            Some(map) => {
-                map.iter().for_each(|(&tag, &i)| tags[i] = tag);
-                // mshio keeps one index per tag: a tag listed twice in a block leaves a hole
-                if map.len() < tags.len() {
-                    return Err(error(
-                        path,
-                        None,
-                        format!(
-                            "a node block of entity {} lists {} nodes under {} distinct tags: some node tag is listed twice",
-                            block.entity_tag,
-                            tags.len(),
-                            map.len()
-                        ),
-                    ));
-                }
-            }
-            None => {
-                for t in tags.iter_mut() {
-                    *t = next_tag;
-                    next_tag += 1;
-                }
-            }
-        }
-        for (tag, n) in tags.into_iter().zip(&block.nodes) {
-            let at = [n.x, n.y, n.z];
-            if let Some(c) = at.iter().find(|c| !c.is_finite()) {
-                return Err(error(path, None, format!("node {tag} has the coordinate {c}: every coordinate must be a finite number")));
-            }
-            match node_at.insert(tag, at) {
-                Some(before) if before != at => {
-                    return Err(error(
-                        path,
-                        None,
-                        format!(
-                            "node tag {tag} is listed twice, at ({}, {}, {}) and at ({}, {}, {})",
-                            before[0], before[1], before[2], at[0], at[1], at[2]
-                        ),
-                    ));
-                }
-                Some(_) => {}
-                None => node_order.push(tag),
-            }
-        }
-    }
-    // more nodes than tags between the smallest and the largest: some tag is listed twice (mshio
-    // drops the tags of such a section, so the duplicate itself cannot be shown)
-    if nodes.num_nodes > nodes.max_node_tag.saturating_sub(nodes.min_node_tag) + 1 {
-        return Err(error(
-            path,
-            None,
-            format!(
-                "the $Nodes section has {} nodes but only {} tags between {} and {}: some node tag is listed twice",
-                nodes.num_nodes,
-                nodes.max_node_tag.saturating_sub(nodes.min_node_tag) + 1,
-                nodes.min_node_tag,
-                nodes.max_node_tag
-            ),
-        ));
-    }
-    let listed: usize = nodes.node_blocks.iter().map(|b| b.nodes.len()).sum();
-    if listed as u64 != nodes.num_nodes {
-        return Err(error(path, None, format!("the $Nodes header declares {} nodes, its blocks hold {listed}", nodes.num_nodes)));
-    }
+    let node_at = nodes_by_tag(path, &bytes, binary, nodes)?;
     let listed: usize = elements.element_blocks.iter().map(|b| b.elements.len()).sum();
     if listed as u64 != elements.num_elements {
         return Err(error(
@@ -331,7 +320,7 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     if tri_nodes.is_empty() {
         return Err(error(path, None, "the file has no linear triangles (element type 2): a 2D mesh is expected"));
     }
-    // vertices: the nodes of the triangles, in the file's node order
+    // vertices: the nodes of the triangles, in ascending tag order
     let mut used: HashMap<u64, usize> = HashMap::new();
     for (tri, tag) in &tri_nodes {
         for n in tri {
@@ -342,7 +331,7 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
         }
     }
     let mut vertices = Vec::with_capacity(used.len());
-    for tag in &node_order {
+    for tag in node_at.keys() {
         if let Some(index) = used.get_mut(tag)
             && *index == usize::MAX
         {

@@ -10,6 +10,7 @@
 pub mod gmsh;
 pub mod io;
 pub mod locate;
+mod msh_nodes;
 pub mod refine;
 
 use crate::problems::Problem;
@@ -44,6 +45,11 @@ pub enum MeshError {
         "malformed mesh description '{0}': expected 'structured:N' or 'symmetric:N' with N a positive integer (N even keeps y = 0.5 a vertex), or 'gmsh:PATH.msh'"
     )]
     BadSpec(String),
+    /// `symmetric:N` with N odd (or 0): the mirror line y = 0.5 must be a grid line.
+    #[error(
+        "malformed mesh description '{spec}': symmetric:N needs N even (it mirrors the lower N/2 rows of squares onto the upper half about y = 0.5, so y = 0.5 must be a grid line): use {suggest}, or structured:N for any N"
+    )]
+    OddSymmetric { spec: String, suggest: String },
     #[error("triangle {t} has non-positive area {area:e} (vertices must be counter-clockwise and distinct)")]
     NonPositiveArea { t: usize, area: f64 },
     #[error("mesh is not conforming: edge ({a}, {b}) is shared by {count} triangles")]
@@ -90,6 +96,13 @@ impl MeshSpec {
         match kind.trim() {
             "structured" if n >= 1 => Ok(MeshSpec::Structured(n)),
             "symmetric" if n >= 2 && n.is_multiple_of(2) => Ok(MeshSpec::Symmetric(n)),
+            "symmetric" => {
+                let suggest = match n {
+                    0 | 1 => "symmetric:2".to_string(),
+                    _ => format!("symmetric:{} or symmetric:{}", n - 1, n as u128 + 1),
+                };
+                Err(MeshError::OddSymmetric { spec: s.to_string(), suggest })
+            }
             _ => Err(bad()),
         }
     }

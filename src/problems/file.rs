@@ -305,6 +305,8 @@ impl Exact for ExactExprs {
 #[derive(Clone, Debug)]
 pub struct FileProblem {
     name: String,
+    /// The file it was read from.
+    file: PathBuf,
     description: String,
     material: Material,
     /// Predicates on boundary-edge midpoints (built-in meshes): contact, then Dirichlet; the
@@ -572,6 +574,7 @@ impl FileProblem {
         let tables::Parts { groups, contact_predicate, dirichlet_predicate, declared_parts, .. } = parts;
         Ok(FileProblem {
             name,
+            file: path.to_path_buf(),
             description: raw.description.unwrap_or_default(),
             material,
             contact_predicate,
@@ -611,6 +614,9 @@ impl Problem for FileProblem {
     }
     fn description(&self) -> &str {
         &self.description
+    }
+    fn source(&self) -> Option<&Path> {
+        Some(&self.file)
     }
     fn material(&self) -> Material {
         self.material

@@ -108,6 +108,10 @@ pub trait Problem: Send + Sync {
     fn exact(&self) -> Option<&dyn Exact> {
         None
     }
+    /// The file the problem was read from (for error messages); `None` for a built-in problem.
+    fn source(&self) -> Option<&Path> {
+        None
+    }
     /// How the problem declares its boundary parts, as its source states them (e.g.
     /// `parts.dirichlet = "x < 1e-12"`), for error messages; empty if it states none.
     fn declared_parts(&self) -> Vec<String> {

@@ -1,0 +1,131 @@
+//! Contact data that make physical sense on the mesh, checked once per solve before anything is
+//! assembled ([`check_contact_data`], called by [`solve`](super::solve::solve), so the command
+//! line, the adaptive loop and every study get it).
+//!
+//! * **The constraint direction points out of the body.** The Signorini condition u . n <= chi
+//!   stops the body moving through the obstacle along n; n must leave the body where it is
+//!   used. At every contact node the declared normal is compared with the outward unit normal
+//!   of the contact edges holding the node (at a vertex between two contact edges, the more
+//!   favourable of the two: a corner may take any direction of its normal cone). A normal with
+//!   n . n_out < 0 is reversed (the constraint would pull the body into the obstacle); one with
+//!   n . n_out < cos 80 degrees (within 10 degrees of the boundary) is nearly tangent: the
+//!   constraint would act mostly along the surface, limiting sliding, and the normal gap it
+//!   measures is inflated by 1 / cos(angle) > 5.8. 80 degrees, not less, because a declared
+//!   direction is often a flat foundation's, not the surface's normal (`hertz.toml`: the arc of
+//!   a cylinder against the direction (0, -1)), and such a part legitimately reaches well past
+//!   45 degrees on a curved body.
+//! * **The obstacle does not overlap the body by more than its size.** A gap chi(p) < -D, D the
+//!   diameter of the mesh's bounding box, asks the body to move by more than its own size at p:
+//!   outside linear (small-strain) elasticity everywhere it happens, and in practice a sign or
+//!   unit mistake.
+//!
+//! Not repeated here: a normal of length 0 or a gap that is not a finite number is refused by
+//! the data watch (`problems::BadDatum`, after assembly); a declared normal is normalised where
+//! it is evaluated; Young's modulus, Poisson's ratio and the Lamé constants are checked when a
+//! problem file is read (`problems::file`).
+
+use crate::assembly::DofMap;
+use crate::mesh::{Mesh, P2Nodes, Part};
+use crate::problems::Problem;
+
+/// The largest angle, in degrees, a declared contact normal may make with the outward normal.
+pub const MAX_NORMAL_ANGLE_DEGREES: f64 = 80.0;
+
+/// Contact data without physical sense on this mesh.
+#[derive(Debug, thiserror::Error)]
+pub enum ContactDataError {
+    #[error(
+        "{problem}: the contact normal (`contact.normal`) at ({x}, {y}) on the contact part ({part}), edge ({ax}, {ay})-({bx}, {by}), is ({nx:.6}, {ny:.6}), {how} the edge's outward normal ({ox:.6}, {oy:.6}) (n . n_out = {dot:.6}, an angle of {angle:.1} degrees): a contact normal must point out of the body, within {max} degrees of the outward normal",
+        x = .at[0], y = .at[1], ax = .edge[0][0], ay = .edge[0][1], bx = .edge[1][0], by = .edge[1][1],
+        nx = .normal[0], ny = .normal[1], ox = .outward[0], oy = .outward[1],
+        how = if *.dot < 0.0 { "reversed against" } else { "nearly tangent to the boundary: far from" },
+        angle = .dot.clamp(-1.0, 1.0).acos().to_degrees(), max = MAX_NORMAL_ANGLE_DEGREES
+    )]
+    Normal { problem: String, part: String, at: [f64; 2], edge: [[f64; 2]; 2], normal: [f64; 2], outward: [f64; 2], dot: f64 },
+    #[error(
+        "{problem}: the gap `contact.chi` at ({x}, {y}) on the contact part ({part}) is {chi}: the obstacle would overlap the body by more than the body's size (the diameter of the mesh's bounding box, {diameter}); a gap below minus the body's size is a sign or unit mistake",
+        x = .at[0], y = .at[1]
+    )]
+    Gap { problem: String, part: String, at: [f64; 2], chi: f64, diameter: f64 },
+}
+
+/// The problem as errors name it: its file, or its built-in name.
+fn problem_name(problem: &dyn Problem) -> String {
+    match problem.source() {
+        Some(file) => format!("problem file {}", file.display()),
+        None => format!("problem {}", problem.name()),
+    }
+}
+
+/// How the problem declares its contact part (`parts.contact = ...`), or "Gamma_C".
+fn contact_part(problem: &dyn Problem) -> String {
+    problem.declared_parts().into_iter().find(|d| d.starts_with("parts.contact")).unwrap_or_else(|| "Gamma_C".into())
+}
+
+/// The outward unit normal of every contact edge of the mesh (by index into `mesh.boundary`),
+/// away from the third vertex of the triangle that holds the edge.
+fn outward_normals(mesh: &Mesh, nodes: &P2Nodes) -> Vec<Option<[f64; 2]>> {
+    let mut out = vec![None; mesh.boundary.len()];
+    for (t, local) in nodes.element_boundary.iter().enumerate() {
+        for &b in local.iter().flatten() {
+            if mesh.boundary[b].part != Part::Contact {
+                continue;
+            }
+            let [p, q] = mesh.boundary[b].v.map(|v| mesh.vertices[v]);
+            let inside = mesh.triangles[t].iter().map(|&v| mesh.vertices[v]).find(|&x| x != p && x != q).unwrap_or(p);
+            let (tx, ty) = (q[0] - p[0], q[1] - p[1]);
+            let l = tx.hypot(ty);
+            let mut n = [ty / l, -tx / l];
+            let m = [0.5 * (p[0] + q[0]) - inside[0], 0.5 * (p[1] + q[1]) - inside[1]];
+            if n[0] * m[0] + n[1] * m[1] < 0.0 {
+                n = [-n[0], -n[1]];
+            }
+            out[b] = Some(n);
+        }
+    }
+    out
+}
+
+/// Check the problem's contact data at every contact node of the mesh (see the module docs).
+/// Data that are not finite numbers are left to the data watch, which names their key: when
+/// the gap or normal `dofs` holds already tripped it, nothing is checked here.
+pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem) -> Result<(), Box<ContactDataError>> {
+    if problem.bad_datum().is_some() {
+        return Ok(());
+    }
+    let outward = outward_normals(mesh, nodes);
+    let cos_max = MAX_NORMAL_ANGLE_DEGREES.to_radians().cos();
+    // per contact node, the most favourable of its contact edges: (n . n_out, edge)
+    let mut best: Vec<Option<(f64, usize)>> = vec![None; dofs.contact.len()];
+    for (b, three) in nodes.boundary_nodes.iter().enumerate() {
+        let Some(o) = outward[b] else { continue };
+        for &p in three {
+            let Some(k) = dofs.contact_index[p] else { continue };
+            let n = dofs.contact[k].normal;
+            let dot = n[0] * o[0] + n[1] * o[1];
+            if dot.is_finite() && best[k].is_none_or(|(d, _)| dot > d) {
+                best[k] = Some((dot, b));
+            }
+        }
+    }
+    let bounds = mesh.vertices.iter().fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |r, v| {
+        [r[0].min(v[0]), r[1].min(v[1]), r[2].max(v[0]), r[3].max(v[1])]
+    });
+    let diameter = (bounds[2] - bounds[0]).hypot(bounds[3] - bounds[1]);
+    for (k, c) in dofs.contact.iter().enumerate() {
+        let at = nodes.coords[c.node];
+        if let Some((dot, b)) = best[k]
+            && dot < cos_max
+        {
+            let edge = mesh.boundary[b].v.map(|v| mesh.vertices[v]);
+            let outward = outward[b].expect("a contact edge");
+            let (problem, part) = (problem_name(problem), contact_part(problem));
+            return Err(Box::new(ContactDataError::Normal { problem, part, at, edge, normal: c.normal, outward, dot }));
+        }
+        if c.gap < -diameter {
+            let (problem, part) = (problem_name(problem), contact_part(problem));
+            return Err(Box::new(ContactDataError::Gap { problem, part, at, chi: c.gap, diameter }));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,131 @@
+//! Physically meaningless contact data are refused, named, on every path that solves (command
+//! line `solve` and `adapt`, studies): a contact normal reversed against the outward normal of
+//! its part or nearly tangent to it, a gap that makes the obstacle overlap the body by more than
+//! the body's size; and a material without elastic sense (Young's modulus <= 0, Poisson's ratio
+//! outside (-1, 0.5) in plane strain, Lamé constants that are not coercive).
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn fixture(name: &str) -> String {
+    std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(name)).unwrap()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("signorini-bad-physics-{name}-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `signorini ARGS` in a folder holding `v.toml` (`base` with `from` replaced by `to`) and
+/// `sq.msh` (the Gmsh square): (exit code, stderr).
+fn run(name: &str, base: &str, from: &str, to: &str, args: &[&str]) -> (i32, String) {
+    let dir = tmp(name);
+    let text = fixture(base);
+    assert!(text.contains(from), "{from} not in {base}");
+    std::fs::write(dir.join("v.toml"), text.replace(from, to)).unwrap();
+    std::fs::write(dir.join("sq.msh"), fixture("square.msh")).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_signorini")).current_dir(&dir).args(args).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(!err.contains("panicked"), "{name}: {err}");
+    (o.status.code().unwrap_or(-1), err)
+}
+
+const SOLVE: &[&str] = &["solve", "--problem", "v.toml", "--mesh", "structured:4"];
+const SQUARE: &str = "bad_data_square.toml";
+const OUTWARD: &str = r#"normal = "outward""#;
+
+#[test]
+fn a_reversed_contact_normal_is_named_with_both_vectors() {
+    let (code, err) = run("reversed", SQUARE, OUTWARD, "normal = [0, 1]", SOLVE);
+    assert_eq!(code, 1, "{err}");
+    for says in [
+        "problem file v.toml",
+        "the contact normal (`contact.normal`) at (",
+        r#"parts.contact = "y < 1e-12""#,
+        "is (0.000000, 1.000000), reversed against the edge's outward normal (0.000000, -1.000000)",
+        "n . n_out = -1.000000",
+        "must point out of the body",
+    ] {
+        assert!(err.contains(says), "{says}: {err}");
+    }
+}
+
+#[test]
+fn a_nearly_tangent_contact_normal_is_refused_and_80_degrees_is_the_bound() {
+    // (1, 0) on the bottom side: 90 degrees; (1, -0.1): 84.3 degrees
+    for (name, normal) in [("tangent", "[1, 0]"), ("84deg", "[1, -0.1]")] {
+        let (code, err) = run(name, SQUARE, OUTWARD, &format!("normal = {normal}"), SOLVE);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(err.contains("nearly tangent to the boundary") && err.contains("within 80 degrees"), "{name}: {err}");
+    }
+    // (1, -0.2): 78.7 degrees, and the foundation's direction (0, -1): solved
+    for (name, normal) in [("79deg", "[1, -0.2]"), ("straight", "[0, -1]")] {
+        let (code, err) = run(name, SQUARE, OUTWARD, &format!("normal = {normal}"), SOLVE);
+        assert_eq!(code, 0, "{name}: {err}");
+    }
+}
+
+#[test]
+fn a_reversed_normal_on_a_gmsh_part_names_the_edge() {
+    let args = ["solve", "--problem", "v.toml", "--mesh", "gmsh:sq.msh"];
+    let (code, err) = run("gmsh", "bad_data_gmsh.toml", "normal = [0, -1]", "normal = [0, 1]", &args);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains(r#"parts.contact = ["bottom"]"#) && err.contains("edge (0, 0)-(1, 0)") && err.contains("reversed"), "{err}");
+}
+
+#[test]
+fn the_adaptive_loop_and_a_study_refuse_it_too() {
+    let args = ["adapt", "--problem", "v.toml", "--mesh", "structured:4", "--levels", "2"];
+    let (code, err) = run("adapt", SQUARE, OUTWARD, "normal = [0, 1]", &args);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("reversed against the edge's outward normal"), "{err}");
+    // a study: the manifest's run is refused before any record is written
+    let dir = tmp("study");
+    std::fs::write(dir.join("v.toml"), fixture(SQUARE).replace(OUTWARD, "normal = [1, 0]")).unwrap();
+    let manifest = "description = \"tests/bad_physics.rs\"\n[defaults]\nproblem = \"v.toml\"\nmesh = \"structured:4\"\nlevels = 2\n[[run]]\nid = \"a\"\n";
+    std::fs::write(dir.join("physics.toml"), manifest).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["run", "physics.toml", "--results", "results"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_ne!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("nearly tangent to the boundary"), "{err}");
+}
+
+#[test]
+fn a_gap_deeper_than_the_body_is_refused() {
+    // the unit square's diameter is sqrt(2) = 1.414...
+    let (code, err) = run("deep", SQUARE, r#"chi = "0.001""#, r#"chi = "-1.5""#, SOLVE);
+    assert_eq!(code, 1, "{err}");
+    assert!(
+        err.contains("the gap `contact.chi` at (")
+            && err.contains("is -1.5")
+            && err.contains("more than the body's size")
+            && err.contains("1.414"),
+        "{err}"
+    );
+    let (code, err) = run("shallow", SQUARE, r#"chi = "0.001""#, r#"chi = "-1.4""#, SOLVE);
+    assert_eq!(code, 0, "{err}");
+}
+
+#[test]
+fn a_material_without_elastic_sense_is_refused_naming_the_key() {
+    let young = "mu = 1\nlambda = 1";
+    for (name, to, says) in [
+        ("e0", "E = 0\nnu = 0.3\nmodel = \"plane_strain\"", "a positive Young's modulus, got 0"),
+        ("eneg", "E = -5\nnu = 0.3\nmodel = \"plane_strain\"", "a positive Young's modulus, got -5"),
+        ("nuhalf", "E = 1\nnu = 0.5\nmodel = \"plane_strain\"", "a Poisson ratio in (-1, 0.5) in plane strain, got 0.5"),
+        ("numinus1", "E = 1\nnu = -1\nmodel = \"plane_strain\"", "a Poisson ratio in (-1, 0.5) in plane strain, got -1"),
+        ("nustress", "E = 1\nnu = 1\nmodel = \"plane_stress\"", "a Poisson ratio in (-1, 1) in plane stress, got 1"),
+        ("lame", "mu = 1\nlambda = -1", "mu > 0 and lambda + mu > 0"),
+        ("mu0", "mu = 0\nlambda = 1", "mu > 0 and lambda + mu > 0"),
+    ] {
+        let (code, err) = run(name, SQUARE, young, to, SOLVE);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(err.contains("v.toml") && err.contains("material") && err.contains(says), "{name}: {err}");
+    }
+}
