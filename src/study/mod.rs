@@ -20,6 +20,7 @@ pub mod checkpoint;
 pub mod drift;
 mod lock;
 pub mod manifest;
+pub mod progress;
 pub mod provenance;
 pub mod reference;
 pub mod store;
@@ -31,8 +32,8 @@ use crate::mesh::MeshSpec;
 use crate::problems;
 use crate::records::{Batch, MeshSnapshot, RunRecord, RunSpec, StudyDir};
 use anyhow::{Context, Result, bail};
-use indicatif::{ProgressBar, ProgressStyle};
 use manifest::Manifest;
+use progress::Progress;
 use reference::ReferenceField;
 use std::collections::HashMap;
 use std::ops::ControlFlow;
@@ -433,13 +434,13 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
             let computed = reference_for(&key, || {
                 let started = std::time::Instant::now();
                 let label = format!("{study}/{}: reference solution (adaptive to NDF >= {})", spec.id, rs.min_ndof);
-                let spinner = bar(progress, 0, &label);
+                let spinner = Progress::new(progress, 0, &label);
                 let field = reference::compute(problem.as_ref(), &mesh_spec, rs, &mut |r| {
-                    spinner.set_message(format!("level {} NDF {}", r.level, r.ndof));
+                    spinner.message(format!("level {}, NDF {} of at least {}", r.level, r.ndof, rs.min_ndof));
                     if interrupted() { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
                 })
                 .with_context(|| format!("{study}/{}: computing the reference solution", spec.id))?;
-                spinner.finish_and_clear();
+                spinner.finish();
                 let field = field.ok_or_else(|| anyhow::anyhow!("interrupted"))?;
                 if progress {
                     eprintln!("{label}: NDF {} in {:.1} s", field.ndof, started.elapsed().as_secs_f64());
@@ -536,7 +537,7 @@ fn loop_of(
     progress: bool,
 ) -> Result<Option<adapt::AdaptResult>> {
     let problem = prepared.problem.as_ref();
-    let pb = bar(progress, spec.levels as u64, &format!("{study}/{}", spec.id));
+    let pb = Progress::new(progress, spec.levels as u64, &format!("{study}/{}", spec.id));
     pb.inc(start.level as u64);
     let mut level_error: Option<anyhow::Error> = None;
     let mut stopped = false;
@@ -545,7 +546,7 @@ fn loop_of(
     let result = prepared.with_error_against(|error_against| {
         adapt::run_from(problem, start, config, error_against, &mut |level: Level| {
             let r = level.record;
-            pb.set_message(format!(
+            pb.message(format!(
                 "level {} NDF {} estimate {:.3e}{}",
                 r.level,
                 r.ndof,
@@ -571,7 +572,7 @@ fn loop_of(
         })
     });
     let result = result.with_context(|| format!("{study}/{}", spec.id))?;
-    pb.finish_and_clear();
+    pb.finish();
     if let Some(e) = level_error {
         return Err(e);
     }
@@ -593,22 +594,6 @@ pub fn replay_stored_level(manifest: &Manifest, stored: &RunRecord, level: usize
         .with_error_against(|r| adapt::replay::solve_stored_level(problem, mesh0, &config, history, level, stored.levels.get(level), r))
         .context(what)?;
     Ok(solved)
-}
-
-fn bar(progress: bool, len: u64, prefix: &str) -> ProgressBar {
-    if !progress {
-        return ProgressBar::hidden();
-    }
-    let pb = if len == 0 { ProgressBar::new_spinner() } else { ProgressBar::new(len) };
-    let style = if len == 0 {
-        ProgressStyle::with_template("{spinner} {prefix} [{elapsed}]").expect("valid template")
-    } else {
-        ProgressStyle::with_template("{prefix} [{bar:30}] {pos}/{len} {msg} [{elapsed}]").expect("valid template").progress_chars("=> ")
-    };
-    pb.set_style(style);
-    pb.set_prefix(prefix.to_string());
-    pb.enable_steady_tick(std::time::Duration::from_millis(200));
-    pb
 }
 
 /// A level just solved: its record must be one a file can hold (every float finite; otherwise

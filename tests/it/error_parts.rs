@@ -3,7 +3,7 @@
 //! on Gamma_C sampled at its own points, and the edge straddling a free boundary found where
 //! there is one (Example 7.2) and not where contact is everywhere (Example 7.1).
 
-mod common;
+use crate::common;
 use common::*;
 use signorini::adapt;
 use signorini::norms::{self, Sampling};

@@ -1,7 +1,7 @@
 //! Example 7.1 on structured meshes: the observed L-infinity rate in h is at least 2.85 on the
 //! finest pairs (NDF^(-3/2)), and the active set is the whole contact boundary.
 
-mod common;
+use crate::common;
 use common::*;
 use signorini::norms;
 use signorini::problems::{Ex71, Exact};

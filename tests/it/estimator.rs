@@ -8,7 +8,7 @@
 //! 3. the residual terms are linear in the data: scaling f, g, u_D and chi by k (material
 //!    unchanged) scales the discrete solution and eta_1..eta_5 by k.
 
-mod common;
+use crate::common;
 use common::*;
 use signorini::estimate::{self, ContactTerm, EstimatorConfig, LogFactor, Terms};
 use signorini::mesh::{Mesh, Part};

@@ -2,7 +2,7 @@
 //! for any contact normal (local frames at contact nodes), and the assembled operator is
 //! symmetric with a correct Schur complement.
 
-mod common;
+use crate::common;
 use common::*;
 use signorini::assembly::{self, DofMap};
 use signorini::contact::ContactSolver;

@@ -1,7 +1,7 @@
 //! Studies: malformed manifests are clear errors; results are the same on 1 and 2 threads; an
 //! interrupted study resumes; the quick form is an exact prefix of the full one.
 
-mod common;
+use crate::common;
 use common::parse_err;
 
 use signorini::records::{RunRecord, StudyDir};

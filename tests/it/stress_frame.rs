@@ -2,7 +2,7 @@
 //! bottom edge (n = (0, -1)) the Cartesian reading swaps the tangential and normal stresses, on
 //! Example 7.2's right edge (n = (1, 0)) both readings agree; the other terms never change.
 
-mod common;
+use crate::common;
 
 use signorini::estimate::{self, EstimatorConfig, StressFrame};
 use signorini::problems::{Ex71, Ex72, Problem};

@@ -1,7 +1,7 @@
 //! The discrete KKT conditions at every discrete solution: no penetration at contact nodes,
 //! lambda_p >= 0, lambda_p = 0 off the active set, the equations at free nodes.
 
-mod common;
+use crate::common;
 use common::*;
 use signorini::problems::{self, Problem};
 

@@ -7,7 +7,7 @@
 //! 6. the observed rates of every estimator term and of the error for Example 7.1, uniform and
 //!    adaptive, for both contact-term variants (frozen, so a change is noticed).
 
-mod common;
+use crate::common;
 use common::*;
 use signorini::adapt::{self, AdaptConfig, Level, LevelRecord, Refine};
 use signorini::estimate::{ContactTerm, EstimatorConfig};

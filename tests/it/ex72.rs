@@ -1,7 +1,7 @@
 //! Example 7.2 (rigid wedge): symmetry about y = 0.5 on a mesh that is itself symmetric, and a
 //! contact zone that settles as the mesh is refined.
 
-mod common;
+use crate::common;
 use common::*;
 use signorini::mesh::dist;
 use signorini::problems::Ex72;

@@ -2,7 +2,7 @@
 //! the same `AdaptConfig::validate` as the command line; unknown keys are errors everywhere;
 //! serde's Rust type names never reach the reader.
 
-mod common;
+use crate::common;
 use common::parse_err;
 
 use signorini::adapt::AdaptConfig;

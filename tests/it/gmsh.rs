@@ -1,7 +1,7 @@
 //! Gmsh meshes (`gmsh:PATH.msh`): parsing, tagging by physical group, curved boundaries under
 //! refinement, errors naming the line; the contact zone as arc-length intervals.
 
-mod common;
+use crate::common;
 use common::*;
 use signorini::mesh::{Curve, Mesh, MeshError, MeshSpec, Part};
 use signorini::problems::{Material, Problem};
@@ -65,7 +65,7 @@ fn area(m: &Mesh) -> f64 {
 
 /// The unit square as two triangles (the second listed clockwise), "bottom" on y = 0 and
 /// "sides" on the other three sides: a hand-written MSH 4.1 ASCII file.
-const SQUARE: &str = include_str!("fixtures/square.msh");
+const SQUARE: &str = include_str!("../fixtures/square.msh");
 
 fn square_problem() -> Named {
     Named { groups: vec![("bottom", Part::Contact, None), ("sides", Part::Dirichlet, None)] }
@@ -396,11 +396,17 @@ fn contact_zone_arc_length_along_a_curve() {
 fn manifest_mesh_paths_are_relative_to_the_manifest() {
     use signorini::study::manifest::{Manifest, resolve_mesh};
     let text = |mesh: &str| format!("[defaults]\nproblem = \"ex71\"\nlevels = 2\nmesh = \"{mesh}\"\n[[run]]\nid = \"a\"\n");
-    let file = Path::new("studies/own/hertz.toml");
-    let m = Manifest::parse(file, &text("gmsh:meshes/hertz.msh")).unwrap();
+    // the manifest reads the mesh (its hash is part of the run's spec): put one where it points
+    let root = std::env::temp_dir().join(format!("signorini-mesh-paths-{}", std::process::id()));
+    std::fs::create_dir_all(root.join("studies/own/meshes")).unwrap();
+    std::fs::copy(Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/meshes/hertz.msh"), root.join("studies/own/meshes/hertz.msh"))
+        .unwrap();
+    let file = root.join("studies/own/hertz.toml");
+    let m = Manifest::parse(&file, &text("gmsh:meshes/hertz.msh")).unwrap();
     assert_eq!(m.runs[0].spec.mesh, "gmsh:meshes/hertz.msh");
-    assert_eq!(resolve_mesh(file, &m.runs[0].spec.mesh), "gmsh:studies/own/meshes/hertz.msh");
-    assert_eq!(m.mesh_files(), vec![Path::new("studies/own/meshes/hertz.msh").to_path_buf()]);
+    assert_eq!(resolve_mesh(&file, &m.runs[0].spec.mesh), format!("gmsh:{}", root.join("studies/own/meshes/hertz.msh").display()));
+    assert_eq!(m.mesh_files(), vec![root.join("studies/own/meshes/hertz.msh")]);
+    std::fs::remove_dir_all(&root).unwrap();
     assert_eq!(resolve_mesh(Path::new("hertz.toml"), "gmsh:meshes/hertz.msh"), "gmsh:meshes/hertz.msh");
     assert_eq!(resolve_mesh(Path::new("studies/hertz.toml"), "gmsh:/abs/hertz.msh"), "gmsh:/abs/hertz.msh");
     assert_eq!(resolve_mesh(Path::new("studies/hertz.toml"), "structured:4"), "structured:4");

@@ -2,7 +2,7 @@
 //! results and figures, loaded in headless Chromium, every image must load, every CLAIMS row of
 //! the study must be on the page, and no console error may appear.
 
-mod common;
+use crate::common;
 use std::path::Path;
 
 #[test]

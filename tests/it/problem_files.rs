@@ -3,7 +3,7 @@
 //! built-ins; `hertz.toml` maps its physical groups; every kind of bad file is an error naming
 //! the file, the key and the position.
 
-mod common;
+use crate::common;
 use common::*;
 use signorini::adapt::{self, AdaptConfig};
 use signorini::mesh::{Curve, Part};

@@ -1,7 +1,7 @@
 //! The contact pressure recovered from the nodal contact forces (`solve::contact_samples`), which
 //! the Hertz comparison reads.
 
-mod common;
+use crate::common;
 
 use signorini::problems::Ex71;
 use signorini::solve;

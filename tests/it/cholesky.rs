@@ -3,7 +3,7 @@
 //! sequential one's, bitwise the same on one and two threads; a matrix that is not positive
 //! definite is a clear error.
 
-mod common;
+use crate::common;
 
 use common::*;
 use faer::Side;

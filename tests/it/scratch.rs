@@ -113,7 +113,7 @@ fn figures_of_one_study_are_drawn_into_its_scratch_folder_only() {
     assert_eq!(figs, ["hertz_mesh.png", "hertz_mesh.svg", "hertz_pressure.png", "hertz_pressure.svg"]);
     let claims = std::fs::read_to_string(dir.join("CLAIMS.md")).unwrap();
     assert!(claims.contains(&format!("from the records in `{}/`", dir.display())), "{claims}");
-    let hertz = claims.lines().find(|l| l.starts_with("| **hertz**")).unwrap();
+    let hertz = claims.lines().find(|l| l.starts_with("| [**hertz**]")).unwrap();
     assert!(hertz.ends_with("| holds (beyond the paper) |"), "{hertz}");
     assert!(out.contains(&format!("wrote {}", dir.join("CLAIMS.md").display())), "{out}");
     assert_eq!(tracked_state(), before, "figures --results DIR changed results/, figures/ or target/drift/");

@@ -3,7 +3,7 @@
 //! contact zone tends to [a, 1]; the discrete KKT conditions hold; the CLI solves it.
 #![allow(clippy::needless_range_loop)] // component loops read as the formulas they check
 
-mod common;
+use crate::common;
 use common::*;
 use signorini::norms;
 use signorini::problems::{self, Exact, Fb, Problem};
