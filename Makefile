@@ -23,7 +23,7 @@ test: build
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-before-test
 	$(CARGO) fmt --check
 	$(CARGO) clippy --release --locked --all-targets -- -D warnings
-	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || command -v google-chrome >/dev/null || [ -n "$$CHROMIUM" ] || echo "NOTE: no chromium on this machine: the browser check of the study pages (tests/report_page.rs) is SKIPPED (apt-get install chromium; CI installs it)"
+	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || command -v google-chrome >/dev/null || [ -n "$$CHROMIUM" ] || echo "NOTE: no chromium on this machine: the browser check of the study pages (tests/it/report_page.rs) is SKIPPED (apt-get install chromium; CI installs it)"
 	$(CARGO) test --release --locked
 	$(CARGO) run --release --locked --example own_problem
 	$(BIN) drift

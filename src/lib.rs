@@ -2,7 +2,7 @@
 //! supremum-norm a posteriori error estimator (Khandelwal, Porwal, Wadhawan).
 //!
 //! The crate is built in floors, one folder each; code uses only its own floor and the floors
-//! below (`tests/layers.rs` checks it, and that no two files use each other):
+//! below (`tests/it/layers.rs` checks it, and that no two files use each other):
 //!
 //! ```text
 //!   main.rs, bin/     the command line, the benchmark

@@ -1,6 +1,6 @@
 // A small test mesh: the quarter of the unit disc in x >= 0, y >= 0.
 // Physical curves: "bottom" (y = 0), "arc" (the circle of radius 1 about the origin), "left"
-// (x = 0); physical surface "body". Size 0.25: a few dozen triangles (tests/gmsh.rs).
+// (x = 0); physical surface "body". Size 0.25: a few dozen triangles (tests/it/gmsh.rs).
 // Regenerate with `make meshes`.
 h = 0.25;
 Point(1) = {0, 0, 0, h};

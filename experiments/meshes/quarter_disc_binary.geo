@@ -1,4 +1,4 @@
 // The tests' quarter disc (quarter_disc.geo) written as binary MSH 4.1: the reader must give the
-// same mesh from both encodings (tests/gmsh.rs). Regenerate with `make meshes`.
+// same mesh from both encodings (tests/it/gmsh.rs). Regenerate with `make meshes`.
 Merge "quarter_disc.geo";
 Mesh.Binary = 1;

@@ -34,7 +34,7 @@ use crate::problems::Problem;
 /// every level of every study (`signorini drift`, 2026-11-24, up to 1.1M unknowns): the
 /// largest values were 4.9e-14 for the equations (ex71), 1.5e-16 for complementarity (hertz),
 /// exactly 0 for the sign and for penetration. A floating body solved through its singular
-/// matrix misses the equations by 8.7e-4 (tests/kkt.rs). 1e-9 lies four orders of magnitude
+/// matrix misses the equations by 8.7e-4 (tests/it/kkt.rs). 1e-9 lies four orders of magnitude
 /// above the round-off, room for the growth of the condition number to 1e7 unknowns and more.
 pub const TOLERANCE: f64 = 1e-9;
 

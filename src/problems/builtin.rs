@@ -1,6 +1,6 @@
 //! The built-in problems: Examples 7.1 and 7.2 of the paper, the free-boundary problem `fb` and
 //! the patch test. `experiments/problems/{ex71,ex72,fb}.toml` state the first three as problem
-//! files; `tests/problem_files.rs` keeps the two equal.
+//! files; `tests/it/problem_files.rs` keeps the two equal.
 
 use super::Part;
 use super::{Exact, Material, Problem};
@@ -63,7 +63,7 @@ impl Problem for Ex71 {
     }
     /// f = -div sigma(u) = (2 e^y (y^2 + y - 1) - 6 y + 2, 3 y (x - 2)(y + 3) e^y), derived here
     /// from the exact u of Example 7.1 (the paper prints no f) and checked against finite
-    /// differences of the exact stress in tests/problems.rs.
+    /// differences of the exact stress in tests/it/problems.rs.
     fn body_force(&self, x: [f64; 2]) -> [f64; 2] {
         let (x, y) = (x[0], x[1]);
         let e = y.exp();
@@ -204,7 +204,7 @@ impl Problem for Fb {
     /// f = -div sigma(u) from the exact second derivatives of u (no finite differences), with
     /// div sigma = mu Laplace u + (mu + zeta) grad div u; for zeta = mu = 1 this is
     /// f = (3 y r''' - 2 p'/3, r'' - y p''/3). Checked against finite differences of the exact
-    /// stress in tests/fb.rs.
+    /// stress in tests/it/fb.rs.
     fn body_force(&self, x: [f64; 2]) -> [f64; 2] {
         let (r, p, y) = (Self::r(x[0]), Self::p(x[0]), x[1]);
         let Material { mu, zeta } = self.material();

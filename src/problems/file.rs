@@ -4,7 +4,7 @@
 //! expressions in `x` and `y`, the boundary parts predicates in `x`, `y` (the built-in meshes) or
 //! lists of Gmsh physical groups. Every key is described, with an example, in
 //! `experiments/problems/README.md`; `ex71.toml`, `ex72.toml` and `fb.toml` there state the
-//! built-in problems (`tests/problem_files.rs` solves both and compares).
+//! built-in problems (`tests/it/problem_files.rs` solves both and compares).
 //!
 //! Expressions are parsed once, when the file is read, by the `exmex` crate, chosen because it
 //! parses into a flat expression (operands and operators in evaluation order: no tree to walk,

@@ -3,7 +3,7 @@
 //! stored as dense blocks), computed on the graph of the mesh nodes.
 //!
 //! The structure is exactly the one faer's supernodal symbolic factorisation computes for the
-//! same permutation (the test in `tests/cholesky.rs` compares every array): the elimination tree
+//! same permutation (the test in `tests/it/cholesky.rs` compares every array): the elimination tree
 //! and the column counts of L, fundamental supernodes (column j joins column j - 1 when j is the
 //! only parent of j - 1 and its column count is one less), faer's default relaxation (a supernode
 //! absorbs the one just before it, its child, while the share of explicit zeros this adds stays

@@ -84,7 +84,7 @@ fn the_adaptive_loop_and_a_study_refuse_it_too() {
     // a study: the manifest's run is refused before any record is written
     let dir = tmp("study");
     std::fs::write(dir.join("v.toml"), fixture(SQUARE).replace(OUTWARD, "normal = [1, 0]")).unwrap();
-    let manifest = "description = \"tests/bad_physics.rs\"\n[defaults]\nproblem = \"v.toml\"\nmesh = \"structured:4\"\nlevels = 2\n[[run]]\nid = \"a\"\n";
+    let manifest = "description = \"tests/it/bad_physics.rs\"\n[defaults]\nproblem = \"v.toml\"\nmesh = \"structured:4\"\nlevels = 2\n[[run]]\nid = \"a\"\n";
     std::fs::write(dir.join("physics.toml"), manifest).unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
         .current_dir(&dir)
