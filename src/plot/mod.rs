@@ -157,7 +157,7 @@ pub fn draw_studies(results: &Path, figures: &Path, studies: Option<&[String]>) 
     let keep = |figure: &str| studies.is_none_or(|s| study_of(figure).is_some_and(|st| s.iter().any(|x| x == st)));
     let outcome = draw_figures_where(results, figures, &keep)?;
     for (name, why) in &outcome.skipped {
-        eprintln!("figures: skipped {name}: {why}");
+        crate::base::note::line(format_args!("figures: skipped {name}: {why}"));
     }
     Ok(outcome.written)
 }

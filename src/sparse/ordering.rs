@@ -558,7 +558,7 @@ mod tests {
         assert_eq!(choice.method, Method::MinimumDegree, "{choice:?}");
         let amd = choice.flops_minimum_degree.expect("computed on a graded mesh");
         assert!(amd < 0.5 * choice.flops_nested_dissection, "{choice:?}");
-        eprintln!("graded: {} unknowns, {choice:?}", sys.matrix.n());
+        crate::base::note::line(format_args!("graded: {} unknowns, {choice:?}", sys.matrix.n()));
     }
 
     #[test]

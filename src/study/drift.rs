@@ -389,7 +389,10 @@ fn replay_tier(manifest: &Manifest, stored: &[RunRecord], progress: bool, c: &mu
         let Some(s) = stored.iter().find(|r| &r.run.id == id) else { continue }; // a missing run is a row already
         let Some(level) = s.levels.iter().rposition(|l| tier.replay_max_ndof.is_none_or(|m| l.ndof <= m)) else { continue };
         if progress {
-            eprintln!("{study}/{id}: replaying level {level} (NDF {}) from the stored refinement history", s.levels[level].ndof);
+            crate::base::note::line(format_args!(
+                "{study}/{id}: replaying level {level} (NDF {}) from the stored refinement history",
+                s.levels[level].ndof
+            ));
         }
         match super::replay_stored_level(manifest, s, level, progress) {
             Ok(solved) => {
@@ -647,7 +650,7 @@ pub fn run(
             if !replay.is_empty() {
                 tiers.push(format!("the last level of {replay} replayed from its history"));
             }
-            eprintln!("{}: a deep study: {} (all to the end: drift --deep)", m.study, tiers.join(", "));
+            crate::base::note::line(format_args!("{}: a deep study: {} (all to the end: drift --deep)", m.study, tiers.join(", ")));
         }
         let fresh_root = match &opts.against {
             Some(dir) => dir.clone(),
@@ -688,11 +691,11 @@ pub fn run(
             c.rows.extend(compare_provenance(&m.study, &stored_dir, &StudyDir::new(&fresh_root, &m.study)));
         }
         if opts.progress {
-            eprintln!(
+            crate::base::note::line(format_args!(
                 "{}: {}",
                 m.study,
                 if c.rows.is_empty() { "no drift".to_string() } else { format!("{} field(s) moved", c.rows.len()) }
-            );
+            ));
         }
         report.studies.push(serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": c.rows.len(), "quick": quick }));
         report.rows.extend(c.rows);

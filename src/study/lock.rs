@@ -76,7 +76,7 @@ fn claim(mut file: std::fs::File, path: &Path, what: &str, wait: bool) -> Result
                     path.display()
                 );
             }
-            eprintln!("{what} is being written by {holder}; waiting for it to finish");
+            crate::base::note::line(format_args!("{what} is being written by {holder}; waiting for it to finish"));
             file.lock().with_context(|| format!("waiting for the lock {}", path.display()))?;
         }
         Err(std::fs::TryLockError::Error(e)) => return Err(e).with_context(|| format!("locking {}", path.display())),

@@ -188,11 +188,19 @@ fn set_up(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &RunOp
     for s in &stale {
         match s {
             store::Stale::Undeclared { id } => {
-                eprintln!("{}/{id}: removing the stored run, not declared in {}", manifest.study, manifest.file.display());
+                crate::base::note::line(format_args!(
+                    "{}/{id}: removing the stored run, not declared in {}",
+                    manifest.study,
+                    manifest.file.display()
+                ));
                 store::remove_run(dir, id)?;
             }
             store::Stale::Damaged { file, what } => {
-                eprintln!("{}/{file}: removing the damaged record and its snapshots ({})", manifest.study, what.join("; "));
+                crate::base::note::line(format_args!(
+                    "{}/{file}: removing the damaged record and its snapshots ({})",
+                    manifest.study,
+                    what.join("; ")
+                ));
                 store::remove_run(dir, file)?;
                 runs = store::read_runs(dir)?;
             }
@@ -274,7 +282,10 @@ fn run_planned(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &
         match stored(&spec.id)? {
             Some(r) if r.run == *spec => {
                 if opts.progress {
-                    eprintln!("{}/{}: finished earlier, kept (use --fresh to start over)", manifest.study, spec.id);
+                    crate::base::note::line(format_args!(
+                        "{}/{}: finished earlier, kept (use --fresh to start over)",
+                        manifest.study, spec.id
+                    ));
                 }
                 continue;
             }
@@ -288,12 +299,12 @@ fn run_planned(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &
                 dir.root.display(),
                 store::spec_differences(&r.run, spec).join("; ")
             ),
-            Some(r) => eprintln!(
+            Some(r) => crate::base::note::line(format_args!(
                 "{}/{}: replacing the stored run when the new one has finished ({})",
                 manifest.study,
                 spec.id,
                 store::spec_differences(&r.run, spec).join("; ")
-            ),
+            )),
             None => {}
         }
         let mut meshes = Batch::default();
@@ -443,7 +454,7 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
                 spinner.finish();
                 let field = field.ok_or_else(|| anyhow::anyhow!("interrupted"))?;
                 if progress {
-                    eprintln!("{label}: NDF {} in {:.1} s", field.ndof, started.elapsed().as_secs_f64());
+                    crate::base::note::line(format_args!("{label}: NDF {} in {:.1} s", field.ndof, started.elapsed().as_secs_f64()));
                 }
                 Ok(field)
             });
@@ -477,7 +488,13 @@ fn run_one(
     let (levels, history) = (result.records, result.history);
     if progress {
         let last = levels.last().expect("at least one level");
-        eprintln!("{study}/{}: {} levels, final NDF {}, estimate {:.3e}", spec.id, levels.len(), last.ndof, last.terms.estimate);
+        crate::base::note::line(format_args!(
+            "{study}/{}: {} levels, final NDF {}, estimate {:.3e}",
+            spec.id,
+            levels.len(),
+            last.ndof,
+            last.terms.estimate
+        ));
     }
     let reference_ndof = prepared.reference.as_ref().map(|r| r.ndof);
     Ok(Some(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof, history: Some(history) }))
@@ -497,7 +514,12 @@ fn start_of(
     let mesh0 = prepared.initial_mesh()?;
     let Some(c) = checkpoint::read(dir, spec) else { return Ok(adapt::Start::new(mesh0)) };
     let done = c.levels.len();
-    eprintln!("{study}/{}: resuming after level {} (from {})", spec.id, done - 1, checkpoint::file(dir, &spec.id).display());
+    crate::base::note::line(format_args!(
+        "{study}/{}: resuming after level {} (from {})",
+        spec.id,
+        done - 1,
+        checkpoint::file(dir, &spec.id).display()
+    ));
     let problem = prepared.problem.as_ref();
     for &l in spec.save_levels.iter().filter(|&&l| l < done) {
         let (mesh, solved) = prepared
@@ -518,7 +540,7 @@ fn start_of(
         c.next_active.as_ref().map(|f| f.decode()).transpose().with_context(|| format!("{study}/{}: the checkpoint", spec.id))?;
     let start = adapt::replay::resume(mesh0, c.levels, c.history, next_active).with_context(|| format!("{study}/{}: resuming", spec.id))?;
     if progress {
-        eprintln!("{study}/{}: level {} rebuilt from the stored marks", spec.id, start.level);
+        crate::base::note::line(format_args!("{study}/{}: level {} rebuilt from the stored marks", spec.id, start.level));
     }
     Ok(start)
 }

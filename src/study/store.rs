@@ -199,7 +199,11 @@ pub fn remove_orphans(study: &str, dir: &StudyDir, runs: &[RunRecord]) -> Result
     for f in &found {
         std::fs::remove_file(f).with_context(|| format!("removing {}", f.display()))?;
     }
-    eprintln!("{study}: removed {} file(s) of an unfinished run (no finished run accounts for them): {}", found.len(), names(dir, &found));
+    crate::base::note::line(format_args!(
+        "{study}: removed {} file(s) of an unfinished run (no finished run accounts for them): {}",
+        found.len(),
+        names(dir, &found)
+    ));
     Ok(())
 }
 
@@ -383,13 +387,13 @@ impl Store {
     /// Name the leftovers of an unfinished run a reader ignores, in one line.
     pub fn note_leftovers(&self, leftovers: &[PathBuf]) {
         if !leftovers.is_empty() {
-            eprintln!(
+            crate::base::note::line(format_args!(
                 "{}: ignoring {} file(s) of an unfinished run in {} (`signorini run` removes them): {}",
                 self.study,
                 leftovers.len(),
                 self.dir.root.display(),
                 names(&self.dir, leftovers)
-            );
+            ));
         }
     }
 }

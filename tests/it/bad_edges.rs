@@ -132,3 +132,22 @@ fn interrupted_adapt_stops_after_the_current_level_and_says_what_it_kept() {
     assert!(err.contains(&format!("interrupted after level {last}; the table above holds levels 0 to {last}")), "{err}");
     assert!(save.exists() && rest.iter().any(|l| l.contains(&format!("(level {last},"))), "{rest:?}");
 }
+
+/// The library's own notes (a study's progress, "finished earlier, kept", drift's lines) cannot
+/// stop it either: a study run twice with stderr on a full device computes, then keeps, and
+/// exits 0 both times (it exited with a panic's 101 while the library wrote with `eprintln!`).
+#[test]
+fn a_study_whose_notes_cannot_be_written_still_runs_and_exits_0() {
+    let dir = std::env::temp_dir().join(format!("signorini-edges-notes-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let manifest = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny.toml");
+    let bin = env!("CARGO_BIN_EXE_signorini");
+    for pass in ["computes", "keeps"] {
+        let script = format!("exec 2>/dev/full; exec {bin} run {} --results {}", manifest.display(), dir.join("res").display());
+        let out = Command::new("bash").args(["-c", &script]).output().unwrap();
+        assert_eq!(out.status.code(), Some(0), "the run that {pass}: {}", String::from_utf8_lossy(&out.stdout));
+    }
+    assert!(dir.join("res").read_dir().unwrap().next().is_some(), "the study was stored");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
