@@ -106,29 +106,18 @@ impl LineFit {
     }
 }
 
-/// The least-squares line through (x, y) evaluated at `x`, with the 95% half-width of that value
-/// (the interval of the mean response: t_{0.975, n-2} s sqrt(1/n + (x - mean x)^2 / Sxx));
-/// None with fewer than 3 points or no spread in x.
-pub fn line_value_at(pts: &[(f64, f64)], x: f64) -> Option<(f64, f64)> {
-    let n = pts.len();
-    if n < 3 {
-        return None;
-    }
-    let nf = n as f64;
-    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / nf, pts.iter().map(|p| p.1).sum::<f64>() / nf);
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    if sxx <= 0.0 {
-        return None;
-    }
-    let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx;
-    let rss: f64 = pts.iter().map(|p| (p.1 - my - slope * (p.0 - mx)).powi(2)).sum();
-    let s = (rss / (nf - 2.0)).sqrt();
-    Some((my + slope * (x - mx), t_quantile_975(n - 2) * s * (1.0 / nf + (x - mx).powi(2) / sxx).sqrt()))
+/// The least-squares sums of (x, y): n, mean x, mean y, Sxx, the slope and the residual sum of
+/// squares; None with fewer than 2 points or no spread in x.
+struct LeastSquares {
+    n: usize,
+    mx: f64,
+    my: f64,
+    sxx: f64,
+    slope: f64,
+    rss: f64,
 }
 
-/// Least-squares line through (x, y) with a 95% interval on the slope; None with fewer than 2
-/// points or no spread in x.
-pub fn fit_line(pts: &[(f64, f64)]) -> Option<LineFit> {
+fn least_squares(pts: &[(f64, f64)]) -> Option<LeastSquares> {
     let n = pts.len();
     if n < 2 {
         return None;
@@ -140,13 +129,26 @@ pub fn fit_line(pts: &[(f64, f64)]) -> Option<LineFit> {
         return None;
     }
     let slope = pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx;
-    let half_width = if n > 2 {
-        let rss: f64 = pts.iter().map(|p| (p.1 - my - slope * (p.0 - mx)).powi(2)).sum();
-        t_quantile_975(n - 2) * (rss / (nf - 2.0) / sxx).sqrt()
-    } else {
-        f64::INFINITY
-    };
-    Some(LineFit { slope, half_width, points: n })
+    let rss: f64 = pts.iter().map(|p| (p.1 - my - slope * (p.0 - mx)).powi(2)).sum();
+    Some(LeastSquares { n, mx, my, sxx, slope, rss })
+}
+
+/// The least-squares line through (x, y) evaluated at `x`, with the 95% half-width of that value
+/// (the interval of the mean response: t_{0.975, n-2} s sqrt(1/n + (x - mean x)^2 / Sxx));
+/// None with fewer than 3 points or no spread in x.
+pub fn line_value_at(pts: &[(f64, f64)], x: f64) -> Option<(f64, f64)> {
+    let l = least_squares(pts).filter(|l| l.n >= 3)?;
+    let nf = l.n as f64;
+    let s = (l.rss / (nf - 2.0)).sqrt();
+    Some((l.my + l.slope * (x - l.mx), t_quantile_975(l.n - 2) * s * (1.0 / nf + (x - l.mx).powi(2) / l.sxx).sqrt()))
+}
+
+/// Least-squares line through (x, y) with a 95% interval on the slope; None with fewer than 2
+/// points or no spread in x.
+pub fn fit_line(pts: &[(f64, f64)]) -> Option<LineFit> {
+    let l = least_squares(pts)?;
+    let half_width = if l.n > 2 { t_quantile_975(l.n - 2) * (l.rss / (l.n as f64 - 2.0) / l.sxx).sqrt() } else { f64::INFINITY };
+    Some(LineFit { slope: l.slope, half_width, points: l.n })
 }
 
 #[cfg(test)]
