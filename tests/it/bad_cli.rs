@@ -3,6 +3,7 @@
 //! solution that falls short, and the smaller things a reviewer trips over (help text, export's
 //! silence, 17-digit contact zones, the Makefile's binary, `cargo run`'s binary).
 
+use crate::common::signorini_in;
 use signorini::study::manifest::Manifest;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -12,14 +13,6 @@ fn tmp(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-/// (exit code, stdout, stderr) of the binary run in `dir`.
-fn signorini_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).current_dir(dir).output().unwrap();
-    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned());
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    (out.status.code().unwrap_or(-1), stdout, stderr)
 }
 
 fn signorini(args: &[&str]) -> (i32, String, String) {

@@ -4,22 +4,14 @@
 //! expected values and the same value named; and a loop with nothing to mark says so instead of
 //! solving the same mesh again.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use crate::common::signorini_in;
+use std::path::PathBuf;
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("signorini-settings-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-/// (exit code, stdout, stderr) of the binary run in `dir`.
-fn signorini_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).current_dir(dir).output().unwrap();
-    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned());
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    (out.status.code().unwrap_or(-1), stdout, stderr)
 }
 
 /// The part of an error from `marker` to the end of its line, the run's name dropped.

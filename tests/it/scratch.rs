@@ -3,20 +3,12 @@
 //! --study S`) without touching the tracked tree or `make test`'s drift report; a comparison
 //! with nothing to compare, or with records made from an edited manifest, says so.
 
+use crate::common::signorini_in;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::OnceLock;
 
 fn repo() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// (exit code, stdout, stderr) of the binary run in `dir`.
-fn signorini_in(dir: &Path, args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).current_dir(dir).output().unwrap();
-    let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned());
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    (out.status.code().unwrap_or(-1), stdout, stderr)
 }
 
 fn tmp(name: &str) -> PathBuf {
