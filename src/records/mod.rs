@@ -11,11 +11,13 @@
 
 mod finite;
 pub mod history;
+pub mod reference;
 pub mod report;
 
 pub use crate::contact::solve::ContactSample;
 pub use finite::{NonFinite, first_non_finite};
 pub use history::{BadFlags, Flags, History, LevelHistory};
+pub use reference::ReferenceRecord;
 
 use std::io::Write;
 use std::path::Path;
@@ -340,6 +342,23 @@ impl StudyDir {
     pub fn provenance_file(&self) -> PathBuf {
         self.root.join("provenance.json")
     }
+    /// `references/KEY.json`: a reference solution's refinement history
+    /// ([`ReferenceRecord::key_of`]).
+    pub fn reference_file(&self, key: &str) -> PathBuf {
+        self.root.join("references").join(format!("{key}.json"))
+    }
+
+    /// The stored reference solution of `key`, if there is one; one that does not parse is an
+    /// error naming the file.
+    pub fn read_reference(&self, key: &str) -> std::io::Result<Option<ReferenceRecord>> {
+        let f = self.reference_file(key);
+        match std::fs::read_to_string(&f) {
+            Ok(text) => serde_json::from_str(&text).map(Some).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display()))),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+            Err(e) => Err(std::io::Error::new(e.kind(), format!("reading {}: {e}", f.display()))),
+        }
+    }
+
     /// `meshes/RUN_levelL.vtu` and `.json`.
     pub fn mesh_file(&self, run: &str, level: usize, ext: &str) -> PathBuf {
         self.root.join("meshes").join(format!("{run}_level{level}.{ext}"))

@@ -360,21 +360,53 @@ fn compare_histories(study: &str, stored: &RunRecord, fresh: &RunRecord, out: &m
             return;
         }
     };
-    for (a, b) in s.levels.iter().zip(&f.levels) {
-        let what = if a.mesh != b.mesh || a.n_elements != b.n_elements {
-            Some(("history.mesh", format!("{} elements, {}", a.n_elements, a.mesh), format!("{} elements, {}", b.n_elements, b.mesh)))
+    if let Some((level, field, sv, fv)) = first_history_difference(s, f) {
+        out.push(row(study, id, Some(level), &format!("history.{field}"), sv, fv, None, "exact".into()));
+    }
+}
+
+/// The first level at which two refinement histories differ, as far as the shorter goes: the
+/// level, what differs (`mesh`, `marks`, `initial_active`) and the two sides, for a row.
+fn first_history_difference(s: &crate::records::History, f: &crate::records::History) -> Option<(usize, &'static str, String, String)> {
+    s.levels.iter().zip(&f.levels).find_map(|(a, b)| {
+        if a.mesh != b.mesh || a.n_elements != b.n_elements {
+            Some((a.level, "mesh", format!("{} elements, {}", a.n_elements, a.mesh), format!("{} elements, {}", b.n_elements, b.mesh)))
         } else if a.marks != b.marks {
-            Some(("history.marks", "stored marks".into(), "other marks".into()))
+            Some((a.level, "marks", "stored marks".into(), "other marks".into()))
         } else if a.initial_active != b.initial_active {
-            Some(("history.initial_active", "stored warm start".into(), "another warm start".into()))
+            Some((a.level, "initial_active", "stored warm start".into(), "another warm start".into()))
         } else {
             None
-        };
-        if let Some((field, sv, fv)) = what {
-            out.push(row(study, id, Some(a.level), field, sv, fv, None, "exact".into()));
-            return;
+        }
+    })
+}
+
+/// The reference solutions of a study's runs, stored against fresh (`references/KEY.json`):
+/// each present on both sides with the same refinement history, level for level, and the same
+/// NDF. Rows under run `reference KEY`. (Without `--deep` the fresh side is the stored one
+/// rebuilt in one solve, its meshes checked by their fingerprints on the way, so only a missing
+/// file shows here; `--deep` computes it by the adaptive loop and compares every level.)
+fn compare_references(study: &str, stored: &StudyDir, fresh: &StudyDir, runs: &[RunRecord]) -> Vec<DriftRow> {
+    let mut out = Vec::new();
+    let keys: std::collections::BTreeSet<String> = runs.iter().filter_map(|r| crate::records::ReferenceRecord::key_of(&r.run)).collect();
+    let describe = |r: &Option<crate::records::ReferenceRecord>| {
+        r.as_ref().map_or("(missing)".to_string(), |r| format!("NDF {} after {} levels", r.ndof, r.history.levels.len()))
+    };
+    for key in keys {
+        let label = format!("reference {key}");
+        let (s, f) = (stored.read_reference(&key).ok().flatten(), fresh.read_reference(&key).ok().flatten());
+        match (&s, &f) {
+            (Some(a), Some(b)) => {
+                if let Some((level, field, sv, fv)) = first_history_difference(&a.history, &b.history) {
+                    out.push(row(study, &label, Some(level), &format!("history.{field}"), sv, fv, None, "exact".into()));
+                } else if a.ndof != b.ndof || a.history.levels.len() != b.history.levels.len() {
+                    out.push(row(study, &label, None, "history", describe(&s), describe(&f), None, "exact".into()));
+                }
+            }
+            _ => out.push(row(study, &label, None, "history", describe(&s), describe(&f), None, "exact".into())),
         }
     }
+    out
 }
 
 /// The replay tier of a deep study in its tiers: the last level of every run in
@@ -655,6 +687,10 @@ pub fn run(
         let fresh_root = match &opts.against {
             Some(dir) => dir.clone(),
             None => {
+                if !opts.deep {
+                    // a stored reference replayed in one solve; --deep computes it anew
+                    super::preload_references(m, &StudyDir::new(&opts.results, &m.study), opts.progress)?;
+                }
                 let options = super::RunOptions {
                     quick,
                     shard: None,
@@ -687,6 +723,7 @@ pub fn run(
             replay_tier(m, &stored, opts.progress, &mut c)?;
         }
         c.rows.extend(checked.faults.iter().map(|f| fault_row(&stored_dir, &m.study, f)));
+        c.rows.extend(compare_references(&m.study, &stored_dir, &StudyDir::new(&fresh_root, &m.study), &stored));
         if opts.against.is_some() {
             c.rows.extend(compare_provenance(&m.study, &stored_dir, &StudyDir::new(&fresh_root, &m.study)));
         }

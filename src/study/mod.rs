@@ -258,7 +258,7 @@ fn start_over(dir: &StudyDir, sharded: bool, planned: &[RunSpec]) -> Result<()> 
     if sharded {
         return planned.iter().try_for_each(|spec| store::remove_run(dir, &spec.id));
     }
-    for sub in ["runs", "meshes", ".partial"] {
+    for sub in ["runs", "meshes", "references", ".partial"] {
         let p = dir.root.join(sub);
         if p.exists() {
             std::fs::remove_dir_all(&p).with_context(|| format!("removing {}", p.display()))?;
@@ -287,6 +287,7 @@ fn run_planned(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &
                         manifest.study, spec.id
                     ));
                 }
+                store_missing_reference(manifest, dir, spec, opts)?;
                 continue;
             }
             // stored by another process while this one waited for the run: the same check as
@@ -319,6 +320,41 @@ fn run_planned(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &
         executed.push(spec.id.clone());
     }
     Ok(executed)
+}
+
+/// A finished run whose reference solution the study does not store (a folder written before
+/// references were stored, or a deleted file): computed once by the adaptive loop and stored
+/// with its history, after checking that it is the reference the run was measured against
+/// (the same NDF; the errors the drift check compares tell the rest).
+fn store_missing_reference(manifest: &Manifest, dir: &StudyDir, spec: &RunSpec, opts: &RunOptions) -> Result<()> {
+    let Some(key) = crate::records::ReferenceRecord::key_of(spec) else { return Ok(()) };
+    if matches!(dir.read_reference(&key), Ok(Some(_))) {
+        return Ok(());
+    }
+    crate::base::note::line(format_args!(
+        "{}/{}: the history of its reference solution is not stored in {}; computing it once",
+        manifest.study,
+        spec.id,
+        dir.root.display()
+    ));
+    let Some(prepared) = prepare(&manifest.study, spec, &manifest.file, opts.progress)? else {
+        return Err(interruption(manifest, dir, opts));
+    };
+    let reference = prepared.reference.expect("a run with a reference spec is prepared with its reference");
+    let stored = dir.read_run(&spec.id)?.and_then(|r| r.reference_ndof);
+    if stored != Some(reference.ndof) {
+        bail!(
+            "{}/{}: the reference solution computed now has {} unknowns, the stored run was measured against one of {}; rerun it with --replace",
+            manifest.study,
+            spec.id,
+            reference.ndof,
+            stored.map_or("none".to_string(), |n| n.to_string())
+        );
+    }
+    let _lock = StudyLock::acquire(dir, true)?;
+    let mut batch = Batch::default();
+    store::stage_reference(dir, &reference.record, &mut batch)?;
+    Ok(batch.commit()?)
 }
 
 /// The error of an interrupted study: the runs kept, those missing, the command that resumes.
@@ -446,7 +482,7 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
                 let started = std::time::Instant::now();
                 let label = format!("{study}/{}: reference solution (adaptive to NDF >= {})", spec.id, rs.min_ndof);
                 let spinner = Progress::new(progress, 0, &label);
-                let field = reference::compute(problem.as_ref(), &mesh_spec, rs, &mut |r| {
+                let field = reference::compute(problem.as_ref(), &mesh_spec, spec, &mut |r| {
                     spinner.message(format!("level {}, NDF {} of at least {}", r.level, r.ndof, rs.min_ndof));
                     if interrupted() { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
                 })
@@ -467,6 +503,47 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
         _ => None,
     };
     Ok(Some(Prepared { problem, mesh_spec, reference }))
+}
+
+/// Take the reference solutions of `manifest`'s runs from the study folder `stored` where it
+/// holds them (`references/KEY.json`): each rebuilt from its refinement history in one solve
+/// ([`reference::replay`]) into this process's cache, where [`prepare`] finds it instead of
+/// computing it by the adaptive loop. What the drift check does, so that a 4.5e6-unknown
+/// reference costs one solve, not forty; `drift --deep` computes them anew and compares their
+/// histories with the stored ones. A run whose reference is not stored is left to [`prepare`].
+pub fn preload_references(manifest: &Manifest, stored: &StudyDir, progress: bool) -> Result<()> {
+    for planned in &manifest.runs {
+        let spec = &planned.spec;
+        let problem_path = manifest::resolve_problem(&manifest.file, &spec.problem);
+        let mesh_path = manifest::resolve_mesh(&manifest.file, &spec.mesh);
+        let (Some(key), Some(file_key)) = (reference_key(spec, &problem_path, &mesh_path), crate::records::ReferenceRecord::key_of(spec))
+        else {
+            continue;
+        };
+        let Some(record) = stored.read_reference(&file_key)? else { continue };
+        let study = &manifest.study;
+        reference_for(&key, || {
+            let started = std::time::Instant::now();
+            let label = format!(
+                "{study}/{}: reference solution rebuilt from its stored history (level {}, NDF {})",
+                spec.id,
+                record.history.levels.len().saturating_sub(1),
+                record.ndof
+            );
+            let spinner = Progress::new(progress, 0, &label);
+            let problem = problems::load(&problem_path, &spec.constants)?;
+            let mesh_spec = MeshSpec::parse(&mesh_path)?;
+            let field = reference::replay(problem.as_ref(), &mesh_spec, &record).with_context(|| {
+                format!("{study}/{}: replaying the stored reference {}", spec.id, stored.reference_file(&file_key).display())
+            })?;
+            spinner.finish();
+            if progress {
+                crate::base::note::line(format_args!("{label}: {:.1} s", started.elapsed().as_secs_f64()));
+            }
+            Ok(field)
+        })?;
+    }
+    Ok(())
 }
 
 /// One run of the manifest at `manifest_file` (its problem and mesh files are relative to it): the
@@ -497,6 +574,9 @@ fn run_one(
         ));
     }
     let reference_ndof = prepared.reference.as_ref().map(|r| r.ndof);
+    if let Some(r) = &prepared.reference {
+        store::stage_reference(dir, &r.record, meshes)?;
+    }
     Ok(Some(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof, history: Some(history) }))
 }
 

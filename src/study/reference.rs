@@ -1,12 +1,14 @@
 //! Reference solutions for problems without an exact solution (Example 7.2): a discrete
-//! solution on a much finer adaptive mesh, evaluated anywhere by point location.
+//! solution on a much finer adaptive mesh, evaluated anywhere by point location. Computed by
+//! the adaptive loop ([`compute`]) or rebuilt from its stored refinement history in one solve
+//! ([`replay`]), to the same numbers.
 
 use crate::adapt::{self, AdaptConfig, Refine};
 use crate::element::{self, N_NODES};
 use crate::mesh::locate::Locator;
 use crate::mesh::{Mesh, MeshSpec};
 use crate::problems::Problem;
-use crate::records::ReferenceSpec;
+use crate::records::{ReferenceRecord, ReferenceSpec, RunSpec};
 
 /// A P2 field on a mesh with an R*-tree for point location ([`Locator`]).
 pub struct ReferenceField {
@@ -15,13 +17,15 @@ pub struct ReferenceField {
     values: Vec<[f64; 2]>,
     locator: Locator,
     pub ndof: usize,
+    /// How to rebuild it: what the study stores (`references/KEY.json`).
+    pub record: ReferenceRecord,
 }
 
 impl ReferenceField {
-    pub fn new(mesh: Mesh, elements: Vec<[usize; 6]>, values: Vec<[f64; 2]>) -> Self {
+    pub fn new(mesh: Mesh, elements: Vec<[usize; 6]>, values: Vec<[f64; 2]>, record: ReferenceRecord) -> Self {
         let locator = Locator::new(&mesh);
         let ndof = 2 * values.len();
-        ReferenceField { mesh, elements, values, locator, ndof }
+        ReferenceField { mesh, elements, values, locator, ndof, record }
     }
 
     /// The field at x: in the triangle containing x (the one of smallest index where x is on an
@@ -51,22 +55,32 @@ pub enum ReferenceError {
     /// The loop ended before the reference reached `min_ndof` unknowns.
     #[error("the reference solution reached {ndof} unknowns after {levels} levels, short of reference.min_ndof = {min_ndof}: {why}")]
     Short { ndof: usize, levels: usize, min_ndof: usize, why: String },
+    /// A stored reference that does not rebuild to what it records.
+    #[error("the stored reference ({stored} unknowns) replays to {replayed} unknowns")]
+    Replayed { stored: usize, replayed: usize },
 }
 
-/// Compute the reference solution: adaptive refinement from `mesh_spec` (estimator with
-/// `spec.contact_term`, otherwise the defaults) until the NDF reaches `spec.min_ndof`; the last
-/// level's solution. `on_level` sees every level (progress) and may stop the loop (an
+/// The adaptive loop of a reference solution: the maximum strategy with `spec.theta`, the
+/// estimator with `spec.contact_term` (otherwise the defaults), as many levels as it takes.
+fn config_of(spec: &ReferenceSpec) -> AdaptConfig {
+    let estimator = crate::estimate::EstimatorConfig { contact_term: spec.contact_term, ..Default::default() };
+    AdaptConfig { levels: REFERENCE_LEVELS, refine: Refine::Adaptive, theta: spec.theta, estimator, ..Default::default() }
+}
+
+/// Compute the reference solution `run` declares: adaptive refinement from `mesh_spec`
+/// ([`config_of`]) until the NDF reaches `min_ndof`; the last level's solution, with the
+/// history that rebuilds it. `on_level` sees every level (progress) and may stop the loop (an
 /// interrupt): then the result is `None`. A loop that ends short of `min_ndof` (after
 /// [`REFERENCE_LEVELS`] levels) is an error saying how far it got.
 pub fn compute(
     problem: &dyn Problem,
     mesh_spec: &MeshSpec,
-    spec: &ReferenceSpec,
+    run: &RunSpec,
     on_level: &mut dyn FnMut(&crate::adapt::LevelRecord) -> std::ops::ControlFlow<()>,
 ) -> Result<Option<ReferenceField>, ReferenceError> {
+    let spec = run.reference.as_ref().expect("compute is called for a run that declares a reference");
     let mesh = mesh_spec.build(problem).map_err(|e| adapt::AdaptError::Solve(e.into()))?;
-    let estimator = crate::estimate::EstimatorConfig { contact_term: spec.contact_term, ..Default::default() };
-    let config = AdaptConfig { levels: REFERENCE_LEVELS, refine: Refine::Adaptive, theta: spec.theta, estimator, ..Default::default() };
+    let config = config_of(spec);
     // the automatic ordering even in a round-off measurement (SIGNORINI_ORDERING): the reference
     // stays the one the stored errors were measured against (crate::ordering::automatic)
     let out = crate::ordering::automatic(|| {
@@ -76,7 +90,8 @@ pub fn compute(
     })?;
     let last = out.records.last().expect("level 0 is always solved");
     if last.ndof >= spec.min_ndof {
-        return Ok(Some(ReferenceField::new(out.mesh, out.solution.nodes.elements, out.solution.u)));
+        let record = ReferenceRecord::new(run, spec, last.clone(), out.history, &out.solution.active);
+        return Ok(Some(ReferenceField::new(out.mesh, out.solution.nodes.elements, out.solution.u, record)));
     }
     if out.termination == adapt::Termination::StoppedByObserver {
         return Ok(None); // on_level stopped it (an interrupt)
@@ -89,4 +104,25 @@ pub fn compute(
         out.records.windows(2).map(|w| w[1].ndof.saturating_sub(w[0].ndof)).max().unwrap_or(0)
     );
     Err(ReferenceError::Short { ndof: last.ndof, levels: out.records.len(), min_ndof: spec.min_ndof, why })
+}
+
+/// Rebuild a stored reference solution: the last mesh of its history from `mesh_spec`'s mesh
+/// (every level's fingerprint checked), solved once, as the loop solved it (the automatic
+/// ordering, as in [`compute`]), from the active set the loop's solve ended with (else from its
+/// warm start): the same solution in one solve, and in one numeric factorisation.
+pub fn replay(problem: &dyn Problem, mesh_spec: &MeshSpec, record: &ReferenceRecord) -> Result<ReferenceField, ReferenceError> {
+    use adapt::replay::ReplayError;
+    let mesh0 = mesh_spec.build(problem).map_err(|e| adapt::AdaptError::Solve(e.into()))?;
+    let config = config_of(&record.spec);
+    let last = record.history.levels.len().checked_sub(1).ok_or(adapt::AdaptError::from(ReplayError::Short { level: 0, held: 0 }))?;
+    let mesh = adapt::replay::mesh_at(mesh0, &record.history, last).map_err(adapt::AdaptError::from)?;
+    let start = record.final_active.as_ref().or(record.history.levels[last].initial_active.as_ref());
+    let start =
+        start.map(|f| f.decode()).transpose().map_err(|source| adapt::AdaptError::from(ReplayError::Flags { level: last, source }))?;
+    let measured = record.last.measured_peak();
+    let solved = crate::ordering::automatic(|| adapt::solve_level(problem, &mesh, last, &config, None, start, measured))?;
+    if solved.record.ndof != record.ndof {
+        return Err(ReferenceError::Replayed { stored: record.ndof, replayed: solved.record.ndof });
+    }
+    Ok(ReferenceField::new(mesh, solved.solution.nodes.elements, solved.solution.u, record.clone()))
 }

@@ -164,9 +164,13 @@ pub fn orphans(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<PathBuf>> {
     let meshes = dir.root.join("meshes");
     let mut out = Vec::new();
     let runs_dir = dir.root.join("runs");
-    for sub in [dir.root.clone(), runs_dir.clone(), meshes.clone()] {
+    let references = dir.root.join("references");
+    let keys: Vec<String> = runs.iter().filter_map(|r| records::ReferenceRecord::key_of(&r.run)).collect();
+    for sub in [dir.root.clone(), runs_dir.clone(), meshes.clone(), references.clone()] {
         for (name, path) in files_in(&sub)? {
             let stray_mesh = sub == meshes && StudyDir::parse_mesh_name(&name).is_some_and(|(run, level)| !saved(runs, run, level));
+            // a reference no stored run is measured against (its runs replaced or removed)
+            let stray_reference = sub == references && name.strip_suffix(".json").is_some_and(|k| !keys.iter().any(|key| key == k));
             let temporary = records::is_temporary(&name);
             // a temporary file of a run another process computes now is not an orphan
             let of_run = name.strip_prefix('.').and_then(|n| n.rsplit_once(".tmp")).and_then(|(target, _)| {
@@ -177,7 +181,7 @@ pub fn orphans(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<PathBuf>> {
                 }
             });
             let in_progress = temporary && of_run.is_some_and(|id| super::lock::run_in_progress(dir, &id));
-            if (temporary || stray_mesh) && !in_progress {
+            if (temporary || stray_mesh || stray_reference) && !in_progress {
                 out.push(path);
             }
         }
@@ -364,6 +368,7 @@ impl Store {
         }
         let runs: Vec<RunRecord> = files.into_iter().map(|(_, r)| r).collect();
         faults.extend(summary_faults(&self.dir, &self.study, &runs));
+        faults.extend(reference_faults(&self.dir, &runs));
         let leftovers = orphans(&self.dir, &runs)?;
         Ok(Checked { runs, faults, leftovers })
     }
@@ -470,4 +475,46 @@ pub fn summary_faults(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<Fa
         Ok(_) => {}
     }
     out
+}
+
+/// The stored reference solutions against the runs measured against them: each one present
+/// parses, is the reference of the runs naming it (its key) and has the NDF they record. A
+/// reference not stored is no fault here (a folder written before references were stored; the
+/// drift check computes it and names it missing); `run` stores it ([`stage_reference`]).
+pub fn reference_faults(dir: &StudyDir, runs: &[RunRecord]) -> Vec<Fault> {
+    let mut out = Vec::new();
+    let mut seen = std::collections::BTreeSet::new();
+    for r in runs {
+        let Some(key) = records::ReferenceRecord::key_of(&r.run) else { continue };
+        let file = dir.reference_file(&key);
+        let what = match dir.read_reference(&key) {
+            Ok(None) => continue,
+            Err(e) => format!("cannot be read ({e})"),
+            Ok(Some(stored)) if stored.key() != key => {
+                format!("is the reference of {} on {}, not of run {}", stored.problem, stored.mesh, r.run.id)
+            }
+            Ok(Some(stored)) if Some(stored.ndof) != r.reference_ndof => format!(
+                "has {} unknowns; run {} was measured against a reference of {}",
+                stored.ndof,
+                r.run.id,
+                r.reference_ndof.map_or("none".to_string(), |n| n.to_string())
+            ),
+            Ok(Some(_)) => continue,
+        };
+        if seen.insert(file.clone()) {
+            out.push(Fault { file, what, record: None });
+        }
+    }
+    out
+}
+
+/// Add `reference` to `batch` unless the study stores it already (the same history to the
+/// same NDF): a run stores the reference it was measured against, with the run.
+pub fn stage_reference(dir: &StudyDir, reference: &records::ReferenceRecord, batch: &mut Batch) -> Result<()> {
+    let file = dir.reference_file(&reference.key());
+    let same = |s: &records::ReferenceRecord| s.history == reference.history && s.ndof == reference.ndof && s.key() == reference.key();
+    if !matches!(dir.read_reference(&reference.key()), Ok(Some(s)) if same(&s)) {
+        batch.add_json(&file, reference)?;
+    }
+    Ok(())
 }

@@ -225,6 +225,28 @@ fn drift_command_fails_on_perturbed_record_csv_or_claims() {
     let (ok, text) = drift();
     assert!(ok, "{text}");
     let dir = StudyDir::new(&res, "tiny");
+    // the reference solution of run a is stored with its history, and drift rebuilt it from there
+    assert!(text.contains("reference solution rebuilt from its stored history"), "{text}");
+    let key = signorini::records::ReferenceRecord::key_of(&dir.read_run("a").unwrap().unwrap().run).unwrap();
+    let reference = std::fs::read_to_string(dir.reference_file(&key)).unwrap();
+    // a deleted reference: drift computes it and names the stored one missing; run stores it again
+    std::fs::remove_file(dir.reference_file(&key)).unwrap();
+    let (ok, text) = drift();
+    assert!(!ok && text.contains(&format!("reference {key}")) && text.contains("(missing)"), "{text}");
+    let (ok, text) = run(&["run", "experiments/tiny.toml", "--quick", "--results", "results"]);
+    assert!(ok && text.contains("computing it once"), "{text}");
+    let (again, before) =
+        (dir.read_reference(&key).unwrap().unwrap(), serde_json::from_str::<signorini::records::ReferenceRecord>(&reference).unwrap());
+    assert!(again.history == before.history && again.ndof == before.ndof, "the reference computed again is the stored one");
+    // a reference file that does not rebuild what it records: an error naming the file
+    std::fs::write(dir.reference_file(&key), reference.replacen("\"ndof\": ", "\"ndof\": 1", 1)).unwrap();
+    let (ok, text) = drift();
+    assert!(!ok && text.contains(&format!("{key}.json")) && text.contains("replays to"), "{text}");
+    // and the store's own check says the runs were measured against another reference
+    let checked = signorini::study::store::Store::new(&res, "tiny").check().unwrap();
+    assert!(checked.faults_text().contains("measured against a reference of"), "{}", checked.faults_text());
+    std::fs::write(dir.reference_file(&key), &reference).unwrap();
+    assert!(drift().0);
     // a float at the last level
     let original = std::fs::read_to_string(dir.run_file("b")).unwrap();
     let mut rec: RunRecord = serde_json::from_str(&original).unwrap();

@@ -129,3 +129,34 @@ fn quick_form_is_an_exact_prefix() {
         }
     }
 }
+
+/// A reference solution rebuilt from its stored history in one solve is the one the adaptive
+/// loop computed, bit for bit, at points anywhere in the body; a history whose marks were
+/// altered does not rebuild (its meshes' fingerprints are checked) and says at which level.
+#[test]
+fn stored_reference_replays_to_the_computed_one() {
+    use signorini::mesh::MeshSpec;
+    use signorini::study::reference;
+    let m = Manifest::load(Path::new(&fixture())).unwrap();
+    let spec = &m.runs[0].spec;
+    let problem = signorini::problems::load(&spec.problem, &spec.constants).unwrap();
+    let mesh_spec = MeshSpec::parse(&spec.mesh).unwrap();
+    let computed = reference::compute(problem.as_ref(), &mesh_spec, spec, &mut |_| std::ops::ControlFlow::Continue(())).unwrap().unwrap();
+    assert!(computed.record.history.levels.len() > 3, "the reference loop refines several levels");
+    let replayed = reference::replay(problem.as_ref(), &mesh_spec, &computed.record).unwrap();
+    assert_eq!(replayed.ndof, computed.ndof);
+    for i in 0..=20 {
+        for j in 0..=20 {
+            let x = [i as f64 / 20.0, j as f64 / 20.0];
+            assert_eq!(replayed.eval(x), computed.eval(x), "at {x:?}");
+        }
+    }
+    let mut altered = computed.record.clone();
+    let level = altered.history.levels.len() / 2;
+    let mut marks = altered.history.levels[level].marks.decode().unwrap();
+    let first_unmarked = marks.iter().position(|m| !m).unwrap();
+    marks[first_unmarked] = true;
+    altered.history.levels[level].marks = signorini::records::Flags::encode(&marks);
+    let e = reference::replay(problem.as_ref(), &mesh_spec, &altered).err().expect("altered marks do not replay").to_string();
+    assert!(e.contains(&format!("level {}", level + 1)) && e.contains("fingerprint"), "{e}");
+}
