@@ -495,8 +495,9 @@ fn obstacle_samples<DB: DrawingBackend>(
     for s in prepared {
         for seg in &s.segments {
             let px: Vec<(i32, i32)> = seg.iter().map(|p| chart.backend_coord(p)).collect();
+            let r = s.series.style.radius(MARKER);
             for &(x, y) in &px {
-                for (dx, dy) in [(-MARKER, -MARKER), (MARKER, -MARKER), (-MARKER, MARKER), (MARKER, MARKER), (0, 0)] {
+                for (dx, dy) in [(-r, -r), (r, -r), (-r, r), (r, r), (0, 0)] {
                     out.push((x + dx, y + dy));
                 }
             }
