@@ -88,7 +88,8 @@ pub enum Criterion {
     Rate { what: String, claim: f64, abscissa: Abscissa },
     /// The trend of `what` is bounded: [`verdict::judge_trend`].
     Bounded { what: String },
-    /// `what` decays at all: the 95% interval of its rate in NDF above 0.
+    /// `what` decays at all: the 95% interval of its rate in NDF above 0 (an interval reaching 0
+    /// over two decades shows no decay: it fails).
     Decays { what: String },
     /// `what` is at most `limit`; `interval`: it is known within an interval.
     AtMost { what: String, limit: f64, interval: bool },
@@ -166,10 +167,8 @@ impl Criterion {
                     Outcome::Open
                 } else if f.rate.lo() > 0.0 {
                     Outcome::Pass
-                } else if f.rate.hi() < 0.0 {
-                    Outcome::Fail
                 } else {
-                    Outcome::Open
+                    Outcome::Fail
                 }
             }
             (Criterion::AtMost { limit, .. }, Evidence::Value(v)) => {
@@ -256,7 +255,7 @@ impl Criterion {
                 verdict::MAX_WIDTH
             ),
             Criterion::Decays { what } => format!(
-                "fails if the 95% interval of the rate of {what} in NDF lies below 0 (it grows); not decided if it contains 0 or the window spans less than {d} decades of NDF"
+                "fails unless the 95% interval of the rate of {what} in NDF lies above 0 (a decay); not decided if the window spans less than {d} decades of NDF"
             ),
             Criterion::AtMost { what, limit, interval: false } => format!("fails if {what} exceeds {}", number(*limit)),
             Criterion::AtMost { what, limit, interval: true } => {
@@ -323,6 +322,8 @@ mod tests {
         assert_eq!(i.judge(Some(&Evidence::Interval(0.01, 0.03))), Outcome::Open);
         let z = Criterion::Decays { what: "z".into() };
         assert_eq!(z.judge(Some(&Evidence::Fit(fit(-0.3, 0.1, 2.5, Abscissa::Ndof)))), Outcome::Fail);
+        assert_eq!(z.judge(Some(&Evidence::Fit(fit(0.0, 0.0, 2.5, Abscissa::Ndof)))), Outcome::Fail, "a zone that stalls");
+        assert_eq!(z.judge(Some(&Evidence::Fit(fit(0.5, 0.1, 1.5, Abscissa::Ndof)))), Outcome::Open, "a short window");
         assert_eq!(z.judge(Some(&Evidence::Fit(fit(0.3, 0.1, 2.5, Abscissa::Ndof)))), Outcome::Pass);
         let t = Criterion::Test { passes_if: "it is".into(), open_if_not: false };
         assert_eq!(t.judge(Some(&Evidence::Bool(false))), Outcome::Fail);

@@ -289,7 +289,7 @@ pub(super) fn estimator_repair_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io
     let test = Criterion::All(vec![
         Criterion::Each { of: judged_problems.clone(), each: Box::new(Criterion::All(criteria_parts())) },
         Criterion::Test {
-            passes_if: "some criterion holds for the repair and not for eta_5 as written on the same problem (a criterion both pass is no evidence for the repair)".into(),
+            passes_if: "some criterion passes for the repair and not for eta_5 as written on the same problem (a criterion both pass is no evidence for the repair)".into(),
             open_if_not: true,
         },
     ]);
