@@ -10,11 +10,13 @@
 //! computed twice, with errors sampled at the quadrature points (the paper's way) and on a dense
 //! lattice (`err_dense`); the `sampling` row lists the verdicts that differ.
 
+pub mod criterion;
 mod ex72;
-mod repair;
+pub mod repair;
 
 use crate::records::{MeshSnapshot, RunRecord, StudyDir};
-use crate::verdict::{self, RateReport, RateVerdict, refinement};
+use crate::verdict::{self, Abscissa, RateReport, RateVerdict, refinement};
+pub use criterion::{Criterion, Evidence, Kind};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -23,6 +25,9 @@ pub const OPTIMAL: f64 = 1.5;
 /// The 95% half-width a rate verdict aims at (in NDF; doubled for a fit in h_min): a wider one
 /// is marked in its row.
 pub const TARGET_HALF_WIDTH: f64 = 0.05;
+/// How far along Gamma_C either side of a claimed refinement location the edge lengths are
+/// compared ([`refinement::local_minimum`]).
+pub const REFINE_REACH: f64 = 0.15;
 /// Poisson ratio of Example 7.2 (E = 500, nu = 0.3).
 pub const EX72_NU: f64 = 0.3;
 /// The free boundary of `fb`: contact exactly on [a, 1] x {0}, a = sqrt(2) - 1.
@@ -86,10 +91,22 @@ pub struct Claim {
     pub summary: Summary,
     pub claim: String,
     pub measured: String,
+    /// Judged by `criterion` on the row's evidence ([`Criterion::verdict`]).
     pub verdict: Verdict,
+    /// The rule the verdict applies; it also states what would fail the row ([`Criterion::fails_if`]).
+    pub criterion: Criterion,
+    /// Whose claim `criterion` judges (the verdict's words: reproduced or holds).
+    pub kind: Kind,
     /// Why the verdict is fragile: it changes with the fit window ([`verdict::window_fragility`])
     /// or with the dense sampling of the error (set by [`claims`]).
     pub fragile: Option<String>,
+}
+
+impl Claim {
+    /// Whose claim the row judges.
+    pub fn kind(&self) -> Kind {
+        self.kind
+    }
 }
 
 /// Which error the verdicts use: sampled at the quadrature points or on the dense lattice.
@@ -258,11 +275,7 @@ fn slowest_headline(ctx: &Ctx, r: Option<&RunRecord>, names: &[&str]) -> String 
         .unwrap_or("n/a".into())
 }
 
-fn judge(rep: Option<&RateReport>, claim: f64) -> Verdict {
-    rep.map_or(Verdict::NoData, |r| verdict::judge_rate(&r.main, claim).into())
-}
-
-/// The window fragility of the verdict `judge(rep, claim)`.
+/// The window fragility of a rate verdict on `rep` against `claim`.
 fn fragility(rep: Option<&RateReport>, claim: f64) -> Option<String> {
     rep.and_then(|r| verdict::window_fragility(r, claim))
 }
@@ -358,6 +371,7 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         let text = rate_text(&format!("{name} ({})", source(r)), ctx.rate(r, Q::Error).as_ref(), Some(OPTIMAL));
         r.map_or(text.clone(), |r| format!("{text}; {}", ctx.floor_text(r)))
     };
+    let test = Criterion::rate(format!("the adaptive error ({})", source(a71)), OPTIMAL, Abscissa::Ndof);
     out.push(Claim {
         fragile: fragility(err.as_ref(), OPTIMAL),
         id: "7.1-error-rate",
@@ -373,10 +387,13 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             with_floor("without full-contact nodes", wfc),
             with_floor("uniform", u71)
         ),
-        verdict: judge(err.as_ref(), OPTIMAL),
+        verdict: test.verdict(Kind::Paper, Evidence::rate(err.as_ref()).as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     });
 
     let est = ctx.rate(a71, Q::Field("eta_h"));
+    let test = Criterion::rate(format!("eta_h ({})", source(a71)), OPTIMAL, Abscissa::Ndof);
     out.push(Claim {
         fragile: fragility(est.as_ref(), OPTIMAL),
         id: "7.1-estimator-rate",
@@ -393,7 +410,9 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             source(wfc),
             estimator_text(ctx, wfc)
         ),
-        verdict: judge(est.as_ref(), OPTIMAL),
+        verdict: test.verdict(Kind::Paper, Evidence::rate(est.as_ref()).as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     });
 
     let terms: Vec<String> =
@@ -402,7 +421,12 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         let rates: Option<Vec<f64>> = ["eta4", "eta5"].iter().map(|n| ctx.rate(r, Q::Field(n)).map(|x| x.main.rate.slope)).collect();
         rates.map(|v| format!("NDF^(-{:.2})", v[0].min(v[1]))).unwrap_or("n/a".into())
     };
-    let all = ["eta1", "eta2", "eta3", "eta4", "eta5"].map(|n| judge(ctx.rate(a71, Q::Field(n)).as_ref(), OPTIMAL));
+    let names = ["eta1", "eta2", "eta3", "eta4", "eta5"];
+    let test = Criterion::Each {
+        of: names.iter().map(|n| n.to_string()).collect(),
+        each: Box::new(Criterion::rate(format!("the term ({})", source(a71)), OPTIMAL, Abscissa::Ndof)),
+    };
+    let ev = a71.map(|_| Evidence::All(names.iter().map(|n| Evidence::rate(ctx.rate(a71, Q::Field(n)).as_ref())).collect()));
     out.push(Claim {
         fragile: None,
         id: "7.1-eta5",
@@ -427,20 +451,13 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             slower(u71),
             slower(u71c),
         ),
-        verdict: if a71.is_none() {
-            Verdict::NoData
-        } else if all.iter().all(|v| *v == Verdict::Reproduced) {
-            Verdict::Reproduced
-        } else if all.contains(&Verdict::NotReproduced) {
-            Verdict::NotReproduced
-        } else if all.contains(&Verdict::Different) {
-            Verdict::Different
-        } else {
-            Verdict::Inconclusive
-        },
+        verdict: test.verdict(Kind::Paper, ev.as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     });
 
     let g = ctx.growth(a71, Q::Efficiency);
+    let test = Criterion::Bounded { what: format!("estimate / error ({})", source(a71)) };
     out.push(Claim {
         fragile: None,
         id: "7.1-efficiency",
@@ -459,15 +476,14 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             growth_text("efficiency", ctx.growth(wfc, Q::Efficiency).as_ref()),
             growth_text("efficiency / l_h", ctx.growth(wfc, Q::EfficiencyOverLh).as_ref()),
         ),
-        verdict: match g.map(|g| verdict::judge_trend(&g)) {
-            None => Verdict::NoData,
-            Some(verdict::Trend::Bounded) => Verdict::Reproduced,
-            Some(verdict::Trend::Inconclusive | verdict::Trend::Short) => Verdict::Inconclusive,
-            Some(_) => Verdict::NotReproduced,
-        },
+        verdict: test.verdict(Kind::Paper, Evidence::fit(g.as_ref()).as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     });
 
     let eta67 = a71.map(|r| r.levels.iter().map(|l| l.terms.eta6.max(l.terms.eta7)).fold(0.0, f64::max));
+    let test =
+        Criterion::AtMost { what: format!("the largest eta_6 or eta_7 at any level ({})", source(a71)), limit: 1e-12, interval: false };
     out.push(Claim {
         fragile: None,
         id: "7.1-eta6-eta7",
@@ -478,11 +494,9 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         },
         claim: "Ex. 7.1: ||(chi + u_h2)^+||_Linf(Lambda) and ||(-u_h2 - chi)^+||_Linf(Gamma_C) vanish".into(),
         measured: eta67.map(|v| format!("max over levels of eta6, eta7: {v:.3e}")).unwrap_or_default(),
-        verdict: match eta67 {
-            None => Verdict::NoData,
-            Some(v) if v <= 1e-12 => Verdict::Reproduced,
-            Some(_) => Verdict::NotReproduced,
-        },
+        verdict: test.verdict(Kind::Paper, eta67.map(Evidence::Value).as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     });
     Ok(())
 }
@@ -498,6 +512,11 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         }
     }
     let worst = rows.iter().map(|r| r.1).fold(0.0, f64::max);
+    let test = Criterion::AtMost {
+        what: format!("the smallest reliable C_0 (the largest error / eta_h at any level of {} runs with an error)", rows.len()),
+        limit: 0.45,
+        interval: false,
+    };
     out.push(Claim {
         fragile: None,
         id: "c0",
@@ -519,7 +538,9 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 rows.iter().map(|r| r.0.clone()).collect::<Vec<_>>().join("; ")
             )
         },
-        verdict: if rows.is_empty() { Verdict::NoData } else if worst <= 0.45 { Verdict::Reproduced } else { Verdict::NotReproduced },
+        verdict: test.verdict(Kind::Paper, (!rows.is_empty()).then_some(Evidence::Value(worst)).as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     });
     Ok(())
 }
@@ -556,6 +577,7 @@ fn efficiency_size_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()>
     }
     let (lo, hi) = (per_problem.iter().map(|p| p.1).fold(f64::INFINITY, f64::min), per_problem.iter().map(|p| p.1).fold(0.0, f64::max));
     let c0s = per_problem.iter().map(|(p, c)| format!("{p} {c:.1e}")).collect::<Vec<_>>().join(", ");
+    let reported = Criterion::Reported { why: "the paper makes no claim on the size of the efficiency index".into() };
     out.push(Claim {
         fragile: None,
         id: "efficiency-size",
@@ -570,7 +592,9 @@ fn efficiency_size_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()>
         },
         claim: "How large the efficiency index C_0 eta_h / error is, per problem and contact term, over the levels of each run's error-rate fit (the paper plots it in Fig. 2b and uses one C_0 = 0.45 for both examples; no claim on its size), and the smallest reliable C_0 per problem (the largest over its runs of max error / eta_h)".into(),
         measured: if rows.is_empty() { "no data".into() } else { format!("estimate / error: {}. Smallest reliable C_0: {c0s}", rows.join("; ")) },
-        verdict: if rows.is_empty() { Verdict::NoData } else { Verdict::NoClaim },
+        verdict: reported.verdict(Kind::Beyond, (!rows.is_empty()).then_some(Evidence::Bool(true)).as_ref()),
+        criterion: reported,
+        kind: Kind::Beyond,
     });
     Ok(())
 }
@@ -595,6 +619,7 @@ fn theta_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             headline.push(format!("θ = {}: {}", r.run.theta, rep.map_or("n/a".into(), |p| format!("{}{}", p.main.text(), short(&p)))));
         }
     }
+    let reported = Criterion::Reported { why: "the paper does not give theta; an ablation".into() };
     out.push(Claim {
         fragile: None,
         id: "theta (ablation)",
@@ -605,7 +630,9 @@ fn theta_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         },
         claim: "The maximum strategy's theta (the paper does not give it): the error rate per theta in 0.3, 0.5, 0.7 and under uniform refinement (study theta_ablation, small runs: windows shorter than two decades are no verdict, and their ranges say so)".into(),
         measured: if rows.is_empty() { "no data".into() } else { rows.join("; ") },
-        verdict: if rows.is_empty() { Verdict::NoData } else { Verdict::NoClaim },
+        verdict: reported.verdict(Kind::Beyond, (!rows.is_empty()).then_some(Evidence::Bool(true)).as_ref()),
+        criterion: reported,
+        kind: Kind::Beyond,
     });
     Ok(())
 }
@@ -615,6 +642,7 @@ fn log_factor_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let la = StudyDir::new(ctx.results, "log_ablation").read_runs()?;
     let rows: Vec<String> =
         la.iter().map(|r| growth_text(&format!("{} efficiency", r.run.id), ctx.growth(Some(r), Q::Efficiency).as_ref())).collect();
+    let reported = Criterion::Reported { why: "an ablation of eq. 6.3's factor, no claim of the paper".into() };
     out.push(Claim {
         fragile: None,
         id: "log-factor (ablation)",
@@ -629,7 +657,9 @@ fn log_factor_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         },
         claim: "Eq. 6.3's factor l_h = 1 + |log h_min|^2 against 1 + |log h_min| and 1: the trend of the efficiency index (no claim of the paper; for reading the rows above)".into(),
         measured: rows.join("; "),
-        verdict: if rows.is_empty() { Verdict::NoData } else { Verdict::NoClaim },
+        verdict: reported.verdict(Kind::Beyond, (!rows.is_empty()).then_some(Evidence::Bool(true)).as_ref()),
+        criterion: reported,
+        kind: Kind::Beyond,
     });
     Ok(())
 }
@@ -646,6 +676,7 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 
     let (e_ad, e_wfc, e_un) = (ctx.rate(ad, Q::Error), ctx.rate(wfc, Q::Error), ctx.rate(un, Q::Error));
     // the paper's claim carried over, judged for its estimator as written (the variant beside it)
+    let test = Criterion::rate(format!("the adaptive error ({})", source(ad)), OPTIMAL, Abscissa::Ndof);
     out.push(Claim {
         fragile: fragility(e_ad.as_ref(), OPTIMAL),
         id: "fb-error-rate",
@@ -671,10 +702,17 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 against_uniform(wfc)
             )
         },
-        verdict: if none { Verdict::NoData } else { judge(e_ad.as_ref(), OPTIMAL) },
+        verdict: test.verdict(Kind::Paper, Evidence::rate(e_ad.as_ref()).as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     });
 
     let rows: Vec<(String, f64)> = [ad, wfc, un].into_iter().filter_map(|r| c0_text(&source(r), r?, ctx.err_field())).collect();
+    let test = Criterion::AtMost {
+        what: format!("the smallest reliable C_0 (the largest error / eta_h at any level of {})", [ad, wfc, un].map(source).join(", ")),
+        limit: 0.45,
+        interval: false,
+    };
     out.push(Claim {
         fragile: None,
         id: "fb-reliability",
@@ -689,17 +727,14 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         },
         claim: "fb: C_0 = 0.45 is reliable, C_0 eta_h >= ||u - u_h||_Linf at every level; the smallest reliable C_0".into(),
         measured: if rows.is_empty() { "no data".into() } else { rows.iter().map(|r| r.0.clone()).collect::<Vec<_>>().join("; ") },
-        verdict: if rows.is_empty() {
-            Verdict::NoData
-        } else if rows.iter().all(|r| r.1 <= 0.45) {
-            Verdict::Holds
-        } else {
-            Verdict::Fails
-        },
+        verdict: test.verdict(Kind::Beyond, rows.iter().map(|r| r.1).reduce(f64::max).map(Evidence::Value).as_ref()),
+        criterion: test,
+        kind: Kind::Beyond,
     });
 
     // judged for the paper's estimator as written, like 7.1-efficiency
     let g = ctx.growth(ad, Q::Efficiency);
+    let test = Criterion::Bounded { what: format!("estimate / error ({})", source(ad)) };
     out.push(Claim {
         fragile: None,
         id: "fb-efficiency",
@@ -722,24 +757,22 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 growth_text("efficiency / l_h", ctx.growth(wfc, Q::EfficiencyOverLh).as_ref())
             )
         },
-        verdict: match g.map(|g| verdict::judge_trend(&g)) {
-            None => Verdict::NoData,
-            Some(verdict::Trend::Bounded) => Verdict::Holds,
-            Some(verdict::Trend::Inconclusive | verdict::Trend::Short) => Verdict::Inconclusive,
-            Some(_) => Verdict::Fails,
-        },
+        verdict: test.verdict(Kind::Beyond, Evidence::fit(g.as_ref()).as_ref()),
+        criterion: test,
+        kind: Kind::Beyond,
     });
 
     // refinement at x = a along Gamma_C = (0, 1) x {0}
     let mut parts = Vec::new();
-    let mut verdict = Verdict::NoData;
+    // the first mesh found decides
+    let mut decides: Option<(String, bool)> = None;
     for id in ["adaptive_wfc", "adaptive"] {
         let Some(m) = latest_mesh(ctx.results, "fb", id) else { continue };
         let prof = refinement::profile(&m, [0.0, 0.0], [1.0, 0.0]);
-        match refinement::local_minimum(&prof, a, 0.15) {
+        match refinement::local_minimum(&prof, a, REFINE_REACH) {
             Some(lm) => {
-                if verdict == Verdict::NoData {
-                    verdict = if lm.holds { Verdict::Holds } else { Verdict::Fails };
+                if decides.is_none() {
+                    decides = Some((format!("fb/{id} level {}", m.level), lm.holds));
                 }
                 parts.push(format!(
                     "{id} level {} (NDF {}): at x = a {} → {}",
@@ -752,6 +785,13 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             None => parts.push(format!("{id} level {}: no mesh edge on Gamma_C contains x = a", m.level)),
         }
     }
+    let test = Criterion::Test {
+        passes_if: format!(
+            "the edge length along Gamma_C on the last saved mesh of {} has a local minimum (or a plateau of its own) at x = a: no edge within {REFINE_REACH} of a on either side is smaller than the edges at a, and one on each side is larger",
+            decides.as_ref().map_or("fb/adaptive_wfc (else fb/adaptive)".into(), |d| d.0.clone())
+        ),
+        open_if_not: false,
+    };
     out.push(Claim {
         fragile: None,
         id: "fb-refinement",
@@ -760,21 +800,23 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             paper: "the mesh concentrates at free boundaries (beyond the paper)",
             headline: parts.first().cloned().unwrap_or("n/a".into()),
         },
-        claim: "fb: the adaptive mesh concentrates at the free boundary x = a: a local minimum (or plateau of its own) of the edge length along Gamma_C within 0.15 of a".into(),
+        claim: format!("fb: the adaptive mesh concentrates at the free boundary x = a: a local minimum (or plateau of its own) of the edge length along Gamma_C within {REFINE_REACH} of a"),
         measured: if parts.is_empty() { "no data".into() } else { parts.join("; ") },
-        verdict,
+        verdict: test.verdict(Kind::Beyond, decides.map(|d| Evidence::Bool(d.1)).as_ref()),
+        criterion: test,
+        kind: Kind::Beyond,
     });
 
     // the discrete contact zone [zone_min, zone_max] -> [a, 1]
-    let zone = |r: Option<&RunRecord>| -> Option<(String, bool)> {
+    let zone = |r: Option<&RunRecord>| -> Option<(String, String, Evidence)> {
         let r = r?;
         let ndof: Vec<usize> = r.levels.iter().map(|l| l.ndof).collect();
         let d0: Vec<Option<f64>> = r.levels.iter().map(|l| l.zone_min.map(|z| (z - a).abs())).collect();
         let last = r.levels.last()?;
         let fit = verdict::rate_over(&ndof, &d0, ndof.len() - 1)?;
         let end_ok = last.zone_max.is_some_and(|z| (z - 1.0).abs() <= 1e-12);
-        let ok = fit.spans_enough() && fit.rate.lo() > 0.0 && end_ok;
         Some((
+            source(Some(r)),
             format!(
                 "{}/{}: last level zone [{:.6}, {:.6}], |zone start - a| {:.1e} (h_min {:.1e}), decays at NDF^-({}) ({})",
                 r.study,
@@ -786,10 +828,17 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 fit.text(),
                 fit.range()
             ),
-            ok,
+            Evidence::All(vec![Some(Evidence::Fit(fit)), Some(Evidence::Bool(end_ok))]),
         ))
     };
-    let zs: Vec<(String, bool)> = [ad, wfc, un].into_iter().filter_map(zone).collect();
+    let zs: Vec<(String, String, Evidence)> = [ad, wfc, un].into_iter().filter_map(zone).collect();
+    let test = Criterion::Each {
+        of: zs.iter().map(|z| z.0.clone()).collect(),
+        each: Box::new(Criterion::All(vec![
+            Criterion::Decays { what: "|zone start - a| (the zone's first contact node against a, per level)".into() },
+            Criterion::Test { passes_if: "the last level's zone ends at x = 1 (within 1e-12)".into(), open_if_not: false },
+        ])),
+    };
     let zone_decay = ad.and_then(|r| {
         let ndof: Vec<usize> = r.levels.iter().map(|l| l.ndof).collect();
         let d0: Vec<Option<f64>> = r.levels.iter().map(|l| l.zone_min.map(|z| (z - a).abs())).collect();
@@ -806,14 +855,11 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         },
         claim: "fb: the discrete contact zone tends to [a, 1]: |zone start - a| decays (rate interval above 0) and the zone ends at x = 1"
             .into(),
-        measured: if zs.is_empty() { "no data".into() } else { zs.iter().map(|z| z.0.clone()).collect::<Vec<_>>().join("; ") },
-        verdict: if zs.is_empty() {
-            Verdict::NoData
-        } else if zs.iter().all(|z| z.1) {
-            Verdict::Holds
-        } else {
-            Verdict::Fails
-        },
+        measured: if zs.is_empty() { "no data".into() } else { zs.iter().map(|z| z.1.clone()).collect::<Vec<_>>().join("; ") },
+        verdict: test
+            .verdict(Kind::Beyond, (!zs.is_empty()).then(|| Evidence::All(zs.iter().map(|z| Some(z.2.clone())).collect())).as_ref()),
+        criterion: test,
+        kind: Kind::Beyond,
     });
     Ok(())
 }
@@ -828,7 +874,7 @@ pub const HERTZ_TOLERANCE: f64 = 0.02;
 fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let runs = StudyDir::new(ctx.results, "hertz").read_runs()?;
     let mut rows = Vec::new();
-    let mut judged = None;
+    let mut judged: Option<Evidence> = None;
     let mut headline = None;
     for r in &runs {
         let Some(snap) = latest_mesh(ctx.results, "hertz", &r.run.id) else { continue };
@@ -870,15 +916,17 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 100.0 * c.peak_deviation(),
                 snap.ndof
             ));
-            judged = Some(if hi <= HERTZ_TOLERANCE && p_dev <= HERTZ_TOLERANCE {
-                Verdict::Holds
-            } else if lo > HERTZ_TOLERANCE || p_dev > HERTZ_TOLERANCE {
-                Verdict::Fails
-            } else {
-                Verdict::Inconclusive
-            });
+            judged = Some(Evidence::All(vec![Some(Evidence::Interval(lo, hi)), Some(Evidence::Value(p_dev))]));
         }
     }
+    let test = Criterion::All(vec![
+        Criterion::AtMost {
+            what: "|a_h - a| / a on hertz/adaptive's finest mesh (a_h ± half the node spacing at the zone's ends)".into(),
+            limit: HERTZ_TOLERANCE,
+            interval: true,
+        },
+        Criterion::AtMost { what: "|p0_h - p0| / p0 there".into(), limit: HERTZ_TOLERANCE, interval: false },
+    ]);
     out.push(Claim {
         fragile: None,
         id: "hertz",
@@ -888,7 +936,9 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             100.0 * HERTZ_TOLERANCE
         ),
         measured: if rows.is_empty() { "no data".into() } else { rows.join("; ") },
-        verdict: judged.unwrap_or(Verdict::NoData),
+        verdict: test.verdict(Kind::Beyond, judged.as_ref()),
+        criterion: test,
+        kind: Kind::Beyond,
     });
     Ok(())
 }
@@ -937,6 +987,13 @@ pub fn claims(results: &Path) -> std::io::Result<Vec<Claim>> {
         .filter(|(q, d)| q.verdict != d.verdict)
         .map(|(q, d)| format!("{}: {} → {} (dense: {})", q.id, q.verdict.text(), d.verdict.text(), d.measured))
         .collect();
+    let test = Criterion::AtMost {
+        what: "the number of verdicts above that change when the error (and, where a dense run is stored, the estimator) is sampled on the dense lattice".into(),
+        limit: 0.0,
+        interval: false,
+    };
+    // nothing recomputed (every row without data): no verdict can hold or flip
+    let evidence = (!out.iter().all(|c| c.verdict == Verdict::NoData)).then_some(Evidence::Value(flips.len() as f64));
     out.push(Claim {
         fragile: None,
         id: "sampling",
@@ -952,13 +1009,9 @@ pub fn claims(results: &Path) -> std::io::Result<Vec<Claim>> {
             out.len(),
             if dense_runs.is_empty() { "none".to_string() } else { dense_runs.join(", ") }
         ),
-        verdict: if out.iter().all(|c| c.verdict == Verdict::NoData) {
-            Verdict::NoData // nothing was recomputed: no verdict can hold or flip
-        } else if flips.is_empty() {
-            Verdict::Holds
-        } else {
-            Verdict::Fails
-        },
+        verdict: test.verdict(Kind::Beyond, evidence.as_ref()),
+        criterion: test,
+        kind: Kind::Beyond,
     });
     Ok(out)
 }
@@ -970,6 +1023,12 @@ pub fn anchor(id: &str) -> String {
         .chars()
         .filter_map(|c| if c == ' ' { Some('-') } else { (c.is_alphanumeric() || c == '-' || c == '_').then_some(c) })
         .collect()
+}
+
+/// `text` with its first letter in upper case.
+pub fn capitalised(text: &str) -> String {
+    let mut c = text.chars();
+    c.next().map(|f| f.to_uppercase().chain(c).collect()).unwrap_or_default()
 }
 
 /// The markdown document, generated from the records in `results/`.
@@ -1030,9 +1089,10 @@ pub fn markdown_for(claims: &[Claim], results: &Path) -> String {
         let fragile = c.fragile.as_ref().map(|f| format!(", *fragile*: {f}")).unwrap_or_default();
         let _ = write!(
             s,
-            "\n### {}\n\n**Claim.** {}\n\n**Measured.** {}\n\n**Verdict.** {}{}\n",
+            "\n### {}\n\n**Claim.** {}\n\n**What would fail it.** {}\n\n**Measured.** {}\n\n**Verdict.** {}{}\n",
             c.id,
             c.claim,
+            capitalised(&c.criterion.fails_if()),
             c.measured,
             c.verdict.text(),
             fragile

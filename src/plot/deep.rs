@@ -21,7 +21,13 @@ pub(super) fn deep_error(results: &Path) -> anyhow::Result<Built> {
     for (problem, title) in [("ex71", "Example 7.1"), ("fb", "free boundary (fb)")] {
         let mut p = Panel::new(format!("{title}: error vs NDF to 1e7"), NDF_DESC, format!("error {ERR}"));
         for (k, r) in runs.iter().filter(|r| r.run.problem == problem).enumerate() {
-            let style = Style { color: PALETTE[k % PALETTE.len()], marker: MARKERS[k % MARKERS.len()], dashed: k % 2 == 1, filled: true };
+            let style = Style {
+                color: PALETTE[k % PALETTE.len()],
+                marker: MARKERS[k % MARKERS.len()],
+                dashed: k % 2 == 1,
+                filled: true,
+                large: false,
+            };
             let label = r.run.id.strip_prefix(&format!("{problem}_")).unwrap_or(&r.run.id).replace('_', " ");
             p.series.push(series(r, label, style, |l| l.err_quadrature));
         }
@@ -33,7 +39,7 @@ pub(super) fn deep_error(results: &Path) -> anyhow::Result<Built> {
     if panels.is_empty() {
         return Ok(Err(format!("study {STUDY} has no levels")));
     }
-    Ok(Ok(Figure::Lines(LineFigure { title: Some("Deep runs: the error over two decades and more".to_string()), panels })))
+    Ok(Ok(Figure::Lines(LineFigure { title: Some("Deep runs: the error over two decades and more".to_string()), panels, columns: None })))
 }
 
 /// Error, estimate and round-off floor together: where the error of a deep run would meet
@@ -55,6 +61,7 @@ pub(super) fn deep_floor(results: &Path) -> anyhow::Result<Built> {
                 marker: MARKERS[(3 * k + i) % MARKERS.len()],
                 dashed,
                 filled,
+                large: false,
             };
             p.series.push(series(r, format!("{label}: error {ERR}"), style(0, false, true), |l| l.err_quadrature));
             if variant != "uniform" {
@@ -71,5 +78,9 @@ pub(super) fn deep_floor(results: &Path) -> anyhow::Result<Built> {
     if panels.is_empty() {
         return Ok(Err(format!("study {STUDY} has no levels")));
     }
-    Ok(Ok(Figure::Lines(LineFigure { title: Some("Deep runs: error, estimate and the round-off floor of u_h".to_string()), panels })))
+    Ok(Ok(Figure::Lines(LineFigure {
+        title: Some("Deep runs: error, estimate and the round-off floor of u_h".to_string()),
+        panels,
+        columns: None,
+    })))
 }

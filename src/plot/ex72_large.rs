@@ -23,7 +23,13 @@ pub(super) fn ex72_large_error(results: &Path) -> anyhow::Result<Built> {
     for (title, axis, field) in panels_of {
         let mut p = Panel::new(format!("Example 7.2, error on {title}"), NDF_DESC, format!("error {ERR}{axis}"));
         for (k, r) in runs.iter().enumerate() {
-            let style = Style { color: PALETTE[k % PALETTE.len()], marker: MARKERS[k % MARKERS.len()], dashed: k % 2 == 1, filled: true };
+            let style = Style {
+                color: PALETTE[k % PALETTE.len()],
+                marker: MARKERS[k % MARKERS.len()],
+                dashed: k % 2 == 1,
+                filled: true,
+                large: false,
+            };
             p.series.push(series(r, r.run.id.replace('_', " "), style, field));
         }
         p.slopes.push(slope());
@@ -37,5 +43,6 @@ pub(super) fn ex72_large_error(results: &Path) -> anyhow::Result<Built> {
     Ok(Ok(Figure::Lines(LineFigure {
         title: Some("Example 7.2 deep: the error against a reference of 4.5e6 unknowns".to_string()),
         panels,
+        columns: None,
     })))
 }

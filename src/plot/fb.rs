@@ -31,13 +31,19 @@ pub(super) fn fb_error(results: &Path) -> anyhow::Result<Built> {
         let color = PALETTE[k % PALETTE.len()];
         let id = &r.run.id;
         if r.levels.iter().any(|l| l.err_quadrature.is_some()) {
-            p.series.push(series(r, format!("error, {id}"), Style { color, marker: Marker::Circle, dashed: false, filled: true }, |l| {
-                l.err_quadrature
-            }));
+            p.series.push(series(
+                r,
+                format!("error, {id}"),
+                Style { color, marker: Marker::Circle, dashed: false, filled: true, large: false },
+                |l| l.err_quadrature,
+            ));
         }
-        p.series.push(series(r, format!("estimate, {id}"), Style { color, marker: Marker::Square, dashed: true, filled: false }, |l| {
-            Some(l.terms.estimate)
-        }));
+        p.series.push(series(
+            r,
+            format!("estimate, {id}"),
+            Style { color, marker: Marker::Square, dashed: true, filled: false, large: false },
+            |l| Some(l.terms.estimate),
+        ));
     }
     for r in &runs {
         if let Some(l) = r.levels.last() {

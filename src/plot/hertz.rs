@@ -50,7 +50,7 @@ pub(super) fn hertz_pressure(results: &Path) -> anyhow::Result<Built> {
     profile.series.push(Series {
         label: "Hertz: √(1 − x²/a²)".to_string(),
         points: curve,
-        style: Style { color: RGBColor(0, 0, 0), marker: Marker::None, dashed: true, filled: false },
+        style: Style { color: RGBColor(0, 0, 0), marker: Marker::None, dashed: true, filled: false, large: false },
         roundoff: false,
     });
     for (k, r) in runs.iter().enumerate() {
@@ -63,7 +63,7 @@ pub(super) fn hertz_pressure(results: &Path) -> anyhow::Result<Built> {
         let mut nodes: Vec<_> = snap.contact_nodes.iter().filter(|n| ((n.x[0] - c.centre) / a).abs() <= 1.5).collect();
         nodes.sort_by(|u, v| u.x[0].total_cmp(&v.x[0]));
         // thousands of nodes: a line, no markers
-        let style = Style { color: PALETTE[k % PALETTE.len()], marker: Marker::None, dashed: false, filled: true };
+        let style = Style { color: PALETTE[k % PALETTE.len()], marker: Marker::None, dashed: false, filled: true, large: false };
         let s = |n: &&crate::records::ContactSample| (n.x[0] - c.centre) / a;
         profile.series.push(Series {
             label: format!(
@@ -107,6 +107,7 @@ pub(super) fn hertz_pressure(results: &Path) -> anyhow::Result<Built> {
     Ok(Ok(Figure::Lines(LineFigure {
         title: Some("Hertz: an elastic cylinder on a rigid flat (plane strain), finest adaptive meshes".to_string()),
         panels: vec![profile, deviation],
+        columns: None,
     })))
 }
 

@@ -15,8 +15,8 @@
 //!
 //! | figure | study / runs | shows |
 //! |---|---|---|
-//! | `fig2a` | `ex71`, all runs (the first, `adaptive`, solid; others dashed, hollow markers) | `err_quadrature` (blue circles) and `estimate` (red squares) vs NDF, log-log; NDF^-3/2 reference 2.5x below the adaptive error |
-//! | `fig2b` | `ex71`, all runs | efficiency index `efficiency` (= estimate / err_quadrature; recomputed if absent) vs NDF, log x; y log if it spans more than a decade, else linear from 0; line at 1 |
+//! | `fig2a` | `ex71`, all runs (the first, `adaptive`, solid; others dashed, hollow markers) | `err_quadrature` (blue circles) and `estimate` (red squares) vs NDF, log-log; NDF^-3/2 reference 2.5x below the adaptive error; a series with the same values as a later one (uniform and uniform_cartesian) gets large hollow markers around it and the later one's legend names it |
+//! | `fig2b` | `ex71`, all runs | two panels: the efficiency index `efficiency` (= estimate / err_quadrature; recomputed if absent) and the efficiency / l_h, vs NDF, log x; y log if it spans more than a decade, else linear from 0; line at 1 |
 //! | `fig3a` | `ex72`, all runs | `estimate` vs NDF, log-log, plus `err_quadrature` (against the reference solution, its NDF from `reference_ndof` noted in the legend) where present; NDF^-3/2 below the adaptive estimate |
 //! | `fig3b_variant` | `contact_term_ablation`, `meshes/ex72_without_full_contact_level20.json` | as `fig3b`, for the run marking with eta_5 without full-contact nodes: the mesh beside the paper's |
 //! | `fig3b` | `ex72`, `meshes/adaptive_level20.json` (else the finest saved level, said in the title) | the triangles, thin; equal aspect; active contact nodes red, inactive blue; the obstacle's kink (`kinks`) as a black diamond; NDF, triangle and vertex counts |
@@ -30,7 +30,7 @@
 //! | `hertz_pressure`, `hertz_mesh` | `hertz` | see `plot/hertz.rs`: the contact pressure against Hertz's, and the mesh near the contact |
 //! | `deep_error`, `deep_floor` | `deep` | see `plot/deep.rs`: the error of the deep runs to 1e7 unknowns, and error, estimate and round-off floor together |
 //! | `ex72_large_error` | `ex72_large` | see `plot/ex72_large.rs`: Example 7.2's error on the square and on Gamma_C against the reference, every run |
-//! | `estimator_repair` | `estimator_repair`, a panel per problem | `err_quadrature` (solid) and `estimate` (dashed) vs NDF for each run (adaptive or uniform, and its l_h) of the repaired estimator |
+//! | `estimator_repair` | the runs the CLAIMS row `estimator-repair` reads (`claims::repair::Stored::fitted`: `deep`, `ex72_large`, `estimator_repair`), a 2 x 2 grid, a panel per problem | `err_quadrature` (solid, filled) and `estimate` (dashed, hollow) vs NDF for the repaired run, eta_5 as written, uniform refinement and the repaired run with l_h = 1; the run without full-contact nodes drawn only where it differs from the repaired one (else a note says it coincides) |
 //!
 //! Style: log axes labelled at the decades (`10⁻⁴`; also 2x and 5x when less than two decades
 //! show), light grid lines at 2..9 x each decade; one colour and marker shape per series; the
@@ -63,6 +63,7 @@ mod glyphs;
 mod hertz;
 pub mod page;
 pub mod render;
+mod repair;
 mod rich;
 
 use crate::estimate::{ContactTerm, LogFactor};
@@ -249,7 +250,7 @@ fn build(name: &str, results: &Path) -> anyhow::Result<Built> {
         "c0_sweep" => c0_sweep(results),
         "log_ablation" => log_ablation(results),
         "contact_term_ablation" => contact_term_ablation(results),
-        "estimator_repair" => estimator_repair(results),
+        "estimator_repair" => repair::estimator_repair(results),
         "theta_ablation" => theta_ablation(results),
         "fb_error" => fb::fb_error(results),
         "fb_mesh" => fb::fb_mesh(results),
@@ -359,7 +360,7 @@ fn sci(v: f64) -> String {
 }
 
 fn single(panel: Panel) -> Figure {
-    Figure::Lines(LineFigure { title: None, panels: vec![panel] })
+    Figure::Lines(LineFigure { title: None, panels: vec![panel], columns: None })
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -377,8 +378,8 @@ fn error_and_estimate(runs: &[RunRecord], panel: &mut Panel, error_label: &str) 
         let id = &r.run.id;
         let (error_style, estimate_style) = if k == 0 {
             (
-                Style { color: COLOR_ERROR, marker: Marker::Circle, dashed: false, filled: true },
-                Style { color: COLOR_ESTIMATE, marker: Marker::Square, dashed: false, filled: true },
+                Style { color: COLOR_ERROR, marker: Marker::Circle, dashed: false, filled: true, large: false },
+                Style { color: COLOR_ESTIMATE, marker: Marker::Square, dashed: false, filled: true, large: false },
             )
         } else {
             // colours 0 and 1 of the palette are the first run's
@@ -392,6 +393,40 @@ fn error_and_estimate(runs: &[RunRecord], panel: &mut Panel, error_label: &str) 
     }
 }
 
+/// Whether two series hold the same values at the same abscissae (to 1e-12 relative).
+fn same_values(a: &Series, b: &Series) -> bool {
+    a.points.len() == b.points.len()
+        && a.points.iter().zip(&b.points).all(|(p, q)| {
+            p.0 == q.0
+                && match (p.1, q.1) {
+                    (Some(x), Some(y)) => (x - y).abs() <= 1e-12 * x.abs().max(y.abs()),
+                    (x, y) => x.is_none() && y.is_none(),
+                }
+        })
+}
+
+/// Series of `p` that coincide with a later one would hide under it: each such series gets large
+/// hollow markers (drawn around the later one's), and the later one's legend says which it
+/// coincides with (`run` names a series' run in the label).
+fn show_coincident(p: &mut Panel, run: impl Fn(&str) -> String) {
+    for j in 0..p.series.len() {
+        let same: Vec<usize> = (0..j).filter(|&i| same_values(&p.series[i], &p.series[j])).collect();
+        if same.is_empty() {
+            continue;
+        }
+        let names: Vec<String> = same.iter().map(|&i| run(&p.series[i].label)).collect();
+        for &i in &same {
+            p.series[i].style = p.series[i].style.large();
+        }
+        p.series[j].label = format!("{} (same values as {})", p.series[j].label, names.join(", "));
+    }
+}
+
+/// The run named at the end of a label "…, RUN" (fig2a's labels).
+fn run_of_label(label: &str) -> String {
+    label.rsplit(", ").next().unwrap_or(label).to_string()
+}
+
 fn fig2a(results: &Path) -> anyhow::Result<Built> {
     let runs = match runs(results, "ex71")? {
         Ok(r) => r,
@@ -399,6 +434,7 @@ fn fig2a(results: &Path) -> anyhow::Result<Built> {
     };
     let mut p = Panel::new("Example 7.1: error and estimate vs NDF", NDF_DESC, format!("error {ERR} and {ESTIMATE}"));
     error_and_estimate(&runs, &mut p, &format!("error {ERR}"));
+    show_coincident(&mut p, run_of_label);
     p.slopes.push(Slope { anchor: SlopeAnchor::Below(0), ..slope() });
     Ok(Ok(single(p)))
 }
@@ -408,16 +444,28 @@ fn fig2b(results: &Path) -> anyhow::Result<Built> {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
-    let mut p = Panel::new("Example 7.1: efficiency index", NDF_DESC, EFF_DESC);
-    p.y_scale = YScale::Auto;
-    for (k, r) in runs.iter().enumerate() {
-        p.series.push(series(r, r.run.id.clone(), Style::nth(k).dashed(r.run.refine == Refine::Uniform), efficiency));
+    // the efficiency, and the efficiency with eq. 6.3's log factor l_h divided out (the row
+    // 7.1-efficiency judges the trend of both)
+    type Eff = fn(&LevelRecord) -> Option<f64>;
+    let kinds: [(&str, &str, Eff); 2] = [
+        ("efficiency index", EFF_DESC, efficiency),
+        ("efficiency / l_h", "efficiency index / l_{h},  l_{h} = 1 + |log h_{min}|^{2}", |l| efficiency(l).map(|e| e / l.terms.l_h)),
+    ];
+    let mut out = Vec::new();
+    for (title, desc, y) in kinds {
+        let mut p = Panel::new(title, NDF_DESC, desc);
+        p.y_scale = YScale::Auto;
+        for (k, r) in runs.iter().enumerate() {
+            p.series.push(series(r, r.run.id.clone(), Style::nth(k).dashed(r.run.refine == Refine::Uniform), y));
+        }
+        show_coincident(&mut p, |l| l.to_string());
+        p.hlines.push(eff_one());
+        out.push(p);
     }
-    p.hlines.push(eff_one());
-    if !p.has_data() {
+    if !out.iter().any(Panel::has_data) {
         return Ok(Err("study ex71 has no errors recorded".to_string()));
     }
-    Ok(Ok(single(p)))
+    Ok(Ok(panels("Example 7.1: efficiency index (Fig. 2b), and with l_h divided out", out)))
 }
 
 fn fig3a(results: &Path) -> anyhow::Result<Built> {
@@ -597,7 +645,7 @@ fn panels(title: &str, panels: Vec<Panel>) -> Figure {
         p.title = format!("{title}: {}", p.title);
         single(p)
     } else {
-        Figure::Lines(LineFigure { title: Some(title.to_string()), panels })
+        Figure::Lines(LineFigure { title: Some(title.to_string()), panels, columns: None })
     }
 }
 
@@ -690,29 +738,6 @@ fn contact_term_ablation(results: &Path) -> anyhow::Result<Built> {
         out.push(p);
     }
     Ok(Ok(panels("Contact term ablation: η_{5} with and without full-contact nodes", out)))
-}
-
-fn estimator_repair(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, "estimator_repair")? {
-        Ok(r) => r,
-        Err(why) => return Ok(Err(why)),
-    };
-    let mut out = Vec::new();
-    for (problem, group) in by_problem(&runs) {
-        let mut p = Panel::new(problem_title(&problem), NDF_DESC, format!("error {ERR} (solid) and {ESTIMATE} (dashed)"));
-        for (k, r) in group.iter().enumerate() {
-            let how = |o: &RunRecord| {
-                let refine = if o.run.refine == Refine::Uniform { "uniform" } else { "adaptive" };
-                format!("{refine}, {}", log_label(o.run.estimator.log_factor))
-            };
-            let st = Style::nth(k);
-            p.series.push(series(r, format!("error, {}", how(r)), st, |l| l.err_quadrature));
-            let dashed = Style { marker: render::MARKERS[(k + 4) % render::MARKERS.len()], ..st }.dashed(true);
-            p.series.push(series(r, format!("estimate, {}", how(r)), dashed, |l| Some(l.terms.estimate)));
-        }
-        out.push(p);
-    }
-    Ok(Ok(panels("The repaired estimator: tensile η_{5} at full contact, η_{7} on full-contact edges", out)))
 }
 
 fn theta_ablation(results: &Path) -> anyhow::Result<Built> {

@@ -105,9 +105,10 @@ fn claims_table(claims: &[&Claim]) -> String {
         // the summary line shows; the claim's full wording and its evidence fold behind it
         let _ = writeln!(
             s,
-            "<tr class=\"claim\" id=\"claim-{id}\"><td><b>{id}</b>: {}<details><summary>the claim in full</summary>{}</details></td><td>{}</td><td>{}<details><summary>evidence</summary>{}</details></td><td>{}</td></tr>",
+            "<tr class=\"claim\" id=\"claim-{id}\"><td><b>{id}</b>: {}<details><summary>the claim in full</summary>{}</details><details><summary>what would fail it</summary>{}</details></td><td>{}</td><td>{}<details><summary>evidence</summary>{}</details></td><td>{}</td></tr>",
             escape(c.summary.topic),
             escape(&c.claim),
+            escape(&crate::claims::capitalised(&c.criterion.fails_if())),
             escape(c.summary.paper),
             escape(&c.summary.headline),
             escape(&c.measured),

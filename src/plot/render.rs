@@ -75,17 +75,30 @@ pub(crate) struct Style {
     pub marker: Marker,
     pub dashed: bool,
     pub filled: bool,
+    /// Markers half as large again (and hollow): a series drawn under another that coincides
+    /// with it stays visible around it.
+    pub large: bool,
 }
 
 impl Style {
     /// Series number `i` of a panel: colour and marker cycle together.
     pub fn nth(i: usize) -> Self {
-        Style { color: PALETTE[i % PALETTE.len()], marker: MARKERS[i % MARKERS.len()], dashed: false, filled: true }
+        Style { color: PALETTE[i % PALETTE.len()], marker: MARKERS[i % MARKERS.len()], dashed: false, filled: true, large: false }
     }
     pub fn dashed(mut self, dashed: bool) -> Self {
         self.dashed = dashed;
         self.filled = !dashed;
         self
+    }
+    /// Large hollow markers ([`Style::large`]).
+    pub fn large(mut self) -> Self {
+        self.large = true;
+        self.filled = false;
+        self
+    }
+    /// The marker radius for a base radius `r`.
+    pub fn radius(&self, r: i32) -> i32 {
+        if self.large { r * 2 } else { r }
     }
 }
 
@@ -199,6 +212,17 @@ pub(crate) struct LineFigure {
     /// Title over all panels (a single panel has its own title only).
     pub title: Option<String>,
     pub panels: Vec<Panel>,
+    /// Panels per row (None: all in one row); the rows fill from the top.
+    pub columns: Option<usize>,
+}
+
+impl LineFigure {
+    /// (rows, columns) of the panels' grid.
+    pub fn grid(&self) -> (usize, usize) {
+        let n = self.panels.len().max(1);
+        let cols = self.columns.unwrap_or(n).clamp(1, n);
+        (n.div_ceil(cols), cols)
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -210,7 +234,10 @@ pub(crate) enum Figure {
 impl Figure {
     pub fn size(&self) -> (u32, u32) {
         match self {
-            Figure::Lines(f) if f.panels.len() > 1 => (800 * f.panels.len() as u32, 650),
+            Figure::Lines(f) if f.panels.len() > 1 => {
+                let (rows, cols) = f.grid();
+                (if rows > 1 { 900 } else { 800 } * cols as u32, if rows > 1 { 780 } else { 650 } * rows as u32)
+            }
             Figure::Lines(_) => (900, 650),
             Figure::Mesh(m) => m.size(900),
         }
@@ -249,7 +276,7 @@ fn render_lines<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, f: &LineFigur
         Some(t) => titled(root, root, t, FS_FIGURE_TITLE, m)?,
         None => root.clone(),
     };
-    let areas = body.split_evenly((1, f.panels.len().max(1)));
+    let areas = body.split_evenly(f.grid());
     let mut out = Vec::new();
     for (k, (area, panel)) in areas.iter().zip(&f.panels).enumerate() {
         if let Some(r) = panel::render_panel(root, area, panel, m)? {
@@ -282,6 +309,7 @@ fn message<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, area: &DrawingArea
 
 /// A marker centred at a backend pixel; hollow markers are white inside.
 pub(crate) fn draw_marker<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, (x, y): (i32, i32), st: Style, r: i32) -> anyhow::Result<()> {
+    let r = st.radius(r);
     let fill = if st.filled { st.color.filled() } else { WHITE.filled() };
     let edge = st.color.stroke_width(2);
     let poly = |pts: Vec<(i32, i32)>| -> anyhow::Result<()> {

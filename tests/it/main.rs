@@ -14,6 +14,7 @@ mod bad_settings;
 mod bad_slurm;
 mod bad_store;
 mod cholesky;
+mod claims_criteria;
 mod cli_output;
 mod convergence;
 mod doc_commands;

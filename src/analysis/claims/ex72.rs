@@ -4,11 +4,16 @@
 //! the adaptive mesh refines.
 
 use super::{
-    Claim, Ctx, EX72_NU, OPTIMAL, Q, Summary, Verdict, estimator_text, fragility, growth_text, halving_exponents, judge, latest_mesh,
-    rate_headline, rate_text, run, slowest_headline, source,
+    Claim, Criterion, Ctx, EX72_NU, Evidence, Kind, OPTIMAL, Q, REFINE_REACH, Summary, estimator_text, fragility, growth_text,
+    halving_exponents, latest_mesh, rate_headline, rate_text, run, slowest_headline, source,
 };
 use crate::records::{RunRecord, StudyDir};
-use crate::verdict::{self, RateReport, RateVerdict, refinement};
+use crate::verdict::{self, Abscissa, RateReport, refinement};
+
+/// A corner is a refinement centre when its smallest element within this distance of it ...
+const CORNER_NEAR: f64 = 0.02;
+/// ... is smaller than every element between [`CORNER_NEAR`] and this distance.
+const CORNER_RING: f64 = 0.1;
 
 /// The claims of Example 7.2.
 pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
@@ -64,7 +69,11 @@ impl<'a> Errors<'a> {
 fn rates(ctx: &Ctx, a72: Option<&RunRecord>) -> Claim {
     let names = ["eta_h", "eta1", "eta2", "eta3", "eta4", "eta5", "eta6", "eta7"];
     let reps: Vec<Option<RateReport>> = names.iter().map(|n| ctx.rate(a72, Q::Field(n))).collect();
-    let verdicts: Vec<Verdict> = reps.iter().map(|r| judge(r.as_ref(), OPTIMAL)).collect();
+    let test = Criterion::Each {
+        of: names.iter().map(|n| n.to_string()).collect(),
+        each: Box::new(Criterion::rate(format!("the term ({})", source(a72)), OPTIMAL, Abscissa::Ndof)),
+    };
+    let ev = a72.map(|_| Evidence::All(reps.iter().map(|r| Evidence::rate(r.as_ref())).collect()));
     Claim {
         fragile: None,
         id: "7.2-rates",
@@ -89,15 +98,9 @@ fn rates(ctx: &Ctx, a72: Option<&RunRecord>) -> Claim {
                 names[1..].iter().zip(&reps[1..]).map(|(n, r)| rate_text(n, r.as_ref(), Some(OPTIMAL))).collect::<Vec<_>>().join("; ")
             )
         },
-        verdict: if a72.is_none() {
-            Verdict::NoData
-        } else if verdicts.iter().all(|v| *v == Verdict::Reproduced) {
-            Verdict::Reproduced
-        } else if verdicts.contains(&Verdict::NotReproduced) {
-            Verdict::NotReproduced
-        } else {
-            Verdict::Inconclusive
-        },
+        verdict: test.verdict(Kind::Paper, ev.as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     }
 }
 
@@ -135,6 +138,7 @@ fn error(ctx: &Ctx, errors: &Errors, aw: Option<&RunRecord>, wfc: Option<&RunRec
         let ndf = (8..n).map(|i| a.levels[i].ndof as f64 / w.levels[i].ndof as f64).fold(1.0, f64::max);
         (rel, ndf, n)
     });
+    let reported = Criterion::Reported { why: "the paper does not measure Example 7.2's error".into() };
     Claim {
         fragile: None,
         id: "7.2-error (beyond the paper)",
@@ -163,7 +167,9 @@ fn error(ctx: &Ctx, errors: &Errors, aw: Option<&RunRecord>, wfc: Option<&RunRec
                 )
             })
             .unwrap_or_default(),
-        verdict: if a72.is_none() { Verdict::NoData } else { Verdict::NoClaim },
+        verdict: reported.verdict(Kind::Beyond, a72.map(|_| Evidence::Bool(true)).as_ref()),
+        criterion: reported,
+        kind: Kind::Beyond,
     }
 }
 
@@ -192,6 +198,11 @@ fn corners(ctx: &Ctx, a72: Option<&RunRecord>, errors: &Errors) -> Claim {
         })
         .unwrap_or_default();
     let eu = ctx.rate(u72, Q::Error);
+    let test = Criterion::rate(
+        format!("the uniform error ({})", source(u72)),
+        lambda / 2.0,
+        u72.map_or(Abscissa::InverseHMin, verdict::abscissa_of),
+    );
     Claim {
         fragile: fragility(eu.as_ref(), lambda / 2.0),
         id: "7.2-corners (beyond the paper)",
@@ -218,14 +229,9 @@ fn corners(ctx: &Ctx, a72: Option<&RunRecord>, errors: &Errors) -> Claim {
             ),
             None => String::new(),
         },
-        verdict: match &eu {
-            None => Verdict::NoData,
-            Some(r) => match verdict::judge_rate(&r.main, lambda / 2.0) {
-                RateVerdict::Reproduced => Verdict::Holds,
-                RateVerdict::Inconclusive => Verdict::Inconclusive,
-                _ => Verdict::Fails,
-            },
-        },
+        verdict: test.verdict(Kind::Beyond, Evidence::rate(eu.as_ref()).as_ref()),
+        criterion: test,
+        kind: Kind::Beyond,
     }
 }
 
@@ -240,6 +246,7 @@ fn away(ctx: &Ctx, errors: &Errors) -> Claim {
         ("uniform, on x >= 1/2", ctx.rate(u72, Q::Field("err_right_half"))),
     ];
     let have = away.iter().any(|a| a.1.is_some());
+    let test = Criterion::rate(format!("the adaptive error on Gamma_C ({})", source(a72)), OPTIMAL, Abscissa::Ndof);
     Claim {
         fragile: None,
         id: "7.2-error-away-from-corners (beyond the paper)",
@@ -258,7 +265,9 @@ fn away(ctx: &Ctx, errors: &Errors) -> Claim {
         } else {
             "no data (records without err_contact / err_right_half: rerun ex72)".into()
         },
-        verdict: if have { judge(away[0].1.as_ref(), OPTIMAL) } else { Verdict::NoData },
+        verdict: test.verdict(Kind::Paper, Evidence::rate(away[0].1.as_ref()).as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     }
 }
 
@@ -291,6 +300,8 @@ fn eta6_eta7(a72: Option<&RunRecord>) -> Claim {
             .fold(1.0, f64::max);
         (fit(|l| l.terms.eta6), fit(|l| l.terms.eta7), plateaus, within)
     });
+    let reported = Criterion::Reported { why: "the paper claims NDF^-1.5 for eta_6, eta_7 (Fig. 4b); this row measures them against h_fb instead, which is no test of that claim (7.2-rates judges it)".into() };
+    let measured = matches!(&fb_edge, Some((_, _, p, _)) if !p.is_empty());
     Claim {
         fragile: None,
         id: "7.2-eta6-eta7 (beyond the paper)",
@@ -319,10 +330,9 @@ fn eta6_eta7(a72: Option<&RunRecord>) -> Claim {
             ),
             _ => "no data (records without h_free_boundary: rerun ex72)".into(),
         },
-        verdict: match &fb_edge {
-            Some((_, _, p, _)) if !p.is_empty() => Verdict::NoClaim,
-            _ => Verdict::NoData,
-        },
+        verdict: reported.verdict(Kind::Beyond, measured.then_some(Evidence::Bool(true)).as_ref()),
+        criterion: reported,
+        kind: Kind::Beyond,
     }
 }
 
@@ -330,38 +340,54 @@ fn eta6_eta7(a72: Option<&RunRecord>) -> Claim {
 fn where_refined(ctx: &Ctx, a72: Option<&RunRecord>, wfc: Option<&RunRecord>) -> Claim {
     // where the adaptive mesh refines: local minima of h along Gamma_C = {1} x (0, 1), corners
     let mut parts = Vec::new();
-    let mut ok = true;
-    let mut any = false;
+    // (free boundary, corners) of ex72/adaptive, the run judged
+    let mut judged: Option<(bool, bool)> = None;
     let mut headline = Vec::new();
     for (study, id, record) in [("ex72", "adaptive", a72), ("contact_term_ablation", "ex72_without_full_contact", wfc)] {
         let (Some(m), Some(r)) = (latest_mesh(ctx.results, study, id), record) else { continue };
         let Some((z0, z1)) = r.levels.get(m.level).and_then(|l| l.zone_min.zip(l.zone_max)) else { continue };
-        any = true;
+        if study == "ex72" {
+            judged = Some((true, true));
+        }
         let prof = refinement::profile(&m, [1.0, 0.0], [1.0, 1.0]);
         let mut pts: Vec<String> = Vec::new();
         for (name, s, claimed) in
             [("free boundary y = zone start", z0, true), ("free boundary y = zone end", z1, true), ("wedge tip y = 0.5", 0.5, false)]
         {
-            if let Some(lm) = refinement::local_minimum(&prof, s, 0.15) {
-                if claimed && study == "ex72" {
-                    ok &= lm.holds;
+            if let Some(lm) = refinement::local_minimum(&prof, s, REFINE_REACH) {
+                if let (true, Some(j)) = (claimed, judged.as_mut().filter(|_| study == "ex72")) {
+                    j.0 &= lm.holds;
                     headline.push(format!("ex72/{id} {name}: {}", if lm.holds { "local minimum" } else { "no local minimum" }));
                 }
                 pts.push(format!("{name} ({s:.4}): {} → {}", lm.text(), if lm.holds { "local minimum" } else { "no local minimum" }));
             }
         }
         for (name, p) in [("corner (0, 0)", [0.0, 0.0]), ("corner (0, 1)", [0.0, 1.0])] {
-            let (inner, ring) = refinement::corner(&m, p, 0.02, 0.1);
-            if study == "ex72" {
-                ok &= inner < ring;
+            let (inner, ring) = refinement::corner(&m, p, CORNER_NEAR, CORNER_RING);
+            if let Some(j) = judged.as_mut().filter(|_| study == "ex72") {
+                j.1 &= inner < ring;
             }
             pts.push(format!(
-                "{name}: h_min {inner:.1e} within 0.02, {ring:.1e} at 0.02–0.1 → {}",
+                "{name}: h_min {inner:.1e} within {CORNER_NEAR}, {ring:.1e} at {CORNER_NEAR}–{CORNER_RING} → {}",
                 if inner < ring { "refinement centre" } else { "no refinement centre" }
             ));
         }
         parts.push(format!("{study}/{id} level {} (NDF {}): {}", m.level, m.ndof, pts.join("; ")));
     }
+    let test = Criterion::All(vec![
+        Criterion::Test {
+            passes_if: format!(
+                "on ex72/adaptive's last saved mesh the edge length along Gamma_C has a local minimum (or a plateau of its own) at both ends of the contact zone (the free boundary): no edge within {REFINE_REACH} on either side smaller than the edges there, and one on each side larger"
+            ),
+            open_if_not: false,
+        },
+        Criterion::Test {
+            passes_if: format!(
+                "at both corners (0, 0) and (0, 1) of that mesh the smallest element within {CORNER_NEAR} is smaller than every element at {CORNER_NEAR}–{CORNER_RING}"
+            ),
+            open_if_not: false,
+        },
+    ]);
     Claim {
         fragile: None,
         id: "7.2-refinement",
@@ -370,8 +396,13 @@ fn where_refined(ctx: &Ctx, a72: Option<&RunRecord>, wfc: Option<&RunRecord>) ->
             paper: "at the free boundary and the Dirichlet/Neumann corners (Fig. 3b)",
             headline: headline.join("; "),
         },
-        claim: "Ex. 7.2: the adaptive mesh is refined around the free boundary and near the corners where Dirichlet meets Neumann (Fig. 3b); each claimed location tested as a local minimum (or plateau of its own) of the edge length along Gamma_C within 0.15, each corner as smaller elements within 0.02 than at 0.02–0.1".into(),
+        claim: format!(
+            "Ex. 7.2: the adaptive mesh is refined around the free boundary and near the corners where Dirichlet meets Neumann (Fig. 3b); each claimed location tested as a local minimum (or plateau of its own) of the edge length along Gamma_C within {REFINE_REACH}, each corner as smaller elements within {CORNER_NEAR} than at {CORNER_NEAR}–{CORNER_RING}"
+        ),
         measured: parts.join(". "),
-        verdict: if !any { Verdict::NoData } else if ok { Verdict::Reproduced } else { Verdict::NotReproduced },
+        verdict: test
+            .verdict(Kind::Paper, judged.map(|(f, c)| Evidence::All(vec![Some(Evidence::Bool(f)), Some(Evidence::Bool(c))])).as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     }
 }

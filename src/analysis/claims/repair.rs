@@ -20,32 +20,13 @@
 //! against the 4e6 reference) where they are stored; otherwise, and for Hertz, on the runs of
 //! `estimator_repair`.
 
-use super::{Claim, Ctx, OPTIMAL, Q, Summary, Verdict, c0_text, deep_or, growth_text, rate_text, run, short_range, source};
+use super::criterion::Outcome;
+use super::{
+    Claim, Criterion, Ctx, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, deep_or, growth_text, rate_text, run, short_range, source,
+};
 use crate::base::stats::line_value_at;
 use crate::records::{RunRecord, StudyDir};
-use crate::verdict::{self, RateVerdict, Trend};
-
-/// How one criterion of the row came out.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Outcome {
-    Holds,
-    Fails,
-    /// Not decided: the intervals overlap, the window is short, or nothing was measured.
-    Open,
-    /// The criterion cannot tell anything on this problem (and says why).
-    NotApplicable,
-}
-
-impl Outcome {
-    fn text(self) -> &'static str {
-        match self {
-            Outcome::Holds => "holds",
-            Outcome::Fails => "fails",
-            Outcome::Open => "not decided",
-            Outcome::NotApplicable => "not applicable",
-        }
-    }
-}
+use crate::verdict::{self, Abscissa};
 
 /// (ln NDF, ln error) at the levels of `r`'s error-rate fit (every other level of its window).
 fn fit_points(ctx: &Ctx, r: &RunRecord) -> Option<Vec<(f64, f64)>> {
@@ -64,23 +45,26 @@ fn fit_points(ctx: &Ctx, r: &RunRecord) -> Option<Vec<(f64, f64)>> {
 /// NDF-rate interval below 1.5 - 0.1; elsewhere uniform attains the rate and the criterion is
 /// not applicable), from the fitted lines of ln error against ln NDF of both runs at the end of
 /// their common window (at least a decade of NDF, no extrapolation): the adaptive error's 95%
-/// interval below the uniform one's holds, above fails, overlapping is not decided.
-pub(super) fn unknowns(ctx: &Ctx, ad: &RunRecord, un: &RunRecord) -> (String, Outcome) {
-    let Some(ur) = ctx.rate(Some(un), Q::Error) else { return (format!("{}: no error rate", source(Some(un))), Outcome::Open) };
+/// interval below the uniform one's holds, above fails, overlapping is not decided. The decision
+/// is [`Criterion::FewerUnknowns`]'s on the evidence returned (None: no uniform error rate).
+pub(super) fn unknowns(ctx: &Ctx, ad: &RunRecord, un: &RunRecord) -> (String, Option<Evidence>) {
+    let Some(ur) = ctx.rate(Some(un), Q::Error) else { return (format!("{}: no error rate", source(Some(un))), None) };
     let scale = ur.main.claim_in_abscissa(OPTIMAL).0 / OPTIMAL; // 2 for a fit in h_min
     let (rate, half, hi) = (ur.main.rate.slope / scale, ur.main.rate.half_width / scale, ur.main.rate.hi() / scale);
     let uniform = format!("uniform refinement's error at NDF^-({rate:.3} ± {half:.3}) ({}, {})", short_range(&ur.main), source(Some(un)));
     let needed = OPTIMAL - verdict::RATE_BAND;
-    if hi >= needed {
+    let test = Criterion::FewerUnknowns { claim: OPTIMAL };
+    let open = Some(Evidence::Unknowns { uniform_rate_hi: hi, lines: None });
+    if test.judge(open.as_ref()) == Outcome::NotApplicable {
         return (
             format!(
                 "unknowns for the same error: not applicable, {uniform} reaches the claimed rate's band (its interval up to {hi:.3} >= {needed}): adaptive refinement cannot be faster than claimed, so equal unknowns is all it can show"
             ),
-            Outcome::NotApplicable,
+            open,
         );
     }
     let (Some(pa), Some(pu)) = (fit_points(ctx, ad), fit_points(ctx, un)) else {
-        return (format!("unknowns for the same error: not decided, no fitted error lines; {uniform}"), Outcome::Open);
+        return (format!("unknowns for the same error: not decided, no fitted error lines; {uniform}"), open);
     };
     let (lo_x, hi_x) = (pa[0].0.max(pu[0].0), pa[pa.len() - 1].0.min(pu[pu.len() - 1].0));
     if hi_x - lo_x < std::f64::consts::LN_10 {
@@ -90,19 +74,14 @@ pub(super) fn unknowns(ctx: &Ctx, ad: &RunRecord, un: &RunRecord) -> (String, Ou
                 lo_x.exp(),
                 hi_x.exp()
             ),
-            Outcome::Open,
+            open,
         );
     }
     let (Some((ya, wa)), Some((yu, wu))) = (line_value_at(&pa, hi_x), line_value_at(&pu, hi_x)) else {
-        return (format!("unknowns for the same error: not decided, too few levels; {uniform}"), Outcome::Open);
+        return (format!("unknowns for the same error: not decided, too few levels; {uniform}"), open);
     };
-    let outcome = if ya + wa < yu - wu {
-        Outcome::Holds
-    } else if ya - wa > yu + wu {
-        Outcome::Fails
-    } else {
-        Outcome::Open
-    };
+    let evidence = Some(Evidence::Unknowns { uniform_rate_hi: hi, lines: Some(((ya, wa), (yu, wu))) });
+    let outcome = test.judge(evidence.as_ref());
     let interval = |y: f64, w: f64| format!("{:.2e} [{:.2e}, {:.2e}]", y.exp(), (y - w).exp(), (y + w).exp());
     (
         format!(
@@ -113,60 +92,70 @@ pub(super) fn unknowns(ctx: &Ctx, ad: &RunRecord, un: &RunRecord) -> (String, Ou
             interval(ya, wa),
             interval(yu, wu),
             match outcome {
-                Outcome::Holds => "adaptive needs fewer unknowns",
-                Outcome::Fails => "adaptive needs more unknowns",
+                Outcome::Pass => "adaptive needs fewer unknowns",
+                o if o.failed() => "adaptive needs more unknowns",
                 _ => "not told apart",
             }
         ),
-        outcome,
+        evidence,
     )
 }
 
-/// The four criteria for one adaptive run: texts and outcomes. `l1` is the run with l_h = 1,
-/// for its reliability.
-fn criteria(ctx: &Ctx, ad: Option<&RunRecord>, l1: Option<&RunRecord>, un: Option<&RunRecord>) -> (Vec<String>, Vec<Outcome>) {
-    let (mut texts, mut oks) = (Vec::new(), Vec::new());
+/// The four criteria of one problem, each applied to its adaptive run: (1) the error rate,
+/// (2) the efficiency with l_h = 1 bounded, (3) C_0 = 0.45 reliable, (4) fewer unknowns than
+/// uniform refinement.
+fn criteria_parts() -> Vec<Criterion> {
+    vec![
+        Criterion::rate("the adaptive run's error", OPTIMAL, Abscissa::Ndof),
+        Criterion::Bounded { what: "C_0 (Psi + eta_6 + eta_7) / error (the efficiency with l_h = 1)".into() },
+        Criterion::AtMost {
+            what: "the smallest reliable C_0 (largest error / eta_h at any level of the run and of its l_h = 1 twin)".into(),
+            limit: 0.45,
+            interval: false,
+        },
+        Criterion::FewerUnknowns { claim: OPTIMAL },
+    ]
+}
+
+/// The evidence of the four criteria ([`criteria_parts`]) for one adaptive run, with their texts
+/// and outcomes. `l1` is the run with l_h = 1, for its reliability.
+fn criteria(
+    ctx: &Ctx,
+    ad: Option<&RunRecord>,
+    l1: Option<&RunRecord>,
+    un: Option<&RunRecord>,
+) -> (Vec<String>, Vec<Option<Evidence>>, Vec<Outcome>) {
+    let (mut texts, mut evidence) = (Vec::new(), Vec::new());
     let rate = ctx.rate(ad, Q::Error);
     texts.push(rate_text(&format!("error rate ({})", source(ad)), rate.as_ref(), Some(OPTIMAL)));
-    oks.push(rate.as_ref().map_or(Outcome::Open, |r| match verdict::judge_rate(&r.main, OPTIMAL) {
-        RateVerdict::Reproduced => Outcome::Holds,
-        RateVerdict::Inconclusive => Outcome::Open,
-        _ => Outcome::Fails,
-    }));
+    evidence.push(Evidence::rate(rate.as_ref()));
     let g1 = ctx.growth(ad, Q::EfficiencyL1);
     texts.push(format!(
         "{}; {}",
         growth_text("efficiency, l_h = 1", g1.as_ref()),
         growth_text("efficiency, l_h of eq. 6.3", ctx.growth(ad, Q::Efficiency).as_ref())
     ));
-    oks.push(g1.map_or(Outcome::Open, |g| match verdict::judge_trend(&g) {
-        Trend::Bounded => Outcome::Holds,
-        Trend::Inconclusive | Trend::Short => Outcome::Open,
-        _ => Outcome::Fails,
-    }));
+    evidence.push(Evidence::fit(g1.as_ref()));
     let rel: Vec<(String, f64)> = [ad, l1].into_iter().flatten().filter_map(|r| c0_text(&source(Some(r)), r, ctx.err_field())).collect();
     texts.push(if rel.is_empty() {
         "reliability: no error measured".into()
     } else {
         rel.iter().map(|r| r.0.clone()).collect::<Vec<_>>().join("; ")
     });
-    oks.push(match rel.is_empty() {
-        true => Outcome::Open,
-        false if rel.iter().all(|r| r.1 <= 0.45) => Outcome::Holds,
-        false => Outcome::Fails,
-    });
+    evidence.push(rel.iter().map(|r| r.1).reduce(f64::max).map(Evidence::Value));
     match (ad, un) {
         (Some(a), Some(u)) => {
-            let (t, ok) = unknowns(ctx, a, u);
+            let (t, e) = unknowns(ctx, a, u);
             texts.push(t);
-            oks.push(ok);
+            evidence.push(e);
         }
         _ => {
             texts.push("no uniform companion".into());
-            oks.push(Outcome::Open);
+            evidence.push(None);
         }
     }
-    (texts, oks)
+    let oks = criteria_parts().iter().zip(&evidence).map(|(c, e)| c.judge(e.as_ref())).collect();
+    (texts, evidence, oks)
 }
 
 /// Whether two runs made the same meshes and errors: "coincide at all 28 levels (same NDF, errors
@@ -193,47 +182,86 @@ fn coincidence(ctx: &Ctx, a: &RunRecord, b: &RunRecord) -> String {
     }
 }
 
-pub(super) fn estimator_repair_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let runs = StudyDir::new(ctx.results, "estimator_repair").read_runs()?;
-    let deep = StudyDir::new(ctx.results, "deep").read_runs()?;
-    let ex72_large = StudyDir::new(ctx.results, "ex72_large").read_runs()?;
-    let names = ["error rate", "efficiency", "reliability", "unknowns"];
-    let (mut parts, mut headline) = (Vec::new(), Vec::new());
-    let (mut repaired_all, mut separating) = (Vec::new(), 0usize);
-    let (mut coinciding, mut compared) = (0usize, 0usize);
-    for problem in ["ex71", "fb", "ex72", "hertz"] {
-        let small = |s: &str| run(&runs, &format!("{problem}_{s}"));
-        // (repaired, eta_5 as written, without full-contact nodes, uniform)
-        let (ad, aw, wfc, un) = match problem {
+/// The problems of the row, in its order.
+pub const PROBLEMS: [&str; 4] = ["ex71", "fb", "ex72", "hertz"];
+
+/// The runs the row reads for one problem (the figure `estimator_repair` draws the same).
+#[derive(Clone, Copy, Debug)]
+pub struct Fitted<'a> {
+    pub problem: &'static str,
+    /// The repaired estimator's adaptive run: every criterion is judged on it.
+    pub repaired: Option<&'a RunRecord>,
+    /// eta_5 as written on the same problem: each criterion applied to it too.
+    pub as_written: Option<&'a RunRecord>,
+    /// Without full-contact nodes: compared level by level with the repaired run.
+    pub without_full_contact: Option<&'a RunRecord>,
+    /// Uniform refinement: the unknowns criterion.
+    pub uniform: Option<&'a RunRecord>,
+    /// The repaired estimator with l_h = 1: its reliability.
+    pub l1: Option<&'a RunRecord>,
+}
+
+/// The studies the row reads: `estimator_repair`, `deep` and `ex72_large`.
+pub struct Stored {
+    pub estimator_repair: Vec<RunRecord>,
+    pub deep: Vec<RunRecord>,
+    pub ex72_large: Vec<RunRecord>,
+}
+
+impl Stored {
+    pub fn read(results: &std::path::Path) -> std::io::Result<Stored> {
+        let load = |s: &str| StudyDir::new(results, s).read_runs();
+        Ok(Stored { estimator_repair: load("estimator_repair")?, deep: load("deep")?, ex72_large: load("ex72_large")? })
+    }
+
+    /// The runs of `problem`: Examples 7.1 and fb from `deep`, 7.2 from `ex72_large`, where
+    /// stored; else (and for Hertz) those of `estimator_repair`.
+    pub fn fitted(&self, problem: &'static str) -> Fitted<'_> {
+        let small = |s: &str| run(&self.estimator_repair, &format!("{problem}_{s}"));
+        let (deep, large) = (&self.deep, &self.ex72_large);
+        let (repaired, as_written, without_full_contact, uniform) = match problem {
             "ex72" => (
-                deep_or(&ex72_large, "repaired", small("adaptive")),
-                run(&ex72_large, "adaptive"),
-                run(&ex72_large, "without_full_contact"),
-                deep_or(&ex72_large, "uniform", small("uniform")),
+                deep_or(large, "repaired", small("adaptive")),
+                run(large, "adaptive"),
+                run(large, "without_full_contact"),
+                deep_or(large, "uniform", small("uniform")),
             ),
             _ => (
-                deep_or(&deep, &format!("{problem}_repaired"), small("adaptive")),
-                run(&deep, &format!("{problem}_as_written")),
-                run(&deep, &format!("{problem}_without_full_contact")),
-                deep_or(&deep, &format!("{problem}_uniform"), small("uniform")),
+                deep_or(deep, &format!("{problem}_repaired"), small("adaptive")),
+                run(deep, &format!("{problem}_as_written")),
+                run(deep, &format!("{problem}_without_full_contact")),
+                deep_or(deep, &format!("{problem}_uniform"), small("uniform")),
             ),
         };
+        Fitted { problem, repaired, as_written, without_full_contact, uniform, l1: small("adaptive_l1") }
+    }
+}
+
+pub(super) fn estimator_repair_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
+    let stored = Stored::read(ctx.results)?;
+    let names = ["error rate", "efficiency", "reliability", "unknowns"];
+    let (mut parts, mut headline) = (Vec::new(), Vec::new());
+    let (mut judged_problems, mut per_problem, mut separating) = (Vec::new(), Vec::new(), 0usize);
+    let (mut coinciding, mut compared) = (0usize, 0usize);
+    for problem in PROBLEMS {
+        let f = stored.fitted(problem);
+        let (ad, aw, wfc, un) = (f.repaired, f.as_written, f.without_full_contact, f.uniform);
         let Some(a) = ad else { continue };
         if ctx.values(a, Q::Error).iter().all(Option::is_none) {
             parts.push(format!("{problem} ({}): not judged, no error measured (no exact or reference solution)", source(ad)));
             headline.push(format!("{problem}: not judged (no error)"));
             continue;
         }
-        let (texts, oks) = criteria(ctx, ad, small("adaptive_l1"), un);
+        let (texts, evidence, oks) = criteria(ctx, ad, f.l1, un);
         // the same criteria for eta_5 as written: a criterion both pass does not separate them
-        let written = aw.map(|w| criteria(ctx, Some(w), None, un).1);
+        let written = aw.map(|w| criteria(ctx, Some(w), None, un).2);
         let judged: Vec<String> = names
             .iter()
             .enumerate()
             .map(|(i, n)| {
                 let also = match (oks[i], written.as_ref().map(|w| w[i])) {
-                    (Outcome::Holds, Some(Outcome::Holds)) => " (holds for eta_5 as written too: does not separate the variants)",
-                    (Outcome::Holds, Some(_)) => {
+                    (Outcome::Pass, Some(Outcome::Pass)) => " (holds for eta_5 as written too: does not separate the variants)",
+                    (Outcome::Pass, Some(_)) => {
                         separating += 1;
                         " (eta_5 as written does not pass it: separates)"
                     }
@@ -247,15 +275,26 @@ pub(super) fn estimator_repair_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io
         compared += usize::from(same.is_some());
         let same = same.map(|t| format!("; {t}")).unwrap_or_default();
         parts.push(format!("{problem}: {} [{}]{same}", texts.join("; "), judged.join(", ")));
-        let failed: Vec<&str> = names.iter().zip(&oks).filter(|(_, o)| **o == Outcome::Fails).map(|(n, _)| *n).collect();
-        let open: Vec<&str> = names.iter().zip(&oks).filter(|(_, o)| **o == Outcome::Open).map(|(n, _)| *n).collect();
+        let failed: Vec<&str> = names.iter().zip(&oks).filter(|(_, o)| o.failed()).map(|(n, _)| *n).collect();
+        let open: Vec<&str> =
+            names.iter().zip(&oks).filter(|(_, o)| matches!(o, Outcome::Open | Outcome::NoData)).map(|(n, _)| *n).collect();
         headline.push(match (failed.is_empty(), open.is_empty()) {
             (false, _) => format!("{problem}: fails {}", failed.join(", ")),
             (true, false) => format!("{problem}: not decided {}", open.join(", ")),
             (true, true) => format!("{problem}: every applicable criterion holds"),
         });
-        repaired_all.extend(oks);
+        judged_problems.push(problem.to_string());
+        per_problem.push(Some(Evidence::All(evidence)));
     }
+    let test = Criterion::All(vec![
+        Criterion::Each { of: judged_problems.clone(), each: Box::new(Criterion::All(criteria_parts())) },
+        Criterion::Test {
+            passes_if: "some criterion passes for the repair and not for eta_5 as written on the same problem (a criterion both pass is no evidence for the repair)".into(),
+            open_if_not: true,
+        },
+    ]);
+    let evidence =
+        (!judged_problems.is_empty()).then(|| Evidence::All(vec![Some(Evidence::All(per_problem)), Some(Evidence::Bool(separating > 0))]));
     out.push(Claim {
         fragile: None,
         id: "estimator-repair (beyond the paper)",
@@ -269,15 +308,9 @@ pub(super) fn estimator_repair_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io
         },
         claim: "The repaired estimator (contact_term = \"tensile_on_full_contact\": only the tensile normal stress at full-contact nodes in eta_5, eta_7 on full-contact edges and the edges of isolated active nodes), per problem (Examples 7.1 and fb: study deep; 7.2: ex72_large; Hertz: estimator_repair): (1) the adaptive error rate's interval inside 1.5 ± 0.1; (2) the efficiency trend bounded (judged for l_h = 1); (3) C_0 = 0.45 reliable at every level; (4) fewer unknowns than uniform refinement for the same error, from the fitted error lines at the end of their common window, and only where uniform refinement is slower than the claimed rate beyond its band. Each criterion is also applied to eta_5 as written: one that both pass is no evidence for the repair. The repaired runs are compared with the runs without full-contact nodes: where they coincide (same meshes, same errors), the evidence is that variant's; they would part only where the tensile normal stress at a full-contact node is the largest indicator. Holds when no criterion fails, none is undecided and at least one separates the repair from eta_5 as written".into(),
         measured: if parts.is_empty() { "no data".into() } else { parts.join(". ") },
-        verdict: if repaired_all.is_empty() {
-            Verdict::NoData
-        } else if repaired_all.contains(&Outcome::Fails) {
-            Verdict::Fails
-        } else if repaired_all.contains(&Outcome::Open) || separating == 0 {
-            Verdict::Inconclusive
-        } else {
-            Verdict::Holds
-        },
+        verdict: test.verdict(Kind::Beyond, evidence.as_ref()),
+        criterion: test,
+        kind: Kind::Beyond,
     });
     Ok(())
 }

@@ -77,9 +77,9 @@ const ROW: i32 = 26;
 const DENSE_PX: f64 = 7.0;
 const VERTEX_R: i32 = 3;
 
-const INACTIVE: Style = Style { color: RGBColor(31, 119, 180), marker: Marker::Circle, dashed: false, filled: true };
-const ACTIVE: Style = Style { color: RGBColor(214, 39, 40), marker: Marker::Circle, dashed: false, filled: true };
-const KINK: Style = Style { color: BLACK, marker: Marker::Diamond, dashed: false, filled: false };
+const INACTIVE: Style = Style { color: RGBColor(31, 119, 180), marker: Marker::Circle, dashed: false, filled: true, large: false };
+const ACTIVE: Style = Style { color: RGBColor(214, 39, 40), marker: Marker::Circle, dashed: false, filled: true, large: false };
+const KINK: Style = Style { color: BLACK, marker: Marker::Diamond, dashed: false, filled: false, large: false };
 
 pub(super) fn render_mesh<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, m: &MeshFigure, metrics: Metrics) -> anyhow::Result<()> {
     let body = titled(root, root, &m.title, FS_TITLE + 2.0, metrics)?;

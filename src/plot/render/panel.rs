@@ -198,6 +198,8 @@ pub(super) fn render_panel<DB: DrawingBackend>(
     }
     let hline_label_w: Vec<i32> = p.hlines.iter().map(|h| rich::width(root, &h.label, FS_LEGEND, m)).collect::<anyhow::Result<_>>()?;
     let inset = 10;
+    // the y axis before any room is made for the legend at the top
+    let ya_data = ya;
     let mut chart = build(ya, 24, 14)?;
     let mut legend_at = None;
     let mut label_at: Vec<(i32, i32)> = Vec::new();
@@ -271,6 +273,8 @@ pub(super) fn render_panel<DB: DrawingBackend>(
             // beside the plot, on the right, or under it: whichever leaves the plot's shorter
             // side longer (a convergence plot squashed flat is as hard to read as a narrow one)
             beside = true;
+            // the room made at the top did not take the legend: give it back to the data
+            ya = ya_data;
             let (w, h) = (xr.end - xr.start, yr.end - yr.start);
             below = w.min(h - legend_h - 12) > (w - legend_w - 16).min(h);
             chart = if below { build(ya, 24, 14 + legend_h + 12)? } else { build(ya, 24 + legend_w + 16, 14)? };
@@ -495,8 +499,9 @@ fn obstacle_samples<DB: DrawingBackend>(
     for s in prepared {
         for seg in &s.segments {
             let px: Vec<(i32, i32)> = seg.iter().map(|p| chart.backend_coord(p)).collect();
+            let r = s.series.style.radius(MARKER);
             for &(x, y) in &px {
-                for (dx, dy) in [(-MARKER, -MARKER), (MARKER, -MARKER), (-MARKER, MARKER), (MARKER, MARKER), (0, 0)] {
+                for (dx, dy) in [(-r, -r), (r, -r), (-r, r), (r, r), (0, 0)] {
                     out.push((x + dx, y + dy));
                 }
             }
