@@ -459,6 +459,13 @@ fn check_writable(path: &std::path::Path) -> Result<()> {
     if !dir.is_dir() {
         bail!("--save {}: the folder {} does not exist", path.display(), dir.display());
     }
+    if path.is_dir() {
+        bail!("--save {}: this is a folder; give the path of a file in it, e.g. {}", path.display(), path.join("solution.vtu").display());
+    }
+    // a file can be made there (the write goes through a temporary file in the same folder)
+    let probe = dir.join(format!(".signorini-save-probe.{}", std::process::id()));
+    std::fs::File::create(&probe).with_context(|| format!("--save {}: cannot create a file in {}", path.display(), dir.display()))?;
+    std::fs::remove_file(&probe).ok();
     Ok(())
 }
 

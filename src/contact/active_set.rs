@@ -264,8 +264,7 @@ impl ContactSolver {
             n_interior,
             strategy,
             // not touched here: loading the values writes every one
-            l_values: cholesky::zeros(symbolic.len_val(), "the Cholesky factor L")
-                .map_err(|e| ContactError::OutOfMemory(e.to_string()))?,
+            l_values: cholesky::zeros(symbolic.len_val(), "the Cholesky factor L").map_err(|e| ContactError::OutOfMemory(e.to_string()))?,
             l_zeroed: true,
             symbolic,
             placement: Some(placement),

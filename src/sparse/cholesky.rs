@@ -465,8 +465,7 @@ impl Context<'_> {
             );
             if scratch.stack_bytes < need.unaligned_bytes_required() {
                 let bytes = need.unaligned_bytes_required();
-                scratch.stack =
-                    MemBuffer::try_new(need).map_err(|_| OutOfMemory { what: "the dense Cholesky's workspace", bytes })?;
+                scratch.stack = MemBuffer::try_new(need).map_err(|_| OutOfMemory { what: "the dense Cholesky's workspace", bytes })?;
                 scratch.stack_bytes = bytes;
             }
             try_with_local_map(sn.n(), |local| {
