@@ -16,6 +16,7 @@
 //! * a run id `.` or `.x` made a hidden record (`runs/..json`), and ids differing only in case
 //!   share one record file on macOS (the manifest's id check).
 //! * `adapt --save DIR/` computed every level, then failed to write (`check_writable`).
+//! * standard output on a full device panicked (exit 101): `stdout_write` in main.rs.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -220,4 +221,21 @@ fn bad_save_path_that_is_a_folder_is_refused_before_solving() {
     assert!(dir.join("s.vtu").is_file());
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "the probe file is removed");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Standard output on a full device: the error's exit status (1) naming it, not a panic (101,
+/// as std's `println!` ended before), for `solve`, `solve --json` and `adapt`.
+#[test]
+fn bad_full_stdout_exits_with_the_error_status_not_a_panic() {
+    for args in [
+        &["solve", "--problem", "ex71", "--mesh", "structured:4"][..],
+        &["solve", "--problem", "ex71", "--mesh", "structured:4", "--json"],
+        &["adapt", "--problem", "ex71", "--levels", "3"],
+    ] {
+        let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).stdout(full).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains("error: writing standard output: No space left on device") && !err.contains("panicked"), "{args:?}: {err}");
+    }
 }
