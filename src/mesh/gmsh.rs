@@ -83,6 +83,17 @@ fn physical_names(path: &Path, bytes: &[u8]) -> Result<PhysicalNames, MeshError>
         let (tag, rest) = field(&rest).ok_or_else(bad)?;
         let (dim, tag): (i32, i32) = (dim.parse().map_err(|_| bad())?, tag.parse().map_err(|_| bad())?);
         let name = rest.trim().strip_prefix('"').and_then(|s| s.strip_suffix('"')).ok_or_else(bad)?;
+        // a problem names groups by name: two groups of one dimension under one name would be
+        // one boundary part the file keeps apart (Gmsh itself gives a name one tag)
+        if let Some(((_, other), (_, at))) = names.iter().find(|((d, t), (m, _))| *d == dim && *t != tag && m == name) {
+            return Err(error(
+                path,
+                Some(i),
+                format!(
+                    "$PhysicalNames: the name \"{name}\" is given to groups {other} (line {at}) and {tag} of dimension {dim}: a name must be one group"
+                ),
+            ));
+        }
         names.insert((dim, tag), (name.to_string(), i));
     }
     match lines.next() {

@@ -17,6 +17,7 @@
 //!   share one record file on macOS (the manifest's id check).
 //! * `adapt --save DIR/` computed every level, then failed to write (`check_writable`).
 //! * standard output on a full device panicked (exit 101): `stdout_write` in main.rs.
+//! * one name given to two physical groups merged them into one part (`physical_names`).
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -238,4 +239,25 @@ fn bad_full_stdout_exits_with_the_error_status_not_a_panic() {
         assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
         assert!(err.contains("error: writing standard output: No space left on device") && !err.contains("panicked"), "{args:?}: {err}");
     }
+}
+
+/// Two physical groups of lines under one name in `$PhysicalNames`: refused naming both tags and
+/// lines (a problem names groups by name, so the two would silently be one part).
+#[test]
+fn bad_physical_name_given_to_two_groups_is_refused() {
+    let dir = tmp("dupname");
+    std::fs::write(dir.join("sq.msh"), fixture("square.msh").replace(r#"1 2 "sides""#, r#"1 2 "bottom""#)).unwrap();
+    std::fs::write(dir.join("v.toml"), fixture("bad_data_gmsh.toml")).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["solve", "--problem", "v.toml", "--mesh", "gmsh:sq.msh"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(r#"sq.msh, line 7: $PhysicalNames: the name "bottom" is given to groups 1 (line 6) and 2 of dimension 1"#),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
 }
