@@ -19,6 +19,42 @@ macro_rules! say {
     }};
 }
 
+/// The first error writing standard output, if one happened (a full device, a file-size limit).
+static STDOUT_ERROR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+
+/// Write to standard output without panicking: std's `println!` panics when the write fails
+/// (`> /dev/full` ended in exit 101). The first error is kept, later output dropped, and [`main`]
+/// exits with the error status naming it. Every `print!`/`println!` of this file comes here (the
+/// two macros below shadow std's).
+fn stdout_write(args: std::fmt::Arguments, newline: bool) {
+    use std::io::Write as _;
+    if STDOUT_ERROR.get().is_some() {
+        return;
+    }
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_fmt(args).and_then(|_| if newline { out.write_all(b"\n") } else { Ok(()) }) {
+        let _ = STDOUT_ERROR.set(e.to_string());
+    }
+}
+
+/// Flush standard output (its last lines are buffered) and report the first write error.
+fn stdout_result() -> std::result::Result<(), String> {
+    use std::io::Write as _;
+    if let Err(e) = std::io::stdout().flush() {
+        let _ = STDOUT_ERROR.set(e.to_string());
+    }
+    STDOUT_ERROR.get().map_or(Ok(()), |e| Err(e.clone()))
+}
+
+macro_rules! println {
+    () => { stdout_write(format_args!(""), true) };
+    ($($arg:tt)*) => { stdout_write(format_args!($($arg)*), true) };
+}
+
+macro_rules! print {
+    ($($arg:tt)*) => { stdout_write(format_args!($($arg)*), false) };
+}
+
 #[derive(Parser)]
 #[command(name = "signorini", version, about = "P2 finite elements for the Signorini problem and its supremum-norm a posteriori estimator")]
 struct Cli {
@@ -459,6 +495,13 @@ fn check_writable(path: &std::path::Path) -> Result<()> {
     if !dir.is_dir() {
         bail!("--save {}: the folder {} does not exist", path.display(), dir.display());
     }
+    if path.is_dir() {
+        bail!("--save {}: this is a folder; give the path of a file in it, e.g. {}", path.display(), path.join("solution.vtu").display());
+    }
+    // a file can be made there (the write goes through a temporary file in the same folder)
+    let probe = dir.join(format!(".signorini-save-probe.{}", std::process::id()));
+    std::fs::File::create(&probe).with_context(|| format!("--save {}: cannot create a file in {}", path.display(), dir.display()))?;
+    std::fs::remove_file(&probe).ok();
     Ok(())
 }
 
@@ -819,6 +862,8 @@ fn main() -> ExitCode {
             run_report(results.as_deref(), figures.as_deref(), out.as_deref(), study, drift_report.as_deref())
         }
     };
+    // what was computed and kept stays; output that could not be written is an error
+    let result = result.and_then(|()| stdout_result().map_err(|e| anyhow::anyhow!("writing standard output: {e}")));
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if e.downcast_ref::<study::Interrupted>().is_some() || e.downcast_ref::<AdaptInterrupted>().is_some() => {

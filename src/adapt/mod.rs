@@ -88,7 +88,7 @@ impl AdaptConfig {
             return bad("stop_ndof", "a number of unknowns >= 1", "0".into());
         }
         if !(self.theta > 0.0 && self.theta <= 1.0) {
-            return bad("theta", "a number in (0, 1]", self.theta.to_string());
+            return bad("theta", "a number in (0, 1]", ConfigError::number(self.theta));
         }
         self.estimator.validate()?;
         if self.pdas.max_iterations == 0 {

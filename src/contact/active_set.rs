@@ -57,6 +57,9 @@ pub enum ContactError {
     NotPositiveDefinite(String),
     #[error("sparse factorisation failed: {0}")]
     Factorisation(String),
+    /// A buffer of the factorisation could not be allocated ([`cholesky::OutOfMemory`]).
+    #[error("{0} (lower the mesh size or raise the memory limit)")]
+    OutOfMemory(String),
 }
 
 /// Settings of the active-set method.
@@ -261,7 +264,7 @@ impl ContactSolver {
             n_interior,
             strategy,
             // not touched here: loading the values writes every one
-            l_values: vec![0.0; symbolic.len_val()],
+            l_values: cholesky::zeros(symbolic.len_val(), "the Cholesky factor L").map_err(|e| ContactError::OutOfMemory(e.to_string()))?,
             l_zeroed: true,
             symbolic,
             placement: Some(placement),
@@ -322,8 +325,10 @@ impl ContactSolver {
     /// Numeric factorisation of the loaded values in place ([`cholesky::factorize`]).
     fn factorize(&mut self) -> Result<(), ContactError> {
         let t0 = Instant::now();
-        cholesky::factorize(&self.symbolic, &self.plan, &mut self.l_values)
-            .map_err(|e| ContactError::NotPositiveDefinite(e.to_string()))?;
+        cholesky::factorize(&self.symbolic, &self.plan, &mut self.l_values).map_err(|e| match e {
+            cholesky::FactorError::NotPositiveDefinite(e) => ContactError::NotPositiveDefinite(e.to_string()),
+            cholesky::FactorError::OutOfMemory(e) => ContactError::OutOfMemory(e.to_string()),
+        })?;
         self.timings.numeric += t0.elapsed().as_secs_f64();
         Ok(())
     }

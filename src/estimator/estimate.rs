@@ -135,13 +135,27 @@ pub struct ConfigError {
     pub got: String,
 }
 
+impl ConfigError {
+    /// A number as an error shows it: as Rust prints it while that is short (0.5, -1, NaN),
+    /// else in exponent form (1e-320 and 1e308, not hundreds of digits).
+    pub fn number(x: f64) -> String {
+        let plain = x.to_string();
+        if plain.len() <= 24 { plain } else { format!("{x:e}") }
+    }
+}
+
 impl EstimatorConfig {
     /// Check the settings: C_0 must be a positive normal number (not zero, NaN, infinite or
     /// subnormal, where C_0 eta_h loses its digits). Whether C_0 eta_h is finite depends on
     /// eta_h too: [`Terms::check_finite`] checks that once the estimate is computed.
     pub fn validate(&self) -> Result<(), ConfigError> {
         if !(self.c0 > 0.0 && self.c0.is_normal()) {
-            return Err(ConfigError { key: "estimator.c0", expected: "a positive number".into(), got: self.c0.to_string() });
+            let expected = if self.c0 > 0.0 && self.c0.is_finite() {
+                format!("a positive number of at least {:e} (a subnormal C_0 leaves C_0 eta_h few digits)", f64::MIN_POSITIVE)
+            } else {
+                "a positive number".into()
+            };
+            return Err(ConfigError { key: "estimator.c0", expected, got: ConfigError::number(self.c0) });
         }
         Ok(())
     }

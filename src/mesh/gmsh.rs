@@ -83,6 +83,17 @@ fn physical_names(path: &Path, bytes: &[u8]) -> Result<PhysicalNames, MeshError>
         let (tag, rest) = field(&rest).ok_or_else(bad)?;
         let (dim, tag): (i32, i32) = (dim.parse().map_err(|_| bad())?, tag.parse().map_err(|_| bad())?);
         let name = rest.trim().strip_prefix('"').and_then(|s| s.strip_suffix('"')).ok_or_else(bad)?;
+        // a problem names groups by name: two groups of one dimension under one name would be
+        // one boundary part the file keeps apart (Gmsh itself gives a name one tag)
+        if let Some(((_, other), (_, at))) = names.iter().find(|((d, t), (m, _))| *d == dim && *t != tag && m == name) {
+            return Err(error(
+                path,
+                Some(i),
+                format!(
+                    "$PhysicalNames: the name \"{name}\" is given to groups {other} (line {at}) and {tag} of dimension {dim}: a name must be one group"
+                ),
+            ));
+        }
         names.insert((dim, tag), (name.to_string(), i));
     }
     match lines.next() {
@@ -382,6 +393,50 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
 }
 
 impl GmshFile {
+    /// Every physical group `problem` names in its parts is a group of the file's boundary lines:
+    /// a misspelt name (`["contcat", "contact"]`), a group of another dimension (a surface) or
+    /// a group of another mesh would otherwise tag nothing, silently.
+    fn check_named_groups(&self, problem: &dyn Problem) -> Result<(), MeshError> {
+        let have: Vec<&str> = self.groups.iter().map(|(g, _)| g.as_str()).collect();
+        for g in problem.groups() {
+            if !have.contains(&g.as_str()) {
+                return Err(error(
+                    &self.path,
+                    None,
+                    format!(
+                        "problem {} names the physical group \"{g}\", which is not a group of boundary lines of this file (its groups of lines: {}); a group of surfaces or points is not a boundary part",
+                        problem.name(),
+                        have.iter().map(|g| format!("\"{g}\"")).collect::<Vec<_>>().join(", ")
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Both vertices of line element `e` lie on the curve `c` its group is declared on (within
+    /// [`Curve::VERTEX_TOLERANCE`] of its size).
+    fn check_on_curve(&self, c: &crate::problems::Curve, e: &GroupEdge, problem: &dyn Problem) -> Result<(), MeshError> {
+        for v in e.v {
+            let x = self.vertices[v];
+            let off = c.relative_distance(x);
+            if !(off <= crate::problems::Curve::VERTEX_TOLERANCE) {
+                return Err(error(
+                    &self.path,
+                    e.line,
+                    format!(
+                        "the vertex ({}, {}) of this line element of group \"{}\" is off the curve problem {} declares for the group ([curves]: {c:?}) by {off:.3e} of its size: the curve must be the one the mesh follows (refinement puts new boundary vertices on it)",
+                        x[0],
+                        x[1],
+                        self.groups[e.group].0,
+                        problem.name()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Number of P2 unknowns: 2 (V + E), E counted from the triangles.
     pub fn ndof(&self) -> f64 {
         let mut count: HashMap<(usize, usize), u8> = HashMap::new();
@@ -422,6 +477,7 @@ impl GmshFile {
                 }
             }
         }
+        self.check_named_groups(problem)?;
         // edges: owners (triangle, local edge)
         let mut owners: HashMap<(usize, usize), Vec<(usize, usize)>> = HashMap::new();
         for (t, tri) in self.triangles.iter().enumerate() {
@@ -482,6 +538,9 @@ impl GmshFile {
                     });
                 };
                 let (part, curve): (Part, _) = parts[e.group];
+                if let Some(c) = curve {
+                    self.check_on_curve(&c, e, problem)?;
+                }
                 boundary.push(BoundaryEdge { v: [tri[i], tri[j]], part, curve });
             }
         }

@@ -39,4 +39,17 @@ impl Curve {
             }
         }
     }
+
+    /// The distance from `x` to the curve, relative to its size (the circle's radius).
+    pub fn relative_distance(&self, x: [f64; 2]) -> f64 {
+        match *self {
+            Curve::Circle { centre, radius } => ((x[0] - centre[0]).hypot(x[1] - centre[1]) - radius).abs() / radius,
+        }
+    }
+
+    /// How far (relative to its size) a mesh vertex may lie from the curve its boundary edge is
+    /// declared on: a mesher places them on it to round-off; a curve declared with another
+    /// centre or radius than the mesh's misses them by far more, and refinement would then pull
+    /// new vertices onto a curve the mesh does not follow.
+    pub const VERTEX_TOLERANCE: f64 = 1e-6;
 }

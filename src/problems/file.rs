@@ -91,10 +91,49 @@ struct PartsToml {
     neumann: Option<Spanned<PartToml>>,
 }
 
+/// Exactly two values: a point, a vector, a row of a gradient. serde reads a longer TOML array
+/// into `[T; 2]` by dropping the rest (`[1, 0.5, 0]` was the point (1, 0.5), an exact solution
+/// with three components used two); this type refuses it, for every pair of a problem file.
+#[derive(Clone, Debug)]
+struct Two<T>([T; 2]);
+
+impl<T> std::ops::Deref for Two<T> {
+    type Target = [T; 2];
+    fn deref(&self) -> &[T; 2] {
+        &self.0
+    }
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for Two<T> {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visit<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for Visit<T> {
+            type Value = Two<T>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("an array of exactly two values")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Two<T>, A::Error> {
+                use serde::de::Error;
+                let a = seq.next_element()?.ok_or_else(|| A::Error::invalid_length(0, &self))?;
+                let b = seq.next_element()?.ok_or_else(|| A::Error::invalid_length(1, &self))?;
+                let mut n = 2;
+                while seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+                    n += 1;
+                }
+                if n != 2 {
+                    return Err(A::Error::invalid_length(n, &self));
+                }
+                Ok(Two([a, b]))
+            }
+        }
+        d.deserialize_seq(Visit(std::marker::PhantomData))
+    }
+}
+
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CircleToml {
-    centre: [f64; 2],
+    centre: Two<f64>,
     radius: f64,
 }
 
@@ -114,8 +153,8 @@ struct ContactToml {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ExactToml {
-    u: Spanned<[Scalar; 2]>,
-    grad: Option<Spanned<[[Scalar; 2]; 2]>>,
+    u: Spanned<Two<Scalar>>,
+    grad: Option<Spanned<Two<Two<Scalar>>>>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -125,7 +164,7 @@ struct FileToml {
     body_force: Option<Spanned<VectorToml>>,
     traction: Option<Spanned<VectorToml>>,
     dirichlet: Option<Spanned<VectorToml>>,
-    required_vertices: Option<Spanned<Vec<[Scalar; 2]>>>,
+    required_vertices: Option<Spanned<Vec<Two<Scalar>>>>,
     load_breaks: Option<Spanned<Vec<Scalar>>>,
     #[serde(default)]
     constants: BTreeMap<String, Spanned<Scalar>>,
@@ -140,6 +179,80 @@ struct FileToml {
 // Numbers in expressions: exmex's default literals have no exponent ("1e-12" would read as
 // 1, Euler's e, -12); these do (and `e` alone is still Euler's number).
 literal_matcher_from_pattern!(Number, r"^([0-9]+(\.[0-9]*)?|\.[0-9]+)([eE][+-]?[0-9]+)?");
+
+/// The 1-based character position of a unary minus whose operand (a number, a name, a call
+/// or a parenthesised group) is the base of `^`, if `text` has one: exmex binds that minus
+/// before the power, so `-s^2` is `(-s)^2`, where a reader (and every other calculator) reads
+/// `-(s^2)`. Refused rather than read against the reader.
+fn negated_power(text: &str) -> Option<usize> {
+    let c: Vec<char> = text.chars().collect();
+    let skip = |mut j: usize| {
+        while j < c.len() && c[j].is_whitespace() {
+            j += 1;
+        }
+        j
+    };
+    let group = |mut j: usize| {
+        // j at '(': past its matching ')'
+        let mut depth = 0usize;
+        while j < c.len() {
+            match c[j] {
+                '(' => depth += 1,
+                ')' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        return j + 1;
+                    }
+                }
+                _ => {}
+            }
+            j += 1;
+        }
+        j
+    };
+    let mut prev: Option<char> = None;
+    for i in 0..c.len() {
+        if c[i].is_whitespace() {
+            continue;
+        }
+        if c[i] == '-' && prev.is_none_or(|p| "(,+-*/^".contains(p)) {
+            let mut j = skip(i + 1);
+            if j < c.len() && (c[j].is_ascii_digit() || c[j] == '.') {
+                while j < c.len() && (c[j].is_ascii_digit() || c[j] == '.') {
+                    j += 1;
+                }
+                if j < c.len() && (c[j] == 'e' || c[j] == 'E') {
+                    j += 1;
+                    if j < c.len() && (c[j] == '+' || c[j] == '-') {
+                        j += 1;
+                    }
+                    while j < c.len() && c[j].is_ascii_digit() {
+                        j += 1;
+                    }
+                }
+            } else if j < c.len() && (c[j].is_alphabetic() || c[j] == '_') {
+                while j < c.len() && (c[j].is_alphanumeric() || c[j] == '_') {
+                    j += 1;
+                }
+                let k = skip(j);
+                if k < c.len() && c[k] == '(' {
+                    j = group(k);
+                }
+            } else if j < c.len() && c[j] == '(' {
+                j = group(j);
+            } else {
+                prev = Some(c[i]);
+                continue;
+            }
+            let k = skip(j);
+            if k < c.len() && c[k] == '^' {
+                return Some(i + 1);
+            }
+        }
+        prev = Some(c[i]);
+    }
+    None
+}
 
 /// A parsed expression: exmex's default float operators, numbers with exponents.
 type Flat = FlatEx<f64, FloatOpsFactory<f64>, Number>;
@@ -357,7 +470,20 @@ impl Reader<'_> {
             Scalar::Number(v) => return Ok(Expr::Const(*v)),
             Scalar::Text(t) => t,
         };
-        let flat = Flat::parse(text).map_err(|e| self.error(key, span.clone(), format!("cannot parse {text:?}: {}", e.msg())))?;
+        if let Some(column) = negated_power(text) {
+            return Err(self.error(
+                key,
+                span,
+                format!(
+                    "{text:?}: the `-` at character {column} negates the base of a power, which exmex applies before `^` (-s^2 reads (-s)^2 = s^2, not -(s^2)): write -(s^2) or 0 - s^2 for minus the power, (-s)^2 for the power of the negation"
+                ),
+            ));
+        }
+        let flat = Flat::parse(text).map_err(|e| {
+            // exmex's message for two operands side by side ("2x", "500 MPa")
+            let hint = if e.msg().contains("ops and") { " (a product needs `*`, as in 2*x; numbers carry no units)" } else { "" };
+            self.error(key, span.clone(), format!("cannot parse {text:?}: {}{hint}", e.msg()))
+        })?;
         let names = flat.var_names();
         if names.len() > MAX_VARS {
             return Err(self.error(

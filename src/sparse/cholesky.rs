@@ -84,6 +84,55 @@ pub struct NotPositiveDefinite {
     pub column: usize,
 }
 
+/// A buffer of the factorisation could not be allocated: the allocator refused `bytes` (the
+/// address-space limit, `ulimit -v`, or the machine's memory). The named error in place of
+/// the abort an infallible allocation ends in.
+#[derive(Debug, thiserror::Error)]
+#[error("out of memory: allocating {what} of {bytes} bytes ({mib:.1} MiB) failed", mib = *bytes as f64 / 1048576.0)]
+pub struct OutOfMemory {
+    pub what: &'static str,
+    pub bytes: usize,
+}
+
+/// Why [`factorize`] failed.
+#[derive(Debug, thiserror::Error)]
+pub enum FactorError {
+    #[error(transparent)]
+    NotPositiveDefinite(#[from] NotPositiveDefinite),
+    #[error(transparent)]
+    OutOfMemory(#[from] OutOfMemory),
+}
+
+/// `len` zeros, allocated fallibly: the one allocation of L's values (a vector of the length
+/// of [`Symbolic::len_val`]). Zeroed by the allocator (calloc), so that its pages are first
+/// touched by [`load`] and the factorisation, as `vec![0.0; len]` would leave them.
+pub fn zeros(len: usize, what: &'static str) -> Result<Vec<f64>, OutOfMemory> {
+    let bytes = len.saturating_mul(std::mem::size_of::<f64>());
+    if len == 0 {
+        return Ok(Vec::new());
+    }
+    let layout = std::alloc::Layout::array::<f64>(len).map_err(|_| OutOfMemory { what, bytes })?;
+    // SAFETY: the layout has a nonzero size; a non-null pointer from alloc_zeroed holds `len`
+    // zeroed f64 (0.0 is all zero bits) with the alignment of f64, allocated by the global
+    // allocator with this layout, as Vec::from_raw_parts requires
+    unsafe {
+        let ptr = std::alloc::alloc_zeroed(layout) as *mut f64;
+        if ptr.is_null() {
+            return Err(OutOfMemory { what, bytes });
+        }
+        Ok(Vec::from_raw_parts(ptr, len, len))
+    }
+}
+
+/// Grow `v` to at least `len` (new entries zero), fallibly.
+fn grow<T: Clone + Default>(v: &mut Vec<T>, len: usize, what: &'static str) -> Result<(), OutOfMemory> {
+    if v.len() < len {
+        v.try_reserve_exact(len - v.len()).map_err(|_| OutOfMemory { what, bytes: len.saturating_mul(std::mem::size_of::<T>()) })?;
+        v.resize(len, T::default());
+    }
+    Ok(())
+}
+
 /// A supernode's place in L: first column, columns, row pattern below them, offset of its values.
 struct Supernode<'a> {
     begin: usize,
@@ -308,6 +357,14 @@ fn with_local_map<R>(n: usize, f: impl FnOnce(&mut [u32]) -> R) -> R {
     })
 }
 
+/// [`with_local_map`] with the map grown fallibly (the factorisation's path).
+fn try_with_local_map<R>(n: usize, f: impl FnOnce(&mut [u32]) -> R) -> Result<R, OutOfMemory> {
+    LOCAL.with_borrow_mut(|local| {
+        grow(local, n, "the factorisation's row map")?;
+        Ok(f(local))
+    })
+}
+
 /// Runs of supernodes that [`load`] hands to the threads, each about this share of L's values.
 const LOAD_RUNS: usize = 64;
 
@@ -367,7 +424,7 @@ pub fn load(sn: &Symbolic, placement: &Placement, values: &[f64], l: &mut [f64],
 
 /// Overwrite `l` (the layout of `sn`, holding a matrix's values from [`load`]) with the
 /// Cholesky factor of that matrix, permuted as planned.
-pub fn factorize(sn: &Symbolic, plan: &Plan, l: &mut [f64]) -> Result<(), NotPositiveDefinite> {
+pub fn factorize(sn: &Symbolic, plan: &Plan, l: &mut [f64]) -> Result<(), FactorError> {
     assert_eq!(l.len(), sn.len_val());
     let shared = Shared::new(l);
     let ctx = Context { sn, plan, l: shared };
@@ -383,7 +440,7 @@ struct Context<'a> {
 impl Context<'_> {
     /// Compute supernode s's block of L from the matrix's values there and its (finished)
     /// descendants.
-    fn supernode(&self, s: usize, alone: bool) -> Result<(), NotPositiveDefinite> {
+    fn supernode(&self, s: usize, alone: bool) -> Result<(), FactorError> {
         let (sn, plan) = (self.sn, self.plan);
         // faer's parallel dense kernels give the same bits as its sequential ones (tested: one and
         // two threads agree bitwise), so this choice changes only the time
@@ -400,19 +457,18 @@ impl Context<'_> {
                 stack: MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
                 stack_bytes: 0,
             });
-            if scratch.update.len() < plan.max_update {
-                scratch.update.resize(plan.max_update, 0.0);
-            }
+            grow(&mut scratch.update, plan.max_update, "the factorisation's update product")?;
             let need = faer::linalg::cholesky::llt::factor::cholesky_in_place_scratch::<f64>(
                 plan.max_cols,
                 Par::rayon(0),
                 Spec::<LltParams, f64>::default(),
             );
             if scratch.stack_bytes < need.unaligned_bytes_required() {
-                scratch.stack = MemBuffer::new(need);
-                scratch.stack_bytes = need.unaligned_bytes_required();
+                let bytes = need.unaligned_bytes_required();
+                scratch.stack = MemBuffer::try_new(need).map_err(|_| OutOfMemory { what: "the dense Cholesky's workspace", bytes })?;
+                scratch.stack_bytes = bytes;
             }
-            with_local_map(sn.n(), |local| {
+            try_with_local_map(sn.n(), |local| {
                 for (i, &r) in node.pattern.iter().enumerate() {
                     local[r as usize] = (ncols + i) as u32;
                 }
@@ -452,7 +508,7 @@ impl Context<'_> {
                     }));
                     scatter_subtract(block, nrows, product, rows, mid, rel);
                 }
-            });
+            })?;
             let ls = MatMut::from_column_major_slice_mut(block, nrows, ncols);
             let (mut top, bot) = ls.split_at_row_mut(ncols);
             faer::linalg::cholesky::llt::factor::cholesky_in_place(
@@ -464,7 +520,7 @@ impl Context<'_> {
             )
             .map_err(|e| match e {
                 faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => {
-                    NotPositiveDefinite { column: node.begin + index }
+                    FactorError::from(NotPositiveDefinite { column: node.begin + index })
                 }
             })?;
             faer::linalg::triangular_solve::solve_lower_triangular_in_place(top.rb(), bot.transpose_mut(), par);

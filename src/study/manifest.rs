@@ -311,12 +311,22 @@ fn parse_run(
 ) -> Result<PlannedRun, ManifestError> {
     let key = |k: &str| format!("run[{i}].{k}");
     let id = r.id.clone().ok_or_else(|| invalid.at(key("id"), "a run name (string)", "nothing".into()))?;
-    if id.is_empty() || !id.chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) {
-        return Err(invalid.at(key("id"), "a name of letters, digits, '_', '-', '.'", format!("{id:?}")));
+    // the first character a letter or digit: a record runs/.ID.json would be a hidden file, and
+    // the store's temporaries (.NAME.tmpPID.N) and leftovers start with '.'
+    if !id.starts_with(|c: char| c.is_ascii_alphanumeric()) || !id.chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c)) {
+        return Err(invalid.at(
+            key("id"),
+            "a name of letters, digits, '_', '-', '.' that starts with a letter or digit",
+            format!("{id:?}"),
+        ));
     }
-    if !ids.insert(id.clone()) {
-        return Err(invalid.at(key("id"), "a name unique within the study", format!("{id:?} twice")));
+    // unique ignoring case too: runs/A.json and runs/a.json are one file where the results folder
+    // is copied to a case-insensitive file system (macOS, Windows)
+    if let Some(other) = ids.iter().find(|o| o.eq_ignore_ascii_case(&id)) {
+        let got = if *other == id { format!("{id:?} twice") } else { format!("{id:?} and {other:?}, the same name but for case") };
+        return Err(invalid.at(key("id"), "a name unique within the study (ignoring case: the records' file names)", got));
     }
+    ids.insert(id.clone());
     let problem = r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid.at(key("problem"), "a problem name", "nothing".into()))?;
     let mut constants = d.constants.clone().unwrap_or_default();
     constants.extend(r.constants.clone().unwrap_or_default());
@@ -356,7 +366,7 @@ fn parse_run(
     if let Some(rf) = &reference
         && !(rf.theta > 0.0 && rf.theta <= 1.0)
     {
-        return Err(invalid.at(key("reference.theta"), "a number in (0, 1]", rf.theta.to_string()));
+        return Err(invalid.at(key("reference.theta"), "a number in (0, 1]", crate::adapt::ConfigError::number(rf.theta)));
     }
     let inputs = input_hashes(path, &problem, &mesh).map_err(|(k, e)| invalid.at(key(k), "a readable file", e))?;
     let spec = RunSpec {
@@ -457,7 +467,7 @@ fn check_drift(drift: &DriftSpec, runs: &[PlannedRun], invalid: &Invalid) -> Res
             ));
         }
         if !r.min.is_finite() {
-            return Err(invalid.at(key("min"), "a finite rate", r.min.to_string()));
+            return Err(invalid.at(key("min"), "a finite rate", crate::adapt::ConfigError::number(r.min)));
         }
         if r.last < 2 || r.last > run.spec.levels {
             return Err(invalid.at(

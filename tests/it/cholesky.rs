@@ -75,7 +75,7 @@ fn faers_symbolic(matrix: &SymCsc, ours: &Symbolic) -> SymbolicCholesky<usize> {
 }
 
 /// Our factor of `matrix` (or of other `values` on its pattern) on `threads` threads.
-fn ours(matrix: &SymCsc, symbolic: &Symbolic, values: &[f64], threads: usize) -> Result<Vec<f64>, cholesky::NotPositiveDefinite> {
+fn ours(matrix: &SymCsc, symbolic: &Symbolic, values: &[f64], threads: usize) -> Result<Vec<f64>, cholesky::FactorError> {
     let plan = Plan::new(symbolic);
     let mut l = vec![f64::NAN; symbolic.len_val()];
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
@@ -159,7 +159,9 @@ fn a_matrix_that_is_not_positive_definite_is_an_error_naming_its_column() {
     // a negative diagonal entry at unknown 5
     let at = matrix.position(5, 5);
     values[at] = -values[at];
-    let err = ours(&matrix, &symbolic, &values, 2).unwrap_err();
+    let cholesky::FactorError::NotPositiveDefinite(err) = ours(&matrix, &symbolic, &values, 2).unwrap_err() else {
+        panic!("not the pivot error")
+    };
     let inv = symbolic.inv();
     // columns before it do not see the entry; at its own column the pivot is -K_55 minus squares
     assert_eq!(err.column, inv[5], "{err}");
@@ -272,4 +274,21 @@ fn solves_finished_from_a_kept_forward_substitution_are_the_whole_solves() {
             });
         }
     }
+}
+
+/// L's values are allocated fallibly: a length the allocator cannot give is the named memory
+/// error with the size asked, not an abort; a length it can is zeros, as `vec!` would give.
+#[test]
+fn an_allocation_of_l_that_cannot_be_made_is_the_named_memory_error() {
+    let len = usize::MAX / 16;
+    let err = cholesky::zeros(len, "the Cholesky factor L").unwrap_err();
+    assert_eq!(err.bytes, len * 8);
+    let text = err.to_string();
+    assert!(text.contains("out of memory") && text.contains("the Cholesky factor L") && text.contains(&(len * 8).to_string()), "{text}");
+    // larger than the address space: refused by the layout, named the same way
+    let err = cholesky::zeros(usize::MAX, "L").unwrap_err();
+    assert!(err.to_string().contains("out of memory"), "{err}");
+    let ok = cholesky::zeros(1000, "L").unwrap();
+    assert!(ok.len() == 1000 && ok.iter().all(|v| v.to_bits() == 0));
+    assert!(cholesky::zeros(0, "L").unwrap().is_empty());
 }

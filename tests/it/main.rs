@@ -5,6 +5,7 @@
 mod common;
 
 mod adaptivity;
+mod bad_battery;
 mod bad_cli;
 mod bad_data;
 mod bad_edges;

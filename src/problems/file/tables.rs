@@ -183,7 +183,7 @@ impl Reader<'_> {
                     format!("a finite centre and a positive radius, got radius {}", c.radius),
                 ));
             }
-            curves.insert(group.clone(), Curve::Circle { centre: c.centre, radius: c.radius });
+            curves.insert(group.clone(), Curve::Circle { centre: c.centre.0, radius: c.radius });
         }
         Ok(curves)
     }
@@ -270,7 +270,7 @@ impl Reader<'_> {
                 let u = self.pair("exact.u", e.u.span(), e.u.get_ref(), &xy)?;
                 let grad = match &e.grad {
                     Some(g) => {
-                        let [g0, g1] = g.get_ref();
+                        let [g0, g1] = &g.get_ref().0;
                         [self.pair("exact.grad[0]", g.span(), g0, &xy)?, self.pair("exact.grad[1]", g.span(), g1, &xy)?]
                     }
                     None => {
