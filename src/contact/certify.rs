@@ -169,12 +169,13 @@ const ADVICE_KKT: &str =
 /// semi-coercive case).
 #[derive(Debug, thiserror::Error)]
 #[error(
-    "the body can move rigidly: {body} {held}, so the stiffness matrix is singular (a body needs Dirichlet data at two points at least, e.g. one Dirichlet edge). The mesh's boundary edges: {edges}{declared}"
+    "the body can move rigidly: {body} {held}, so the stiffness matrix is singular (a body needs Dirichlet data at two points at least, e.g. one Dirichlet edge, or components prescribed that stop both translations and the rotation). The mesh's boundary edges: {edges}{declared}"
 )]
 pub struct RigidMotionError {
     /// Which body (of how many), with its size and a point of it.
     pub body: String,
-    /// "has no Dirichlet node" or "is held at one point only, (x, y)".
+    /// "has no Dirichlet node", "is held at one point only, (x, y)", or which rigid motion
+    /// its prescribed components leave free.
     pub held: String,
     /// Number of boundary edges per part.
     pub edges: String,
@@ -182,37 +183,86 @@ pub struct RigidMotionError {
     pub declared: String,
 }
 
-/// Check that the Dirichlet nodes stop the rigid motions of every body of the mesh (an
-/// edge-connected set of triangles: two triangles sharing only a vertex can turn about it): a
-/// body needs two distinct Dirichlet nodes (Dirichlet data fix both components of a node, so
-/// two points stop both translations and the rotation).
+/// The prescribed components of one body, as far as they stop its rigid motions
+/// a + theta (-y, x): a prescribed u_1 at (x, y) asks a_1 = theta y, a prescribed u_2 asks
+/// a_2 = -theta x. The motions are stopped unless u_1 or u_2 is prescribed nowhere, or every
+/// prescribed u_1 is on one line y = y0 and every prescribed u_2 on one line x = x0 (a rotation
+/// about (x0, y0) is left; two distinct fully prescribed nodes always stop it).
+#[derive(Clone, Debug, Default)]
+struct Held {
+    triangles: usize,
+    /// The first node with a prescribed component, and whether another one exists.
+    first: Option<usize>,
+    second: bool,
+    /// Per component, the range of the other coordinate over its prescribed nodes (y for u_1,
+    /// x for u_2), `None` if it is prescribed nowhere.
+    range: [Option<[f64; 2]>; 2],
+}
+
+impl Held {
+    fn see(&mut self, p: usize, x: [f64; 2], fixed: [bool; 2]) {
+        match self.first {
+            None => self.first = Some(p),
+            Some(q) if q != p => self.second = true,
+            _ => {}
+        }
+        for (i, r) in self.range.iter_mut().enumerate().filter(|&(i, _)| fixed[i]) {
+            let c = x[1 - i];
+            *r = Some(r.map_or([c, c], |[a, b]| [a.min(c), b.max(c)]));
+        }
+    }
+
+    /// `None` if the rigid motions are stopped, else what is left free (for the error).
+    fn free_motion(&self, nodes: &P2Nodes, scale: f64) -> Option<String> {
+        let at = |p: usize| format!("({:.6}, {:.6})", nodes.coords[p][0], nodes.coords[p][1]);
+        let p = match self.first {
+            None => return Some("has no Dirichlet node".to_string()),
+            Some(p) if !self.second => return Some(format!("is held at one point only, {}", at(p))),
+            Some(p) => p,
+        };
+        let on_one_line = |r: [f64; 2]| r[1] - r[0] <= 1e-9 * scale;
+        match self.range {
+            [None, _] => Some(format!("has u_1 prescribed nowhere (a horizontal translation is free; first prescribed node {})", at(p))),
+            [_, None] => Some(format!("has u_2 prescribed nowhere (a vertical translation is free; first prescribed node {})", at(p))),
+            [Some(r0), Some(r1)] if on_one_line(r0) && on_one_line(r1) => Some(format!(
+                "has u_1 prescribed only on the line y = {:.6} and u_2 only on the line x = {:.6} (a rotation about their crossing is free)",
+                r0[0], r1[0]
+            )),
+            _ => None,
+        }
+    }
+}
+
+/// Check that the prescribed components (Dirichlet data and point constraints) stop the rigid
+/// motions of every body of the mesh (an edge-connected set of triangles: two triangles sharing
+/// only a vertex can turn about it), as [`Held`] decides: with both components prescribed, two
+/// distinct nodes suffice; rollers on a side need a prescribed u_2 somewhere else.
 pub fn check_held(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem) -> Result<(), RigidMotionError> {
     let bodies = bodies(nodes);
     let n_bodies = bodies.iter().copied().max().map_or(0, |b| b + 1);
-    // per body: (triangles, first Dirichlet node, whether a second one exists)
-    let mut held = vec![(0usize, None::<usize>, false); n_bodies];
+    let mut held = vec![Held::default(); n_bodies];
     for (t, el) in nodes.elements.iter().enumerate() {
         let h = &mut held[bodies[t]];
-        h.0 += 1;
-        for &p in el.iter().filter(|&&p| dofs.dof[p][0] == crate::assembly::FIXED) {
-            match h.1 {
-                None => h.1 = Some(p),
-                Some(q) if q != p => h.2 = true,
-                _ => {}
+        h.triangles += 1;
+        for &p in el {
+            let fixed = dofs.dof[p].map(|d| d == crate::assembly::FIXED);
+            if fixed != [false, false] {
+                h.see(p, nodes.coords[p], fixed);
             }
         }
     }
-    let Some((b, &(triangles, first, _))) = held.iter().enumerate().find(|(_, h)| !h.2) else { return Ok(()) };
+    let scale = nodes.coords.iter().fold(0.0f64, |a, x| a.max(x[0].abs()).max(x[1].abs())).max(f64::MIN_POSITIVE);
+    let Some((b, triangles, held)) =
+        held.iter().enumerate().find_map(|(b, h)| h.free_motion(nodes, scale).map(|why| (b, h.triangles, why)))
+    else {
+        return Ok(());
+    };
     let t = bodies.iter().position(|&x| x == b).expect("every body has a triangle");
     let c = nodes.coords[nodes.elements[t][0]];
     let body = if n_bodies == 1 {
         format!("the mesh ({triangles} triangles)")
     } else {
         format!("body {} of the {n_bodies} separate bodies of the mesh ({triangles} triangles, one at ({:.4}, {:.4}))", b + 1, c[0], c[1])
-    };
-    let held = match first {
-        None => "has no Dirichlet node".to_string(),
-        Some(p) => format!("is held at one point only, ({:.6}, {:.6})", nodes.coords[p][0], nodes.coords[p][1]),
     };
     let count = |part| mesh.boundary.iter().filter(|e| e.part == part).count();
     let edges = format!("{} Dirichlet, {} contact, {} Neumann", count(Part::Dirichlet), count(Part::Contact), count(Part::Neumann));

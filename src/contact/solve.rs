@@ -43,6 +43,9 @@ pub struct DiscreteSolution {
     /// of `dofs.contact`), computed from the residual F - K u, element by element (eq. 4.5 /
     /// Lemma 5.2; [`assembly::stiffness_times`]).
     pub lambda: Vec<f64>,
+    /// Per point constraint (`dofs.points`), the Cartesian residual K u - F at its node
+    /// ([`assembly::point_reactions`]): minus the reaction force at a prescribed component.
+    pub reactions: Vec<[f64; 2]>,
     /// Active contact nodes (u_h(p).n = chi_h(p) enforced).
     pub active: Vec<bool>,
     pub pdas: Vec<PdasIteration>,
@@ -166,6 +169,7 @@ pub fn solve(
     let zero = vec![[0.0; 2]; dirichlet.len()];
     let roundoff = dofs.displacement(&correction, &zero).iter().fold(0.0f64, |a, v| a.max(v[0].abs()).max(v[1].abs()));
     let u = dofs.displacement(&out.u, &dirichlet);
+    let reactions = assembly::point_reactions(mesh, &nodes, &dofs, problem, &u);
     let timings = SolveTimings {
         assembly: assembly_time,
         contact: contact_timings,
@@ -177,6 +181,7 @@ pub fn solve(
         dofs,
         u,
         lambda,
+        reactions,
         active: out.active,
         pdas: out.iterations,
         termination: out.termination,

@@ -378,6 +378,8 @@ fn node_terms(
             let Some(bi) = nodes.element_boundary[t][le] else { continue };
             match mesh.boundary[bi].part {
                 Part::Neumann if part == Some(Part::Neumann) => e[2] = e[2].max(local[t].neumann[le]),
+                // the residual of the components Gamma_D leaves free (zero where it prescribes both)
+                Part::Dirichlet if part == Some(Part::Dirichlet) => e[2] = e[2].max(local[t].neumann[le]),
                 Part::Contact if part == Some(Part::Contact) => {
                     has_contact_edge = true;
                     e[3] = e[3].max(local[t].tangential[le]);

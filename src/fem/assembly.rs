@@ -35,7 +35,7 @@ pub struct ContactNode {
 #[derive(Clone, Debug)]
 pub struct DofMap {
     /// Per node, the unknowns of its two local components (Cartesian, or (normal, tangential) at
-    /// contact nodes); `FIXED` at Dirichlet nodes.
+    /// contact nodes); `FIXED` for a prescribed component (Dirichlet data or a point constraint).
     pub dof: Vec<[usize; 2]>,
     pub n_free: usize,
     /// Unknowns `0..n_interior` are not contact normals; `n_interior + k` is the normal unknown
@@ -44,30 +44,55 @@ pub struct DofMap {
     pub contact: Vec<ContactNode>,
     /// Per node, its index in `contact`.
     pub contact_index: Vec<Option<usize>>,
+    /// The nodes of the problem's point constraints with their prescribed components (in the
+    /// order of `Problem::point_constraints`; a point that is not a vertex is left out, and
+    /// the solve refuses such a mesh before, `Mesh::check_vertices`).
+    pub points: Vec<(usize, [Option<f64>; 2])>,
 }
 
+/// Within this distance a point constraint is at a vertex (as `Mesh::check_vertices` finds it).
+const POINT_TOLERANCE: f64 = 1e-12;
+
 impl DofMap {
-    /// Contact nodes are the nodes on Gamma_C not on the closure of Gamma_D (the Dirichlet part
-    /// wins at shared corners, see `P2Nodes::part`).
+    /// Contact nodes are the nodes on Gamma_C with no prescribed component (the Dirichlet part
+    /// wins at shared corners, see `P2Nodes::part`). A node's component is prescribed on
+    /// Gamma_D if the problem's Dirichlet data prescribe it (`Problem::dirichlet_components`),
+    /// and at a point constraint's vertex if the constraint does.
     pub fn new(nodes: &P2Nodes, problem: &dyn Problem) -> Self {
         let n = nodes.len();
+        let on_dirichlet = problem.dirichlet_components();
+        let mut fixed: Vec<[bool; 2]> =
+            nodes.part.iter().map(|part| if *part == Some(Part::Dirichlet) { on_dirichlet } else { [false, false] }).collect();
+        let points: Vec<(usize, [Option<f64>; 2])> = problem
+            .point_constraints()
+            .iter()
+            .filter_map(|c| {
+                let p = (0..nodes.n_vertices).find(|&p| crate::mesh::dist(nodes.coords[p], c.at) < POINT_TOLERANCE)?;
+                Some((p, c.u))
+            })
+            .collect();
+        for (p, u) in &points {
+            for i in 0..2 {
+                fixed[*p][i] |= u[i].is_some();
+            }
+        }
         let mut dof = vec![[FIXED; 2]; n];
         let mut contact = Vec::new();
         let mut contact_index = vec![None; n];
         let mut next = 0;
         for p in 0..n {
-            match nodes.part[p] {
-                Some(Part::Dirichlet) => {}
-                Some(Part::Contact) => {
-                    let x = nodes.coords[p];
-                    contact_index[p] = Some(contact.len());
-                    contact.push(ContactNode { node: p, normal: problem.contact_normal(x), gap: problem.gap(x) });
-                    dof[p][1] = next; // tangential unknown among the interior ones
+            if nodes.part[p] == Some(Part::Contact) && fixed[p] == [false, false] {
+                let x = nodes.coords[p];
+                contact_index[p] = Some(contact.len());
+                contact.push(ContactNode { node: p, normal: problem.contact_normal(x), gap: problem.gap(x) });
+                dof[p][1] = next; // tangential unknown among the interior ones
+                next += 1;
+                continue;
+            }
+            for i in 0..2 {
+                if !fixed[p][i] {
+                    dof[p][i] = next;
                     next += 1;
-                }
-                _ => {
-                    dof[p] = [next, next + 1];
-                    next += 2;
                 }
             }
         }
@@ -75,7 +100,31 @@ impl DofMap {
         for (k, c) in contact.iter().enumerate() {
             dof[c.node][0] = n_interior + k;
         }
-        DofMap { dof, n_free: n_interior + contact.len(), n_interior, contact, contact_index }
+        DofMap { dof, n_free: n_interior + contact.len(), n_interior, contact, contact_index, points }
+    }
+
+    /// The prescribed value of every node's fixed components (0 elsewhere): the problem's
+    /// Dirichlet data on Gamma_D, then the point constraints' values at their vertices.
+    pub fn prescribed(&self, nodes: &P2Nodes, problem: &dyn Problem) -> Vec<[f64; 2]> {
+        let mut values: Vec<[f64; 2]> = (0..nodes.len())
+            .map(|p| {
+                let mut v = if nodes.part[p] == Some(Part::Dirichlet) { problem.dirichlet(nodes.coords[p]) } else { [0.0, 0.0] };
+                for (i, vi) in v.iter_mut().enumerate() {
+                    if self.dof[p][i] != FIXED {
+                        *vi = 0.0;
+                    }
+                }
+                v
+            })
+            .collect();
+        for (p, u) in &self.points {
+            for i in 0..2 {
+                if let Some(ui) = u[i] {
+                    values[*p][i] = ui;
+                }
+            }
+        }
+        values
     }
 
     /// The rotation taking Cartesian components to the node's local ones (identity off contact).
@@ -103,10 +152,9 @@ impl DofMap {
         (0..self.dof.len())
             .map(|p| {
                 let d = self.dof[p];
-                if d[0] == FIXED {
-                    return dirichlet[p];
-                }
-                let local = [free[d[0]], free[d[1]]];
+                // a node with a prescribed component is never rotated (not a contact node)
+                let value = |i: usize| if d[i] == FIXED { dirichlet[p][i] } else { free[d[i]] };
+                let local = [value(0), value(1)];
                 match self.frame(p) {
                     // u = R^T local
                     Some(r) => [r[0][0] * local[0] + r[1][0] * local[1], r[0][1] * local[0] + r[1][1] * local[1]],
@@ -122,7 +170,8 @@ impl DofMap {
 pub struct System {
     pub matrix: SymCsc,
     pub rhs: Vec<f64>,
-    /// Dirichlet values (P2 interpolant of the data) at every node; zero off Gamma_D.
+    /// Prescribed values (P2 interpolant of the Dirichlet data, point constraints) of every
+    /// node's fixed components; zero elsewhere.
     pub dirichlet: Vec<[f64; 2]>,
 }
 
@@ -257,9 +306,7 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
     let material = problem.material();
     let mut matrix = pattern(nodes, dofs);
     let mut rhs = vec![0.0; dofs.n_free];
-    let dirichlet: Vec<[f64; 2]> = (0..nodes.len())
-        .map(|p| if nodes.part[p] == Some(Part::Dirichlet) { problem.dirichlet(nodes.coords[p]) } else { [0.0, 0.0] })
-        .collect();
+    let dirichlet = dofs.prescribed(nodes, problem);
     let stiff_rule = element::triangle_rule(2);
     let load_rule = element::triangle_rule(LOAD_DEGREE);
     let load_basis: Vec<[f64; N_NODES]> = load_rule.points.iter().map(|q| element::p2_values(q[0], q[1])).collect();
@@ -268,21 +315,7 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
         let corners = mesh.corners(t);
         let map = Affine::new(corners);
         e.k = element_stiffness(&map, material, &stiff_rule);
-        e.f = [0.0; 12];
-        let area = map.det.abs();
-        let crossing = breaks.iter().find(|&&c| corners.iter().any(|v| v[0] < c) && corners.iter().any(|v| v[0] > c));
-        if let Some(&c) = crossing {
-            e.f = split_load(&map, corners, c, &|x| problem.body_force(x));
-        } else {
-            for ((q, w), phi) in load_rule.points.iter().zip(&load_rule.weights).zip(&load_basis) {
-                let fx = problem.body_force(map.map(*q));
-                let (f0, f1) = (w * area * fx[0], w * area * fx[1]);
-                for (a, &p) in phi.iter().enumerate() {
-                    e.f[2 * a] += f0 * p;
-                    e.f[2 * a + 1] += f1 * p;
-                }
-            }
-        }
+        e.f = element_load(&map, corners, problem, &breaks, &load_rule, &load_basis);
         let el = &nodes.elements[t];
         rotate(&mut e.k, Some(&mut e.f), el, dofs);
         e.locate(el, dofs, &dirichlet);
@@ -303,6 +336,79 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
     drop(local);
     neumann_load(mesh, nodes, dofs, problem, &mut rhs);
     System { matrix, rhs, dirichlet }
+}
+
+/// The body-force load int_T f phi_a of one triangle, local order `2 a + i` (Cartesian): the
+/// rule `load_rule` (with its P2 values `load_basis`), or piecewise across a load break.
+fn element_load(
+    map: &Affine,
+    corners: [[f64; 2]; 3],
+    problem: &dyn Problem,
+    breaks: &[f64],
+    load_rule: &element::Rule<2>,
+    load_basis: &[[f64; N_NODES]],
+) -> [f64; 12] {
+    let crossing = breaks.iter().find(|&&c| corners.iter().any(|v| v[0] < c) && corners.iter().any(|v| v[0] > c));
+    if let Some(&c) = crossing {
+        return split_load(map, corners, c, &|x| problem.body_force(x));
+    }
+    let mut f = [0.0; 12];
+    let area = map.det.abs();
+    for ((q, w), phi) in load_rule.points.iter().zip(&load_rule.weights).zip(load_basis) {
+        let fx = problem.body_force(map.map(*q));
+        let (f0, f1) = (w * area * fx[0], w * area * fx[1]);
+        for (a, &p) in phi.iter().enumerate() {
+            f[2 * a] += f0 * p;
+            f[2 * a + 1] += f1 * p;
+        }
+    }
+    f
+}
+
+/// At every point constraint's node (`DofMap::points`), the Cartesian residual K u - F of its
+/// two components, from the elements around it (stiffness times the full displacement `u`,
+/// body force and Neumann traction as [`assemble`] integrates them): at a prescribed component
+/// the reaction force the constraint exerts (with its sign reversed), at a free one the
+/// equilibrium residual (zero to round-off).
+pub fn point_reactions(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem, u: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    if dofs.points.is_empty() {
+        return Vec::new();
+    }
+    let stiff_rule = element::triangle_rule(2);
+    let load_rule = element::triangle_rule(LOAD_DEGREE);
+    let load_basis: Vec<[f64; N_NODES]> = load_rule.points.iter().map(|q| element::p2_values(q[0], q[1])).collect();
+    let breaks = problem.load_breaks();
+    let gauss = element::gauss_legendre(EDGE_POINTS);
+    dofs.points
+        .iter()
+        .map(|&(p, _)| {
+            let mut r = [0.0; 2];
+            for (t, el) in nodes.elements.iter().enumerate() {
+                let Some(a) = el.iter().position(|&q| q == p) else { continue };
+                let corners = mesh.corners(t);
+                let map = Affine::new(corners);
+                let k = element_stiffness(&map, problem.material(), &stiff_rule);
+                let f = element_load(&map, corners, problem, &breaks, &load_rule, &load_basis);
+                for i in 0..2 {
+                    let row = 2 * a + i;
+                    r[i] += (0..12).map(|l| k[row][l] * u[el[l / 2]][l % 2]).sum::<f64>() - f[row];
+                }
+            }
+            for (be, bn) in mesh.boundary.iter().zip(&nodes.boundary_nodes) {
+                let Some(i) = bn.iter().position(|&q| q == p).filter(|_| be.part == Part::Neumann) else { continue };
+                let (a, b) = (mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
+                let (normal, len) = edge_normal(a, b);
+                for (s, w) in gauss.points.iter().zip(&gauss.weights) {
+                    let x = [a[0] + s[0] * (b[0] - a[0]), a[1] + s[0] * (b[1] - a[1])];
+                    let g = problem.traction(x, normal);
+                    let phi = edge_basis(s[0])[i];
+                    r[0] -= w * len * g[0] * phi;
+                    r[1] -= w * len * g[1] * phi;
+                }
+            }
+            r
+        })
+        .collect()
 }
 
 /// K u on the unknowns, element by element: for every triangle its stiffness in the local frames

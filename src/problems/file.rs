@@ -157,6 +157,14 @@ struct ExactToml {
     grad: Option<Spanned<Two<Two<Scalar>>>>,
 }
 
+/// `[[point_constraints]]`: components prescribed at one point.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PointToml {
+    at: Spanned<[Scalar; 2]>,
+    u: Spanned<[Scalar; 2]>,
+}
+
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct FileToml {
@@ -166,6 +174,8 @@ struct FileToml {
     dirichlet: Option<Spanned<VectorToml>>,
     required_vertices: Option<Spanned<Vec<Two<Scalar>>>>,
     load_breaks: Option<Spanned<Vec<Scalar>>>,
+    #[serde(default)]
+    point_constraints: Vec<PointToml>,
     #[serde(default)]
     constants: BTreeMap<String, Spanned<Scalar>>,
     material: MaterialToml,
@@ -434,6 +444,9 @@ pub struct FileProblem {
     body_force: [Expr; 2],
     traction: VectorData,
     dirichlet: VectorData,
+    /// The components `dirichlet` prescribes (a `"free"` one is not).
+    dirichlet_components: [bool; 2],
+    point_constraints: Vec<super::PointConstraint>,
     chi: Expr,
     normal: Normal,
     required_vertices: Vec<[f64; 2]>,
@@ -691,7 +704,8 @@ impl FileProblem {
             }
         };
         let traction = r.vector("traction", raw.traction.as_ref(), &["x", "y", "nx", "ny"], has_exact)?;
-        let dirichlet = r.vector("dirichlet", raw.dirichlet.as_ref(), &xy, has_exact)?;
+        let (dirichlet, dirichlet_components) = r.dirichlet(raw.dirichlet.as_ref(), has_exact)?;
+        let point_constraints = r.point_constraints(&raw.point_constraints)?;
         let chi = r.expr("contact.chi", raw.contact.chi.span(), raw.contact.chi.get_ref(), &xy)?;
         let normal_value = &raw.contact.normal;
         let normal = r.normal(normal_value, &parts, &curves)?;
@@ -711,6 +725,8 @@ impl FileProblem {
             body_force,
             traction,
             dirichlet,
+            dirichlet_components,
+            point_constraints,
             chi,
             normal,
             required_vertices,
@@ -789,6 +805,12 @@ impl Problem for FileProblem {
         };
         self.checked("dirichlet", x, u)
     }
+    fn dirichlet_components(&self) -> [bool; 2] {
+        self.dirichlet_components
+    }
+    fn point_constraints(&self) -> Vec<super::PointConstraint> {
+        self.point_constraints.clone()
+    }
     fn bad_datum(&self) -> Option<super::BadDatum> {
         self.watch.first()
     }
@@ -820,8 +842,9 @@ impl Problem for FileProblem {
     fn gap(&self, x: [f64; 2]) -> f64 {
         self.watch.check(&self.name, "contact.chi", x, self.chi.at(x))
     }
+    /// The declared ones, then the point constraints' points.
     fn required_vertices(&self) -> Vec<[f64; 2]> {
-        self.required_vertices.clone()
+        self.required_vertices.iter().copied().chain(self.point_constraints.iter().map(|c| c.at)).collect()
     }
     fn load_breaks(&self) -> Vec<f64> {
         self.load_breaks.clone()

@@ -88,8 +88,20 @@ pub trait Problem: Send + Sync {
     fn body_force(&self, x: [f64; 2]) -> [f64; 2];
     /// Neumann traction g at `x` on Gamma_N with outward unit normal `n`.
     fn traction(&self, x: [f64; 2], n: [f64; 2]) -> [f64; 2];
-    /// Dirichlet value on Gamma_D.
+    /// Dirichlet value on Gamma_D (of the components [`Problem::dirichlet_components`] names).
     fn dirichlet(&self, x: [f64; 2]) -> [f64; 2];
+    /// Which Cartesian components the Dirichlet data prescribe on Gamma_D: both by default. A
+    /// component left free carries zero traction there (rollers: `[true, false]` on a side
+    /// x = c prescribes u_1 and leaves the shear traction zero).
+    fn dirichlet_components(&self) -> [bool; 2] {
+        [true, true]
+    }
+    /// Components prescribed at single mesh vertices (e.g. u_2 = 0 at one point, fixing the
+    /// rigid motion that rollers leave free). Each point is also a required vertex; where a
+    /// point lies on Gamma_D its prescribed components win over the Dirichlet data.
+    fn point_constraints(&self) -> Vec<PointConstraint> {
+        Vec::new()
+    }
     /// Outward unit normal of Gamma_C at `x`.
     fn contact_normal(&self, x: [f64; 2]) -> [f64; 2];
     /// The gap chi: the constraint is u . n <= chi on Gamma_C.
@@ -124,6 +136,14 @@ pub trait Problem: Send + Sync {
     fn bad_datum(&self) -> Option<BadDatum> {
         None
     }
+}
+
+/// Components of the displacement prescribed at one point (a mesh vertex).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct PointConstraint {
+    pub at: [f64; 2],
+    /// The prescribed value of each Cartesian component; `None` leaves it free.
+    pub u: [Option<f64>; 2],
 }
 
 /// A datum of a problem that is not a finite number at a point where it is used (a body force

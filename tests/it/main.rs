@@ -41,6 +41,7 @@ mod problems;
 mod record_schema;
 mod report_page;
 mod resume;
+mod rollers;
 mod scratch;
 mod store;
 mod stress_frame;

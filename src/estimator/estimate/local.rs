@@ -129,7 +129,8 @@ pub(super) fn element_locals(
         .collect()
 }
 
-/// The residuals on local edge `le` of element `t` if it is a Neumann or contact edge.
+/// The residuals on local edge `le` of element `t` if it is a Neumann or contact edge, or a
+/// Dirichlet edge with a component left free.
 #[allow(clippy::too_many_arguments)]
 fn boundary_edge(
     mesh: &Mesh,
@@ -182,7 +183,13 @@ fn boundary_edge(
                 out.penetration[le] = out.penetration[le].max(un - gap);
                 out.separation[le] = out.separation[le].max(gap - un);
             }
-            Part::Dirichlet => {}
+            Part::Dirichlet => {
+                // a component the Dirichlet data leave free carries zero traction (rollers):
+                // its residual is a Neumann one
+                let prescribed = problem.dirichlet_components();
+                let free = (0..2).filter(|&i| !prescribed[i]).fold(0.0f64, |a, i| a.max(tr[i].abs()));
+                out.neumann[le] = out.neumann[le].max(free);
+            }
         }
     }
 }

@@ -261,6 +261,69 @@ impl Reader<'_> {
         Ok((required_vertices, load_breaks))
     }
 
+    /// `dirichlet`: the data and the components they prescribe; a component written `"free"` is
+    /// not prescribed (zero traction there, rollers), and at least one must be.
+    pub(super) fn dirichlet(
+        &self,
+        value: Option<&Spanned<VectorToml>>,
+        has_exact: bool,
+    ) -> Result<(VectorData, [bool; 2]), ProblemFileError> {
+        if let Some(v) = value
+            && let VectorToml::Pair(pair) = v.get_ref()
+        {
+            let free = [0, 1].map(|i| is_free(&pair[i]));
+            if free == [true, true] {
+                return Err(self.error(
+                    "dirichlet",
+                    v.span(),
+                    "at least one component prescribed (a number or an expression; \"free\" leaves one free): a side with both free is Neumann, leave it out of parts.dirichlet",
+                ));
+            }
+            let data = [0, 1].map(|i| if free[i] { Scalar::Number(0.0) } else { pair[i].clone() });
+            return Ok((VectorData::Exprs(self.pair("dirichlet", v.span(), &data, &["x", "y"])?), free.map(|f| !f)));
+        }
+        Ok((self.vector("dirichlet", value, &["x", "y"], has_exact)?, [true, true]))
+    }
+
+    /// `[[point_constraints]]`: each a point `at` (numbers or expressions of the constants) and
+    /// the components `u` prescribed there (numbers or expressions of the constants, or
+    /// `"free"`; at least one prescribed); no point twice.
+    pub(super) fn point_constraints(&self, raw: &[PointToml]) -> Result<Vec<super::super::PointConstraint>, ProblemFileError> {
+        let mut out: Vec<super::super::PointConstraint> = Vec::new();
+        for (i, c) in raw.iter().enumerate() {
+            let key = format!("point_constraints[{i}]");
+            let number = |k: &str, v: &Spanned<[Scalar; 2]>, j: usize| {
+                self.number(&format!("{key}.{k}[{j}]"), &Spanned::new(v.span(), v.get_ref()[j].clone()))
+            };
+            let at = [number("at", &c.at, 0)?, number("at", &c.at, 1)?];
+            let mut u = [None, None];
+            for (j, uj) in u.iter_mut().enumerate() {
+                if !is_free(&c.u.get_ref()[j]) {
+                    *uj = Some(number("u", &c.u, j)?);
+                }
+            }
+            if u == [None, None] {
+                return Err(self.error(
+                    &format!("{key}.u"),
+                    c.u.span(),
+                    "at least one component prescribed (a number or an expression of the constants; \"free\" leaves one free)",
+                ));
+            }
+            if let Some(j) = out.iter().position(|o| (o.at[0] - at[0]).hypot(o.at[1] - at[1]) < 1e-12) {
+                return Err(self.error(
+                    &format!("{key}.at"),
+                    c.at.span(),
+                    format!(
+                        "a point not constrained before: ({}, {}) is point_constraints[{j}] too (give both components in one entry)",
+                        at[0], at[1]
+                    ),
+                ));
+            }
+            out.push(super::super::PointConstraint { at, u });
+        }
+        Ok(out)
+    }
+
     /// `[exact]`: the exact displacement and its gradient (derived when not given).
     pub(super) fn exact(&self, raw: &Option<ExactToml>) -> Result<Option<ExactExprs>, ProblemFileError> {
         let xy = ["x", "y"];
@@ -290,4 +353,9 @@ impl Reader<'_> {
             }
         })
     }
+}
+
+/// Whether a component is written `"free"` (not prescribed).
+fn is_free(value: &Scalar) -> bool {
+    matches!(value, Scalar::Text(t) if t.trim() == "free")
 }
