@@ -49,10 +49,11 @@ fn string(s: &str) -> String {
 
 /// A value written anew; `expr`: its strings are expressions and its numbers may be written as
 /// expression strings (a number or expression key), else strings are kept as they are (names,
-/// predicates, the words "exact" and "outward").
+/// predicates, the words "exact", "outward" and "free").
 fn value(v: &Value, expr: bool, c: &mut Choices) -> String {
     match v {
-        Value::String(s) if expr => string(&expression(s, c)),
+        // "free" (a component left free) is a word, not an expression
+        Value::String(s) if expr && s != "free" => string(&expression(s, c)),
         Value::String(s) => string(s),
         Value::Integer(i) => match c.pick(3) {
             0 => i.to_string(),
