@@ -17,7 +17,7 @@ pub mod report;
 pub use crate::contact::solve::ContactSample;
 pub use finite::{NonFinite, first_non_finite};
 pub use history::{BadFlags, Flags, History, LevelHistory};
-pub use reference::ReferenceRecord;
+pub use reference::{Rebuild, ReferenceRecord};
 
 use std::io::Write;
 use std::path::Path;

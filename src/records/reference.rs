@@ -20,6 +20,13 @@ pub struct ReferenceRecord {
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub inputs: BTreeMap<String, String>,
     pub spec: ReferenceSpec,
+    #[serde(flatten)]
+    pub rebuild: Rebuild,
+}
+
+/// How to rebuild a reference solution from the initial mesh, whatever it is the reference of.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Rebuild {
     /// NDF of the reference solution (its last level).
     pub ndof: usize,
     /// The record of the last level (timings and memory as measured when it was computed).
@@ -44,18 +51,15 @@ struct Identity<'a> {
 }
 
 impl ReferenceRecord {
-    /// The record of a reference computed for `run` (whose spec declares it).
-    pub fn new(run: &RunSpec, spec: &ReferenceSpec, last: LevelRecord, history: History, final_active: &[bool]) -> Self {
+    /// The record of `run`'s reference solution (its spec declares `spec`), rebuilt by `rebuild`.
+    pub fn new(run: &RunSpec, spec: &ReferenceSpec, rebuild: Rebuild) -> Self {
         ReferenceRecord {
             problem: run.problem.clone(),
             mesh: run.mesh.clone(),
             constants: run.constants.clone(),
             inputs: run.inputs.clone(),
             spec: spec.clone(),
-            ndof: last.ndof,
-            last,
-            history,
-            final_active: Some(super::Flags::encode(final_active)),
+            rebuild,
         }
     }
 

@@ -390,16 +390,16 @@ fn compare_references(study: &str, stored: &StudyDir, fresh: &StudyDir, runs: &[
     let mut out = Vec::new();
     let keys: std::collections::BTreeSet<String> = runs.iter().filter_map(|r| crate::records::ReferenceRecord::key_of(&r.run)).collect();
     let describe = |r: &Option<crate::records::ReferenceRecord>| {
-        r.as_ref().map_or("(missing)".to_string(), |r| format!("NDF {} after {} levels", r.ndof, r.history.levels.len()))
+        r.as_ref().map_or("(missing)".to_string(), |r| format!("NDF {} after {} levels", r.rebuild.ndof, r.rebuild.history.levels.len()))
     };
     for key in keys {
         let label = format!("reference {key}");
         let (s, f) = (stored.read_reference(&key).ok().flatten(), fresh.read_reference(&key).ok().flatten());
         match (&s, &f) {
             (Some(a), Some(b)) => {
-                if let Some((level, field, sv, fv)) = first_history_difference(&a.history, &b.history) {
+                if let Some((level, field, sv, fv)) = first_history_difference(&a.rebuild.history, &b.rebuild.history) {
                     out.push(row(study, &label, Some(level), &format!("history.{field}"), sv, fv, None, "exact".into()));
-                } else if a.ndof != b.ndof || a.history.levels.len() != b.history.levels.len() {
+                } else if a.rebuild.ndof != b.rebuild.ndof || a.rebuild.history.levels.len() != b.rebuild.history.levels.len() {
                     out.push(row(study, &label, None, "history", describe(&s), describe(&f), None, "exact".into()));
                 }
             }

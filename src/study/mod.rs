@@ -353,7 +353,7 @@ fn store_missing_reference(manifest: &Manifest, dir: &StudyDir, spec: &RunSpec, 
     }
     let _lock = StudyLock::acquire(dir, true)?;
     let mut batch = Batch::default();
-    store::stage_reference(dir, &reference.record, &mut batch)?;
+    store::stage_reference(dir, &crate::records::ReferenceRecord::new(spec, &reference.spec, reference.rebuild.clone()), &mut batch)?;
     Ok(batch.commit()?)
 }
 
@@ -482,7 +482,7 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
                 let started = std::time::Instant::now();
                 let label = format!("{study}/{}: reference solution (adaptive to NDF >= {})", spec.id, rs.min_ndof);
                 let spinner = Progress::new(progress, 0, &label);
-                let field = reference::compute(problem.as_ref(), &mesh_spec, spec, &mut |r| {
+                let field = reference::compute(problem.as_ref(), &mesh_spec, rs, &mut |r| {
                     spinner.message(format!("level {}, NDF {} of at least {}", r.level, r.ndof, rs.min_ndof));
                     if interrupted() { ControlFlow::Break(()) } else { ControlFlow::Continue(()) }
                 })
@@ -527,13 +527,13 @@ pub fn preload_references(manifest: &Manifest, stored: &StudyDir, progress: bool
             let label = format!(
                 "{study}/{}: reference solution rebuilt from its stored history (level {}, NDF {})",
                 spec.id,
-                record.history.levels.len().saturating_sub(1),
-                record.ndof
+                record.rebuild.history.levels.len().saturating_sub(1),
+                record.rebuild.ndof
             );
             let spinner = Progress::new(progress, 0, &label);
             let problem = problems::load(&problem_path, &spec.constants)?;
             let mesh_spec = MeshSpec::parse(&mesh_path)?;
-            let field = reference::replay(problem.as_ref(), &mesh_spec, &record).with_context(|| {
+            let field = reference::replay(problem.as_ref(), &mesh_spec, &record.spec, &record.rebuild).with_context(|| {
                 format!("{study}/{}: replaying the stored reference {}", spec.id, stored.reference_file(&file_key).display())
             })?;
             spinner.finish();
@@ -575,7 +575,7 @@ fn run_one(
     }
     let reference_ndof = prepared.reference.as_ref().map(|r| r.ndof);
     if let Some(r) = &prepared.reference {
-        store::stage_reference(dir, &r.record, meshes)?;
+        store::stage_reference(dir, &crate::records::ReferenceRecord::new(spec, &r.spec, r.rebuild.clone()), meshes)?;
     }
     Ok(Some(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof, history: Some(history) }))
 }

@@ -8,7 +8,7 @@ use crate::element::{self, N_NODES};
 use crate::mesh::locate::Locator;
 use crate::mesh::{Mesh, MeshSpec};
 use crate::problems::Problem;
-use crate::records::{ReferenceRecord, ReferenceSpec, RunSpec};
+use crate::records::{Flags, Rebuild, ReferenceSpec};
 
 /// A P2 field on a mesh with an R*-tree for point location ([`Locator`]).
 pub struct ReferenceField {
@@ -17,15 +17,17 @@ pub struct ReferenceField {
     values: Vec<[f64; 2]>,
     locator: Locator,
     pub ndof: usize,
-    /// How to rebuild it: what the study stores (`references/KEY.json`).
-    pub record: ReferenceRecord,
+    /// How it was computed and how to rebuild it: what a study stores (`references/KEY.json`,
+    /// `records::ReferenceRecord`).
+    pub spec: ReferenceSpec,
+    pub rebuild: Rebuild,
 }
 
 impl ReferenceField {
-    pub fn new(mesh: Mesh, elements: Vec<[usize; 6]>, values: Vec<[f64; 2]>, record: ReferenceRecord) -> Self {
+    pub fn new(mesh: Mesh, elements: Vec<[usize; 6]>, values: Vec<[f64; 2]>, spec: ReferenceSpec, rebuild: Rebuild) -> Self {
         let locator = Locator::new(&mesh);
         let ndof = 2 * values.len();
-        ReferenceField { mesh, elements, values, locator, ndof, record }
+        ReferenceField { mesh, elements, values, locator, ndof, spec, rebuild }
     }
 
     /// The field at x: in the triangle containing x (the one of smallest index where x is on an
@@ -67,7 +69,7 @@ fn config_of(spec: &ReferenceSpec) -> AdaptConfig {
     AdaptConfig { levels: REFERENCE_LEVELS, refine: Refine::Adaptive, theta: spec.theta, estimator, ..Default::default() }
 }
 
-/// Compute the reference solution `run` declares: adaptive refinement from `mesh_spec`
+/// Compute the reference solution `spec` declares: adaptive refinement from `mesh_spec`
 /// ([`config_of`]) until the NDF reaches `min_ndof`; the last level's solution, with the
 /// history that rebuilds it. `on_level` sees every level (progress) and may stop the loop (an
 /// interrupt): then the result is `None`. A loop that ends short of `min_ndof` (after
@@ -75,10 +77,9 @@ fn config_of(spec: &ReferenceSpec) -> AdaptConfig {
 pub fn compute(
     problem: &dyn Problem,
     mesh_spec: &MeshSpec,
-    run: &RunSpec,
+    spec: &ReferenceSpec,
     on_level: &mut dyn FnMut(&crate::adapt::LevelRecord) -> std::ops::ControlFlow<()>,
 ) -> Result<Option<ReferenceField>, ReferenceError> {
-    let spec = run.reference.as_ref().expect("compute is called for a run that declares a reference");
     let mesh = mesh_spec.build(problem).map_err(|e| adapt::AdaptError::Solve(e.into()))?;
     let config = config_of(spec);
     // the automatic ordering even in a round-off measurement (SIGNORINI_ORDERING): the reference
@@ -90,8 +91,9 @@ pub fn compute(
     })?;
     let last = out.records.last().expect("level 0 is always solved");
     if last.ndof >= spec.min_ndof {
-        let record = ReferenceRecord::new(run, spec, last.clone(), out.history, &out.solution.active);
-        return Ok(Some(ReferenceField::new(out.mesh, out.solution.nodes.elements, out.solution.u, record)));
+        let rebuild =
+            Rebuild { ndof: last.ndof, last: last.clone(), history: out.history, final_active: Some(Flags::encode(&out.solution.active)) };
+        return Ok(Some(ReferenceField::new(out.mesh, out.solution.nodes.elements, out.solution.u, spec.clone(), rebuild)));
     }
     if out.termination == adapt::Termination::StoppedByObserver {
         return Ok(None); // on_level stopped it (an interrupt)
@@ -110,10 +112,15 @@ pub fn compute(
 /// (every level's fingerprint checked), solved once, as the loop solved it (the automatic
 /// ordering, as in [`compute`]), from the active set the loop's solve ended with (else from its
 /// warm start): the same solution in one solve, and in one numeric factorisation.
-pub fn replay(problem: &dyn Problem, mesh_spec: &MeshSpec, record: &ReferenceRecord) -> Result<ReferenceField, ReferenceError> {
+pub fn replay(
+    problem: &dyn Problem,
+    mesh_spec: &MeshSpec,
+    spec: &ReferenceSpec,
+    record: &Rebuild,
+) -> Result<ReferenceField, ReferenceError> {
     use adapt::replay::ReplayError;
     let mesh0 = mesh_spec.build(problem).map_err(|e| adapt::AdaptError::Solve(e.into()))?;
-    let config = config_of(&record.spec);
+    let config = config_of(spec);
     let last = record.history.levels.len().checked_sub(1).ok_or(adapt::AdaptError::from(ReplayError::Short { level: 0, held: 0 }))?;
     let mesh = adapt::replay::mesh_at(mesh0, &record.history, last).map_err(adapt::AdaptError::from)?;
     let start = record.final_active.as_ref().or(record.history.levels[last].initial_active.as_ref());
@@ -124,5 +131,5 @@ pub fn replay(problem: &dyn Problem, mesh_spec: &MeshSpec, record: &ReferenceRec
     if solved.record.ndof != record.ndof {
         return Err(ReferenceError::Replayed { stored: record.ndof, replayed: solved.record.ndof });
     }
-    Ok(ReferenceField::new(mesh, solved.solution.nodes.elements, solved.solution.u, record.clone()))
+    Ok(ReferenceField::new(mesh, solved.solution.nodes.elements, solved.solution.u, spec.clone(), record.clone()))
 }

@@ -493,9 +493,9 @@ pub fn reference_faults(dir: &StudyDir, runs: &[RunRecord]) -> Vec<Fault> {
             Ok(Some(stored)) if stored.key() != key => {
                 format!("is the reference of {} on {}, not of run {}", stored.problem, stored.mesh, r.run.id)
             }
-            Ok(Some(stored)) if Some(stored.ndof) != r.reference_ndof => format!(
+            Ok(Some(stored)) if Some(stored.rebuild.ndof) != r.reference_ndof => format!(
                 "has {} unknowns; run {} was measured against a reference of {}",
-                stored.ndof,
+                stored.rebuild.ndof,
                 r.run.id,
                 r.reference_ndof.map_or("none".to_string(), |n| n.to_string())
             ),
@@ -512,7 +512,9 @@ pub fn reference_faults(dir: &StudyDir, runs: &[RunRecord]) -> Vec<Fault> {
 /// same NDF): a run stores the reference it was measured against, with the run.
 pub fn stage_reference(dir: &StudyDir, reference: &records::ReferenceRecord, batch: &mut Batch) -> Result<()> {
     let file = dir.reference_file(&reference.key());
-    let same = |s: &records::ReferenceRecord| s.history == reference.history && s.ndof == reference.ndof && s.key() == reference.key();
+    let same = |s: &records::ReferenceRecord| {
+        s.rebuild.history == reference.rebuild.history && s.rebuild.ndof == reference.rebuild.ndof && s.key() == reference.key()
+    };
     if !matches!(dir.read_reference(&reference.key()), Ok(Some(s)) if same(&s)) {
         batch.add_json(&file, reference)?;
     }

@@ -139,11 +139,13 @@ fn stored_reference_replays_to_the_computed_one() {
     use signorini::study::reference;
     let m = Manifest::load(Path::new(&fixture())).unwrap();
     let spec = &m.runs[0].spec;
+    let reference_spec = spec.reference.as_ref().unwrap();
     let problem = signorini::problems::load(&spec.problem, &spec.constants).unwrap();
     let mesh_spec = MeshSpec::parse(&spec.mesh).unwrap();
-    let computed = reference::compute(problem.as_ref(), &mesh_spec, spec, &mut |_| std::ops::ControlFlow::Continue(())).unwrap().unwrap();
-    assert!(computed.record.history.levels.len() > 3, "the reference loop refines several levels");
-    let replayed = reference::replay(problem.as_ref(), &mesh_spec, &computed.record).unwrap();
+    let computed =
+        reference::compute(problem.as_ref(), &mesh_spec, reference_spec, &mut |_| std::ops::ControlFlow::Continue(())).unwrap().unwrap();
+    assert!(computed.rebuild.history.levels.len() > 3, "the reference loop refines several levels");
+    let replayed = reference::replay(problem.as_ref(), &mesh_spec, reference_spec, &computed.rebuild).unwrap();
     assert_eq!(replayed.ndof, computed.ndof);
     for i in 0..=20 {
         for j in 0..=20 {
@@ -151,12 +153,13 @@ fn stored_reference_replays_to_the_computed_one() {
             assert_eq!(replayed.eval(x), computed.eval(x), "at {x:?}");
         }
     }
-    let mut altered = computed.record.clone();
+    let mut altered = computed.rebuild.clone();
     let level = altered.history.levels.len() / 2;
     let mut marks = altered.history.levels[level].marks.decode().unwrap();
     let first_unmarked = marks.iter().position(|m| !m).unwrap();
     marks[first_unmarked] = true;
     altered.history.levels[level].marks = signorini::records::Flags::encode(&marks);
-    let e = reference::replay(problem.as_ref(), &mesh_spec, &altered).err().expect("altered marks do not replay").to_string();
+    let e =
+        reference::replay(problem.as_ref(), &mesh_spec, reference_spec, &altered).err().expect("altered marks do not replay").to_string();
     assert!(e.contains(&format!("level {}", level + 1)) && e.contains("fingerprint"), "{e}");
 }
