@@ -389,9 +389,9 @@ pub fn point_reactions(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dy
                 let map = Affine::new(corners);
                 let k = element_stiffness(&map, problem.material(), &stiff_rule);
                 let f = element_load(&map, corners, problem, &breaks, &load_rule, &load_basis);
-                for i in 0..2 {
+                for (i, ri) in r.iter_mut().enumerate() {
                     let row = 2 * a + i;
-                    r[i] += (0..12).map(|l| k[row][l] * u[el[l / 2]][l % 2]).sum::<f64>() - f[row];
+                    *ri += (0..12).map(|l| k[row][l] * u[el[l / 2]][l % 2]).sum::<f64>() - f[row];
                 }
             }
             for (be, bn) in mesh.boundary.iter().zip(&nodes.boundary_nodes) {
