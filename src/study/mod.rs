@@ -692,9 +692,11 @@ pub fn replay_stored_level(manifest: &Manifest, stored: &RunRecord, level: usize
     let mesh0 = prepared.initial_mesh()?;
     let config = AdaptConfig::for_run(spec);
     let problem = prepared.problem.as_ref();
+    let spinner = Progress::new(progress, 0, &what);
     let (_, solved) = prepared
         .with_error_against(|r| adapt::replay::solve_stored_level(problem, mesh0, &config, history, level, stored.levels.get(level), r))
         .context(what)?;
+    spinner.finish();
     Ok(solved)
 }
 

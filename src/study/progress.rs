@@ -5,16 +5,34 @@
 
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// The longest a plain-line progress stays silent while its step reports.
 pub const PLAIN_EVERY: Duration = Duration::from_secs(10);
 
-/// A progress display: hidden, a bar, or plain lines.
+/// A progress display: hidden, a bar, or plain lines (with a heartbeat: a step that reports
+/// nothing for [`PLAIN_EVERY`], one long solve, still prints a line saying it is at work).
 pub struct Progress {
     bar: ProgressBar,
-    plain: Option<Mutex<Plain>>,
+    plain: Option<Arc<Mutex<Plain>>>,
+    heartbeat: Mutex<Option<Heartbeat>>,
+}
+
+/// The thread that prints a plain line when the step has been silent for [`PLAIN_EVERY`];
+/// stopped (and joined) when the progress is finished or dropped.
+struct Heartbeat {
+    stop: std::sync::mpsc::Sender<()>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Drop for Heartbeat {
+    fn drop(&mut self) {
+        let _ = self.stop.send(());
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
 }
 
 struct Plain {
@@ -23,18 +41,34 @@ struct Plain {
     pos: u64,
     started: Instant,
     last: Instant,
+    /// The step's latest report (what the heartbeat repeats).
+    msg: Option<String>,
+}
+
+impl Plain {
+    /// Print where the step is now, and remember when.
+    fn print(&mut self) {
+        self.last = Instant::now();
+        let left =
+            if self.len > 0 { format!(", {} of {} levels left", self.len.saturating_sub(self.pos), self.len) } else { String::new() };
+        let msg = self.msg.as_deref().unwrap_or("at work");
+        // a progress line that cannot be written is no reason to stop the computation
+        use std::io::Write;
+        let _ = writeln!(std::io::stderr(), "{}: {msg}{left} [{:.0} s]", self.prefix, self.started.elapsed().as_secs_f64());
+    }
 }
 
 impl Progress {
     /// `len` steps (0: unknown, a spinner) under `prefix`; nothing at all unless `progress`.
     pub fn new(progress: bool, len: u64, prefix: &str) -> Progress {
         if !progress {
-            return Progress { bar: ProgressBar::hidden(), plain: None };
+            return Progress { bar: ProgressBar::hidden(), plain: None, heartbeat: Mutex::new(None) };
         }
         if !std::io::stderr().is_terminal() {
             let now = Instant::now();
-            let plain = Plain { prefix: prefix.to_string(), len, pos: 0, started: now, last: now };
-            return Progress { bar: ProgressBar::hidden(), plain: Some(Mutex::new(plain)) };
+            let plain = Arc::new(Mutex::new(Plain { prefix: prefix.to_string(), len, pos: 0, started: now, last: now, msg: None }));
+            let heartbeat = Heartbeat::start(plain.clone());
+            return Progress { bar: ProgressBar::hidden(), plain: Some(plain), heartbeat: Mutex::new(Some(heartbeat)) };
         }
         let bar = if len == 0 { ProgressBar::new_spinner() } else { ProgressBar::new(len) };
         let style = if len == 0 {
@@ -47,7 +81,7 @@ impl Progress {
         bar.set_style(style);
         bar.set_prefix(prefix.to_string());
         bar.enable_steady_tick(Duration::from_millis(200));
-        Progress { bar, plain: None }
+        Progress { bar, plain: None, heartbeat: Mutex::new(None) }
     }
 
     /// `n` more steps done.
@@ -65,17 +99,34 @@ impl Progress {
             return;
         };
         let mut p = p.lock().expect("progress");
-        if p.last.elapsed() < PLAIN_EVERY {
-            return;
+        p.msg = Some(msg);
+        if p.last.elapsed() >= PLAIN_EVERY {
+            p.print();
         }
-        p.last = Instant::now();
-        let left = if p.len > 0 { format!(", {} of {} levels left", p.len.saturating_sub(p.pos), p.len) } else { String::new() };
-        // a progress line that cannot be written is no reason to stop the computation
-        use std::io::Write;
-        let _ = writeln!(std::io::stderr(), "{}: {msg}{left} [{:.0} s]", p.prefix, p.started.elapsed().as_secs_f64());
     }
 
     pub fn finish(&self) {
+        drop(self.heartbeat.lock().expect("progress").take());
         self.bar.finish_and_clear();
+    }
+}
+
+impl Heartbeat {
+    fn start(plain: Arc<Mutex<Plain>>) -> Heartbeat {
+        let (stop, stopped) = std::sync::mpsc::channel::<()>();
+        let thread = std::thread::spawn(move || {
+            loop {
+                let wait = PLAIN_EVERY.saturating_sub(plain.lock().expect("progress").last.elapsed());
+                match stopped.recv_timeout(wait.max(Duration::from_millis(100))) {
+                    Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {}
+                    _ => return,
+                }
+                let mut p = plain.lock().expect("progress");
+                if p.last.elapsed() >= PLAIN_EVERY {
+                    p.print();
+                }
+            }
+        });
+        Heartbeat { stop, thread: Some(thread) }
     }
 }
