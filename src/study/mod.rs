@@ -525,7 +525,7 @@ pub fn preload_references(manifest: &Manifest, stored: &StudyDir, progress: bool
         reference_for(&key, || {
             let started = std::time::Instant::now();
             let label = format!(
-                "{study}/{}: reference solution rebuilt from its stored history (level {}, NDF {})",
+                "{study}/{}: reference solution from its stored history (level {}, NDF {})",
                 spec.id,
                 record.rebuild.history.levels.len().saturating_sub(1),
                 record.rebuild.ndof
@@ -538,7 +538,7 @@ pub fn preload_references(manifest: &Manifest, stored: &StudyDir, progress: bool
             })?;
             spinner.finish();
             if progress {
-                crate::base::note::line(format_args!("{label}: {:.1} s", started.elapsed().as_secs_f64()));
+                crate::base::note::line(format_args!("{label}: rebuilt in {:.1} s", started.elapsed().as_secs_f64()));
             }
             Ok(field)
         })?;
