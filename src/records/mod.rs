@@ -321,6 +321,16 @@ pub struct MeshSnapshot {
     pub kinks: Vec<[f64; 2]>,
 }
 
+/// The JSON file at `path` read as a `T`; `None` if there is no such file; one that does not
+/// parse, or cannot be read, is an error naming it.
+fn read_if_present<T: serde::de::DeserializeOwned>(path: &Path) -> std::io::Result<Option<T>> {
+    match std::fs::read_to_string(path) {
+        Ok(text) => serde_json::from_str(&text).map(Some).map_err(|e| std::io::Error::other(format!("{}: {e}", path.display()))),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(std::io::Error::new(e.kind(), format!("reading {}: {e}", path.display()))),
+    }
+}
+
 /// Where a study's records live: `results/STUDY/`.
 #[derive(Clone, Debug)]
 pub struct StudyDir {
@@ -351,12 +361,7 @@ impl StudyDir {
     /// The stored reference solution of `key`, if there is one; one that does not parse is an
     /// error naming the file.
     pub fn read_reference(&self, key: &str) -> std::io::Result<Option<ReferenceRecord>> {
-        let f = self.reference_file(key);
-        match std::fs::read_to_string(&f) {
-            Ok(text) => serde_json::from_str(&text).map(Some).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display()))),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-            Err(e) => Err(std::io::Error::new(e.kind(), format!("reading {}: {e}", f.display()))),
-        }
+        read_if_present(&self.reference_file(key))
     }
 
     /// `meshes/RUN_levelL.vtu` and `.json`.
@@ -402,12 +407,7 @@ impl StudyDir {
     }
 
     pub fn read_run(&self, run: &str) -> std::io::Result<Option<RunRecord>> {
-        let f = self.run_file(run);
-        match std::fs::read_to_string(&f) {
-            Ok(text) => serde_json::from_str(&text).map(Some).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display()))),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-            Err(e) => Err(std::io::Error::new(e.kind(), format!("reading {}: {e}", f.display()))),
-        }
+        read_if_present(&self.run_file(run))
     }
 
     pub fn read_mesh(&self, run: &str, level: usize) -> std::io::Result<MeshSnapshot> {
