@@ -11,6 +11,18 @@ use std::time::{Duration, Instant};
 /// The longest a plain-line progress stays silent while its step reports.
 pub const PLAIN_EVERY: Duration = Duration::from_secs(10);
 
+/// The environment variable that turns every progress display off: `SIGNORINI_PROGRESS=off`.
+/// Progress lines depend on time (a step slower than [`PLAIN_EVERY`] prints one), so output
+/// compared line by line (the documentation's commands, `tests/it/doc_commands.rs`) is taken
+/// without them; a log that wants only results does the same. Any other value (or none): shown.
+pub const PROGRESS_ENV: &str = "SIGNORINI_PROGRESS";
+
+/// Whether [`PROGRESS_ENV`] turns progress off, read once per process.
+fn switched_off() -> bool {
+    static OFF: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *OFF.get_or_init(|| std::env::var(PROGRESS_ENV).is_ok_and(|v| v == "off"))
+}
+
 /// A progress display: hidden, a bar, or plain lines (with a heartbeat: a step that reports
 /// nothing for [`PLAIN_EVERY`], one long solve, still prints a line saying it is at work).
 pub struct Progress {
@@ -61,7 +73,7 @@ impl Plain {
 impl Progress {
     /// `len` steps (0: unknown, a spinner) under `prefix`; nothing at all unless `progress`.
     pub fn new(progress: bool, len: u64, prefix: &str) -> Progress {
-        if !progress {
+        if !progress || switched_off() {
             return Progress { bar: ProgressBar::hidden(), plain: None, heartbeat: Mutex::new(None) };
         }
         if !std::io::stderr().is_terminal() {

@@ -15,6 +15,9 @@
 //!   (trailing spaces aside), where `[..]` inside a line matches any text and a line `...`
 //!   matches any number of lines; no lines means the output is not checked;
 //! * the command must exit 0.
+//!
+//! Progress lines are switched off (`SIGNORINI_PROGRESS=off`): a step slower than 10 s prints
+//! one, so whether they appear depends on the machine's speed, not on the command.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -147,6 +150,9 @@ fn every_console_block_in_the_docs_runs_as_written() {
             .arg(format!("exec 2>&1; set -o pipefail; {}", case.command))
             .current_dir(&dir)
             .env("PATH", &path)
+            // progress lines come with time (a step slower than 10 s prints one): not part of
+            // what a block shows
+            .env("SIGNORINI_PROGRESS", "off")
             .output()
             .unwrap();
         let printed = String::from_utf8_lossy(&out.stdout).into_owned();
