@@ -28,6 +28,8 @@ pub enum SolveError {
     Data(#[from] crate::problems::BadDatum),
     #[error(transparent)]
     ContactData(#[from] Box<super::plausible::ContactDataError>),
+    #[error(transparent)]
+    Exact(#[from] crate::problems::consistent::ExactError),
     /// No boundary edge of the mesh is in the contact part.
     #[error("the problem's contact part matches no boundary edge of the mesh: there is nothing to be in contact (the problem declares: {})", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") })]
     NoContact { declared: Vec<String> },
@@ -125,6 +127,7 @@ pub fn solve(
     let dofs = DofMap::new(&nodes, problem);
     certify::check_held(mesh, &nodes, &dofs, problem)?;
     super::plausible::check_contact_data(mesh, &nodes, &dofs, problem)?;
+    crate::problems::consistent::check_exact(problem, mesh)?;
     if dofs.contact.is_empty() {
         return Err(SolveError::NoContact { declared: problem.declared_parts() });
     }

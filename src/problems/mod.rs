@@ -7,6 +7,7 @@
 //! expressions in x and y. [`by_name`] takes either.
 
 pub mod builtin;
+pub mod consistent;
 pub mod file;
 
 pub use builtin::{Ex71, Ex72, Fb, Patch, contact_bottom_dirichlet_top};

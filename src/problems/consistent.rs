@@ -1,0 +1,229 @@
+//! An exact solution that is one: its gradient is the derivative of its displacement, and the
+//! body force is -div sigma(u) (paper eq. 1.1), checked on the mesh before a solve
+//! ([`check_exact`]). A problem file may state `exact.grad` by hand (exmex cannot differentiate
+//! `max`), and its body force is always written by hand: a slip in either is otherwise a silent
+//! wrong answer. The traction `"exact"` is sigma(grad) n, so a wrong gradient solves another
+//! problem than the one whose u the errors are measured against; a wrong body force does the
+//! same. Both are certified solutions of the wrong problem, and the error rates only look poor.
+//!
+//! The derivatives are taken by central differences at the centroids of up to [`SAMPLES`]
+//! triangles spread over the mesh, with the steps `s` and `s / 2`, `s` a thousandth of the
+//! triangle's longest edge. A central difference is second-order, so the two steps differ by
+//! about 3/4 of the larger one's error; a mismatch is reported only where it exceeds
+//! [`CONSISTENT`] times the data's scale and [`BEYOND`] times that difference. Where a kink of
+//! the data falls inside the stencil (fb's (x - a)_+^(1/2) in f, at x = a) the two steps
+//! disagree by about as much as the mismatch, and the point proves nothing either way: it is
+//! passed over, not refused.
+
+use crate::mesh::Mesh;
+use crate::problems::Problem;
+
+/// Triangles sampled (spread evenly over the mesh's numbering).
+pub const SAMPLES: usize = 97;
+
+/// The smallest mismatch reported, relative to the largest value of the quantity over the samples.
+pub const CONSISTENT: f64 = 1e-6;
+
+/// How many times the difference between the two steps a mismatch must exceed to be reported.
+pub const BEYOND: f64 = 100.0;
+
+/// An exact solution that contradicts itself or the body force.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ExactError {
+    #[error(
+        "{problem}: the exact solution's gradient contradicts its displacement: at ({x}, {y}) `exact.grad[{i}][{j}]` (d u_{i1} / d {var}) is {declared:.6e}, while central differences of `exact.u[{i}]` give {differenced:.6e} (steps {step:.1e} and half that agree to {spread:.1e}), at {count} of {sampled} sampled points; write the derivative of u there, or leave `exact.grad` out and it is differentiated from u",
+        x = .at[0], y = .at[1], i1 = .i + 1, var = ["x", "y"][*.j]
+    )]
+    Gradient {
+        problem: String,
+        at: [f64; 2],
+        i: usize,
+        j: usize,
+        declared: f64,
+        differenced: f64,
+        step: f64,
+        spread: f64,
+        count: usize,
+        sampled: usize,
+    },
+    #[error(
+        "{problem}: the body force is not -div sigma(u) of the exact solution: at ({x}, {y}) `body_force[{i}]` is {declared:.6e}, while -div sigma(u) is {differenced:.6e} by central differences of sigma(exact.grad) (steps {step:.1e} and half that agree to {spread:.1e}), at {count} of {sampled} sampled points; an exact solution must solve the equations, -div sigma(u) = f (paper eq. 1.1)",
+        x = .at[0], y = .at[1]
+    )]
+    BodyForce {
+        problem: String,
+        at: [f64; 2],
+        i: usize,
+        declared: f64,
+        differenced: f64,
+        step: f64,
+        spread: f64,
+        count: usize,
+        sampled: usize,
+    },
+}
+
+/// One comparison at one point: what the problem states, the difference quotient with the
+/// steps `step` and `step / 2`.
+struct Sample {
+    at: [f64; 2],
+    declared: f64,
+    coarse: f64,
+    fine: f64,
+    step: f64,
+}
+
+impl Sample {
+    /// The mismatch, if it is one: beyond [`CONSISTENT`] times `scale` and [`BEYOND`] times the
+    /// two steps' difference.
+    fn contradicts(&self, scale: f64) -> bool {
+        let off = (self.fine - self.declared).abs();
+        let spread = (self.coarse - self.fine).abs();
+        [self.declared, self.coarse, self.fine].iter().all(|v| v.is_finite()) && off > CONSISTENT * scale && off > BEYOND * spread
+    }
+}
+
+/// Central difference of `f` at `x` along axis `j` with step `s`.
+fn central(f: &dyn Fn([f64; 2]) -> f64, x: [f64; 2], j: usize, s: f64) -> f64 {
+    let (mut a, mut b) = (x, x);
+    a[j] += s;
+    b[j] -= s;
+    (f(a) - f(b)) / (2.0 * s)
+}
+
+/// The centroid of every sampled triangle and its step (a thousandth of its longest edge).
+fn points(mesh: &Mesh) -> Vec<([f64; 2], f64)> {
+    let n = mesh.n_triangles();
+    let (lo, hi) = mesh.vertices.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), v| {
+        ([lo[0].min(v[0]), lo[1].min(v[1])], [hi[0].max(v[0]), hi[1].max(v[1])])
+    });
+    // a step of at least 1e-6 of the body's size: round-off in the differences stays far below
+    // the mismatches reported, on the smallest triangles of a graded mesh too
+    let diameter = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+    let picks = SAMPLES.min(n);
+    (0..picks)
+        .map(|k| {
+            let t = mesh.triangles[k * n / picks].map(|v| mesh.vertices[v]);
+            let c = [(t[0][0] + t[1][0] + t[2][0]) / 3.0, (t[0][1] + t[1][1] + t[2][1]) / 3.0];
+            let longest = (0..3).map(|e| (t[e][0] - t[(e + 1) % 3][0]).hypot(t[e][1] - t[(e + 1) % 3][1])).fold(0.0, f64::max);
+            (c, 1e-3 * longest.max(1e-3 * diameter))
+        })
+        .collect()
+}
+
+/// The first contradicting sample of each list (by key, then point), with how many contradict.
+fn first_contradiction(samples: &[Sample]) -> Option<(&Sample, usize)> {
+    let scale = samples.iter().flat_map(|s| [s.declared.abs(), s.fine.abs()]).filter(|v| v.is_finite()).fold(0.0, f64::max);
+    let bad: Vec<&Sample> = samples.iter().filter(|s| s.contradicts(scale)).collect();
+    bad.first().map(|s| (*s, bad.len()))
+}
+
+/// Check `problem`'s exact solution, if it has one, on `mesh` (see the module docs).
+pub fn check_exact(problem: &dyn Problem, mesh: &Mesh) -> Result<(), ExactError> {
+    let Some(exact) = problem.exact() else { return Ok(()) };
+    let name = match problem.source() {
+        Some(file) => format!("problem file {}", file.display()),
+        None => format!("problem {}", problem.name()),
+    };
+    let pts = points(mesh);
+    for i in 0..2 {
+        for j in 0..2 {
+            let u = |x: [f64; 2]| exact.u(x)[i];
+            let samples: Vec<Sample> = pts
+                .iter()
+                .map(|&(at, s)| Sample {
+                    at,
+                    declared: exact.grad(at)[i][j],
+                    coarse: central(&u, at, j, s),
+                    fine: central(&u, at, j, s / 2.0),
+                    step: s,
+                })
+                .collect();
+            if let Some((s, count)) = first_contradiction(&samples) {
+                let (declared, differenced, step, spread) = (s.declared, s.fine, s.step, (s.coarse - s.fine).abs());
+                return Err(ExactError::Gradient {
+                    problem: name,
+                    at: s.at,
+                    i,
+                    j,
+                    declared,
+                    differenced,
+                    step,
+                    spread,
+                    count,
+                    sampled: pts.len(),
+                });
+            }
+        }
+    }
+    let material = problem.material();
+    for i in 0..2 {
+        // (sigma e_j)_i = sigma_ij: -div sigma(u)_i = -sum_j d/dx_j (sigma(grad) e_j)_i
+        let minus_div = |x: [f64; 2], s: f64| -> f64 {
+            let div: f64 = (0..2)
+                .map(|j| {
+                    let mut e = [0.0; 2];
+                    e[j] = 1.0;
+                    central(&|y| material.traction(exact.grad(y), e)[i], x, j, s)
+                })
+                .sum();
+            -div
+        };
+        let samples: Vec<Sample> = pts
+            .iter()
+            .map(|&(at, s)| Sample {
+                at,
+                declared: problem.body_force(at)[i],
+                coarse: minus_div(at, s),
+                fine: minus_div(at, s / 2.0),
+                step: s,
+            })
+            .collect();
+        if let Some((s, count)) = first_contradiction(&samples) {
+            let (declared, differenced, step, spread) = (s.declared, s.fine, s.step, (s.coarse - s.fine).abs());
+            return Err(ExactError::BodyForce {
+                problem: name,
+                at: s.at,
+                i,
+                declared,
+                differenced,
+                step,
+                spread,
+                count,
+                sampled: pts.len(),
+            });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(declared: f64, coarse: f64, fine: f64) -> Sample {
+        Sample { at: [0.0, 0.0], declared, coarse, fine, step: 1e-3 }
+    }
+
+    #[test]
+    fn a_mismatch_counts_only_beyond_the_steps_own_disagreement() {
+        // converged differences far from the declared value: a contradiction
+        assert!(sample(1.0, 2.0 + 1e-9, 2.0).contradicts(2.0));
+        // a kink inside the stencil: the two steps disagree as much as the mismatch
+        assert!(!sample(1.0, 3.0, 2.0).contradicts(2.0));
+        // round-off sized mismatches, and values that are not numbers, prove nothing
+        assert!(!sample(1.0, 1.0 + 1e-9, 1.0 + 1e-9).contradicts(1.0));
+        assert!(!sample(f64::NAN, 2.0, 2.0).contradicts(2.0));
+    }
+
+    #[test]
+    fn the_built_in_exact_solutions_are_consistent() {
+        for problem in crate::problems::KNOWN {
+            let p = crate::problems::by_name(problem).unwrap();
+            for n in [4, 16] {
+                let mesh = crate::mesh::MeshSpec::parse(&format!("structured:{n}")).unwrap().build(p.as_ref()).unwrap();
+                assert_eq!(check_exact(p.as_ref(), &mesh), Ok(()), "{problem} on structured:{n}");
+            }
+        }
+    }
+}
