@@ -14,8 +14,8 @@ pub const QUADRATURE_DEGREE: usize = 5;
 /// Order of the barycentric lattice of the "dense" norm (28 points per element).
 pub const LATTICE_ORDER: usize = 6;
 
-/// Which points an L-infinity norm is taken over.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// Which points an L-infinity norm is taken over (`--sampling`, `estimator.sampling`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum Sampling {
     Quadrature,

@@ -86,6 +86,9 @@ pub enum MeshSpec {
 }
 
 impl MeshSpec {
+    /// The initial mesh when none is given (`adapt --mesh`, a manifest's `mesh`).
+    pub const DEFAULT: &str = "structured:4";
+
     pub fn parse(s: &str) -> Result<Self, MeshError> {
         let bad = || MeshError::BadSpec(s.to_string());
         let (kind, rest) = s.split_once(':').ok_or_else(bad)?;

@@ -116,8 +116,8 @@ pub fn study_of(figure: &str) -> Option<&'static str> {
     })
 }
 
-/// C0 of Section 7.
-const C0_PAPER: f64 = 0.45;
+// C0 of Section 7
+use crate::estimator::estimate::C0_PAPER;
 /// An estimator term below `ROUNDOFF` times the largest term of its level is round-off: drawn
 /// as 0 (not at all, on a log axis). Legitimate small terms are 1e-6 of the largest or more in
 /// every stored run; round-off is 1e-18 of it.

@@ -291,6 +291,11 @@ pub struct ReferenceSpec {
     pub contact_term: crate::estimate::ContactTerm,
 }
 
+impl ReferenceSpec {
+    /// The contact term of a reference whose manifest names none.
+    pub const DEFAULT_CONTACT_TERM: crate::estimate::ContactTerm = crate::estimate::ContactTerm::WithoutFullContact;
+}
+
 /// The record of one finished run: its spec and one `LevelRecord` per level.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunRecord {

@@ -347,12 +347,13 @@ fn parse_run(
         };
         return Err(invalid.at(key("problem"), &expected, format!("{problem:?}")));
     }
-    let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| "structured:4".into());
+    let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| MeshSpec::DEFAULT.into());
     MeshSpec::parse(&resolve_mesh(path, &mesh))
         .map_err(|_| invalid.at(key("mesh"), "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'", format!("{mesh:?}")))?;
     let levels = r.levels.or(d.levels).ok_or_else(|| invalid.at(key("levels"), "a number of levels >= 1", "nothing".into()))?;
-    let theta = r.theta.or(d.theta).unwrap_or(0.5);
-    let e = EstimatorConfig::default();
+    let defaults = AdaptConfig::default();
+    let theta = r.theta.or(d.theta).unwrap_or(defaults.theta);
+    let e = defaults.estimator;
     let (eo, ed) = (r.estimator.clone().unwrap_or_default(), d.estimator.clone().unwrap_or_default());
     let estimator = EstimatorConfig {
         c0: eo.c0.or(ed.c0).unwrap_or(e.c0),
@@ -373,7 +374,7 @@ fn parse_run(
         id,
         problem,
         mesh,
-        refine: r.refine.or(d.refine).unwrap_or(Refine::Adaptive),
+        refine: r.refine.or(d.refine).unwrap_or(defaults.refine),
         theta,
         levels,
         max_ndof: r.max_ndof.or(d.max_ndof),
@@ -382,7 +383,7 @@ fn parse_run(
         reference: reference.map(|rf| ReferenceSpec {
             theta: rf.theta,
             min_ndof: rf.min_ndof,
-            contact_term: rf.contact_term.unwrap_or(ContactTerm::WithoutFullContact),
+            contact_term: rf.contact_term.unwrap_or(ReferenceSpec::DEFAULT_CONTACT_TERM),
         }),
         save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
         constants,
