@@ -672,7 +672,7 @@ fn run_drift(
         results: results.to_path_buf(),
         progress: true,
     };
-    let report = study::drift::run(&manifests, only.is_empty(), &options, &|r| {
+    let report = study::drift::check(&manifests, only.is_empty(), &options, &|r| {
         signorini::claims::claims(r).map(|c| signorini::claims::markdown_for(&c, r))
     })?;
     // the table first: a report that cannot be written must not cost it

@@ -197,7 +197,7 @@ fn transfer_active_set(old_mesh: &Mesh, old: &DiscreteSolution, refinement: &Ref
 
 /// Why [`run`] stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Termination {
+pub enum AdaptTermination {
     /// All `AdaptConfig::levels` levels were solved.
     LevelsReached,
     /// The next level would have had more unknowns than `AdaptConfig::max_ndof` (it was not solved).
@@ -212,19 +212,19 @@ pub enum Termination {
     NothingMarked,
 }
 
-impl Termination {
+impl AdaptTermination {
     /// Why the loop stopped before its last level, in a sentence (None: all levels were solved,
     /// or the caller stopped it and knows why).
     pub fn note(self, config: &AdaptConfig) -> Option<String> {
         match self {
-            Termination::LevelsReached | Termination::StoppedByObserver => None,
-            Termination::MaxNdofReached => {
+            AdaptTermination::LevelsReached | AdaptTermination::StoppedByObserver => None,
+            AdaptTermination::MaxNdofReached => {
                 Some(format!("stopped: the next level would have more than max_ndof = {} unknowns", config.max_ndof.unwrap_or(0)))
             }
-            Termination::StopNdofReached => {
+            AdaptTermination::StopNdofReached => {
                 Some(format!("stopped: the last level has at least stop_ndof = {} unknowns", config.stop_ndof.unwrap_or(0)))
             }
-            Termination::NothingMarked => Some(
+            AdaptTermination::NothingMarked => Some(
                 "stopped: the estimate is zero on every element, so nothing is marked and the next level would be the same mesh".into(),
             ),
         }
@@ -244,7 +244,7 @@ pub struct AdaptResult {
     pub records: Vec<LevelRecord>,
     /// The refinement history of every level in `records`.
     pub history: History,
-    pub termination: Termination,
+    pub termination: AdaptTermination,
 }
 
 /// Where the loop starts: the mesh of level `level`, the active set its solve starts from, and
@@ -362,7 +362,7 @@ pub fn solve_level(
 /// `config` must be valid ([`AdaptConfig::validate`]); at least level 0 is always solved.
 ///
 /// ```rust
-/// use signorini::adapt::{self, AdaptConfig, Termination};
+/// use signorini::adapt::{self, AdaptConfig, AdaptTermination};
 /// use signorini::mesh::MeshSpec;
 /// use signorini::problems::{self, Problem};
 /// use std::ops::ControlFlow;
@@ -374,7 +374,7 @@ pub fn solve_level(
 /// let exact = problem.exact().unwrap();
 /// let u = |x: [f64; 2]| exact.u(x);
 /// let result = adapt::run(problem.as_ref(), mesh, &config, Some(&u), &mut |_| ControlFlow::Continue(())).unwrap();
-/// assert_eq!(result.termination, Termination::LevelsReached);
+/// assert_eq!(result.termination, AdaptTermination::LevelsReached);
 /// assert_eq!(result.records.len(), 3);
 /// assert_eq!(result.history.levels.len(), 3);
 /// assert_eq!(result.records[2].ndof, 2 * result.solution.nodes.len());
@@ -409,13 +409,13 @@ pub fn run_from(
     }
     let Start { mut mesh, level: first, mut initial_active, mut records, mut history } = start;
     let mut state: Option<(Mesh, DiscreteSolution, Estimate)> = None;
-    let mut termination = Termination::LevelsReached;
+    let mut termination = AdaptTermination::LevelsReached;
     for level in first..config.levels {
         if let Some(max) = config.max_ndof
             && level > 0
             && mesh.p2_ndof() > max
         {
-            termination = Termination::MaxNdofReached;
+            termination = AdaptTermination::MaxNdofReached;
             break;
         }
         let t_level = Instant::now();
@@ -457,13 +457,13 @@ pub fn run_from(
         history.levels.push(entry);
         state = Some((mesh, sol, est));
         if flow.is_break() {
-            termination = Termination::StoppedByObserver;
+            termination = AdaptTermination::StoppedByObserver;
             break;
         }
         if reached {
-            termination = Termination::StopNdofReached;
+            termination = AdaptTermination::StopNdofReached;
         } else if next.is_none() && unmarked && level + 1 < config.levels {
-            termination = Termination::NothingMarked;
+            termination = AdaptTermination::NothingMarked;
         }
         match next {
             Some((m, active)) => {

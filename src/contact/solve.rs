@@ -3,7 +3,7 @@
 
 use crate::assembly::{self, DofMap, System};
 use crate::certify::{self, Certificate, KktError, KktInput, RigidMotionError};
-use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, Strategy, Termination, Timings};
+use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, PdasTermination, Strategy, Timings};
 use crate::element::{self, Affine};
 use crate::mesh::locate::Locator;
 use crate::mesh::{Mesh, MeshError, P2Nodes};
@@ -49,7 +49,7 @@ pub struct DiscreteSolution {
     /// Active contact nodes (u_h(p).n = chi_h(p) enforced).
     pub active: Vec<bool>,
     pub pdas: Vec<PdasIteration>,
-    pub termination: Termination,
+    pub termination: PdasTermination,
     /// Complementarity constant used.
     pub c: f64,
     /// Largest |F - K u| over the unknowns other than contact normals, relative to max |F|.

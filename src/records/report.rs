@@ -69,7 +69,7 @@ pub struct SolveReport {
     /// Largest |F - K u_h| over unknowns other than contact normals, relative to max |F|.
     pub free_residual: f64,
     pub error: Option<LinfError>,
-    pub error_sampling: ErrorSampling,
+    pub error_sampling: NormPoints,
     pub estimator: Terms,
     pub estimator_config: EstimatorConfig,
     pub full_contact_nodes: usize,
@@ -80,7 +80,7 @@ pub struct SolveReport {
 
 /// Which points the error norms are taken over.
 #[derive(Clone, Debug, Serialize)]
-pub struct ErrorSampling {
+pub struct NormPoints {
     pub quadrature: String,
     pub dense: String,
 }
@@ -120,7 +120,7 @@ impl SolveReport {
             certificate_tolerance: crate::certify::TOLERANCE,
             free_residual: sol.free_residual,
             error,
-            error_sampling: ErrorSampling {
+            error_sampling: NormPoints {
                 quadrature: crate::norms::Sampling::Quadrature.describe(),
                 dense: crate::norms::Sampling::Dense.describe(),
             },

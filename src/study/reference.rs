@@ -95,7 +95,7 @@ pub fn compute(
             Rebuild { ndof: last.ndof, last: last.clone(), history: out.history, final_active: Some(Flags::encode(&out.solution.active)) };
         return Ok(Some(ReferenceField::new(out.mesh, out.solution.nodes.elements, out.solution.u, spec.clone(), rebuild)));
     }
-    if out.termination == adapt::Termination::StoppedByObserver {
+    if out.termination == adapt::AdaptTermination::StoppedByObserver {
         return Ok(None); // on_level stopped it (an interrupt)
     }
     let why = format!(
