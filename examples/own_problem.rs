@@ -5,7 +5,8 @@
 //! `cargo run --release --example own_problem`
 
 use signorini::adapt::{self, AdaptConfig, AdaptTermination};
-use signorini::mesh::{MeshSpec, Part};
+use signorini::mesh::MeshSpec;
+use signorini::problems::Part;
 use signorini::problems::{Material, Problem, contact_bottom_dirichlet_top};
 use std::ops::ControlFlow;
 

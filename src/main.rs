@@ -2,11 +2,12 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use signorini::adapt::{self, AdaptConfig, Refine};
+use signorini::adapt::{self, AdaptConfig};
 use signorini::contact::PdasOptions;
 use signorini::estimate::{self, ContactTerm, EstimatorConfig, LogFactor};
 use signorini::mesh::MeshSpec;
 use signorini::norms::Sampling;
+use signorini::records::Refine;
 use signorini::{norms, problems, report, solve, study};
 use std::process::ExitCode;
 
@@ -197,7 +198,7 @@ enum Command {
 }
 
 /// The estimator's flags. Each argument's id is the setting's key (`estimator.c0`, as
-/// [`adapt::ConfigError`] names it), its default the library's ([`EstimatorConfig::default`]),
+/// [`estimate::ConfigError`] names it), its default the library's ([`EstimatorConfig::default`]),
 /// its values the library's enums ([`clap::ValueEnum`]).
 #[derive(clap::Args)]
 struct EstimatorArgs {
@@ -313,7 +314,7 @@ fn flag_of(sub: &str, key: &str) -> String {
 /// Validate the loop's settings as manifests do (the same functions), naming the flag of the
 /// subcommand `sub`: every setting, and `max_ndof` against the initial mesh `spec`.
 fn validate(sub: &str, config: &AdaptConfig, spec: &MeshSpec) -> Result<()> {
-    let flag = |e: adapt::ConfigError| anyhow::anyhow!("{}: expected {}, got {}", flag_of(sub, e.key), e.expected, e.got);
+    let flag = |e: estimate::ConfigError| anyhow::anyhow!("{}: expected {}, got {}", flag_of(sub, e.key), e.expected, e.got);
     config.validate().map_err(flag)?;
     config.check_initial(spec.ndof()?, &spec.to_string()).map_err(flag)
 }
@@ -332,9 +333,9 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
     let config =
         AdaptConfig { levels: args.adapt_levels.map_or(200, |l| l + 1), theta, estimator, pdas: pdas.clone(), ..Default::default() };
     validate("solve", &config, &spec)?;
-    solve::check_memory(&spec.to_string(), spec.ndof()?)?;
+    signorini::memory::check_memory(&spec.to_string(), spec.ndof()?)?;
     if let Some(n) = args.adapt_min_ndof {
-        solve::check_memory(&format!("an adaptive level reaching --adapt-min-ndof {n}"), n as f64)?;
+        signorini::memory::check_memory(&format!("an adaptive level reaching --adapt-min-ndof {n}"), n as f64)?;
     }
     let mut mesh = spec.build(problem.as_ref())?;
     // probes outside the initial mesh fail before anything is solved
@@ -390,7 +391,7 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
     if let Some(path) = &args.save {
         check_writable(path)?;
     }
-    solve::check_memory(&spec.to_string(), spec.ndof()?)?;
+    signorini::memory::check_memory(&spec.to_string(), spec.ndof()?)?;
     let mesh = spec.build(problem.as_ref())?;
     let exact = problem.exact();
     let reference = exact.map(|e| move |x: [f64; 2]| e.u(x));

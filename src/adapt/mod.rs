@@ -7,13 +7,13 @@
 pub mod replay;
 
 use crate::contact::PdasOptions;
-use crate::estimate::{self, Estimate, EstimatorConfig};
+use crate::contact::norms::{self, Reference};
+use crate::contact::solve::{self, DiscreteSolution, SolveError};
+use crate::estimator::estimate::{self, Estimate, EstimatorConfig};
 use crate::mesh::Mesh;
 use crate::mesh::refine::{self, Refinement};
-use crate::norms::{self, Reference};
 use crate::problems::Problem;
-pub use crate::records::{Flags, History, LevelHistory, LevelRecord, Refine};
-use crate::solve::{self, DiscreteSolution, SolveError};
+use crate::records::{Flags, History, LevelHistory, LevelRecord, Refine};
 use std::ops::ControlFlow;
 use std::time::Instant;
 
@@ -35,7 +35,7 @@ pub struct AdaptConfig {
 }
 
 /// A setting of the loop outside its range (the estimator's error type: one for all settings).
-pub use crate::estimate::ConfigError;
+use crate::estimator::estimate::ConfigError;
 
 /// Why the loop could not run: settings out of range (checked before anything is solved) or a
 /// level whose solve failed.
@@ -51,7 +51,7 @@ pub enum AdaptError {
     /// The next level would not fit in memory: levels `0..level` were solved (and seen by the
     /// observer), level `level` was not.
     #[error("stopped before level {level} ({}): {error}", if *level == 0 { "no level was solved".to_string() } else { format!("levels 0 to {} were solved", level - 1) })]
-    Memory { level: usize, error: solve::MemoryError },
+    Memory { level: usize, error: crate::base::memory::MemoryError },
     /// A start at or beyond the last level: nothing is left to solve.
     #[error("nothing to solve: the loop starts at level {start} and has {levels} levels")]
     NothingToSolve { start: usize, levels: usize },
@@ -171,7 +171,7 @@ pub fn free_boundary_edge(mesh: &Mesh, sol: &DiscreteSolution) -> Option<f64> {
     mesh.boundary
         .iter()
         .zip(&sol.nodes.boundary_nodes)
-        .filter(|(e, _)| e.part == crate::mesh::Part::Contact)
+        .filter(|(e, _)| e.part == crate::problems::Part::Contact)
         .filter_map(|(e, nodes)| {
             let active: Vec<bool> = nodes.iter().map(|&n| sol.dofs.contact_index[n].is_some_and(|k| sol.active[k])).collect();
             (active.contains(&true) && active.contains(&false)).then(|| crate::mesh::dist(mesh.vertices[e.v[0]], mesh.vertices[e.v[1]]))
@@ -184,7 +184,7 @@ pub fn free_boundary_edge(mesh: &Mesh, sol: &DiscreteSolution) -> Option<f64> {
 fn transfer_active_set(old_mesh: &Mesh, old: &DiscreteSolution, refinement: &Refinement, problem: &dyn Problem) -> Vec<bool> {
     let new_nodes = crate::mesh::P2Nodes::new(&refinement.mesh);
     let u = refine::transfer_p2(old_mesh, &old.nodes, &old.u, refinement, &new_nodes);
-    let dofs = crate::assembly::DofMap::new(&new_nodes, problem);
+    let dofs = crate::fem::assembly::DofMap::new(&new_nodes, problem);
     let scale = u.iter().fold(0.0f64, |a, v| a.max(v[0].abs()).max(v[1].abs())).max(f64::MIN_POSITIVE);
     dofs.contact
         .iter()
@@ -288,7 +288,7 @@ pub fn solve_level(
     // before every level, not only the first: an adaptive loop grows until it does not fit;
     // `measured`: unknowns and peak resident bytes of a measured solve, if known (the previous
     // level's in the loop, the level's own stored one in a replay)
-    solve::check_memory_measured(&format!("level {level} of the adaptive loop"), ndof as f64, measured)
+    crate::base::memory::check_memory_measured(&format!("level {level} of the adaptive loop"), ndof as f64, measured)
         .map_err(|error| AdaptError::Memory { level, error })?;
     let mut options = config.pdas.clone();
     if config.warm_start {
@@ -420,7 +420,7 @@ pub fn run_from(
         }
         let t_level = Instant::now();
         let previous = records.last().and_then(LevelRecord::measured_peak);
-        let measured = crate::memory::reset_peak_resident();
+        let measured = crate::base::memory::reset_peak_resident();
         let started_from = initial_active.take().filter(|_| config.warm_start);
         let Solved { mut record, solution: sol, estimate: est, marks } =
             solve_level(problem, &mesh, level, config, reference, started_from.clone(), previous)?;
@@ -443,7 +443,7 @@ pub fn run_from(
             Some((refinement.mesh, active))
         };
         record.t_level = t_level.elapsed().as_secs_f64();
-        record.mem_peak_mib = crate::memory::peak_resident().filter(|_| measured).map(|b| b / (1024.0 * 1024.0));
+        record.mem_peak_mib = crate::base::memory::peak_resident().filter(|_| measured).map(|b| b / (1024.0 * 1024.0));
         let flow = observer(Level {
             record: &record,
             mesh: &mesh,

@@ -34,10 +34,10 @@
 //! L never shares the memory with them (at `structured:512` they take 0.6 GB, L 2.2 GB). The
 //! Refactor strategy keeps both: it changes the matrix's values in every iteration.
 
-use crate::cholesky;
-use crate::ordering::OrderingChoice;
+use crate::sparse::cholesky;
 use crate::sparse::csc::SymCsc;
-use crate::symbolic::{self, Placement, Symbolic};
+use crate::sparse::ordering::OrderingChoice;
+use crate::sparse::symbolic::{self, Placement, Symbolic};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use std::time::Instant;
@@ -96,7 +96,7 @@ pub struct PdasIteration {
 
 /// Why the iteration stopped. Only `Converged` and `NoContact` are solutions of the discrete
 /// problem; [`PdasTermination::error`] turns the other two into the [`ContactError`] that
-/// [`crate::solve::solve`] reports.
+/// [`crate::contact::solve::solve`] reports.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub enum PdasTermination {
     /// The active set repeated and the residual was below tolerance.

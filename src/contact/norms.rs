@@ -3,9 +3,9 @@
 //! quadrature points of every element (the paper's way), on a dense barycentric lattice of every
 //! element, and over the nodal values only (which is not the L-infinity norm).
 
-use crate::element;
+use crate::base::element;
+use crate::contact::solve::DiscreteSolution;
 use crate::mesh::Mesh;
-use crate::solve::DiscreteSolution;
 use rayon::prelude::*;
 
 /// Degree of the quadrature rule whose points the "quadrature" norm uses (collapsed Gauss,
@@ -99,7 +99,7 @@ pub fn linf_error_contact(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference)
             let mut refs = Vec::new();
             for b in sol.nodes.element_boundary[t].iter().flatten() {
                 let e = &mesh.boundary[*b];
-                if e.part != crate::mesh::Part::Contact {
+                if e.part != crate::problems::Part::Contact {
                     continue;
                 }
                 let (i, j) = (tri.iter().position(|&v| v == e.v[0])?, tri.iter().position(|&v| v == e.v[1])?);

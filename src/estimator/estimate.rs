@@ -28,11 +28,12 @@
 mod local;
 pub mod repair;
 
-use crate::element::EDGE_VERTICES;
-use crate::mesh::{Mesh, Part, dist};
-use crate::norms::Sampling;
+use crate::base::element::EDGE_VERTICES;
+use crate::contact::norms::Sampling;
+use crate::contact::solve::DiscreteSolution;
+use crate::mesh::{Mesh, dist};
+use crate::problems::Part;
 use crate::problems::Problem;
-use crate::solve::DiscreteSolution;
 use rayon::prelude::*;
 
 /// Threshold, relative to the force scale, above which lambda_p counts as positive (Lambda_h^C).

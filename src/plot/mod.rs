@@ -66,7 +66,7 @@ pub mod render;
 mod repair;
 mod rich;
 
-use crate::estimate::{ContactTerm, LogFactor};
+use crate::estimator::estimate::{ContactTerm, LogFactor};
 use crate::records::{LevelRecord, Refine};
 use crate::records::{MeshSnapshot, RunRecord, StudyDir};
 use anyhow::Context;

@@ -52,10 +52,11 @@
 //! reference, `max_ndof` against the initial mesh) is checked by [`Manifest::check_runs`] for
 //! every run before any is solved.
 
-use crate::adapt::{AdaptConfig, Refine};
-use crate::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
+use crate::adapt::AdaptConfig;
+use crate::contact::norms::Sampling;
+use crate::estimator::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
 use crate::mesh::MeshSpec;
-use crate::norms::Sampling;
+use crate::records::Refine;
 use crate::records::{ReferenceSpec, RunSpec};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -367,7 +368,7 @@ fn parse_run(
     if let Some(rf) = &reference
         && !(rf.theta > 0.0 && rf.theta <= 1.0)
     {
-        return Err(invalid.at(key("reference.theta"), "a number in (0, 1]", crate::adapt::ConfigError::number(rf.theta)));
+        return Err(invalid.at(key("reference.theta"), "a number in (0, 1]", crate::estimator::estimate::ConfigError::number(rf.theta)));
     }
     let inputs = input_hashes(path, &problem, &mesh).map_err(|(k, e)| invalid.at(key(k), "a readable file", e))?;
     let spec = RunSpec {
@@ -468,7 +469,7 @@ fn check_drift(drift: &DriftSpec, runs: &[PlannedRun], invalid: &Invalid) -> Res
             ));
         }
         if !r.min.is_finite() {
-            return Err(invalid.at(key("min"), "a finite rate", crate::adapt::ConfigError::number(r.min)));
+            return Err(invalid.at(key("min"), "a finite rate", crate::estimator::estimate::ConfigError::number(r.min)));
         }
         if r.last < 2 || r.last > run.spec.levels {
             return Err(invalid.at(
@@ -585,7 +586,7 @@ impl Manifest {
     /// solved (a mistake in the last run must not cost the first one's): the mesh is read and
     /// built with the run's problem (a missing or malformed mesh file, a boundary group the
     /// problem does not name, a kink that is not a vertex), the initial mesh and the reference
-    /// solution's `min_ndof` fit in this machine's memory ([`check_memory`](crate::solve::check_memory)),
+    /// solution's `min_ndof` fit in this machine's memory ([`check_memory`](crate::base::memory::check_memory)),
     /// `max_ndof` is at least the initial mesh's unknowns (level 0 is always solved), and a
     /// reference is declared only for a problem without an exact solution.
     pub fn check_runs(&self) -> Result<(), ManifestError> {
@@ -607,7 +608,7 @@ impl Manifest {
         let mesh_spec = MeshSpec::parse(&resolve_mesh(&self.file, &spec.mesh))
             .map_err(|e| invalid("mesh", "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'".into(), format!("{:?}: {e}", spec.mesh)))?;
         let ndof = mesh_spec.ndof().map_err(|e| invalid("mesh", "a readable mesh file".into(), format!("{:?}: {e}", spec.mesh)))?;
-        crate::solve::check_memory(&format!("the initial mesh {}", spec.mesh), ndof)
+        crate::base::memory::check_memory(&format!("the initial mesh {}", spec.mesh), ndof)
             .map_err(|e| invalid("mesh", "an initial mesh that fits in this machine's memory".into(), e.to_string()))?;
         mesh_spec
             .build(problem.as_ref())
@@ -621,9 +622,9 @@ impl Manifest {
                     format!("a reference with min_ndof {}", rf.min_ndof),
                 ));
             }
-            crate::solve::check_memory(&format!("the reference solution (min_ndof {})", rf.min_ndof), rf.min_ndof as f64).map_err(|e| {
-                invalid("reference.min_ndof", "a reference solution that fits in this machine's memory".into(), e.to_string())
-            })?;
+            crate::base::memory::check_memory(&format!("the reference solution (min_ndof {})", rf.min_ndof), rf.min_ndof as f64).map_err(
+                |e| invalid("reference.min_ndof", "a reference solution that fits in this machine's memory".into(), e.to_string()),
+            )?;
         }
         Ok(())
     }

@@ -9,10 +9,12 @@
 
 use crate::common;
 use common::*;
-use signorini::adapt::{self, AdaptConfig, Level, LevelRecord, Refine};
+use signorini::adapt::{self, AdaptConfig, Level};
 use signorini::estimate::{ContactTerm, EstimatorConfig};
-use signorini::mesh::{Mesh, Part, dist};
+use signorini::mesh::{Mesh, dist};
+use signorini::problems::Part;
 use signorini::problems::{Ex71, Ex72, Exact, Problem};
+use signorini::records::{LevelRecord, Refine};
 use std::ops::ControlFlow;
 use std::time::Instant;
 

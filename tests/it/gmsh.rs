@@ -3,7 +3,8 @@
 
 use crate::common;
 use common::*;
-use signorini::mesh::{Curve, Mesh, MeshError, MeshSpec, Part};
+use signorini::mesh::{Mesh, MeshError, MeshSpec};
+use signorini::problems::{Curve, Part};
 use signorini::problems::{Material, Problem};
 use std::path::{Path, PathBuf};
 

@@ -67,7 +67,7 @@ fn schur_and_refactor_strategies_agree() {
 #[test]
 fn non_converged_active_set_method_returns_its_last_iterate() {
     use signorini::assembly::{self, DofMap};
-    use signorini::contact::{ContactSolver, PdasOptions, Strategy, PdasTermination};
+    use signorini::contact::{ContactSolver, PdasOptions, PdasTermination, Strategy};
     use signorini::mesh::P2Nodes;
     let p = problems::Ex72;
     let m = mesh(&p, "structured:16");
@@ -107,7 +107,8 @@ fn cycling_active_set_method_returns_its_last_iterate() {
 /// Example 7.2's mesh with a second copy of the unit square shifted by `shift`, merged with the
 /// first at any vertex they share; the copy's boundary edges are traction free.
 fn two_bodies(shift: [f64; 2]) -> signorini::mesh::Mesh {
-    use signorini::mesh::{BoundaryEdge, Part};
+    use signorini::mesh::BoundaryEdge;
+    use signorini::problems::Part;
     let mut m = mesh(&problems::Ex72, "structured:4");
     let n = m.vertices.len();
     let mut index = Vec::with_capacity(n);
