@@ -50,6 +50,9 @@ fn record_errors_are_typed_and_name_the_file() {
     assert!(nan.to_string().contains("not writing") && nan.to_string().contains("nan.json"), "{nan}");
     let missing = signorini::records::read_text(&dir.join("absent.json")).unwrap_err();
     assert_eq!(missing.kind(), std::io::ErrorKind::NotFound);
-    assert!(matches!(missing.get_ref().and_then(|e| e.downcast_ref::<RecordError>()), Some(RecordError::Io { step: "reading", .. })), "{missing:?}");
+    assert!(
+        matches!(missing.get_ref().and_then(|e| e.downcast_ref::<RecordError>()), Some(RecordError::Io { step: "reading", .. })),
+        "{missing:?}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
