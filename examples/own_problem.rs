@@ -6,8 +6,7 @@
 
 use signorini::adapt::{self, AdaptConfig, AdaptTermination};
 use signorini::mesh::MeshSpec;
-use signorini::problems::Part;
-use signorini::problems::{Material, Problem, contact_bottom_dirichlet_top};
+use signorini::problems::{Material, Part, Problem, contact_bottom_dirichlet_top};
 use std::ops::ControlFlow;
 
 /// The block [0, 1]^2: contact on the bottom y = 0, pushed at the top y = 1, free sides.

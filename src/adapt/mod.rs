@@ -9,7 +9,7 @@ pub mod replay;
 use crate::contact::PdasOptions;
 use crate::contact::norms::{self, Reference};
 use crate::contact::solve::{self, DiscreteSolution, SolveError};
-use crate::estimator::estimate::{self, Estimate, EstimatorConfig};
+use crate::estimator::estimate::{self, ConfigError, Estimate, EstimatorConfig};
 use crate::mesh::Mesh;
 use crate::mesh::refine::{self, Refinement};
 use crate::problems::Problem;
@@ -34,13 +34,12 @@ pub struct AdaptConfig {
     pub warm_start: bool,
 }
 
-/// A setting of the loop outside its range (the estimator's error type: one for all settings).
-use crate::estimator::estimate::ConfigError;
-
 /// Why the loop could not run: settings out of range (checked before anything is solved) or a
 /// level whose solve failed.
 #[derive(Debug, thiserror::Error)]
 pub enum AdaptError {
+    /// A setting of the loop outside its range ([`ConfigError`], the estimator's error type: one
+    /// for all settings).
     #[error("adaptive loop settings: {0}")]
     Config(#[from] ConfigError),
     #[error(transparent)]

@@ -6,8 +6,7 @@
 
 use super::{AdaptConfig, AdaptError, History, LevelRecord, Solved, Start};
 use crate::contact::norms::Reference;
-use crate::mesh::Mesh;
-use crate::mesh::refine;
+use crate::mesh::{Mesh, refine};
 use crate::problems::Problem;
 use crate::records::BadFlags;
 

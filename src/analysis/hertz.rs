@@ -12,8 +12,7 @@
 //! load measures.
 
 use crate::contact::solve::ContactSample;
-use crate::problems::Curve;
-use crate::problems::{Material, Problem};
+use crate::problems::{Curve, Material, Problem};
 
 /// The closed-form solution for a cylinder of radius `radius` with the plane-strain modulus
 /// `e_star` = E / (1 - nu^2).

@@ -26,8 +26,7 @@
 
 use crate::fem::assembly::DofMap;
 use crate::mesh::{Mesh, P2Nodes};
-use crate::problems::Part;
-use crate::problems::Problem;
+use crate::problems::{Part, Problem};
 
 /// The largest angle, in degrees, a declared contact normal may make with the outward normal.
 pub const MAX_NORMAL_ANGLE_DEGREES: f64 = 80.0;

@@ -32,8 +32,7 @@ use crate::base::element::EDGE_VERTICES;
 use crate::contact::norms::Sampling;
 use crate::contact::solve::DiscreteSolution;
 use crate::mesh::{Mesh, dist};
-use crate::problems::Part;
-use crate::problems::Problem;
+use crate::problems::{Part, Problem};
 use rayon::prelude::*;
 
 /// Threshold, relative to the force scale, above which lambda_p counts as positive (Lambda_h^C).

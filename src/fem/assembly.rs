@@ -8,12 +8,10 @@
 
 use crate::base::element::{self, Affine, EDGE_VERTICES, N_NODES};
 use crate::mesh::{Mesh, P2Nodes};
-use crate::problems::Part;
-use crate::problems::{Material, Problem};
+use crate::problems::{Material, Part, Problem};
 use rayon::prelude::*;
 
-use crate::sparse::csc::SymCsc;
-use crate::sparse::csc::{offsets, par_fill};
+use crate::sparse::csc::{SymCsc, offsets, par_fill};
 
 /// Marks a node component that is not an unknown (a Dirichlet value).
 pub const FIXED: usize = usize::MAX;

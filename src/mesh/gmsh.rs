@@ -249,6 +249,12 @@ type TriangleTags = Vec<([u64; 3], u64)>;
 type GroupLineTags = Vec<([u64; 2], i32, u64)>;
 /// The line of an element in the file, by its tag (None in a binary file).
 type LineOf<'a> = dyn Fn(u64) -> Option<usize> + 'a;
+/// The vertex index of every node tag a triangle uses.
+type VertexOf = HashMap<u64, usize>;
+/// A physical group's name and the line of its `$PhysicalNames` entry.
+type Group = (String, Option<usize>);
+/// Triangles (vertex indices) with their lines in the file.
+type Triangles = (Vec<[usize; 3]>, Vec<Option<usize>>);
 
 /// Read and check a Gmsh file (everything that does not depend on the problem), phase by phase:
 /// parse, nodes by tag, elements by kind, vertices, triangles, the boundary groups' edges.
@@ -371,8 +377,8 @@ fn vertices_of(
     tri_nodes: &TriangleTags,
     node_at: &BTreeMap<u64, [f64; 3]>,
     line_of: &LineOf,
-) -> Result<(Vec<[f64; 2]>, HashMap<u64, usize>), MeshError> {
-    let mut used: HashMap<u64, usize> = HashMap::new();
+) -> Result<(Vec<[f64; 2]>, VertexOf), MeshError> {
+    let mut used: VertexOf = HashMap::new();
     for (tri, tag) in tri_nodes {
         for n in tri {
             if !node_at.contains_key(n) {
@@ -402,10 +408,10 @@ fn vertices_of(
 fn oriented_triangles(
     path: &Path,
     vertices: &[[f64; 2]],
-    used: &HashMap<u64, usize>,
+    used: &VertexOf,
     tri_nodes: &TriangleTags,
     line_of: &LineOf,
-) -> Result<(Vec<[usize; 3]>, Vec<Option<usize>>), MeshError> {
+) -> Result<Triangles, MeshError> {
     let mut triangles = Vec::with_capacity(tri_nodes.len());
     let mut triangle_lines = Vec::with_capacity(tri_nodes.len());
     for (tri, tag) in tri_nodes {
@@ -430,12 +436,12 @@ fn oriented_triangles(
 fn group_edges(
     path: &Path,
     line_elems: GroupLineTags,
-    used: &HashMap<u64, usize>,
+    used: &VertexOf,
     node_at: &BTreeMap<u64, [f64; 3]>,
     names: &PhysicalNames,
     line_of: &LineOf,
-) -> Result<(Vec<GroupEdge>, Vec<(String, Option<usize>)>), MeshError> {
-    let mut groups: Vec<(String, Option<usize>)> = Vec::new();
+) -> Result<(Vec<GroupEdge>, Vec<Group>), MeshError> {
+    let mut groups: Vec<Group> = Vec::new();
     let mut group_index: BTreeMap<i32, usize> = BTreeMap::new();
     let mut edges = Vec::with_capacity(line_elems.len());
     for ([a, b], g, tag) in line_elems {

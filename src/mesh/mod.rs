@@ -13,8 +13,7 @@ pub mod locate;
 mod msh_nodes;
 pub mod refine;
 
-use crate::problems::Problem;
-use crate::problems::{Curve, Part};
+use crate::problems::{Curve, Part, Problem};
 use rayon::slice::ParallelSliceMut;
 use std::fmt;
 use std::path::PathBuf;

@@ -135,7 +135,7 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Resul
     write_atomic(path, &json_bytes(path, value)?)
 }
 
-use crate::estimator::estimate::{EstimatorConfig, Terms};
+use crate::estimator::estimate::{ContactTerm, EstimatorConfig, Terms};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -283,12 +283,12 @@ pub struct RunSpec {
 pub struct ReferenceSpec {
     pub theta: f64,
     pub min_ndof: usize,
-    pub contact_term: crate::estimator::estimate::ContactTerm,
+    pub contact_term: ContactTerm,
 }
 
 impl ReferenceSpec {
     /// The contact term of a reference whose manifest names none.
-    pub const DEFAULT_CONTACT_TERM: crate::estimator::estimate::ContactTerm = crate::estimator::estimate::ContactTerm::WithoutFullContact;
+    pub const DEFAULT_CONTACT_TERM: ContactTerm = ContactTerm::WithoutFullContact;
 }
 
 /// The record of one finished run: its spec and one `LevelRecord` per level.

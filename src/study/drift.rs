@@ -33,8 +33,7 @@
 
 use super::manifest::DERIVED;
 use super::manifest::{DriftSpec, Manifest, Tolerance};
-use crate::records::LevelRecord;
-use crate::records::{RunRecord, StudyDir};
+use crate::records::{LevelRecord, RunRecord, StudyDir};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;

@@ -5,11 +5,9 @@
 
 use crate::adapt::{self, AdaptConfig};
 use crate::base::element::{self, N_NODES};
-use crate::mesh::locate::Locator;
-use crate::mesh::{Mesh, MeshSpec};
+use crate::mesh::{Mesh, MeshSpec, locate::Locator};
 use crate::problems::Problem;
-use crate::records::Refine;
-use crate::records::{Flags, Rebuild, ReferenceSpec};
+use crate::records::{Flags, Rebuild, ReferenceSpec, Refine};
 
 /// A P2 field on a mesh with an R*-tree for point location ([`Locator`]).
 pub struct ReferenceField {

@@ -4,8 +4,7 @@
 
 use signorini::estimate::{ContactTerm, EstimatorConfig, LogFactor};
 use signorini::plot::{self, FIGURES};
-use signorini::records::{LevelRecord, Refine};
-use signorini::records::{MeshSnapshot, RunRecord, RunSpec, StudyDir, write_json};
+use signorini::records::{LevelRecord, MeshSnapshot, Refine, RunRecord, RunSpec, StudyDir, write_json};
 use std::path::{Path, PathBuf};
 
 fn level(level: usize, ndof: usize, err: Option<f64>, c0: f64, eta: [f64; 7]) -> LevelRecord {

@@ -4,8 +4,7 @@
 use crate::common;
 use common::*;
 use signorini::mesh::{Mesh, MeshError, MeshSpec};
-use signorini::problems::{Curve, Part};
-use signorini::problems::{Material, Problem};
+use signorini::problems::{Curve, Material, Part, Problem};
 use std::path::{Path, PathBuf};
 
 /// A problem that names physical groups: `groups` maps a name to its part and curve. The body is

@@ -7,8 +7,7 @@ use crate::common;
 use common::*;
 use signorini::adapt::{self, AdaptConfig};
 use signorini::norms;
-use signorini::problems::{self, FileProblem, Material, Problem};
-use signorini::problems::{Curve, Part};
+use signorini::problems::{self, Curve, FileProblem, Material, Part, Problem};
 use std::path::Path;
 
 fn file(name: &str) -> FileProblem {

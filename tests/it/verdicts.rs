@@ -5,8 +5,7 @@
 
 use signorini::claims::{self, Verdict};
 use signorini::estimate::EstimatorConfig;
-use signorini::records::{LevelRecord, Refine};
-use signorini::records::{MeshSnapshot, RunRecord, RunSpec, StudyDir, write_json};
+use signorini::records::{LevelRecord, MeshSnapshot, Refine, RunRecord, RunSpec, StudyDir, write_json};
 use signorini::verdict::{self, RateReport, RateVerdict, refinement};
 use std::path::PathBuf;
 

@@ -9,8 +9,7 @@ use crate::contact::norms::Sampling;
 use crate::contact::solve::DiscreteSolution;
 use crate::fem::assembly::edge_basis;
 use crate::mesh::Mesh;
-use crate::problems::Part;
-use crate::problems::{Material, Problem};
+use crate::problems::{Material, Part, Problem};
 use rayon::prelude::*;
 
 /// Local (per element) quantities before they are gathered on patches.
