@@ -4,9 +4,9 @@
 //!
 //! `cargo run --release --example own_problem`
 
-use signorini::adapt::{self, AdaptConfig, Termination};
-use signorini::mesh::{MeshSpec, Part};
-use signorini::problems::{Material, Problem, contact_bottom_dirichlet_top};
+use signorini::adapt::{self, AdaptConfig, AdaptTermination};
+use signorini::mesh::MeshSpec;
+use signorini::problems::{Material, Part, Problem, contact_bottom_dirichlet_top};
 use std::ops::ControlFlow;
 
 /// The block [0, 1]^2: contact on the bottom y = 0, pushed at the top y = 1, free sides.
@@ -56,11 +56,11 @@ fn main() -> anyhow::Result<()> {
         ControlFlow::Continue(())
     })?;
     let why = match result.termination {
-        Termination::LevelsReached => "all levels solved",
-        Termination::MaxNdofReached => "the next level would exceed max_ndof",
-        Termination::StopNdofReached => "a level reached stop_ndof",
-        Termination::StoppedByObserver => "stopped by the observer",
-        Termination::NothingMarked => "the estimate is zero: nothing to mark",
+        AdaptTermination::LevelsReached => "all levels solved",
+        AdaptTermination::MaxNdofReached => "the next level would exceed max_ndof",
+        AdaptTermination::StopNdofReached => "a level reached stop_ndof",
+        AdaptTermination::StoppedByObserver => "stopped by the observer",
+        AdaptTermination::NothingMarked => "the estimate is zero: nothing to mark",
     };
     let kkt = result.solution.kkt();
     println!("stopped: {why}; final mesh {} triangles, max penetration {:.1e}", result.mesh.n_triangles(), kkt.max_penetration);

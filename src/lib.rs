@@ -22,8 +22,10 @@
 //!
 //! Three entry points: [`solve::solve`] (one discrete solution on a mesh, certified by its KKT
 //! conditions), [`adapt::run`] (the adaptive loop) and [`study::run_study`] (a declared study
-//! into its results folder). Every module keeps a short name at the root (`signorini::solve`,
-//! `signorini::estimate`, `signorini::cholesky`).
+//! into its results folder). Every module has one path in the crate (`crate::contact::solve`);
+//! the most used keep a short name at the root for users, examples and tests
+//! (`signorini::solve`, `signorini::estimate`, `signorini::cholesky`), which code inside the
+//! crate never uses (`tests/it/layers.rs` reads the `pub use` lines below and checks it).
 
 // `!(x > 0.0)` is how this crate rejects NaN together with the out-of-range values, on purpose.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -41,8 +43,8 @@ pub mod records;
 pub mod sparse;
 pub mod study;
 
-// Every module keeps its short name at the root (`signorini::solve`, `signorini::estimate`):
-// what examples, tests and user programs call.
+// The users' prelude: short names at the root (`signorini::solve`, `signorini::estimate`) for
+// examples, tests and user programs; inside the crate only the full paths (`crate::contact::solve`).
 pub use analysis::{claims, hertz, verdict};
 pub use base::{element, memory};
 pub use contact::{certify, norms, solve};

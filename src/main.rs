@@ -2,11 +2,12 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use signorini::adapt::{self, AdaptConfig, Refine};
+use signorini::adapt::{self, AdaptConfig};
 use signorini::contact::PdasOptions;
 use signorini::estimate::{self, ContactTerm, EstimatorConfig, LogFactor};
 use signorini::mesh::MeshSpec;
 use signorini::norms::Sampling;
+use signorini::records::Refine;
 use signorini::{norms, problems, report, solve, study};
 use std::process::ExitCode;
 
@@ -196,62 +197,36 @@ enum Command {
     },
 }
 
+/// The estimator's flags. Each argument's id is the setting's key (`estimator.c0`, as
+/// [`estimate::ConfigError`] names it), its default the library's ([`EstimatorConfig::default`]),
+/// its values the library's enums ([`clap::ValueEnum`]).
 #[derive(clap::Args)]
 struct EstimatorArgs {
     /// Estimator constant C_0 (estimate = C_0 eta_h).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.45)]
+    #[arg(id = "estimator.c0", long = "c0", value_name = "C0", allow_negative_numbers = true, default_value_t = EstimatorConfig::default().c0)]
     c0: f64,
     /// eta_5 over all contact nodes (as-written), without full-contact nodes, or the repaired
     /// contact terms (only the tensile normal stress at full-contact nodes, eta_7 on a narrower set).
-    #[arg(long, value_enum, default_value = "as-written")]
-    contact_term: ContactTermArg,
+    #[arg(long, value_enum, default_value_t = EstimatorConfig::default().contact_term)]
+    contact_term: ContactTerm,
     /// The log factor l_h.
-    #[arg(long, value_enum, default_value = "squared")]
-    log_factor: LogFactorArg,
+    #[arg(long, value_enum, default_value_t = EstimatorConfig::default().log_factor)]
+    log_factor: LogFactor,
     /// Points the L-infinity norms are taken over.
-    #[arg(long, value_enum, default_value = "quadrature")]
-    sampling: SamplingArg,
-}
-
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum ContactTermArg {
-    AsWritten,
-    WithoutFullContact,
-    TensileOnFullContact,
-}
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum LogFactorArg {
-    Squared,
-    Linear,
-    One,
-}
-#[derive(Clone, Copy, clap::ValueEnum)]
-enum SamplingArg {
-    Quadrature,
-    Dense,
+    #[arg(long, value_enum, default_value_t = EstimatorConfig::default().sampling)]
+    sampling: Sampling,
 }
 
 impl EstimatorArgs {
-    fn config(&self) -> Result<EstimatorConfig> {
-        Ok(EstimatorConfig {
+    fn config(&self) -> EstimatorConfig {
+        EstimatorConfig {
             c0: self.c0,
-            contact_term: match self.contact_term {
-                ContactTermArg::AsWritten => ContactTerm::AsWritten,
-                ContactTermArg::WithoutFullContact => ContactTerm::WithoutFullContact,
-                ContactTermArg::TensileOnFullContact => ContactTerm::TensileOnFullContact,
-            },
-            log_factor: match self.log_factor {
-                LogFactorArg::Squared => LogFactor::Squared,
-                LogFactorArg::Linear => LogFactor::Linear,
-                LogFactorArg::One => LogFactor::One,
-            },
-            sampling: match self.sampling {
-                SamplingArg::Quadrature => Sampling::Quadrature,
-                SamplingArg::Dense => Sampling::Dense,
-            },
+            contact_term: self.contact_term,
+            log_factor: self.log_factor,
+            sampling: self.sampling,
             // the reading of sigma-hat in eta_4, eta_5 is a manifest option (estimator.stress_frame)
             ..EstimatorConfig::default()
-        })
+        }
     }
 }
 
@@ -262,13 +237,13 @@ struct AdaptArgs {
     #[arg(long)]
     problem: String,
     /// Initial mesh: structured:N (or symmetric:N, mirrored about y = 0.5), or gmsh:PATH.msh.
-    #[arg(long, default_value = "structured:4")]
+    #[arg(long, default_value = MeshSpec::DEFAULT)]
     mesh: String,
     /// Number of levels solved (level 0 is the initial mesh).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 20)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = AdaptConfig::default().levels)]
     levels: usize,
     /// Marking parameter of the maximum strategy: mark T if eta_T >= theta max eta_T, 0 < theta <= 1.
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0.5, conflicts_with = "uniform")]
+    #[arg(long, allow_negative_numbers = true, default_value_t = AdaptConfig::default().theta, conflicts_with = "uniform")]
     theta: f64,
     /// Refine every element instead of marking.
     #[arg(long)]
@@ -301,15 +276,21 @@ struct SolveArgs {
     #[arg(long = "probe", value_name = "X,Y", allow_hyphen_values = true)]
     probes: Vec<String>,
     /// Maximum number of active-set iterations.
-    #[arg(long, allow_negative_numbers = true, default_value_t = PdasOptions::default().max_iterations)]
+    #[arg(
+        id = "pdas.max_iterations",
+        long = "max-pdas-iterations",
+        value_name = "MAX_PDAS_ITERATIONS",
+        allow_negative_numbers = true,
+        default_value_t = PdasOptions::default().max_iterations
+    )]
     max_pdas_iterations: usize,
     /// Log every active-set iteration on stderr.
     #[arg(long, short)]
     verbose: bool,
     /// Marking parameter of the maximum strategy, 0 < theta <= 1 (only with --adapt-levels /
-    /// --adapt-min-ndof) [default: 0.5].
-    #[arg(long, allow_negative_numbers = true, requires = "adaptive")]
-    theta: Option<f64>,
+    /// --adapt-min-ndof).
+    #[arg(long, allow_negative_numbers = true, requires = "adaptive", default_value_t = AdaptConfig::default().theta)]
+    theta: f64,
     /// Solve on the mesh of this adaptive level instead (refined from --mesh, marked with the
     /// estimator options below); with --adapt-min-ndof, the last level tried.
     #[arg(long, allow_negative_numbers = true)]
@@ -322,23 +303,18 @@ struct SolveArgs {
     estimator: EstimatorArgs,
 }
 
-/// The command-line flag of an `AdaptConfig` field, for its validation errors.
-fn flag_of(key: &str) -> &'static str {
-    match key {
-        "levels" => "--levels",
-        "max_ndof" => "--max-ndof",
-        "stop_ndof" => "--stop-ndof",
-        "theta" => "--theta",
-        "estimator.c0" => "--c0",
-        "pdas.max_iterations" => "--max-pdas-iterations",
-        _ => "an option",
-    }
+/// The flag of the setting `key` (`theta`, `estimator.c0`, `pdas.max_iterations`) in the
+/// subcommand `sub`: the argument whose id is the key, so clap's definitions are the only table.
+fn flag_of(sub: &str, key: &str) -> String {
+    let cmd = <Cli as clap::CommandFactory>::command();
+    let arg = cmd.find_subcommand(sub).and_then(|c| c.get_arguments().find(|a| a.get_id() == key));
+    arg.and_then(|a| a.get_long()).map_or_else(|| key.to_string(), |long| format!("--{long}"))
 }
 
-/// Validate the loop's settings as manifests do (the same functions), naming the flag: every
-/// setting, and `max_ndof` against the initial mesh `spec`.
-fn validate(config: &AdaptConfig, spec: &MeshSpec) -> Result<()> {
-    let flag = |e: adapt::ConfigError| anyhow::anyhow!("{}: expected {}, got {}", flag_of(e.key), e.expected, e.got);
+/// Validate the loop's settings as manifests do (the same functions), naming the flag of the
+/// subcommand `sub`: every setting, and `max_ndof` against the initial mesh `spec`.
+fn validate(sub: &str, config: &AdaptConfig, spec: &MeshSpec) -> Result<()> {
+    let flag = |e: estimate::ConfigError| anyhow::anyhow!("{}: expected {}, got {}", flag_of(sub, e.key), e.expected, e.got);
     config.validate().map_err(flag)?;
     config.check_initial(spec.ndof()?, &spec.to_string()).map_err(flag)
 }
@@ -351,15 +327,15 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
     let spec = MeshSpec::parse(&args.mesh)?;
     let probes = args.probes.iter().map(|p| report::parse_probe(p)).collect::<Result<Vec<_>, _>>()?;
     let pdas = PdasOptions { max_iterations: args.max_pdas_iterations, ..Default::default() };
-    let estimator = args.estimator.config()?;
+    let estimator = args.estimator.config();
     let adaptive = args.adapt_levels.is_some() || args.adapt_min_ndof.is_some();
-    let theta = args.theta.unwrap_or(0.5);
+    let theta = args.theta;
     let config =
         AdaptConfig { levels: args.adapt_levels.map_or(200, |l| l + 1), theta, estimator, pdas: pdas.clone(), ..Default::default() };
-    validate(&config, &spec)?;
-    solve::check_memory(&spec.to_string(), spec.ndof()?)?;
+    validate("solve", &config, &spec)?;
+    signorini::memory::check_memory(&spec.to_string(), spec.ndof()?)?;
     if let Some(n) = args.adapt_min_ndof {
-        solve::check_memory(&format!("an adaptive level reaching --adapt-min-ndof {n}"), n as f64)?;
+        signorini::memory::check_memory(&format!("an adaptive level reaching --adapt-min-ndof {n}"), n as f64)?;
     }
     let mut mesh = spec.build(problem.as_ref())?;
     // probes outside the initial mesh fail before anything is solved
@@ -408,14 +384,14 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
         stop_ndof: args.stop_ndof,
         refine: if args.uniform { Refine::Uniform } else { Refine::Adaptive },
         theta: args.theta,
-        estimator: args.estimator.config()?,
+        estimator: args.estimator.config(),
         ..Default::default()
     };
-    validate(&config, &spec)?;
+    validate("adapt", &config, &spec)?;
     if let Some(path) = &args.save {
         check_writable(path)?;
     }
-    solve::check_memory(&spec.to_string(), spec.ndof()?)?;
+    signorini::memory::check_memory(&spec.to_string(), spec.ndof()?)?;
     let mesh = spec.build(problem.as_ref())?;
     let exact = problem.exact();
     let reference = exact.map(|e| move |x: [f64; 2]| e.u(x));
@@ -697,7 +673,7 @@ fn run_drift(
         results: results.to_path_buf(),
         progress: true,
     };
-    let report = study::drift::run(&manifests, only.is_empty(), &options, &|r| {
+    let report = study::drift::check(&manifests, only.is_empty(), &options, &|r| {
         signorini::claims::claims(r).map(|c| signorini::claims::markdown_for(&c, r))
     })?;
     // the table first: a report that cannot be written must not cost it

@@ -7,13 +7,13 @@
 pub mod replay;
 
 use crate::contact::PdasOptions;
-use crate::estimate::{self, Estimate, EstimatorConfig};
+use crate::contact::norms::{self, Reference};
+use crate::contact::solve::{self, DiscreteSolution, SolveError};
+use crate::estimator::estimate::{self, ConfigError, Estimate, EstimatorConfig};
 use crate::mesh::Mesh;
 use crate::mesh::refine::{self, Refinement};
-use crate::norms::{self, Reference};
 use crate::problems::Problem;
-pub use crate::records::{Flags, History, LevelHistory, LevelRecord, Refine};
-use crate::solve::{self, DiscreteSolution, SolveError};
+use crate::records::{Flags, History, LevelHistory, LevelRecord, Refine};
 use std::ops::ControlFlow;
 use std::time::Instant;
 
@@ -34,13 +34,12 @@ pub struct AdaptConfig {
     pub warm_start: bool,
 }
 
-/// A setting of the loop outside its range (the estimator's error type: one for all settings).
-pub use crate::estimate::ConfigError;
-
 /// Why the loop could not run: settings out of range (checked before anything is solved) or a
 /// level whose solve failed.
 #[derive(Debug, thiserror::Error)]
 pub enum AdaptError {
+    /// A setting of the loop outside its range ([`ConfigError`], the estimator's error type: one
+    /// for all settings).
     #[error("adaptive loop settings: {0}")]
     Config(#[from] ConfigError),
     #[error(transparent)]
@@ -51,7 +50,7 @@ pub enum AdaptError {
     /// The next level would not fit in memory: levels `0..level` were solved (and seen by the
     /// observer), level `level` was not.
     #[error("stopped before level {level} ({}): {error}", if *level == 0 { "no level was solved".to_string() } else { format!("levels 0 to {} were solved", level - 1) })]
-    Memory { level: usize, error: solve::MemoryError },
+    Memory { level: usize, error: crate::base::memory::MemoryError },
     /// A start at or beyond the last level: nothing is left to solve.
     #[error("nothing to solve: the loop starts at level {start} and has {levels} levels")]
     NothingToSolve { start: usize, levels: usize },
@@ -171,7 +170,7 @@ pub fn free_boundary_edge(mesh: &Mesh, sol: &DiscreteSolution) -> Option<f64> {
     mesh.boundary
         .iter()
         .zip(&sol.nodes.boundary_nodes)
-        .filter(|(e, _)| e.part == crate::mesh::Part::Contact)
+        .filter(|(e, _)| e.part == crate::problems::Part::Contact)
         .filter_map(|(e, nodes)| {
             let active: Vec<bool> = nodes.iter().map(|&n| sol.dofs.contact_index[n].is_some_and(|k| sol.active[k])).collect();
             (active.contains(&true) && active.contains(&false)).then(|| crate::mesh::dist(mesh.vertices[e.v[0]], mesh.vertices[e.v[1]]))
@@ -184,7 +183,7 @@ pub fn free_boundary_edge(mesh: &Mesh, sol: &DiscreteSolution) -> Option<f64> {
 fn transfer_active_set(old_mesh: &Mesh, old: &DiscreteSolution, refinement: &Refinement, problem: &dyn Problem) -> Vec<bool> {
     let new_nodes = crate::mesh::P2Nodes::new(&refinement.mesh);
     let u = refine::transfer_p2(old_mesh, &old.nodes, &old.u, refinement, &new_nodes);
-    let dofs = crate::assembly::DofMap::new(&new_nodes, problem);
+    let dofs = crate::fem::assembly::DofMap::new(&new_nodes, problem);
     let scale = u.iter().fold(0.0f64, |a, v| a.max(v[0].abs()).max(v[1].abs())).max(f64::MIN_POSITIVE);
     dofs.contact
         .iter()
@@ -197,7 +196,7 @@ fn transfer_active_set(old_mesh: &Mesh, old: &DiscreteSolution, refinement: &Ref
 
 /// Why [`run`] stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Termination {
+pub enum AdaptTermination {
     /// All `AdaptConfig::levels` levels were solved.
     LevelsReached,
     /// The next level would have had more unknowns than `AdaptConfig::max_ndof` (it was not solved).
@@ -212,19 +211,19 @@ pub enum Termination {
     NothingMarked,
 }
 
-impl Termination {
+impl AdaptTermination {
     /// Why the loop stopped before its last level, in a sentence (None: all levels were solved,
     /// or the caller stopped it and knows why).
     pub fn note(self, config: &AdaptConfig) -> Option<String> {
         match self {
-            Termination::LevelsReached | Termination::StoppedByObserver => None,
-            Termination::MaxNdofReached => {
+            AdaptTermination::LevelsReached | AdaptTermination::StoppedByObserver => None,
+            AdaptTermination::MaxNdofReached => {
                 Some(format!("stopped: the next level would have more than max_ndof = {} unknowns", config.max_ndof.unwrap_or(0)))
             }
-            Termination::StopNdofReached => {
+            AdaptTermination::StopNdofReached => {
                 Some(format!("stopped: the last level has at least stop_ndof = {} unknowns", config.stop_ndof.unwrap_or(0)))
             }
-            Termination::NothingMarked => Some(
+            AdaptTermination::NothingMarked => Some(
                 "stopped: the estimate is zero on every element, so nothing is marked and the next level would be the same mesh".into(),
             ),
         }
@@ -244,7 +243,7 @@ pub struct AdaptResult {
     pub records: Vec<LevelRecord>,
     /// The refinement history of every level in `records`.
     pub history: History,
-    pub termination: Termination,
+    pub termination: AdaptTermination,
 }
 
 /// Where the loop starts: the mesh of level `level`, the active set its solve starts from, and
@@ -288,7 +287,7 @@ pub fn solve_level(
     // before every level, not only the first: an adaptive loop grows until it does not fit;
     // `measured`: unknowns and peak resident bytes of a measured solve, if known (the previous
     // level's in the loop, the level's own stored one in a replay)
-    solve::check_memory_measured(&format!("level {level} of the adaptive loop"), ndof as f64, measured)
+    crate::base::memory::check_memory_measured(&format!("level {level} of the adaptive loop"), ndof as f64, measured)
         .map_err(|error| AdaptError::Memory { level, error })?;
     let mut options = config.pdas.clone();
     if config.warm_start {
@@ -362,7 +361,7 @@ pub fn solve_level(
 /// `config` must be valid ([`AdaptConfig::validate`]); at least level 0 is always solved.
 ///
 /// ```rust
-/// use signorini::adapt::{self, AdaptConfig, Termination};
+/// use signorini::adapt::{self, AdaptConfig, AdaptTermination};
 /// use signorini::mesh::MeshSpec;
 /// use signorini::problems::{self, Problem};
 /// use std::ops::ControlFlow;
@@ -374,7 +373,7 @@ pub fn solve_level(
 /// let exact = problem.exact().unwrap();
 /// let u = |x: [f64; 2]| exact.u(x);
 /// let result = adapt::run(problem.as_ref(), mesh, &config, Some(&u), &mut |_| ControlFlow::Continue(())).unwrap();
-/// assert_eq!(result.termination, Termination::LevelsReached);
+/// assert_eq!(result.termination, AdaptTermination::LevelsReached);
 /// assert_eq!(result.records.len(), 3);
 /// assert_eq!(result.history.levels.len(), 3);
 /// assert_eq!(result.records[2].ndof, 2 * result.solution.nodes.len());
@@ -409,18 +408,18 @@ pub fn run_from(
     }
     let Start { mut mesh, level: first, mut initial_active, mut records, mut history } = start;
     let mut state: Option<(Mesh, DiscreteSolution, Estimate)> = None;
-    let mut termination = Termination::LevelsReached;
+    let mut termination = AdaptTermination::LevelsReached;
     for level in first..config.levels {
         if let Some(max) = config.max_ndof
             && level > 0
             && mesh.p2_ndof() > max
         {
-            termination = Termination::MaxNdofReached;
+            termination = AdaptTermination::MaxNdofReached;
             break;
         }
         let t_level = Instant::now();
         let previous = records.last().and_then(LevelRecord::measured_peak);
-        let measured = crate::memory::reset_peak_resident();
+        let measured = crate::base::memory::reset_peak_resident();
         let started_from = initial_active.take().filter(|_| config.warm_start);
         let Solved { mut record, solution: sol, estimate: est, marks } =
             solve_level(problem, &mesh, level, config, reference, started_from.clone(), previous)?;
@@ -443,7 +442,7 @@ pub fn run_from(
             Some((refinement.mesh, active))
         };
         record.t_level = t_level.elapsed().as_secs_f64();
-        record.mem_peak_mib = crate::memory::peak_resident().filter(|_| measured).map(|b| b / (1024.0 * 1024.0));
+        record.mem_peak_mib = crate::base::memory::peak_resident().filter(|_| measured).map(|b| b / (1024.0 * 1024.0));
         let flow = observer(Level {
             record: &record,
             mesh: &mesh,
@@ -457,13 +456,13 @@ pub fn run_from(
         history.levels.push(entry);
         state = Some((mesh, sol, est));
         if flow.is_break() {
-            termination = Termination::StoppedByObserver;
+            termination = AdaptTermination::StoppedByObserver;
             break;
         }
         if reached {
-            termination = Termination::StopNdofReached;
+            termination = AdaptTermination::StopNdofReached;
         } else if next.is_none() && unmarked && level + 1 < config.levels {
-            termination = Termination::NothingMarked;
+            termination = AdaptTermination::NothingMarked;
         }
         match next {
             Some((m, active)) => {

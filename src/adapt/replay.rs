@@ -5,9 +5,8 @@
 //! interrupted run resumes ([`resume`]).
 
 use super::{AdaptConfig, AdaptError, History, LevelRecord, Solved, Start};
-use crate::mesh::Mesh;
-use crate::mesh::refine;
-use crate::norms::Reference;
+use crate::contact::norms::Reference;
+use crate::mesh::{Mesh, refine};
 use crate::problems::Problem;
 use crate::records::BadFlags;
 

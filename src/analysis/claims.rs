@@ -2,7 +2,7 @@
 //! free-boundary example `fb`), the number we measured with its uncertainty and range, and the
 //! verdict, generated from the stored records only (never written by hand).
 //!
-//! Rates, intervals and the verdict rules are those of [`crate::verdict`]: least-squares slopes
+//! Rates, intervals and the verdict rules are those of [`crate::analysis::verdict`]: least-squares slopes
 //! in log NDF with 95% t intervals, every other level, over the last two decades of NDF, with the
 //! slopes of the windows ending two and four levels earlier beside them. Example 7.1 and `fb`
 //! are judged on the deep study's runs (to at least 1e7 NDF) where it is stored, Example 7.2's
@@ -14,8 +14,8 @@ pub mod criterion;
 mod ex72;
 pub mod repair;
 
+use crate::analysis::verdict::{self, Abscissa, RateReport, RateVerdict, refinement};
 use crate::records::{MeshSnapshot, RunRecord, StudyDir};
-use crate::verdict::{self, Abscissa, RateReport, RateVerdict, refinement};
 pub use criterion::{Criterion, Evidence, Kind};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -879,11 +879,11 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     for r in &runs {
         let Some(snap) = latest_mesh(ctx.results, "hertz", &r.run.id) else { continue };
         let problem = crate::study::stored_problem(ctx.results, "hertz", &r.run).map_err(|e| std::io::Error::other(format!("{e:#}")))?;
-        let Some(h) = crate::hertz::for_problem(problem.as_ref()) else {
+        let Some(h) = crate::analysis::hertz::for_problem(problem.as_ref()) else {
             rows.push(format!("{}: problem {} has no circular contact group", r.run.id, r.run.problem));
             continue;
         };
-        let Some(c) = crate::hertz::compare(&h, &snap.contact_nodes) else {
+        let Some(c) = crate::analysis::hertz::compare(&h, &snap.contact_nodes) else {
             rows.push(format!("{}: contact zone not resolved at level {}", r.run.id, snap.level));
             continue;
         };

@@ -11,9 +11,8 @@
 //! its flat side) deviates from them by terms that vanish as a / R -> 0, which a second, smaller
 //! load measures.
 
-use crate::mesh::Curve;
-use crate::problems::{Material, Problem};
-use crate::records::ContactSample;
+use crate::contact::solve::ContactSample;
+use crate::problems::{Curve, Material, Problem};
 
 /// The closed-form solution for a cylinder of radius `radius` with the plane-strain modulus
 /// `e_star` = E / (1 - nu^2).

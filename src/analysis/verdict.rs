@@ -59,7 +59,7 @@ pub const WINDOW_SHIFT: usize = 2;
 /// round-off floor (`LevelRecord::roundoff_floor`): below, it measures round-off ([`floor_hit`]).
 pub const FLOOR_MARGIN: f64 = 10.0;
 
-pub use crate::base::stats::{LineFit, fit_line, incomplete_beta, t_quantile_975, t_two_sided_tail};
+use crate::base::stats::{LineFit, fit_line};
 
 /// The variable a rate is fitted against.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -404,6 +404,7 @@ pub fn clamped_free_corner_exponent(nu: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::base::stats::t_quantile_975;
 
     #[test]
     fn t_quantiles_match_tables() {

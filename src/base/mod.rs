@@ -1,7 +1,8 @@
-//! Floor 0: what every floor above uses and that uses nothing of the crate: the reference
-//! triangle ([`element`]: P2 basis, affine maps, Gauss rules, sampling lattices) and the memory
-//! a solve needs and may still allocate ([`memory`]), least-squares lines with confidence intervals
-//! ([`stats`]), and notes to standard error that a failed write cannot stop ([`note`]).
+//! The `base/` floor (the lowest): what every floor above uses and that uses nothing of the crate:
+//! the reference triangle ([`element`]: P2 basis, affine maps, Gauss rules, sampling lattices) and
+//! the memory a solve needs and may still allocate ([`memory`]), least-squares lines with
+//! confidence intervals ([`stats`]), and notes to standard error that a failed write cannot stop
+//! ([`note`]).
 
 pub mod element;
 pub mod memory;

@@ -336,7 +336,7 @@ fn print_ng(n: usize, r: usize, who: &str, ng: &NgRun) {
 fn scale_point(n: usize, cold: &[ColdSize], python: &std::path::Path) -> Result<ColdSize> {
     let spec = MeshSpec::Structured(n);
     let ndof = spec.ndof()?;
-    solve::check_memory(&spec.to_string(), ndof)?;
+    signorini::memory::check_memory(&spec.to_string(), ndof)?;
     println!("\nscale point structured:{n} ({ndof:.0} unknowns), load {}:", load());
     let ours = ours_cold(n)?;
     println!("  ours {:.3} s, peak {:.0} MB", ours.whole_s, ours.peak_rss_mb);
@@ -349,7 +349,7 @@ fn scale_point(n: usize, cold: &[ColdSize], python: &std::path::Path) -> Result<
     // the factor grows slightly faster than the unknowns: 10 % on top of their ratio
     let factor = 1.1 * (n as f64 / largest.n as f64).powi(2);
     let needed_mb = factor * median(largest.ngsolve.iter().map(|r| r.peak_rss_mb).collect());
-    let available_mb = solve::available_memory().unwrap_or(0.0) / (1024.0 * 1024.0);
+    let available_mb = signorini::memory::available_memory().unwrap_or(0.0) / (1024.0 * 1024.0);
     if needed_mb > 0.8 * available_mb {
         size.ngsolve_missing = Some(format!(
             "not run: about {needed_mb:.0} MB needed (its structured:{} peak x {factor:.1}), {available_mb:.0} MB available",

@@ -34,10 +34,10 @@
 //! L never shares the memory with them (at `structured:512` they take 0.6 GB, L 2.2 GB). The
 //! Refactor strategy keeps both: it changes the matrix's values in every iteration.
 
-use crate::cholesky;
-use crate::ordering::OrderingChoice;
+use crate::sparse::cholesky;
 use crate::sparse::csc::SymCsc;
-use crate::symbolic::{self, Placement, Symbolic};
+use crate::sparse::ordering::OrderingChoice;
+use crate::sparse::symbolic::{self, Placement, Symbolic};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use std::time::Instant;
@@ -95,10 +95,10 @@ pub struct PdasIteration {
 }
 
 /// Why the iteration stopped. Only `Converged` and `NoContact` are solutions of the discrete
-/// problem; [`Termination::error`] turns the other two into the [`ContactError`] that
-/// [`crate::solve::solve`] reports.
+/// problem; [`PdasTermination::error`] turns the other two into the [`ContactError`] that
+/// [`crate::contact::solve::solve`] reports.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub enum Termination {
+pub enum PdasTermination {
     /// The active set repeated and the residual was below tolerance.
     Converged,
     /// No contact nodes: a single linear solve.
@@ -110,21 +110,21 @@ pub enum Termination {
     Cycling { first_seen: usize, residual: f64 },
 }
 
-impl Termination {
+impl PdasTermination {
     /// Whether the iterate solves the discrete problem.
     pub fn is_converged(&self) -> bool {
-        matches!(self, Termination::Converged | Termination::NoContact)
+        matches!(self, PdasTermination::Converged | PdasTermination::NoContact)
     }
 
     /// The error for a run that stopped without converging after `iterations` iterations; None
     /// if it converged.
     pub fn error(&self, iterations: usize) -> Option<ContactError> {
         match *self {
-            Termination::Converged | Termination::NoContact => None,
-            Termination::MaxIterations { residual, tolerance, next_active } => {
+            PdasTermination::Converged | PdasTermination::NoContact => None,
+            PdasTermination::MaxIterations { residual, tolerance, next_active } => {
                 Some(ContactError::NotConverged { iterations, residual, tolerance, active: next_active })
             }
-            Termination::Cycling { first_seen, residual } => Some(ContactError::Cycling { iterations, first_seen, residual }),
+            PdasTermination::Cycling { first_seen, residual } => Some(ContactError::Cycling { iterations, first_seen, residual }),
         }
     }
 }
@@ -151,7 +151,7 @@ pub struct PdasOutput {
     pub lambda: Vec<f64>,
     pub active: Vec<bool>,
     pub iterations: Vec<PdasIteration>,
-    pub termination: Termination,
+    pub termination: PdasTermination,
     pub c: f64,
 }
 
@@ -450,7 +450,14 @@ impl ContactSolver {
         assert_eq!(gap.len(), m);
         if m == 0 {
             let u = self.solve(rhs);
-            return Ok(PdasOutput { u, lambda: vec![], active: vec![], iterations: vec![], termination: Termination::NoContact, c: 0.0 });
+            return Ok(PdasOutput {
+                u,
+                lambda: vec![],
+                active: vec![],
+                iterations: vec![],
+                termination: PdasTermination::NoContact,
+                c: 0.0,
+            });
         }
         let t_pdas = Instant::now();
         let (solves0, numeric0) = (self.timings.solves, self.timings.numeric);
@@ -466,7 +473,7 @@ impl ContactSolver {
         // the rest of the contact solve: dense active-set work (Schur) or bookkeeping (Refactor)
         let inner = (self.timings.solves - solves0) + (self.timings.numeric - numeric0);
         self.timings.active_set = t_pdas.elapsed().as_secs_f64() - inner;
-        let (mut u, PdasOutcome { lambda, active, iterations, termination, .. }, c) = out?;
+        let (mut u, NormalIterate { lambda, active, iterations, termination, .. }, c) = out?;
         for k in 0..m {
             if active[k] {
                 u[ni + k] = gap[k]; // the constraint holds exactly, not to solver round-off
@@ -610,7 +617,7 @@ fn schur_step(s: &Mat<f64>, yc: &[f64], gap: &[f64], active: &[bool]) -> Result<
 }
 
 /// All unknowns, the active-set outcome and the complementarity constant c.
-type PdasResult = (Vec<f64>, PdasOutcome, f64);
+type PdasResult = (Vec<f64>, NormalIterate, f64);
 
 /// The values of u and lambda at the contact normals (one active-set step's result).
 pub type Pair = (Vec<f64>, Vec<f64>);
@@ -618,13 +625,13 @@ pub type Pair = (Vec<f64>, Vec<f64>);
 /// What [`pdas`] returns: the last iterate (u and lambda at the contact normals, the active set
 /// it was computed with), every iteration, and why the iteration stopped.
 #[derive(Clone, Debug)]
-pub struct PdasOutcome {
+pub struct NormalIterate {
     pub u: Vec<f64>,
     pub lambda: Vec<f64>,
     pub active: Vec<bool>,
     pub iterations: Vec<PdasIteration>,
     /// `Converged`, `MaxIterations` or `Cycling`.
-    pub termination: Termination,
+    pub termination: PdasTermination,
 }
 
 /// The primal–dual active set iteration, whatever solves its linear systems.
@@ -640,7 +647,7 @@ pub fn pdas(
     options: &PdasOptions,
     observe: &mut dyn FnMut(&PdasIteration),
     step: &mut dyn FnMut(&[bool]) -> Result<Pair, ContactError>,
-) -> Result<PdasOutcome, ContactError> {
+) -> Result<NormalIterate, ContactError> {
     let m = g.len();
     let mut active = initial;
     let mut seen: Vec<(Vec<bool>, usize)> = Vec::new();
@@ -665,25 +672,25 @@ pub fn pdas(
         observe(&record);
         iterations.push(record);
         if next == active && residual <= options.tolerance {
-            return Ok(PdasOutcome { u, lambda, active, iterations, termination: Termination::Converged });
+            return Ok(NormalIterate { u, lambda, active, iterations, termination: PdasTermination::Converged });
         }
         if next != active
             && let Some((_, first_seen)) = seen.iter().find(|(a, _)| *a == next)
         {
-            let termination = Termination::Cycling { first_seen: *first_seen, residual };
-            return Ok(PdasOutcome { u, lambda, active, iterations, termination });
+            let termination = PdasTermination::Cycling { first_seen: *first_seen, residual };
+            return Ok(NormalIterate { u, lambda, active, iterations, termination });
         }
         seen.push((active.clone(), it));
         last = (u, lambda);
         last_active = std::mem::replace(&mut active, next);
     }
-    let termination = Termination::MaxIterations {
+    let termination = PdasTermination::MaxIterations {
         residual: iterations.last().map(|r| r.residual).unwrap_or(f64::NAN),
         tolerance: options.tolerance,
         next_active: active.iter().filter(|a| **a).count(),
     };
     let (u, lambda) = last;
-    Ok(PdasOutcome { u, lambda, active: last_active, iterations, termination })
+    Ok(NormalIterate { u, lambda, active: last_active, iterations, termination })
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 //! answer.
 //!
 //! # The KKT conditions and their scales
-//! With r = F - K u (computed element by element, [`crate::assembly::stiffness_times`]) and
+//! With r = F - K u (computed element by element, [`crate::fem::assembly::stiffness_times`]) and
 //! lambda_p = r_p at the normal unknown of contact node p, a discrete solution has
 //!
 //! ```text
@@ -26,9 +26,9 @@
 //! tolerance, [`TOLERANCE`], leaves orders of magnitude between the round-off measured on every
 //! study and a wrong answer.
 
-use crate::assembly::DofMap;
-use crate::mesh::{Mesh, P2Nodes, Part};
-use crate::problems::Problem;
+use crate::fem::assembly::DofMap;
+use crate::mesh::{Mesh, P2Nodes};
+use crate::problems::{Part, Problem};
 
 /// The relative tolerance of every KKT condition ([`certify`]). Measured on all 769 solves of
 /// every level of every study (`signorini drift`, 2026-11-24, up to 1.1M unknowns): the
@@ -116,7 +116,7 @@ pub fn certify(input: &KktInput, tolerance: f64) -> Result<Certificate, KktError
     let relative = |a: f64, s: f64| if a == 0.0 { 0.0 } else { a / s };
     let mut node_of = vec![usize::MAX; dofs.n_free];
     for (p, d) in dofs.dof.iter().enumerate() {
-        for &k in d.iter().filter(|&&k| k != crate::assembly::FIXED) {
+        for &k in d.iter().filter(|&&k| k != crate::fem::assembly::FIXED) {
             node_of[k] = p;
         }
     }
@@ -245,7 +245,7 @@ pub fn check_held(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Pro
         let h = &mut held[bodies[t]];
         h.triangles += 1;
         for &p in el {
-            let fixed = dofs.dof[p].map(|d| d == crate::assembly::FIXED);
+            let fixed = dofs.dof[p].map(|d| d == crate::fem::assembly::FIXED);
             if fixed != [false, false] {
                 h.see(p, nodes.coords[p], fixed);
             }

@@ -1,7 +1,7 @@
-//! Floor 5: the SOLVE step. The primal–dual active set method on the assembled system
-//! ([`active_set`], whose items are re-exported here), one discrete Signorini solution with its
-//! contact force ([`solve`]), the checks that its contact data make physical sense
-//! ([`plausible`]), the certificate of its KKT conditions ([`certify`]) and the
+//! The `contact/` floor (above `fem/`): the SOLVE step. The primal–dual active set method on the
+//! assembled system ([`active_set`], whose items, named below, are the floor's front door), one
+//! discrete Signorini solution with its contact force ([`solve`]), the checks that its contact data
+//! make physical sense ([`plausible`]), the certificate of its KKT conditions ([`certify`]) and the
 //! L-infinity norms of its error ([`norms`]). May import: `base`, `problems`, `mesh`, `sparse`,
 //! `fem`.
 
@@ -11,4 +11,7 @@ pub mod norms;
 pub mod plausible;
 pub mod solve;
 
-pub use active_set::*;
+pub use active_set::{
+    ContactError, ContactSolver, NormalIterate, Pair, PdasIteration, PdasOptions, PdasOutput, PdasTermination, SCHUR_MAX_CONTACT, Strategy,
+    Timings, pdas,
+};

@@ -3,9 +3,9 @@
 //! quadrature points of every element (the paper's way), on a dense barycentric lattice of every
 //! element, and over the nodal values only (which is not the L-infinity norm).
 
-use crate::element;
+use crate::base::element;
+use crate::contact::solve::DiscreteSolution;
 use crate::mesh::Mesh;
-use crate::solve::DiscreteSolution;
 use rayon::prelude::*;
 
 /// Degree of the quadrature rule whose points the "quadrature" norm uses (collapsed Gauss,
@@ -14,8 +14,8 @@ pub const QUADRATURE_DEGREE: usize = 5;
 /// Order of the barycentric lattice of the "dense" norm (28 points per element).
 pub const LATTICE_ORDER: usize = 6;
 
-/// Which points an L-infinity norm is taken over.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// Which points an L-infinity norm is taken over (`--sampling`, `estimator.sampling`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum Sampling {
     Quadrature,
@@ -99,7 +99,7 @@ pub fn linf_error_contact(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference)
             let mut refs = Vec::new();
             for b in sol.nodes.element_boundary[t].iter().flatten() {
                 let e = &mesh.boundary[*b];
-                if e.part != crate::mesh::Part::Contact {
+                if e.part != crate::problems::Part::Contact {
                     continue;
                 }
                 let (i, j) = (tri.iter().position(|&v| v == e.v[0])?, tri.iter().position(|&v| v == e.v[1])?);

@@ -24,9 +24,9 @@
 //! it is evaluated; Young's modulus, Poisson's ratio and the Lamé constants are checked when a
 //! problem file is read (`problems::file`).
 
-use crate::assembly::DofMap;
-use crate::mesh::{Mesh, P2Nodes, Part};
-use crate::problems::Problem;
+use crate::fem::assembly::DofMap;
+use crate::mesh::{Mesh, P2Nodes};
+use crate::problems::{Part, Problem};
 
 /// The largest angle, in degrees, a declared contact normal may make with the outward normal.
 pub const MAX_NORMAL_ANGLE_DEGREES: f64 = 80.0;

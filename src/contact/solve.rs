@@ -1,18 +1,14 @@
 //! The SOLVE step: one discrete Signorini solution (paper eq. 3.4) on a given mesh, with the
 //! discrete contact force (eq. 4.5) and its KKT report.
 
-use crate::assembly::{self, DofMap, System};
-use crate::certify::{self, Certificate, KktError, KktInput, RigidMotionError};
-use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, Strategy, Termination, Timings};
-use crate::element::{self, Affine};
+use crate::base::element::{self, Affine};
+use crate::contact::certify::{self, Certificate, KktError, KktInput, RigidMotionError};
+use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, PdasTermination, Strategy, Timings};
+use crate::fem::assembly::{self, DofMap, System};
 use crate::mesh::locate::Locator;
 use crate::mesh::{Mesh, MeshError, P2Nodes};
 use crate::problems::Problem;
 use std::time::Instant;
-
-pub use crate::memory::{
-    Available, MemoryError, UNKNOWN_MEMORY_LIMIT, available_memory, check_memory, check_memory_measured, human_bytes, memory_estimate,
-};
 
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {
@@ -51,7 +47,7 @@ pub struct DiscreteSolution {
     /// Active contact nodes (u_h(p).n = chi_h(p) enforced).
     pub active: Vec<bool>,
     pub pdas: Vec<PdasIteration>,
-    pub termination: Termination,
+    pub termination: PdasTermination,
     /// Complementarity constant used.
     pub c: f64,
     /// Largest |F - K u| over the unknowns other than contact normals, relative to max |F|.
@@ -97,7 +93,7 @@ pub struct Kkt {
 /// active-set iteration. An active-set method that does not converge is an error naming the
 /// iterations and the residual. A mesh on which the Dirichlet part does not hold every body is
 /// refused before factorising, and the solution is returned only once its KKT conditions hold
-/// to [`certify::TOLERANCE`] ([`crate::certify`]).
+/// to [`certify::TOLERANCE`] ([`crate::contact::certify`]).
 ///
 /// ```rust
 /// use signorini::contact::PdasOptions;
@@ -357,7 +353,7 @@ pub fn contact_density(mesh: &Mesh, sol: &DiscreteSolution) -> Vec<f64> {
 fn contact_weights(mesh: &Mesh, sol: &DiscreteSolution, share: impl Fn(bool, f64) -> f64) -> Vec<f64> {
     let mut weight = vec![0.0; sol.dofs.contact.len()];
     for (be, bn) in mesh.boundary.iter().zip(&sol.nodes.boundary_nodes) {
-        if be.part != crate::mesh::Part::Contact {
+        if be.part != crate::problems::Part::Contact {
             continue;
         }
         let len = crate::mesh::dist(mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);

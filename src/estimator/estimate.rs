@@ -28,11 +28,11 @@
 mod local;
 pub mod repair;
 
-use crate::element::EDGE_VERTICES;
-use crate::mesh::{Mesh, Part, dist};
-use crate::norms::Sampling;
-use crate::problems::Problem;
-use crate::solve::DiscreteSolution;
+use crate::base::element::EDGE_VERTICES;
+use crate::contact::norms::Sampling;
+use crate::contact::solve::DiscreteSolution;
+use crate::mesh::{Mesh, dist};
+use crate::problems::{Part, Problem};
 use rayon::prelude::*;
 
 /// Threshold, relative to the force scale, above which lambda_p counts as positive (Lambda_h^C).
@@ -40,16 +40,20 @@ pub const LAMBDA_POSITIVE: f64 = 1e-10;
 /// Gauss points per edge for the "quadrature" sampling of edge terms.
 pub const EDGE_GAUSS: usize = 3;
 
-/// Which contact nodes eta_5 is taken over.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// Which contact nodes eta_5 is taken over. Manifests spell the values in snake_case
+/// (`as_written`), the command line in kebab-case (`--contact-term as-written`). The variants'
+/// docs are for readers of the code (`help = None`): the flag's help describes the values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum ContactTerm {
     /// All contact nodes, as the paper writes eta_5.
+    #[value(help = None::<&str>)]
     AsWritten,
     /// Without full-contact nodes N_h^FC (u_h.n = chi_h on all of Gamma_{p,C}), as in
     /// Krause–Veeser–Walloth. At a node in full contact the exact normal stress is a compressive
     /// contact pressure, not an error: taken over all contact nodes, eta_5 measures that pressure
     /// and decays only like h (measured: the `contact_term_ablation` study).
+    #[value(help = None::<&str>)]
     WithoutFullContact,
     /// The repaired contact terms (beyond the paper): at a full-contact node eta_5 takes only the
     /// tensile part (n . sigma(u_h) n)^+ of the normal stress, at other contact nodes it is as
@@ -57,18 +61,22 @@ pub enum ContactTerm {
     /// nodes active) and the edges through an active node with positive contact force that lies
     /// on no full-contact edge (an isolated active node). See [`repair`] for why, and for the
     /// step of the proof that is open.
+    #[value(help = None::<&str>)]
     TensileOnFullContact,
 }
 
-/// The log factor l_h multiplying the residual terms.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// The log factor l_h multiplying the residual terms (`--log-factor`, `estimator.log_factor`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
 pub enum LogFactor {
     /// 1 + |log h_min|^2 (eq. 6.3)
+    #[value(help = None::<&str>)]
     Squared,
     /// 1 + |log h_min|
+    #[value(help = None::<&str>)]
     Linear,
     /// 1
+    #[value(help = None::<&str>)]
     One,
 }
 
@@ -111,12 +119,15 @@ pub struct EstimatorConfig {
     pub stress_frame: StressFrame,
 }
 
+/// The constant C_0 of Section 7, the estimator's default.
+pub const C0_PAPER: f64 = 0.45;
+
 impl Default for EstimatorConfig {
     fn default() -> Self {
         EstimatorConfig {
             contact_term: ContactTerm::AsWritten,
             log_factor: LogFactor::Squared,
-            c0: 0.45,
+            c0: C0_PAPER,
             sampling: Sampling::Quadrature,
             stress_frame: StressFrame::Normal,
         }

@@ -6,13 +6,12 @@
 //! The unknowns are numbered so that every contact normal unknown comes last (the block `C`);
 //! the contact solver relies on that to work on a small Schur complement.
 
-use crate::element::{self, Affine, EDGE_VERTICES, N_NODES};
-use crate::mesh::{Mesh, P2Nodes, Part};
-use crate::problems::{Material, Problem};
+use crate::base::element::{self, Affine, EDGE_VERTICES, N_NODES};
+use crate::mesh::{Mesh, P2Nodes};
+use crate::problems::{Material, Part, Problem};
 use rayon::prelude::*;
 
-pub use crate::sparse::csc::{SymCsc, SymCscError};
-use crate::sparse::csc::{offsets, par_fill};
+use crate::sparse::csc::{SymCsc, offsets, par_fill};
 
 /// Marks a node component that is not an unknown (a Dirichlet value).
 pub const FIXED: usize = usize::MAX;
@@ -419,7 +418,7 @@ pub fn point_reactions(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dy
 ///
 /// With it, the magnitude sum_T |K_T| |u| of the same terms and the rows' absolute sums
 /// sum_T |K_T| 1: the scales against which the round-off of F - K u is judged
-/// ([`crate::certify`]).
+/// ([`crate::contact::certify`]).
 pub fn stiffness_times(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, material: Material, u: &[f64]) -> StiffnessProduct {
     assert_eq!(u.len(), dofs.n_free);
     let rule = element::triangle_rule(2);

@@ -134,16 +134,16 @@ fn check_size(path: &Path) -> Result<(), MeshError> {
         return Err(error(path, None, "not a regular file: a mesh is read from a file of known size"));
     }
     let needed = 8.0 * meta.len() as f64;
-    let available = crate::memory::available_memory().unwrap_or(crate::memory::UNKNOWN_MEMORY_LIMIT);
+    let available = crate::base::memory::available_memory().unwrap_or(crate::base::memory::UNKNOWN_MEMORY_LIMIT);
     if needed > available {
         return Err(error(
             path,
             None,
             format!(
                 "the file has {}: reading it needs about {}, more than the {} this process can allocate",
-                crate::memory::human_bytes(meta.len() as f64),
-                crate::memory::human_bytes(needed),
-                crate::memory::human_bytes(available)
+                crate::base::memory::human_bytes(meta.len() as f64),
+                crate::base::memory::human_bytes(needed),
+                crate::base::memory::human_bytes(available)
             ),
         ));
     }
@@ -243,14 +243,45 @@ fn nodes_by_tag(
     Ok(node_at)
 }
 
-/// Read and check a Gmsh file (everything that does not depend on the problem).
+/// The linear triangles of the file, as node tags with their element tag.
+type TriangleTags = Vec<([u64; 3], u64)>;
+/// The 2-node lines of the file's physical groups: node tags, physical group, element tag.
+type GroupLineTags = Vec<([u64; 2], i32, u64)>;
+/// The line of an element in the file, by its tag (None in a binary file).
+type LineOf<'a> = dyn Fn(u64) -> Option<usize> + 'a;
+/// The vertex index of every node tag a triangle uses.
+type VertexOf = HashMap<u64, usize>;
+/// A physical group's name and the line of its `$PhysicalNames` entry.
+type Group = (String, Option<usize>);
+/// Triangles (vertex indices) with their lines in the file.
+type Triangles = (Vec<[usize; 3]>, Vec<Option<usize>>);
+
+/// Read and check a Gmsh file (everything that does not depend on the problem), phase by phase:
+/// parse, nodes by tag, elements by kind, vertices, triangles, the boundary groups' edges.
 pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     check_size(path)?;
     let bytes = std::fs::read(path).map_err(|e| error(path, None, format!("cannot read the mesh file: {e}")))?;
     let names = physical_names(path, &bytes)?;
-    // mshio has a few `expect`s left on malformed input: a panic there is a malformed file too
+    let msh = parse(path, &bytes)?;
+    let binary = msh.header.file_type != 0;
+    let lines = if binary { HashMap::new() } else { element_lines(&bytes) };
+    let line_of = |tag: u64| lines.get(&tag).copied();
+    let nodes = msh.data.nodes.as_ref().ok_or_else(|| error(path, None, "the file has no $Nodes section"))?;
+    let elements = msh.data.elements.as_ref().ok_or_else(|| error(path, None, "the file has no $Elements section"))?;
+    let node_at = nodes_by_tag(path, &bytes, binary, nodes)?;
+    let (tri_nodes, line_elems) = elements_by_kind(path, &msh, elements, &line_of)?;
+    let (vertices, used) = vertices_of(path, &tri_nodes, &node_at, &line_of)?;
+    let (triangles, triangle_lines) = oriented_triangles(path, &vertices, &used, &tri_nodes, &line_of)?;
+    check_folds(path, &vertices, &triangles, &tri_nodes, &line_of)?;
+    let (edges, groups) = group_edges(path, line_elems, &used, &node_at, &names, &line_of)?;
+    Ok(GmshFile { path: path.to_path_buf(), vertices, triangles, triangle_lines, edges, groups })
+}
+
+/// The file parsed by `mshio`; its error turned into one naming the line. `mshio` has a few
+/// `expect`s left on malformed input: a panic there is a malformed file too.
+fn parse(path: &Path, bytes: &[u8]) -> Result<mshio::MshFile<u64, i32, f64>, MeshError> {
     let parsed = std::panic::catch_unwind(|| {
-        mshio::parse_msh_bytes(&bytes).map_err(|e| {
+        mshio::parse_msh_bytes(bytes).map_err(|e| {
             let first = e.begin_msh_errors().next().or(e.backtrace.first());
             let (rest, kind) = first
                 .map(|(r, k)| (r.len(), k.context().map_or_else(|| k.to_string(), |c| format!("cannot read the {c}"))))
@@ -269,17 +300,22 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
             (offset, format!("not a valid MSH 4.1 file: {kind}{within}{end}"))
         })
     });
-    let msh = match parsed {
-        Ok(Ok(m)) => m,
-        Ok(Err((offset, message))) => return Err(error(path, Some(line_at(&bytes, offset)), message)),
-        Err(_) => return Err(error(path, None, "not a valid MSH 4.1 file (the MSH parser gave up)")),
-    };
-    let binary = msh.header.file_type != 0;
-    let lines = if binary { HashMap::new() } else { element_lines(&bytes) };
-    let line_of = |tag: u64| lines.get(&tag).copied();
-    let nodes = msh.data.nodes.as_ref().ok_or_else(|| error(path, None, "the file has no $Nodes section"))?;
-    let elements = msh.data.elements.as_ref().ok_or_else(|| error(path, None, "the file has no $Elements section"))?;
-    let node_at = nodes_by_tag(path, &bytes, binary, nodes)?;
+    match parsed {
+        Ok(Ok(m)) => Ok(m),
+        Ok(Err((offset, message))) => Err(error(path, Some(line_at(bytes, offset)), message)),
+        Err(_) => Err(error(path, None, "not a valid MSH 4.1 file (the MSH parser gave up)")),
+    }
+}
+
+/// The `$Elements` section sorted by kind: the linear triangles, and the 2-node lines of curves
+/// in a physical group (a curve in several groups is an error); points are ignored, any other
+/// element type is an error.
+fn elements_by_kind(
+    path: &Path,
+    msh: &mshio::MshFile<u64, i32, f64>,
+    elements: &mshio::Elements<u64, i32>,
+    line_of: &LineOf,
+) -> Result<(TriangleTags, GroupLineTags), MeshError> {
     let listed: usize = elements.element_blocks.iter().map(|b| b.elements.len()).sum();
     if listed as u64 != elements.num_elements {
         return Err(error(
@@ -295,8 +331,8 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
         .as_ref()
         .map(|e| e.curves.iter().map(|c| (c.tag, c.physical_tags.iter().map(|t| t.abs()).collect())).collect())
         .unwrap_or_default();
-    let mut tri_nodes: Vec<([u64; 3], u64)> = Vec::new();
-    let mut line_elems: Vec<([u64; 2], i32, u64)> = Vec::new();
+    let mut tri_nodes: TriangleTags = Vec::new();
+    let mut line_elems: GroupLineTags = Vec::new();
     for block in &elements.element_blocks {
         let first = block.elements.first().map(|e| e.element_tag);
         match (block.entity_dim, block.element_type) {
@@ -331,9 +367,19 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     if tri_nodes.is_empty() {
         return Err(error(path, None, "the file has no linear triangles (element type 2): a 2D mesh is expected"));
     }
-    // vertices: the nodes of the triangles, in ascending tag order
-    let mut used: HashMap<u64, usize> = HashMap::new();
-    for (tri, tag) in &tri_nodes {
+    Ok((tri_nodes, line_elems))
+}
+
+/// The vertices: the nodes of the triangles (each must be in `$Nodes`, in the plane z = 0), in
+/// ascending tag order; with the vertex index of every node tag used.
+fn vertices_of(
+    path: &Path,
+    tri_nodes: &TriangleTags,
+    node_at: &BTreeMap<u64, [f64; 3]>,
+    line_of: &LineOf,
+) -> Result<(Vec<[f64; 2]>, VertexOf), MeshError> {
+    let mut used: VertexOf = HashMap::new();
+    for (tri, tag) in tri_nodes {
         for n in tri {
             if !node_at.contains_key(n) {
                 return Err(error(path, line_of(*tag), format!("triangle {tag} names node {n}, which the $Nodes section does not have")));
@@ -354,9 +400,21 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
             vertices.push([x, y]);
         }
     }
+    Ok((vertices, used))
+}
+
+/// The triangles in vertex indices, counter-clockwise (none of zero area) and with the longest
+/// edge opposite the first vertex; with their lines in the file.
+fn oriented_triangles(
+    path: &Path,
+    vertices: &[[f64; 2]],
+    used: &VertexOf,
+    tri_nodes: &TriangleTags,
+    line_of: &LineOf,
+) -> Result<Triangles, MeshError> {
     let mut triangles = Vec::with_capacity(tri_nodes.len());
     let mut triangle_lines = Vec::with_capacity(tri_nodes.len());
-    for (tri, tag) in &tri_nodes {
+    for (tri, tag) in tri_nodes {
         let [a, b, c] = tri.map(|n| used[&n]);
         let (pa, pb, pc) = (vertices[a], vertices[b], vertices[c]);
         let area = 0.5 * ((pb[0] - pa[0]) * (pc[1] - pa[1]) - (pb[1] - pa[1]) * (pc[0] - pa[0]));
@@ -370,9 +428,20 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
         triangles.push([t[first], t[(first + 1) % 3], t[(first + 2) % 3]]);
         triangle_lines.push(line_of(*tag));
     }
-    check_folds(path, &vertices, &triangles, &tri_nodes, &line_of)?;
-    // line elements of physical groups
-    let mut groups: Vec<(String, Option<usize>)> = Vec::new();
+    Ok((triangles, triangle_lines))
+}
+
+/// The line elements of the physical groups as edges between vertices (a node of no triangle is
+/// an error), and the groups in order of first use, named from `$PhysicalNames` (or by number).
+fn group_edges(
+    path: &Path,
+    line_elems: GroupLineTags,
+    used: &VertexOf,
+    node_at: &BTreeMap<u64, [f64; 3]>,
+    names: &PhysicalNames,
+    line_of: &LineOf,
+) -> Result<(Vec<GroupEdge>, Vec<Group>), MeshError> {
+    let mut groups: Vec<Group> = Vec::new();
     let mut group_index: BTreeMap<i32, usize> = BTreeMap::new();
     let mut edges = Vec::with_capacity(line_elems.len());
     for ([a, b], g, tag) in line_elems {
@@ -389,7 +458,7 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
         });
         edges.push(GroupEdge { v: [va, vb], group, line: line_of(tag) });
     }
-    Ok(GmshFile { path: path.to_path_buf(), vertices, triangles, triangle_lines, edges, groups })
+    Ok((edges, groups))
 }
 
 impl GmshFile {
@@ -441,7 +510,7 @@ impl GmshFile {
     pub fn ndof(&self) -> f64 {
         let mut count: HashMap<(usize, usize), u8> = HashMap::new();
         for t in &self.triangles {
-            for [i, j] in crate::element::EDGE_VERTICES {
+            for [i, j] in crate::base::element::EDGE_VERTICES {
                 *count.entry(key(t[i], t[j])).or_default() += 1;
             }
         }
@@ -481,7 +550,7 @@ impl GmshFile {
         // edges: owners (triangle, local edge)
         let mut owners: HashMap<(usize, usize), Vec<(usize, usize)>> = HashMap::new();
         for (t, tri) in self.triangles.iter().enumerate() {
-            for (le, [i, j]) in crate::element::EDGE_VERTICES.iter().enumerate() {
+            for (le, [i, j]) in crate::base::element::EDGE_VERTICES.iter().enumerate() {
                 let o = owners.entry(key(tri[*i], tri[*j])).or_default();
                 o.push((t, le));
                 if o.len() > 2 {
@@ -521,7 +590,7 @@ impl GmshFile {
         }
         let mut boundary = Vec::new();
         for (t, tri) in self.triangles.iter().enumerate() {
-            for [i, j] in crate::element::EDGE_VERTICES {
+            for [i, j] in crate::base::element::EDGE_VERTICES {
                 let k = key(tri[i], tri[j]);
                 if owners[&k].len() != 1 {
                     continue;

@@ -3,7 +3,7 @@
 //! coordinates in each decide.
 
 use super::Mesh;
-use crate::element::Affine;
+use crate::base::element::Affine;
 use rstar::RTree;
 use rstar::primitives::{GeomWithData, Rectangle};
 
@@ -69,7 +69,7 @@ impl Locator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::Curve;
+    use crate::problems::Curve;
 
     /// Point location against brute force (every triangle tried) on a mesh graded towards a
     /// corner of a disc: the same triangle (smallest outside, then smallest index) for points

@@ -13,8 +13,7 @@ pub mod locate;
 mod msh_nodes;
 pub mod refine;
 
-use crate::problems::Problem;
-pub use crate::problems::{Curve, Part};
+use crate::problems::{Curve, Part, Problem};
 use rayon::slice::ParallelSliceMut;
 use std::fmt;
 use std::path::PathBuf;
@@ -86,6 +85,9 @@ pub enum MeshSpec {
 }
 
 impl MeshSpec {
+    /// The initial mesh when none is given (`adapt --mesh`, a manifest's `mesh`).
+    pub const DEFAULT: &str = "structured:4";
+
     pub fn parse(s: &str) -> Result<Self, MeshError> {
         let bad = || MeshError::BadSpec(s.to_string());
         let (kind, rest) = s.split_once(':').ok_or_else(bad)?;
@@ -297,7 +299,7 @@ impl Mesh {
         // sort rather than a hash map: 5x faster on the meshes of the benchmark)
         let mut keys: Vec<(usize, usize)> = Vec::with_capacity(3 * self.triangles.len());
         for tri in &self.triangles {
-            keys.extend(crate::element::EDGE_VERTICES.iter().map(|&[i, j]| key(tri[i], tri[j])));
+            keys.extend(crate::base::element::EDGE_VERTICES.iter().map(|&[i, j]| key(tri[i], tri[j])));
         }
         keys.par_sort_unstable();
         let mut tagged: Vec<(usize, usize)> = self.boundary.iter().map(|e| key(e.v[0], e.v[1])).collect();
@@ -419,7 +421,7 @@ impl P2Nodes {
         let mut edge_owner: Vec<[Option<(usize, usize)>; 2]> = Vec::with_capacity(edges.edges.capacity());
         for (t, tri) in mesh.triangles.iter().enumerate() {
             let mut nodes = [tri[0], tri[1], tri[2], 0, 0, 0];
-            for (le, [i, j]) in crate::element::EDGE_VERTICES.iter().enumerate() {
+            for (le, [i, j]) in crate::base::element::EDGE_VERTICES.iter().enumerate() {
                 let e = edges.find_or_insert(tri[*i], tri[*j]);
                 if e == edge_owner.len() {
                     edge_owner.push([None, None]);
@@ -552,7 +554,7 @@ pub(crate) mod tests {
         // a tag on an interior edge (the diagonal of the first triangle that is not on x, y in {0, 1})
         let mut m = Mesh::unit_square(2, false, &tag);
         let interior = (0..m.n_triangles())
-            .flat_map(|t| crate::element::EDGE_VERTICES.map(|[i, j]| [m.triangles[t][i], m.triangles[t][j]]))
+            .flat_map(|t| crate::base::element::EDGE_VERTICES.map(|[i, j]| [m.triangles[t][i], m.triangles[t][j]]))
             .find(|e| {
                 e.iter().any(|&v| {
                     let x = m.vertices[v];

@@ -55,7 +55,7 @@
 //! written here against [`Mesh`] directly.
 
 use super::{BoundaryEdge, Mesh, P2Nodes};
-use crate::element::{Affine, p2_values};
+use crate::base::element::{Affine, p2_values};
 
 /// Marker for "no triangle" in the edge owner table.
 const NONE: usize = usize::MAX;
@@ -69,7 +69,7 @@ pub struct Refinement {
 }
 
 /// The edges of a mesh: per triangle its three edge numbers (local edges `(0,1)`, `(1,2)`,
-/// `(2,0)`, as in [`crate::element::EDGE_VERTICES`]) and per edge its one or two triangles.
+/// `(2,0)`, as in [`crate::base::element::EDGE_VERTICES`]) and per edge its one or two triangles.
 /// Edges are numbered in order of first appearance in the triangle list.
 struct Edges {
     tri_edges: Vec<[usize; 3]>,
@@ -88,7 +88,7 @@ impl Edges {
         // every half-edge reserves a slot in the bucket of its smaller vertex (an upper bound)
         let mut start = vec![0usize; nv + 1];
         for tri in &mesh.triangles {
-            for [i, j] in crate::element::EDGE_VERTICES {
+            for [i, j] in crate::base::element::EDGE_VERTICES {
                 start[tri[i].min(tri[j]) + 1] += 1;
             }
         }
@@ -104,7 +104,7 @@ impl Edges {
         };
         for (t, tri) in mesh.triangles.iter().enumerate() {
             let mut te = [0; 3];
-            for (le, [i, j]) in crate::element::EDGE_VERTICES.iter().enumerate() {
+            for (le, [i, j]) in crate::base::element::EDGE_VERTICES.iter().enumerate() {
                 let (lo, hi) = super::key(tri[*i], tri[*j]);
                 te[le] = match edges.find(lo, hi) {
                     Some(e) => {
@@ -189,7 +189,7 @@ pub fn refine(mesh: &Mesh, marked: &[bool]) -> Refinement {
     vertices.reserve(n_split);
     for (t, tri) in mesh.triangles.iter().enumerate() {
         // visiting the edges through the triangles gives them in edge order (first appearance)
-        for (le, [i, j]) in crate::element::EDGE_VERTICES.iter().enumerate() {
+        for (le, [i, j]) in crate::base::element::EDGE_VERTICES.iter().enumerate() {
             let e = edges.tri_edges[t][le];
             if split[e] && midpoint[e] == NONE {
                 let (p, q) = (mesh.vertices[tri[*i]], mesh.vertices[tri[*j]]);

@@ -7,7 +7,7 @@
 
 use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, ESTIMATE, Figure, NDF_DESC, PALETTE, Style, runs, series, slope};
-use crate::verdict::FLOOR_MARGIN;
+use crate::analysis::verdict::FLOOR_MARGIN;
 use std::path::Path;
 
 const STUDY: &str = "deep";

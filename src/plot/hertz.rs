@@ -8,7 +8,7 @@
 
 use super::render::{LineFigure, Series};
 use super::{Built, Figure, Marker, PALETTE, Panel, Style, YScale, mesh_figure, runs, saved_levels};
-use crate::hertz::{self, Hertz};
+use crate::analysis::hertz::{self, Hertz};
 use crate::records::{MeshSnapshot, RunRecord, StudyDir};
 use anyhow::Context;
 use plotters::style::RGBColor;
@@ -64,7 +64,7 @@ pub(super) fn hertz_pressure(results: &Path) -> anyhow::Result<Built> {
         nodes.sort_by(|u, v| u.x[0].total_cmp(&v.x[0]));
         // thousands of nodes: a line, no markers
         let style = Style { color: PALETTE[k % PALETTE.len()], marker: Marker::None, dashed: false, filled: true, large: false };
-        let s = |n: &&crate::records::ContactSample| (n.x[0] - c.centre) / a;
+        let s = |n: &&crate::contact::solve::ContactSample| (n.x[0] - c.centre) / a;
         profile.series.push(Series {
             label: format!(
                 "{}, NDF {}: F = {:.4}, a_{{h}} = {:.5} ({}), p_{{0,h}} = {:.3} ({})",

@@ -66,9 +66,8 @@ pub mod render;
 mod repair;
 mod rich;
 
-use crate::estimate::{ContactTerm, LogFactor};
-use crate::records::{LevelRecord, Refine};
-use crate::records::{MeshSnapshot, RunRecord, StudyDir};
+use crate::estimator::estimate::{C0_PAPER, ContactTerm, LogFactor};
+use crate::records::{LevelRecord, MeshSnapshot, Refine, RunRecord, StudyDir};
 use anyhow::Context;
 use plotters::prelude::*;
 use render::{Figure, HLine, LineFigure, Marker, MeshFigure, PALETTE, Panel, Series, Slope, SlopeAnchor, Style, YScale};
@@ -116,8 +115,6 @@ pub fn study_of(figure: &str) -> Option<&'static str> {
     })
 }
 
-/// C0 of Section 7.
-const C0_PAPER: f64 = 0.45;
 /// An estimator term below `ROUNDOFF` times the largest term of its level is round-off: drawn
 /// as 0 (not at all, on a log axis). Legitimate small terms are 1e-6 of the largest or more in
 /// every stored run; round-off is 1e-18 of it.

@@ -4,10 +4,10 @@
 //!
 //! Everything on the page is read from files the other commands wrote: the records and
 //! `provenance.json` under the results folder, the PNGs under the figures folder, CLAIMS rows
-//! recomputed from the records ([`crate::claims`]), and the drift report `signorini drift` wrote
+//! recomputed from the records ([`crate::analysis::claims`]), and the drift report `signorini drift` wrote
 //! (`target/drift/report.json` by default), whose date and scope the page states.
 
-use crate::claims::Claim;
+use crate::analysis::claims::Claim;
 use crate::records::{RunRecord, StudyDir};
 use base64::Engine;
 use std::fmt::Write;
@@ -108,7 +108,7 @@ fn claims_table(claims: &[&Claim]) -> String {
             "<tr class=\"claim\" id=\"claim-{id}\"><td><b>{id}</b>: {}<details><summary>the claim in full</summary>{}</details><details><summary>what would fail it</summary>{}</details></td><td>{}</td><td>{}<details><summary>evidence</summary>{}</details></td><td>{}</td></tr>",
             escape(c.summary.topic),
             escape(&c.claim),
-            escape(&crate::claims::capitalised(&c.criterion.fails_if())),
+            escape(&crate::analysis::claims::capitalised(&c.criterion.fails_if())),
             escape(c.summary.paper),
             escape(&c.summary.headline),
             escape(&c.measured),
@@ -279,7 +279,8 @@ pub fn write_pages(results: &Path, figures: &Path, out: &Path, studies: &[String
     for study in &chosen {
         crate::study::store::Store::new(results, study).read()?;
     }
-    let claims = crate::claims::claims(results).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
+    let claims =
+        crate::analysis::claims::claims(results).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
     let drift = match std::fs::read_to_string(drift_report) {
         Ok(t) => Some(serde_json::from_str(&t).with_context(|| format!("reading the drift report {}", drift_report.display()))?),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,

@@ -7,7 +7,7 @@
 
 use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, ESTIMATE, Figure, NDF_DESC, PALETTE, Style, problem_title, series, slope};
-use crate::claims::repair::{Fitted, PROBLEMS, Stored};
+use crate::analysis::claims::repair::{Fitted, PROBLEMS, Stored};
 use crate::records::RunRecord;
 use anyhow::Context;
 use std::path::Path;

@@ -338,7 +338,7 @@ impl Expr {
 
 /// A comparison `lhs op rhs`.
 #[derive(Clone, Debug)]
-struct Comparison {
+struct Inequality {
     lhs: Expr,
     op: Cmp,
     rhs: Expr,
@@ -356,7 +356,7 @@ enum Cmp {
 #[derive(Clone, Debug)]
 struct Predicate {
     /// Disjunction of conjunctions.
-    any: Vec<Vec<Comparison>>,
+    any: Vec<Vec<Inequality>>,
 }
 
 impl Predicate {
@@ -594,7 +594,7 @@ impl Reader<'_> {
                     return Err(self.error(key, span.clone(), format!("one comparison in {comparison:?} (join several with && or ||)")));
                 }
                 let side = |s: &str| self.expr(key, span.clone(), &Scalar::Text(s.trim().to_string()), &["x", "y"]);
-                all.push(Comparison { lhs: side(lhs)?, op, rhs: side(rhs)? });
+                all.push(Inequality { lhs: side(lhs)?, op, rhs: side(rhs)? });
             }
             any.push(all);
         }

@@ -195,50 +195,57 @@ impl<'a> ser::Serializer for &'a mut Walker {
     }
 }
 
-impl ser::SerializeSeq for Compound<'_> {
-    type Ok = ();
-    type Error = Stop;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Stop> {
-        self.element(value)
-    }
-    fn end(self) -> Result<(), Stop> {
+impl Compound<'_> {
+    /// End a compound; a variant's (`variant`) name leaves the path with it.
+    fn close(self, variant: bool) -> Result<(), Stop> {
+        if variant {
+            self.walker.path.pop();
+        }
         Ok(())
     }
 }
 
-impl ser::SerializeTuple for Compound<'_> {
-    type Ok = ();
-    type Error = Stop;
-    fn serialize_element<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Stop> {
-        self.element(value)
-    }
-    fn end(self) -> Result<(), Stop> {
-        Ok(())
-    }
+/// The compound traits whose elements are walked by position (`Trait::method => variant`):
+/// sequences, tuples, tuple structs and tuple variants.
+macro_rules! by_position {
+    ($($trait:ident :: $method:ident => $variant:literal),* $(,)?) => {$(
+        impl ser::$trait for Compound<'_> {
+            type Ok = ();
+            type Error = Stop;
+            fn $method<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Stop> {
+                self.element(value)
+            }
+            fn end(self) -> Result<(), Stop> {
+                self.close($variant)
+            }
+        }
+    )*};
 }
 
-impl ser::SerializeTupleStruct for Compound<'_> {
-    type Ok = ();
-    type Error = Stop;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Stop> {
-        self.element(value)
-    }
-    fn end(self) -> Result<(), Stop> {
-        Ok(())
-    }
+by_position!(
+    SerializeSeq::serialize_element => false,
+    SerializeTuple::serialize_element => false,
+    SerializeTupleStruct::serialize_field => false,
+    SerializeTupleVariant::serialize_field => true,
+);
+
+/// The compound traits whose fields are walked by name: structs and struct variants.
+macro_rules! by_name {
+    ($($trait:ident => $variant:literal),* $(,)?) => {$(
+        impl ser::$trait for Compound<'_> {
+            type Ok = ();
+            type Error = Stop;
+            fn serialize_field<T: Serialize + ?Sized>(&mut self, key: &'static str, value: &T) -> Result<(), Stop> {
+                self.walker.visit(Step::Key(key.into()), value)
+            }
+            fn end(self) -> Result<(), Stop> {
+                self.close($variant)
+            }
+        }
+    )*};
 }
 
-impl ser::SerializeTupleVariant for Compound<'_> {
-    type Ok = ();
-    type Error = Stop;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Stop> {
-        self.element(value)
-    }
-    fn end(self) -> Result<(), Stop> {
-        self.walker.path.pop(); // the variant's name
-        Ok(())
-    }
-}
+by_name!(SerializeStruct => false, SerializeStructVariant => true);
 
 impl ser::SerializeMap for Compound<'_> {
     type Ok = ();
@@ -252,30 +259,7 @@ impl ser::SerializeMap for Compound<'_> {
         self.walker.visit(Step::Key(std::mem::take(&mut self.key)), value)
     }
     fn end(self) -> Result<(), Stop> {
-        Ok(())
-    }
-}
-
-impl ser::SerializeStruct for Compound<'_> {
-    type Ok = ();
-    type Error = Stop;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, key: &'static str, value: &T) -> Result<(), Stop> {
-        self.walker.visit(Step::Key(key.into()), value)
-    }
-    fn end(self) -> Result<(), Stop> {
-        Ok(())
-    }
-}
-
-impl ser::SerializeStructVariant for Compound<'_> {
-    type Ok = ();
-    type Error = Stop;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, key: &'static str, value: &T) -> Result<(), Stop> {
-        self.walker.visit(Step::Key(key.into()), value)
-    }
-    fn end(self) -> Result<(), Stop> {
-        self.walker.path.pop(); // the variant's name
-        Ok(())
+        self.close(false)
     }
 }
 
@@ -403,5 +387,27 @@ mod tests {
         assert_eq!(first_non_finite(&run(1.0, None, f64::NEG_INFINITY)).unwrap().path, "constants.delta");
         assert_eq!(first_non_finite(&vec![[0.0, 1.0], [f64::NAN, 2.0]]).unwrap().path, "[1][0]");
         assert_eq!(first_non_finite(&f32::INFINITY).unwrap().to_string(), "the value is inf, not a finite number");
+    }
+
+    #[derive(Serialize)]
+    enum Shape {
+        Pair(f64, f64),
+        Named { x: f64 },
+    }
+
+    #[derive(Serialize)]
+    struct Shapes {
+        shapes: Vec<Shape>,
+        after: f64,
+    }
+
+    #[test]
+    fn a_variant_names_its_floats_and_leaves_the_path_when_it_ends() {
+        let shapes = |x: f64, after: f64| Shapes { shapes: vec![Shape::Pair(1.0, 2.0), Shape::Named { x }], after };
+        assert_eq!(first_non_finite(&shapes(1.0, 0.0)), None);
+        assert_eq!(first_non_finite(&shapes(f64::NAN, 0.0)).unwrap().path, "shapes[1].Named.x");
+        assert_eq!(first_non_finite(&shapes(1.0, f64::INFINITY)).unwrap().path, "after");
+        let pair = Shapes { shapes: vec![Shape::Pair(1.0, f64::NAN)], after: 0.0 };
+        assert_eq!(first_non_finite(&pair).unwrap().path, "shapes[0].Pair[1]");
     }
 }

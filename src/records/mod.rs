@@ -1,5 +1,5 @@
-//! Floor 7: the records schema (what a level, a run and a solve report hold; [`report`]) and
-//! how records are written to disk. May import every floor below.
+//! The `records/` floor (above `estimator/`): the records schema (what a level, a run and a solve
+//! report hold; [`report`]) and how records are written to disk. May import every floor below.
 //!
 //! Writing records to disk: always atomically (a temporary file in the same directory, then a
 //! rename), so an interrupted run never leaves a half-written file behind, and a write that
@@ -9,12 +9,14 @@
 //! is written: a float JSON cannot hold (NaN, an infinity, which `serde_json` would write as
 //! `null` and then refuse to read) is an error naming the field ([`first_non_finite`]).
 
+mod error;
 mod finite;
 pub mod history;
 pub mod reference;
 pub mod report;
 
-pub use crate::contact::solve::ContactSample;
+use crate::contact::solve::ContactSample;
+pub use error::RecordError;
 pub use finite::{NonFinite, first_non_finite};
 pub use history::{BadFlags, Flags, History, LevelHistory};
 pub use reference::{Rebuild, ReferenceRecord};
@@ -23,9 +25,8 @@ use std::io::Write;
 use std::path::Path;
 
 /// Wrap an I/O error with the step that failed and the path it failed on.
-fn step(what: &str, on: &Path) -> impl FnOnce(std::io::Error) -> std::io::Error {
-    let (what, on) = (what.to_string(), on.display().to_string());
-    move |e: std::io::Error| std::io::Error::new(e.kind(), format!("{what} {on}: {e}"))
+fn step(what: &'static str, on: &Path) -> impl FnOnce(std::io::Error) -> std::io::Error {
+    RecordError::io(what, on)
 }
 
 /// Whether a file name is one of [`Batch`]'s temporary files (`.NAME.tmpPID.N`): what a process
@@ -115,19 +116,16 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 
 /// Read a text file; an error names the path.
 pub fn read_text(path: &Path) -> std::io::Result<String> {
-    std::fs::read_to_string(path).map_err(|e| std::io::Error::new(e.kind(), format!("reading {}: {e}", path.display())))
+    std::fs::read_to_string(path).map_err(step("reading", path))
 }
 
 /// `value` as pretty JSON with a final newline, for the file `path`; an error (naming the path
 /// and the field) if a float in it is not finite, since JSON cannot hold it.
 pub fn json_bytes<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Result<Vec<u8>> {
     if let Some(bad) = first_non_finite(value) {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!("not writing {}: {bad} (JSON cannot hold it, and the file could not be read back)", path.display()),
-        ));
+        return Err(RecordError::NonFinite { path: path.into(), bad }.into());
     }
-    let mut s = serde_json::to_string_pretty(value).map_err(|e| std::io::Error::other(format!("serialising {}: {e}", path.display())))?;
+    let mut s = serde_json::to_string_pretty(value).map_err(|error| RecordError::Serialise { path: path.into(), error })?;
     s.push('\n');
     Ok(s.into_bytes())
 }
@@ -137,10 +135,7 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Resul
     write_atomic(path, &json_bytes(path, value)?)
 }
 
-/// The option enums a [`RunSpec`] holds, re-exported so that readers of records need nothing
-/// from the solver modules.
-pub use crate::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame, Terms};
-pub use crate::norms::Sampling;
+use crate::estimator::estimate::{ContactTerm, EstimatorConfig, Terms};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -288,7 +283,12 @@ pub struct RunSpec {
 pub struct ReferenceSpec {
     pub theta: f64,
     pub min_ndof: usize,
-    pub contact_term: crate::estimate::ContactTerm,
+    pub contact_term: ContactTerm,
+}
+
+impl ReferenceSpec {
+    /// The contact term of a reference whose manifest names none.
+    pub const DEFAULT_CONTACT_TERM: ContactTerm = ContactTerm::WithoutFullContact;
 }
 
 /// The record of one finished run: its spec and one `LevelRecord` per level.
@@ -325,9 +325,9 @@ pub struct MeshSnapshot {
 /// parse, or cannot be read, is an error naming it.
 fn read_if_present<T: serde::de::DeserializeOwned>(path: &Path) -> std::io::Result<Option<T>> {
     match std::fs::read_to_string(path) {
-        Ok(text) => serde_json::from_str(&text).map(Some).map_err(|e| std::io::Error::other(format!("{}: {e}", path.display()))),
+        Ok(text) => serde_json::from_str(&text).map(Some).map_err(RecordError::parse(path)),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(e) => Err(std::io::Error::new(e.kind(), format!("reading {}: {e}", path.display()))),
+        Err(e) => Err(step("reading", path)(e)),
     }
 }
 
@@ -393,14 +393,14 @@ impl StudyDir {
         let mut files: Vec<PathBuf> = match std::fs::read_dir(&dir) {
             Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|e| e == "json")).collect(),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-            Err(e) => return Err(std::io::Error::new(e.kind(), format!("reading the directory {}: {e}", dir.display()))),
+            Err(e) => return Err(step("reading the directory", &dir)(e)),
         };
         files.sort();
         files
             .into_iter()
             .map(|f| {
                 let text = read_text(&f)?;
-                let record = serde_json::from_str(&text).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display())))?;
+                let record = serde_json::from_str(&text).map_err(RecordError::parse(&f))?;
                 Ok((f, record))
             })
             .collect()
@@ -413,7 +413,7 @@ impl StudyDir {
     pub fn read_mesh(&self, run: &str, level: usize) -> std::io::Result<MeshSnapshot> {
         let f = self.mesh_file(run, level, "json");
         let text = read_text(&f)?;
-        serde_json::from_str(&text).map_err(|e| std::io::Error::other(format!("{}: {e}", f.display())))
+        serde_json::from_str(&text).map_err(RecordError::parse(f))
     }
 
     /// Rewrite `levels.csv` from the run records: columns `run`, `problem`, `refine`, `theta`,

@@ -3,12 +3,12 @@
 //! case for the NGSolve cross-check.
 
 use crate::contact::PdasIteration;
-use crate::estimate::{Estimate, EstimatorConfig, Terms};
+use crate::contact::norms::LinfError;
+use crate::contact::solve::{ContactInterval, DiscreteSolution, Kkt, SolveTimings};
+use crate::estimator::estimate::{Estimate, EstimatorConfig, Terms};
 use crate::mesh::locate::Locator;
 use crate::mesh::{Mesh, io};
-use crate::norms::LinfError;
 use crate::records;
-use crate::solve::{ContactInterval, DiscreteSolution, Kkt, SolveTimings};
 use anyhow::Result;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -63,13 +63,13 @@ pub struct SolveReport {
     pub contact_zones: Vec<ContactInterval>,
     pub kkt: Kkt,
     /// The KKT conditions relative to their round-off scales, each within `certificate_tolerance`
-    /// (a solve that misses one is an error, [`crate::certify`]).
-    pub certificate: crate::certify::Certificate,
+    /// (a solve that misses one is an error, [`crate::contact::certify`]).
+    pub certificate: crate::contact::certify::Certificate,
     pub certificate_tolerance: f64,
     /// Largest |F - K u_h| over unknowns other than contact normals, relative to max |F|.
     pub free_residual: f64,
     pub error: Option<LinfError>,
-    pub error_sampling: ErrorSampling,
+    pub error_sampling: NormPoints,
     pub estimator: Terms,
     pub estimator_config: EstimatorConfig,
     pub full_contact_nodes: usize,
@@ -80,7 +80,7 @@ pub struct SolveReport {
 
 /// Which points the error norms are taken over.
 #[derive(Clone, Debug, Serialize)]
-pub struct ErrorSampling {
+pub struct NormPoints {
     pub quadrature: String,
     pub dense: String,
 }
@@ -117,12 +117,12 @@ impl SolveReport {
             contact_zones: sol.contact_zones(),
             kkt: sol.kkt(),
             certificate: sol.certificate,
-            certificate_tolerance: crate::certify::TOLERANCE,
+            certificate_tolerance: crate::contact::certify::TOLERANCE,
             free_residual: sol.free_residual,
             error,
-            error_sampling: ErrorSampling {
-                quadrature: crate::norms::Sampling::Quadrature.describe(),
-                dense: crate::norms::Sampling::Dense.describe(),
+            error_sampling: NormPoints {
+                quadrature: crate::contact::norms::Sampling::Quadrature.describe(),
+                dense: crate::contact::norms::Sampling::Dense.describe(),
             },
             estimator: estimate.terms,
             estimator_config: estimate.config,

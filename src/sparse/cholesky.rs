@@ -1,6 +1,6 @@
 //! The numeric supernodal Cholesky factorisation P K P^T = L L^T, on every core.
 //!
-//! [`crate::symbolic`] computes the structure (the supernodes: runs of columns of L with one row
+//! [`crate::sparse::symbolic`] computes the structure (the supernodes: runs of columns of L with one row
 //! pattern, the layout of L's values) and where the matrix's entries go; this module puts the
 //! matrix's values in L's layout ([`load`]), factorises them there ([`factorize`]) and solves
 //! with L ([`solve_in_place`]). Loading first lets a caller release the matrix before L fills up
@@ -28,7 +28,7 @@
 //! faer's.
 
 use crate::sparse::csc::Shared;
-use crate::symbolic::{Placement, Symbolic};
+use crate::sparse::symbolic::{Placement, Symbolic};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{LltParams, LltRegularization};
 use faer::linalg::matmul::triangular::BlockStructure;

@@ -30,7 +30,7 @@ impl SymCsc {
     /// checking the invariant (see [`SymCsc`]) in O(nnz).
     ///
     /// ```rust
-    /// use signorini::assembly::SymCsc;
+    /// use signorini::sparse::csc::SymCsc;
     /// // [[2, -1], [-1, 2]]: column 0 holds rows 0 and 1, column 1 holds row 1
     /// let a = SymCsc::new(2, vec![0, 2, 3], vec![0, 1, 1], vec![2.0, -1.0, 2.0]).unwrap();
     /// assert_eq!(a.mul(&[1.0, 1.0]), vec![1.0, 1.0]);

@@ -1,7 +1,8 @@
-//! Floor 3: sparse linear algebra, nothing of finite elements. Symmetric matrices stored by
-//! their lower triangle ([`csc`]), fill-reducing orderings ([`ordering`]), the symbolic
-//! supernodal Cholesky structure ([`symbolic`]) and the numeric factorisation and solves
-//! ([`cholesky`]). May import: `base`, `mesh` (the node graph an ordering is computed on).
+//! The `sparse/` floor (above `mesh/`): sparse linear algebra, nothing of finite elements.
+//! Symmetric matrices stored by their lower triangle ([`csc`]), fill-reducing orderings
+//! ([`ordering`]), the symbolic supernodal Cholesky structure ([`symbolic`]) and the numeric
+//! factorisation and solves ([`cholesky`]). May import: `base`, `mesh` (the node graph an ordering
+//! is computed on).
 
 pub mod cholesky;
 pub mod csc;

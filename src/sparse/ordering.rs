@@ -500,7 +500,7 @@ fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::assembly::{self, DofMap};
+    use crate::fem::assembly::{self, DofMap};
     use crate::mesh::{MeshSpec, P2Nodes};
     use crate::problems::Ex72;
 

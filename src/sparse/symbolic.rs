@@ -25,8 +25,8 @@
 //! with W the unknowns of later nodes in the column of node k of L, the w unknowns of node k have
 //! column counts W + w, W + w - 1, ..., W + 1.
 
-use crate::ordering::{Graph, OrderingChoice};
 use crate::sparse::csc::{SymCsc, group_of};
+use crate::sparse::ordering::{Graph, OrderingChoice};
 
 /// faer's default supernode relaxation (`SymbolicSupernodalParams::default`): two adjacent
 /// supernodes of together at most `.0` columns merge while the share of explicit zeros in the
@@ -53,7 +53,7 @@ pub struct Symbolic {
 /// Where the entries of a matrix go in L: for each column j of P K P^T, its entries on and
 /// below the diagonal, each as (row of P K P^T, position in the matrix's values). It depends on
 /// the matrix's pattern and the ordering only, so it serves every matrix with that pattern
-/// ([`crate::cholesky::load`] puts the values in place); once L holds them a solver that will
+/// ([`crate::sparse::cholesky::load`] puts the values in place); once L holds them a solver that will
 /// not refactorise can release it (a quarter of the memory of the symbolic phase at
 /// `structured:512`).
 pub struct Placement {
@@ -65,12 +65,13 @@ pub struct Placement {
 /// The structure of L alone: [`Symbolic`]'s `begin`, `row_ptr`, `rows`, `val_ptr`.
 type Structure = (Vec<usize>, Vec<usize>, Vec<u32>, Vec<usize>);
 
-/// Order the unknowns `0..n_order` of `matrix` (as [`crate::ordering::fill_reducing`] does; the
+/// Order the unknowns `0..n_order` of `matrix` (as [`crate::sparse::ordering::fill_reducing`] does; the
 /// others stay at the end in place) and compute the symbolic factorisation with that order, and
 /// where the matrix's entries go in it.
 pub fn analyse(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (Symbolic, Placement, OrderingChoice) {
-    let ((symbolic, placement), choice) =
-        crate::ordering::fill_reducing_then(matrix, n_order, coords, |graph, node_order| Symbolic::new(matrix, n_order, graph, node_order));
+    let ((symbolic, placement), choice) = crate::sparse::ordering::fill_reducing_then(matrix, n_order, coords, |graph, node_order| {
+        Symbolic::new(matrix, n_order, graph, node_order)
+    });
     (symbolic, placement, choice)
 }
 
@@ -134,14 +135,39 @@ impl Symbolic {
     }
 }
 
-/// The structure of L (see [`Symbolic::new`]).
+/// The structure of L (see [`Symbolic::new`]), in the phases of faer's symbolic module: the
+/// nodes' unknowns and neighbours, the elimination tree with the column counts, fundamental
+/// supernodes, their relaxation, the row patterns; computed on nodes, then spelt in unknowns.
 fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize]) -> (Structure, f64) {
     let n = matrix.n();
-    let nodes_i = node_order.len();
-    assert_eq!(nodes_i, graph.n_nodes());
+    assert_eq!(node_order.len(), graph.n_nodes());
     assert!(n < NONE as usize, "more than 2^32 unknowns: widen the symbolic factorisation's indices");
+    let (first, position) = node_unknowns(n, n_order, graph, node_order);
+    let nodes = first.len() - 1;
+    let adjacency = node_adjacency(matrix, n_order, graph, node_order, &position, nodes);
+    let nodes_i = node_order.len();
+    let weight = |p: usize| first[p + 1] - first[p];
+    let counts = tree_and_counts(&adjacency, nodes_i, &weight);
+    let flops = counts.flops(nodes_i, &weight);
+    if nodes == 0 {
+        return ((vec![0], vec![0], Vec::new(), vec![0]), 0.0);
+    }
+    let fund = fundamental(&counts, &weight);
+    let bounds = relax(&fund, &first, &counts);
+    let node_rows = node_patterns(&adjacency, &bounds, &counts);
+    (in_unknowns(&bounds, &first, &counts, &node_rows), flops)
+}
+
+/// The last node of supernode `s` of the runs `bounds`.
+fn top(s: usize, bounds: &[usize]) -> usize {
+    bounds[s + 1] - 1
+}
+
+/// Node p (new numbering; the unknowns `n_order..n` after the graph's nodes, one node each)
+/// holds the unknowns `first[p]..first[p + 1]`; `position[old]` is the graph node's new number.
+fn node_unknowns(n: usize, n_order: usize, graph: &Graph, node_order: &[usize]) -> (Vec<usize>, Vec<u32>) {
+    let nodes_i = node_order.len();
     let nodes = nodes_i + (n - n_order);
-    // node p (new numbering) holds the unknowns first[p]..first[p + 1] (new numbering)
     let mut first = Vec::with_capacity(nodes + 1);
     first.push(0usize);
     for p in 0..nodes {
@@ -153,12 +179,17 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
     for (p, &old) in node_order.iter().enumerate() {
         position[old] = p as u32;
     }
-    // the unknowns n_order..n are not in the graph: their couplings from the matrix (entries
-    // with rows >= n_order; rows are sorted within a column), as an extra adjacency
+    (first, position)
+}
+
+/// The neighbours of every node in the new numbering: the graph's, and for the unknowns
+/// `n_order..n` (not in the graph) their couplings from the matrix (entries with rows >=
+/// `n_order`; rows are sorted within a column), as an extra adjacency.
+fn node_adjacency(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize], position: &[u32], nodes: usize) -> Adjacency {
+    let (n, nodes_i) = (matrix.n(), node_order.len());
     let mut pairs: Vec<(u32, u32)> = Vec::new();
     let (cols, row_idx) = (matrix.col_ptr(), matrix.row_idx());
     if n > n_order {
-        let position = &position;
         let columns = (0..nodes_i)
             .flat_map(|k| graph.unknowns_of(k).map(move |j| (j, position[k])))
             .chain((n_order..n).map(|j| (j, (nodes_i + j - n_order) as u32)));
@@ -185,30 +216,26 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
         extra[fill[b as usize]] = a;
         fill[b as usize] += 1;
     }
-    // the neighbours of every node, in the new numbering
     let degree = |p: usize| if p < nodes_i { graph.degree(node_order[p]) } else { 0 } + extra_ptr[p + 1] - extra_ptr[p];
-    let adjacency = Adjacency::gather(nodes, &degree, &|p, f| {
+    Adjacency::gather(nodes, &degree, &|p, f| {
         if p < nodes_i {
             graph.neighbours(node_order[p]).for_each(|q| f(position[q]));
         }
         extra[extra_ptr[p]..extra_ptr[p + 1]].iter().for_each(|&q| f(q));
-    });
-    let weight = |p: usize| first[p + 1] - first[p];
-    let counts = tree_and_counts(&adjacency, nodes_i, &weight);
-    let flops = counts.flops(nodes_i, &weight);
-    let Counts { parent, below_w, below_n, .. } = counts;
+    })
+}
+
+/// Fundamental supernodes as runs of nodes (the first node of each, then the number of nodes):
+/// node p continues the run of p - 1 when, in unknowns, its first column is the only parent of
+/// the last column of p - 1 and has one entry less.
+fn fundamental(counts: &Counts, weight: &dyn Fn(usize) -> usize) -> Vec<usize> {
+    let Counts { parent, below_w, .. } = counts;
+    let nodes = parent.len();
     let mut children = vec![0u32; nodes];
     for &q in parent.iter().filter(|&&q| q != NONE) {
         children[q as usize] += 1;
     }
-
-    // fundamental supernodes (runs of nodes): node p continues the run of p - 1 when, in
-    // unknowns, its first column is the only parent of the last column of p - 1 and has one
-    // entry less
-    if nodes == 0 {
-        return ((vec![0], vec![0], Vec::new(), vec![0]), 0.0);
-    }
-    let mut fund = vec![0usize]; // first node of each, then `nodes`
+    let mut fund = vec![0usize];
     for p in 1..nodes {
         let joins = parent[p - 1] as usize == p && children[p] == 1 && below_w[p - 1] == below_w[p] + weight(p);
         if !joins {
@@ -216,19 +243,23 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
         }
     }
     fund.push(nodes);
-    let nf = fund.len() - 1;
-    let super_of = group_of(&fund);
-    let top = |s: usize, bounds: &[usize]| bounds[s + 1] - 1; // the last node of supernode s
+    fund
+}
 
-    // relaxation, as faer does it: in ascending order, a supernode absorbs the one just before
-    // it if that is its child and the explicit zeros stay under the thresholds (sizes and
-    // zeros accumulate along a chain of merges; `size` 0 marks an absorbed supernode)
+/// Relaxation, as faer does it: in ascending order, a supernode absorbs the one just before it
+/// if that is its child and the explicit zeros stay under the thresholds [`RELAX`] (sizes and
+/// zeros accumulate along a chain of merges; `size` 0 marks an absorbed supernode). The relaxed
+/// supernodes, as runs of nodes.
+fn relax(fund: &[usize], first: &[usize], counts: &Counts) -> Vec<usize> {
+    let Counts { parent, below_w, .. } = counts;
+    let nf = fund.len() - 1;
+    let super_of = group_of(fund);
     let mut size: Vec<usize> = (0..nf).map(|s| first[fund[s + 1]] - first[fund[s]]).collect();
-    let degree: Vec<usize> = (0..nf).map(|s| below_w[top(s, &fund)]).collect();
+    let degree: Vec<usize> = (0..nf).map(|s| below_w[top(s, fund)]).collect();
     let mut zeros = vec![0usize; nf];
     for s in 1..nf {
         let c = s - 1;
-        let parent_of_c = parent[top(c, &fund)];
+        let parent_of_c = parent[top(c, fund)];
         if parent_of_c == NONE || super_of[parent_of_c as usize] as usize != s {
             continue;
         }
@@ -248,28 +279,32 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
             zeros[s] = z;
         }
     }
-    // the relaxed supernodes, as runs of nodes
     let mut bounds = vec![0usize];
     for s in 0..nf {
         if size[s] > 0 {
             bounds.push(fund[s + 1]);
         }
     }
-    let ns = bounds.len() - 1;
-    let super_of = group_of(&bounds);
+    bounds
+}
+
+/// Row patterns in nodes, supernode after supernode of `bounds` (each as long as its column
+/// count in nodes, `below_n` of its last node): node p is in the pattern of every supernode on
+/// the tree paths from its lower neighbours' supernodes up to its own (faer's `ereach_super`),
+/// so each pattern fills in ascending order.
+fn node_patterns(adjacency: &Adjacency, bounds: &[usize], counts: &Counts) -> Vec<u32> {
+    let Counts { parent, below_n, .. } = counts;
+    let (nodes, ns) = (parent.len(), bounds.len() - 1);
+    let super_of = group_of(bounds);
     let super_parent: Vec<u32> = (0..ns)
-        .map(|s| match parent[top(s, &bounds)] {
+        .map(|s| match parent[top(s, bounds)] {
             NONE => NONE,
             q => super_of[q as usize],
         })
         .collect();
-
-    // row patterns in nodes: node p is in the pattern of every supernode on the tree paths
-    // from its lower neighbours' supernodes up to its own (faer's `ereach_super`), so each
-    // pattern fills in ascending order
     let mut node_ptr = vec![0usize; ns + 1];
     for s in 0..ns {
-        node_ptr[s + 1] = node_ptr[s] + below_n[top(s, &bounds)] as usize;
+        node_ptr[s + 1] = node_ptr[s] + below_n[top(s, bounds)] as usize;
     }
     let mut node_rows = vec![0u32; node_ptr[ns]];
     let mut next = node_ptr.clone();
@@ -287,23 +322,27 @@ fn structure(matrix: &SymCsc, n_order: usize, graph: &Graph, node_order: &[usize
         }
     }
     assert_eq!(next[..ns], node_ptr[1..], "row patterns disagree with the column counts");
+    node_rows
+}
 
-    // in unknowns
+/// The supernodes `bounds` and their row patterns `node_rows` (in nodes) spelt in unknowns:
+/// [`Symbolic`]'s `begin`, `row_ptr`, `rows`, `val_ptr`.
+fn in_unknowns(bounds: &[usize], first: &[usize], counts: &Counts, node_rows: &[u32]) -> Structure {
+    let ns = bounds.len() - 1;
     let begin: Vec<usize> = bounds.iter().map(|&b| first[b]).collect();
     let mut row_ptr = vec![0usize; ns + 1];
     let mut val_ptr = vec![0usize; ns + 1];
     for s in 0..ns {
-        let (ncols, deg) = (begin[s + 1] - begin[s], below_w[top(s, &bounds)]);
+        let (ncols, deg) = (begin[s + 1] - begin[s], counts.below_w[top(s, bounds)]);
         row_ptr[s + 1] = row_ptr[s] + deg;
         val_ptr[s + 1] = val_ptr[s] + (ncols + deg) * ncols;
     }
     let mut rows = Vec::with_capacity(row_ptr[ns]);
-    for &q in &node_rows {
+    for &q in node_rows {
         rows.extend(first[q as usize] as u32..first[q as usize + 1] as u32);
     }
     assert_eq!(rows.len(), row_ptr[ns]);
-
-    ((begin, row_ptr, rows, val_ptr), flops)
+    (begin, row_ptr, rows, val_ptr)
 }
 
 impl Placement {

@@ -33,8 +33,7 @@
 
 use super::manifest::DERIVED;
 use super::manifest::{DriftSpec, Manifest, Tolerance};
-use crate::records::LevelRecord;
-use crate::records::{RunRecord, StudyDir};
+use crate::records::{LevelRecord, RunRecord, StudyDir};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -147,7 +146,7 @@ pub const REL_RANGE: f64 = 1e-3;
 
 /// What a comparison found: the drift rows, and per float field its largest change.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct Comparison {
+pub struct DriftComparison {
     pub rows: Vec<DriftRow>,
     pub changes: BTreeMap<String, FieldChange>,
 }
@@ -246,12 +245,12 @@ pub fn compare_study(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunReco
 }
 
 /// [`compare_study`] with the largest change of every float field.
-pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], quick: bool) -> Comparison {
+pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], quick: bool) -> DriftComparison {
     let study = &manifest.study;
     let (mut out, mut changes) = (Vec::new(), BTreeMap::new());
     if stored.is_empty() {
         out.push(row(study, "*", None, "study", "(no stored results)".into(), format!("{} runs", fresh.len()), None, "exact".into()));
-        return Comparison { rows: out, changes };
+        return DriftComparison { rows: out, changes };
     }
     for planned in &manifest.runs {
         let id = &planned.spec.id;
@@ -344,7 +343,7 @@ pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], q
             }
         }
     }
-    Comparison { rows: out, changes }
+    DriftComparison { rows: out, changes }
 }
 
 /// The refinement histories of a stored and a fresh run, exactly, as far as the fresh run went
@@ -413,7 +412,7 @@ fn compare_references(study: &str, stored: &StudyDir, fresh: &StudyDir, runs: &[
 /// `[drift.deep] replay` (the last with at most `replay_max_ndof` unknowns where that is given), rebuilt from its stored history and solved once more
 /// ([`super::replay_stored_level`]), against its stored record (rows under run `ID (replayed)`).
 /// A history that does not rebuild its meshes is a row of field `history`.
-fn replay_tier(manifest: &Manifest, stored: &[RunRecord], progress: bool, c: &mut Comparison) -> anyhow::Result<()> {
+fn replay_tier(manifest: &Manifest, stored: &[RunRecord], progress: bool, c: &mut DriftComparison) -> anyhow::Result<()> {
     let Some(tier) = &manifest.drift.deep else { return Ok(()) };
     let study = &manifest.study;
     for id in &tier.replay {
@@ -644,7 +643,7 @@ pub fn compare_provenance(study: &str, stored: &StudyDir, fresh: &StudyDir) -> V
 /// in [`DriftReport::not_compared`], and the provenance of each study (manifest, problem files
 /// and meshes, by hash) must match the stored one ([`compare_provenance`]). Without it, every
 /// run of every manifest is checked ([`Manifest::check_runs`]) before any is rerun.
-pub fn run(
+pub fn check(
     manifests: &[Manifest],
     all_studies: bool,
     opts: &DriftOptions,

@@ -52,11 +52,11 @@
 //! reference, `max_ndof` against the initial mesh) is checked by [`Manifest::check_runs`] for
 //! every run before any is solved.
 
-use crate::adapt::{AdaptConfig, Refine};
-use crate::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
+use crate::adapt::AdaptConfig;
+use crate::contact::norms::Sampling;
+use crate::estimator::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
 use crate::mesh::MeshSpec;
-use crate::norms::Sampling;
-use crate::records::{ReferenceSpec, RunSpec};
+use crate::records::{ReferenceSpec, Refine, RunSpec};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -347,12 +347,13 @@ fn parse_run(
         };
         return Err(invalid.at(key("problem"), &expected, format!("{problem:?}")));
     }
-    let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| "structured:4".into());
+    let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| MeshSpec::DEFAULT.into());
     MeshSpec::parse(&resolve_mesh(path, &mesh))
         .map_err(|_| invalid.at(key("mesh"), "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'", format!("{mesh:?}")))?;
     let levels = r.levels.or(d.levels).ok_or_else(|| invalid.at(key("levels"), "a number of levels >= 1", "nothing".into()))?;
-    let theta = r.theta.or(d.theta).unwrap_or(0.5);
-    let e = EstimatorConfig::default();
+    let defaults = AdaptConfig::default();
+    let theta = r.theta.or(d.theta).unwrap_or(defaults.theta);
+    let e = defaults.estimator;
     let (eo, ed) = (r.estimator.clone().unwrap_or_default(), d.estimator.clone().unwrap_or_default());
     let estimator = EstimatorConfig {
         c0: eo.c0.or(ed.c0).unwrap_or(e.c0),
@@ -366,14 +367,14 @@ fn parse_run(
     if let Some(rf) = &reference
         && !(rf.theta > 0.0 && rf.theta <= 1.0)
     {
-        return Err(invalid.at(key("reference.theta"), "a number in (0, 1]", crate::adapt::ConfigError::number(rf.theta)));
+        return Err(invalid.at(key("reference.theta"), "a number in (0, 1]", crate::estimator::estimate::ConfigError::number(rf.theta)));
     }
     let inputs = input_hashes(path, &problem, &mesh).map_err(|(k, e)| invalid.at(key(k), "a readable file", e))?;
     let spec = RunSpec {
         id,
         problem,
         mesh,
-        refine: r.refine.or(d.refine).unwrap_or(Refine::Adaptive),
+        refine: r.refine.or(d.refine).unwrap_or(defaults.refine),
         theta,
         levels,
         max_ndof: r.max_ndof.or(d.max_ndof),
@@ -382,7 +383,7 @@ fn parse_run(
         reference: reference.map(|rf| ReferenceSpec {
             theta: rf.theta,
             min_ndof: rf.min_ndof,
-            contact_term: rf.contact_term.unwrap_or(ContactTerm::WithoutFullContact),
+            contact_term: rf.contact_term.unwrap_or(ReferenceSpec::DEFAULT_CONTACT_TERM),
         }),
         save_levels: r.save_levels.clone().or(d.save_levels.clone()).unwrap_or_default(),
         constants,
@@ -467,7 +468,7 @@ fn check_drift(drift: &DriftSpec, runs: &[PlannedRun], invalid: &Invalid) -> Res
             ));
         }
         if !r.min.is_finite() {
-            return Err(invalid.at(key("min"), "a finite rate", crate::adapt::ConfigError::number(r.min)));
+            return Err(invalid.at(key("min"), "a finite rate", crate::estimator::estimate::ConfigError::number(r.min)));
         }
         if r.last < 2 || r.last > run.spec.levels {
             return Err(invalid.at(
@@ -584,7 +585,7 @@ impl Manifest {
     /// solved (a mistake in the last run must not cost the first one's): the mesh is read and
     /// built with the run's problem (a missing or malformed mesh file, a boundary group the
     /// problem does not name, a kink that is not a vertex), the initial mesh and the reference
-    /// solution's `min_ndof` fit in this machine's memory ([`check_memory`](crate::solve::check_memory)),
+    /// solution's `min_ndof` fit in this machine's memory ([`check_memory`](crate::base::memory::check_memory)),
     /// `max_ndof` is at least the initial mesh's unknowns (level 0 is always solved), and a
     /// reference is declared only for a problem without an exact solution.
     pub fn check_runs(&self) -> Result<(), ManifestError> {
@@ -606,7 +607,7 @@ impl Manifest {
         let mesh_spec = MeshSpec::parse(&resolve_mesh(&self.file, &spec.mesh))
             .map_err(|e| invalid("mesh", "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'".into(), format!("{:?}: {e}", spec.mesh)))?;
         let ndof = mesh_spec.ndof().map_err(|e| invalid("mesh", "a readable mesh file".into(), format!("{:?}: {e}", spec.mesh)))?;
-        crate::solve::check_memory(&format!("the initial mesh {}", spec.mesh), ndof)
+        crate::base::memory::check_memory(&format!("the initial mesh {}", spec.mesh), ndof)
             .map_err(|e| invalid("mesh", "an initial mesh that fits in this machine's memory".into(), e.to_string()))?;
         mesh_spec
             .build(problem.as_ref())
@@ -620,9 +621,9 @@ impl Manifest {
                     format!("a reference with min_ndof {}", rf.min_ndof),
                 ));
             }
-            crate::solve::check_memory(&format!("the reference solution (min_ndof {})", rf.min_ndof), rf.min_ndof as f64).map_err(|e| {
-                invalid("reference.min_ndof", "a reference solution that fits in this machine's memory".into(), e.to_string())
-            })?;
+            crate::base::memory::check_memory(&format!("the reference solution (min_ndof {})", rf.min_ndof), rf.min_ndof as f64).map_err(
+                |e| invalid("reference.min_ndof", "a reference solution that fits in this machine's memory".into(), e.to_string()),
+            )?;
         }
         Ok(())
     }

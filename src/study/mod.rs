@@ -449,7 +449,7 @@ pub struct Prepared {
 impl Prepared {
     /// Call `f` with what errors are measured against: the exact solution, else the reference
     /// solution, else nothing.
-    pub fn with_error_against<R>(&self, f: impl FnOnce(Option<crate::norms::Reference>) -> R) -> R {
+    pub fn with_error_against<R>(&self, f: impl FnOnce(Option<crate::contact::norms::Reference>) -> R) -> R {
         let exact = self.problem.exact();
         let exact_fn = exact.map(|e| move |x: [f64; 2]| e.u(x));
         let reference_fn = self.reference.as_ref().map(|r| move |x: [f64; 2]| r.eval(x));
@@ -472,7 +472,7 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
     let mesh_path = manifest::resolve_mesh(manifest_file, &spec.mesh);
     let problem = problems::load(&problem_path, &spec.constants)?;
     let mesh_spec = MeshSpec::parse(&mesh_path)?;
-    crate::solve::check_memory(&format!("{study}/{}: the initial mesh {}", spec.id, spec.mesh), mesh_spec.ndof()?)?;
+    crate::base::memory::check_memory(&format!("{study}/{}: the initial mesh {}", spec.id, spec.mesh), mesh_spec.ndof()?)?;
     if spec.reference.is_some() && problem.exact().is_some() {
         bail!("{study}/{}: problem {} has an exact solution; a reference solution is not needed", spec.id, spec.problem);
     }
@@ -659,7 +659,7 @@ fn loop_of(
             let kept_level = keep_level(study, spec, dir, meshes, &level, problem).and_then(|()| {
                 kept.levels.push(r.clone());
                 kept.history.levels.push(level.history.clone());
-                kept.next_active = level.next_active.map(adapt::Flags::encode);
+                kept.next_active = level.next_active.map(crate::records::Flags::encode);
                 if level.continues { checkpoint::write(dir, &kept) } else { Ok(()) }
             });
             if let Err(e) = kept_level {
@@ -732,7 +732,7 @@ fn save_level(
     problem: &dyn problems::Problem,
 ) -> Result<()> {
     let (mesh, sol) = (level.mesh, level.solution);
-    let doc = crate::report::solution_vtu(mesh, sol, &level.estimate.element);
+    let doc = crate::records::report::solution_vtu(mesh, sol, &level.estimate.element);
     let l = level.record.level;
     meshes.add(&dir.mesh_file(&spec.id, l, "vtu"), doc.as_bytes())?;
     let snapshot = MeshSnapshot {
@@ -742,7 +742,7 @@ fn save_level(
         ndof: level.record.ndof,
         vertices: mesh.vertices.clone(),
         triangles: mesh.triangles.clone(),
-        contact_nodes: crate::solve::contact_samples(mesh, sol),
+        contact_nodes: crate::contact::solve::contact_samples(mesh, sol),
         kinks: problem.required_vertices(),
     };
     meshes.add_json(&dir.mesh_file(&spec.id, l, "json"), &snapshot)?;

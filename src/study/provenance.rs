@@ -121,7 +121,7 @@ pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: 
         signorini_version: env!("CARGO_PKG_VERSION").to_string(),
         machine: machine(),
         threads: rayon::current_num_threads(),
-        ordering: match crate::ordering::forced() {
+        ordering: match crate::sparse::ordering::forced() {
             Ok(Some(m)) => serde_json::to_value(m).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
             _ => "auto".into(),
         },

@@ -3,12 +3,11 @@
 //! the adaptive loop ([`compute`]) or rebuilt from its stored refinement history in one solve
 //! ([`replay`]), to the same numbers.
 
-use crate::adapt::{self, AdaptConfig, Refine};
-use crate::element::{self, N_NODES};
-use crate::mesh::locate::Locator;
-use crate::mesh::{Mesh, MeshSpec};
+use crate::adapt::{self, AdaptConfig};
+use crate::base::element::{self, N_NODES};
+use crate::mesh::{Mesh, MeshSpec, locate::Locator};
 use crate::problems::Problem;
-use crate::records::{Flags, Rebuild, ReferenceSpec};
+use crate::records::{Flags, Rebuild, ReferenceSpec, Refine};
 
 /// A P2 field on a mesh with an R*-tree for point location ([`Locator`]).
 pub struct ReferenceField {
@@ -65,7 +64,7 @@ pub enum ReferenceError {
 /// The adaptive loop of a reference solution: the maximum strategy with `spec.theta`, the
 /// estimator with `spec.contact_term` (otherwise the defaults), as many levels as it takes.
 fn config_of(spec: &ReferenceSpec) -> AdaptConfig {
-    let estimator = crate::estimate::EstimatorConfig { contact_term: spec.contact_term, ..Default::default() };
+    let estimator = crate::estimator::estimate::EstimatorConfig { contact_term: spec.contact_term, ..Default::default() };
     AdaptConfig { levels: REFERENCE_LEVELS, refine: Refine::Adaptive, theta: spec.theta, estimator, ..Default::default() }
 }
 
@@ -78,13 +77,13 @@ pub fn compute(
     problem: &dyn Problem,
     mesh_spec: &MeshSpec,
     spec: &ReferenceSpec,
-    on_level: &mut dyn FnMut(&crate::adapt::LevelRecord) -> std::ops::ControlFlow<()>,
+    on_level: &mut dyn FnMut(&crate::records::LevelRecord) -> std::ops::ControlFlow<()>,
 ) -> Result<Option<ReferenceField>, ReferenceError> {
     let mesh = mesh_spec.build(problem).map_err(|e| adapt::AdaptError::Solve(e.into()))?;
     let config = config_of(spec);
     // the automatic ordering even in a round-off measurement (SIGNORINI_ORDERING): the reference
-    // stays the one the stored errors were measured against (crate::ordering::automatic)
-    let out = crate::ordering::automatic(|| {
+    // stays the one the stored errors were measured against (crate::sparse::ordering::automatic)
+    let out = crate::sparse::ordering::automatic(|| {
         adapt::run(problem, mesh, &config, None, &mut |level| {
             if level.record.ndof >= spec.min_ndof { std::ops::ControlFlow::Break(()) } else { on_level(level.record) }
         })
@@ -95,7 +94,7 @@ pub fn compute(
             Rebuild { ndof: last.ndof, last: last.clone(), history: out.history, final_active: Some(Flags::encode(&out.solution.active)) };
         return Ok(Some(ReferenceField::new(out.mesh, out.solution.nodes.elements, out.solution.u, spec.clone(), rebuild)));
     }
-    if out.termination == adapt::Termination::StoppedByObserver {
+    if out.termination == adapt::AdaptTermination::StoppedByObserver {
         return Ok(None); // on_level stopped it (an interrupt)
     }
     let why = format!(
@@ -127,7 +126,7 @@ pub fn replay(
     let start =
         start.map(|f| f.decode()).transpose().map_err(|source| adapt::AdaptError::from(ReplayError::Flags { level: last, source }))?;
     let measured = record.last.measured_peak();
-    let solved = crate::ordering::automatic(|| adapt::solve_level(problem, &mesh, last, &config, None, start, measured))?;
+    let solved = crate::sparse::ordering::automatic(|| adapt::solve_level(problem, &mesh, last, &config, None, start, measured))?;
     if solved.record.ndof != record.ndof {
         return Err(ReferenceError::Replayed { stored: record.ndof, replayed: solved.record.ndof });
     }

@@ -9,10 +9,11 @@
 
 use crate::common;
 use common::*;
-use signorini::adapt::{self, AdaptConfig, Level, LevelRecord, Refine};
+use signorini::adapt::{self, AdaptConfig, Level};
 use signorini::estimate::{ContactTerm, EstimatorConfig};
-use signorini::mesh::{Mesh, Part, dist};
-use signorini::problems::{Ex71, Ex72, Exact, Problem};
+use signorini::mesh::{Mesh, dist};
+use signorini::problems::{Ex71, Ex72, Exact, Part, Problem};
+use signorini::records::{LevelRecord, Refine};
 use std::ops::ControlFlow;
 use std::time::Instant;
 
@@ -416,20 +417,20 @@ fn run_reports_termination_and_final_state() {
         .unwrap()
     };
     let r = go(AdaptConfig { levels: 3, ..Default::default() }, usize::MAX);
-    assert_eq!((r.termination, r.records.len()), (adapt::Termination::LevelsReached, 3));
+    assert_eq!((r.termination, r.records.len()), (adapt::AdaptTermination::LevelsReached, 3));
     assert_eq!(r.records[2].n_elements, r.mesh.n_triangles());
     assert_eq!(r.records[2].ndof, 2 * r.solution.nodes.len());
     assert_eq!(r.records[2].terms.estimate, r.estimate.terms.estimate);
     let r = go(AdaptConfig { levels: 3, ..Default::default() }, 1);
-    assert_eq!((r.termination, r.records.len()), (adapt::Termination::StoppedByObserver, 2));
+    assert_eq!((r.termination, r.records.len()), (adapt::AdaptTermination::StoppedByObserver, 2));
     assert_eq!(r.records[1].n_elements, r.mesh.n_triangles());
     let r = go(AdaptConfig { levels: 10, max_ndof: Some(200), ..Default::default() }, usize::MAX);
-    assert_eq!(r.termination, adapt::Termination::MaxNdofReached);
+    assert_eq!(r.termination, adapt::AdaptTermination::MaxNdofReached);
     assert!(r.records.last().unwrap().ndof <= 200 && r.records.len() < 10);
     assert_eq!(r.records.last().unwrap().n_elements, r.mesh.n_triangles());
     // stop_ndof: the first level at or beyond it is the last, the one before is below it
     let r = go(AdaptConfig { levels: 10, stop_ndof: Some(1000), ..Default::default() }, usize::MAX);
-    assert_eq!(r.termination, adapt::Termination::StopNdofReached);
+    assert_eq!(r.termination, adapt::AdaptTermination::StopNdofReached);
     let n = r.records.len();
     assert!(
         n < 10 && r.records[n - 1].ndof >= 1000 && r.records[n - 2].ndof < 1000,

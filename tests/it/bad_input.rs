@@ -122,7 +122,7 @@ fn memory_estimate_covers_the_measured_peaks() {
     for (ndof, kib) in
         [(8450.0, 16964.0), (33282.0, 54412.0), (132098.0, 197736.0), (526338.0, 839248.0), (1182722.0, 1936888.0), (2101250.0, 3501300.0)]
     {
-        let est = signorini::solve::memory_estimate(ndof);
+        let est = signorini::base::memory::memory_estimate(ndof);
         assert!(est >= 1.2 * kib * 1024.0, "NDF {ndof}: estimate {est} below measured peak {kib} KiB + 20 %");
     }
     assert_eq!(signorini::mesh::MeshSpec::Structured(512).ndof().unwrap(), 2101250.0);
@@ -134,8 +134,8 @@ fn memory_estimate_covers_the_measured_peaks() {
 /// its next level of 1.22e7 unknowns on a 24 GiB machine.
 #[test]
 fn a_level_after_a_measured_one_is_estimated_from_its_peak_where_that_is_smaller() {
+    use signorini::base::memory::memory_estimate;
     use signorini::memory::level_estimate;
-    use signorini::solve::memory_estimate;
     const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
     let (n, previous) = (1.22e7, (8.46e6, 8.1 * GIB));
     // without a measurement, or against an address-space limit: the per-unknown estimate

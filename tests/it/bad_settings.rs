@@ -115,3 +115,37 @@ fn nothing_to_mark_stops_the_loop_and_says_so() {
     assert_eq!(code, 0, "{err}");
     assert_eq!(out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).count(), 3, "{out}");
 }
+
+/// The defaults are the library's, whichever way a run comes: the command line shows and uses
+/// `AdaptConfig::default()`, `EstimatorConfig::default()` and `MeshSpec::DEFAULT` (clap reads
+/// them), and a manifest that leaves every setting out gets the same values.
+#[test]
+fn the_command_line_and_the_manifests_default_to_the_librarys_values() {
+    use clap::ValueEnum;
+    use signorini::adapt::AdaptConfig;
+    use signorini::mesh::MeshSpec;
+    let (a, e) = (AdaptConfig::default(), AdaptConfig::default().estimator);
+    let name = |v: Option<clap::builder::PossibleValue>| v.unwrap().get_name().to_string();
+    let expected = [
+        ("--mesh", MeshSpec::DEFAULT.to_string()),
+        ("--levels", a.levels.to_string()),
+        ("--theta", a.theta.to_string()),
+        ("--c0", e.c0.to_string()),
+        ("--contact-term", name(e.contact_term.to_possible_value())),
+        ("--log-factor", name(e.log_factor.to_possible_value())),
+        ("--sampling", name(e.sampling.to_possible_value())),
+    ];
+    let dir = tmp("defaults");
+    let (code, help, err) = signorini_in(&dir, &["adapt", "--help"]);
+    assert_eq!(code, 0, "{err}");
+    for (flag, value) in &expected {
+        let line = help.lines().find(|l| l.trim_start().starts_with(&format!("{flag} "))).unwrap_or_else(|| panic!("{flag}: {help}"));
+        assert!(line.contains(&format!("[default: {value}]")), "{flag}: {line}");
+    }
+    let manifest = dir.join("defaults.toml");
+    std::fs::write(&manifest, "[defaults]\nproblem = \"ex71\"\nlevels = 3\n\n[[run]]\nid = \"a\"\n").unwrap();
+    let m = signorini::study::manifest::Manifest::load(&manifest).unwrap();
+    let run = &m.runs[0].spec;
+    assert_eq!((run.mesh.as_str(), run.theta, run.refine, run.estimator), (MeshSpec::DEFAULT, a.theta, a.refine, e));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -14,10 +14,11 @@ use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::{Par, Spec};
-use signorini::assembly::{self, DofMap, SymCsc};
+use signorini::assembly::{self, DofMap};
 use signorini::cholesky::{self, Plan};
 use signorini::mesh::{Mesh, P2Nodes, refine::refine};
 use signorini::problems;
+use signorini::sparse::csc::SymCsc;
 use signorini::symbolic::{Placement, Symbolic};
 
 /// Example 7.2's stiffness on `mesh`, the position of every unknown, and the number of unknowns

@@ -4,8 +4,9 @@
 //! violate the condition as stated (its numbers read back from the text) fails the row, while
 //! evidence inside it passes.
 
+use signorini::base::stats::LineFit;
 use signorini::claims::{self, Claim, Criterion, Evidence, Verdict};
-use signorini::verdict::{Abscissa, LineFit, RateFit};
+use signorini::verdict::{Abscissa, RateFit};
 use std::path::Path;
 
 fn stored() -> Vec<Claim> {

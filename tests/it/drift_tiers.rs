@@ -84,7 +84,7 @@ fn drift_rows(root: &Path, m: &Manifest, deep: bool) -> Vec<(String, Option<usiz
         results: root.join("results"),
         progress: false,
     };
-    let report = drift::run(std::slice::from_ref(m), false, &opts, &|_| Ok(String::new())).unwrap();
+    let report = drift::check(std::slice::from_ref(m), false, &opts, &|_| Ok(String::new())).unwrap();
     report.rows.iter().map(|r| (r.run.clone(), r.level, r.field.clone())).collect()
 }
 
@@ -147,7 +147,7 @@ fn a_change_of_the_stored_history_is_caught_by_every_test_run() {
         results: root.join("results"),
         progress: false,
     };
-    let report = drift::run(std::slice::from_ref(&m), false, &opts, &|_| Ok(String::new())).unwrap();
+    let report = drift::check(std::slice::from_ref(&m), false, &opts, &|_| Ok(String::new())).unwrap();
     let rows: Vec<_> = report.rows.iter().map(|r| (r.run.clone(), r.level, r.field.clone())).collect();
     assert_eq!(rows, vec![("c (replayed)".to_string(), Some(5), "history".to_string())]);
     assert!(report.rows[0].fresh.contains("level 3: the replayed mesh"), "{:?}", report.rows[0]);

@@ -11,9 +11,9 @@
 use crate::common;
 use common::*;
 use signorini::estimate::{self, ContactTerm, EstimatorConfig, LogFactor, Terms};
-use signorini::mesh::{Mesh, Part};
+use signorini::mesh::Mesh;
 use signorini::norms::Sampling;
-use signorini::problems::{Ex71, Ex72, Exact, Material, Patch, Problem};
+use signorini::problems::{Ex71, Ex72, Exact, Material, Part, Patch, Problem};
 
 /// The four estimator configurations that differ in what eta_1..eta_5 are (the log factor and
 /// C_0 do not enter eta_1..eta_5, but they enter eta_h and the estimate, which are checked too).

@@ -2,11 +2,12 @@
 //! eta_5 keeps the tensile normal stress at full-contact nodes, which the variant without
 //! full-contact nodes drops; eta_7 is taken over a subset of the paper's Lambda_h^C.
 
-use signorini::adapt::{self, AdaptConfig, Level, Refine};
+use signorini::adapt::{self, AdaptConfig, Level};
 use signorini::contact::PdasOptions;
 use signorini::estimate::{self, ContactTerm, Estimate, EstimatorConfig};
 use signorini::mesh::{Mesh, MeshSpec};
 use signorini::problems::{Ex71, Fb, Problem};
+use signorini::records::Refine;
 use std::ops::ControlFlow;
 
 fn estimates(problem: &dyn Problem, mesh: &str) -> (Mesh, [Estimate; 3]) {
@@ -51,7 +52,7 @@ fn repaired_eta5_sees_tension_on_full_contact_patches() {
         let sol = level.solution;
         let active = |q: usize| sol.dofs.contact_index[q].is_some_and(|k| sol.active[k]);
         for (bi, bn) in sol.nodes.boundary_nodes.iter().enumerate() {
-            if level.mesh.boundary[bi].part == signorini::mesh::Part::Contact && bn.iter().all(|&q| active(q)) {
+            if level.mesh.boundary[bi].part == signorini::problems::Part::Contact && bn.iter().all(|&q| active(q)) {
                 for &q in bn {
                     let x = sol.nodes.coords[q][0];
                     assert!(x >= Fb::A - 1e-12, "level {l}: a full-contact edge reaches x = {x} < a = {}", Fb::A);

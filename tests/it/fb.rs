@@ -70,14 +70,14 @@ fn fb_tractions_are_sigma_n_on_the_sides() {
             let expect = [s[0] * n[0] + s[1] * n[1], s[1] * n[0] + s[2] * n[1]];
             let g = p.traction([x, y], n);
             assert!((g[0] - expect[0]).abs() < 1e-7 && (g[1] - expect[1]).abs() < 1e-7, "g at ({x}, {y}): {g:?} vs {expect:?}");
-            assert_eq!(p.part_of([x, y]), signorini::mesh::Part::Neumann);
+            assert_eq!(p.part_of([x, y]), signorini::problems::Part::Neumann);
         }
     }
     // Dirichlet data are the exact solution on the top
     for &x in &XS {
         assert_eq!(p.dirichlet([x, 1.0]), p.u([x, 1.0]));
-        assert_eq!(p.part_of([x, 1.0]), signorini::mesh::Part::Dirichlet);
-        assert_eq!(p.part_of([x, 0.0]), signorini::mesh::Part::Contact);
+        assert_eq!(p.part_of([x, 1.0]), signorini::problems::Part::Dirichlet);
+        assert_eq!(p.part_of([x, 0.0]), signorini::problems::Part::Contact);
     }
 }
 

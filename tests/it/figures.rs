@@ -2,10 +2,9 @@
 //! the SVGs carry the axis and legend text, and studies without results are skipped, not errors.
 //! The figures are left in `target/tmp/figures-test/figures/` for a look.
 
-use signorini::adapt::{LevelRecord, Refine};
 use signorini::estimate::{ContactTerm, EstimatorConfig, LogFactor};
 use signorini::plot::{self, FIGURES};
-use signorini::records::{MeshSnapshot, RunRecord, RunSpec, StudyDir, write_json};
+use signorini::records::{LevelRecord, MeshSnapshot, Refine, RunRecord, RunSpec, StudyDir, write_json};
 use std::path::{Path, PathBuf};
 
 fn level(level: usize, ndof: usize, err: Option<f64>, c0: f64, eta: [f64; 7]) -> LevelRecord {
@@ -160,7 +159,7 @@ fn mesh_snapshot() -> MeshSnapshot {
     }
     let contact_nodes = ys
         .iter()
-        .map(|&y| signorini::records::ContactSample { x: [1.0, y], lambda: 0.0, pressure: 0.0, active: (y - 0.5).abs() < 0.22 })
+        .map(|&y| signorini::contact::solve::ContactSample { x: [1.0, y], lambda: 0.0, pressure: 0.0, active: (y - 0.5).abs() < 0.22 })
         .collect();
     MeshSnapshot {
         study: "ex72".into(),
@@ -270,9 +269,9 @@ fn full_results(results: &Path) {
 /// The hertz study: one run of the repository's Hertz problem file (found through the provenance's
 /// manifest, as for stored results), its last level with contact nodes sampling Hertz's pressure.
 fn hertz_results(results: &Path) {
+    use signorini::contact::solve::ContactSample;
     use signorini::hertz::Hertz;
     use signorini::problems::Material;
-    use signorini::records::ContactSample;
     let mut r = run("adaptive", "problems/hertz.toml", Refine::Adaptive);
     r.missing = never;
     write_study(results, "hertz", &[r]);

@@ -3,8 +3,8 @@
 
 use crate::common;
 use common::*;
-use signorini::mesh::{Curve, Mesh, MeshError, MeshSpec, Part};
-use signorini::problems::{Material, Problem};
+use signorini::mesh::{Mesh, MeshError, MeshSpec};
+use signorini::problems::{Curve, Material, Part, Problem};
 use std::path::{Path, PathBuf};
 
 /// A problem that names physical groups: `groups` maps a name to its part and curve. The body is

@@ -67,7 +67,7 @@ fn schur_and_refactor_strategies_agree() {
 #[test]
 fn non_converged_active_set_method_returns_its_last_iterate() {
     use signorini::assembly::{self, DofMap};
-    use signorini::contact::{ContactSolver, PdasOptions, Strategy, Termination};
+    use signorini::contact::{ContactSolver, PdasOptions, PdasTermination, Strategy};
     use signorini::mesh::P2Nodes;
     let p = problems::Ex72;
     let m = mesh(&p, "structured:16");
@@ -79,7 +79,7 @@ fn non_converged_active_set_method_returns_its_last_iterate() {
         let mut solver = ContactSolver::with_strategy(sys.matrix.clone(), dofs.n_interior, &dofs.unknown_coords(&nodes), strategy).unwrap();
         let options = PdasOptions { max_iterations: 2, ..Default::default() };
         let out = solver.solve_contact(&sys.rhs, &gap, &options, &mut |_| {}).unwrap();
-        assert!(matches!(out.termination, Termination::MaxIterations { .. }), "{strategy:?}: {:?}", out.termination);
+        assert!(matches!(out.termination, PdasTermination::MaxIterations { .. }), "{strategy:?}: {:?}", out.termination);
         assert!(!out.termination.is_converged());
         assert_eq!((out.iterations.len(), out.u.len(), out.lambda.len(), out.active.len()), (2, sys.matrix.n(), gap.len(), gap.len()));
         assert!(out.u.iter().all(|v| v.is_finite()));
@@ -93,21 +93,22 @@ fn non_converged_active_set_method_returns_its_last_iterate() {
 /// An active set seen before: the iteration stops with `Cycling` and the iterate that led there.
 #[test]
 fn cycling_active_set_method_returns_its_last_iterate() {
-    use signorini::contact::{PdasOptions, Termination, pdas};
+    use signorini::contact::{PdasOptions, PdasTermination, pdas};
     let g = [0.5];
     // inactive -> the node penetrates (next: active); active -> negative force (next: inactive)
     let mut step = |a: &[bool]| Ok(if a[0] { (vec![0.5], vec![-1.0]) } else { (vec![1.5], vec![0.0]) });
     let out = pdas(&g, 1.0, vec![false], &PdasOptions::default(), &mut |_| {}, &mut step).unwrap();
-    assert_eq!(out.termination, Termination::Cycling { first_seen: 1, residual: out.iterations[1].residual });
+    assert_eq!(out.termination, PdasTermination::Cycling { first_seen: 1, residual: out.iterations[1].residual });
     assert_eq!((out.u, out.lambda, out.active, out.iterations.len()), (vec![0.5], vec![-1.0], vec![true], 2));
-    let err = Termination::Cycling { first_seen: 1, residual: 0.25 }.error(2).unwrap().to_string();
+    let err = PdasTermination::Cycling { first_seen: 1, residual: 0.25 }.error(2).unwrap().to_string();
     assert!(err.contains("cycling") && err.contains("iteration 2") && err.contains("iteration 1"), "{err}");
 }
 
 /// Example 7.2's mesh with a second copy of the unit square shifted by `shift`, merged with the
 /// first at any vertex they share; the copy's boundary edges are traction free.
 fn two_bodies(shift: [f64; 2]) -> signorini::mesh::Mesh {
-    use signorini::mesh::{BoundaryEdge, Part};
+    use signorini::mesh::BoundaryEdge;
+    use signorini::problems::Part;
     let mut m = mesh(&problems::Ex72, "structured:4");
     let n = m.vertices.len();
     let mut index = Vec::with_capacity(n);

@@ -6,6 +6,11 @@
 //! it (a folder's `mod.rs` assembles its files: `mesh/gmsh.rs` builds the `Mesh` of
 //! `mesh/mod.rs`, whose `MeshSpec::build` calls it). The floors, bottom first, are those of
 //! `src/lib.rs`'s crate docs.
+//!
+//! Every `crate::` path is a module's one canonical path: lib.rs's short names (its `pub use`
+//! lines, read from the file) are the users' prelude, never used inside the crate, and a path
+//! that resolves to no module of `src/` is an error too (a checker that dropped it would pass
+//! whatever it hides).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -25,25 +30,6 @@ const FLOORS: &[(&str, &[&str])] = &[
     ("analysis", &["analysis/"]),
     ("plot", &["plot/"]),
     ("cli", &["main.rs", "bin/"]),
-];
-
-/// The root's short names (`pub use` in lib.rs) and the module each stands for.
-const ALIASES: &[(&str, &str)] = &[
-    ("element", "base::element"),
-    ("memory", "base::memory"),
-    ("ordering", "sparse::ordering"),
-    ("symbolic", "sparse::symbolic"),
-    ("cholesky", "sparse::cholesky"),
-    ("assembly", "fem::assembly"),
-    ("solve", "contact::solve"),
-    ("certify", "contact::certify"),
-    ("norms", "contact::norms"),
-    ("estimate", "estimator::estimate"),
-    ("report", "records::report"),
-    ("claims", "analysis::claims"),
-    ("hertz", "analysis::hertz"),
-    ("verdict", "analysis::verdict"),
-    ("page", "plot::page"),
 ];
 
 fn src() -> PathBuf {
@@ -84,10 +70,35 @@ fn code(text: &str) -> Vec<(usize, String)> {
     out
 }
 
-/// The file (relative to src/) a module path resolves to: the longest prefix that is a module.
-fn resolve(path: &[&str], modules: &BTreeMap<String, String>) -> Option<String> {
+/// lib.rs's short names, read from its `pub use` lines (`pub use a::{b, c as d};`, `pub use a::b;`),
+/// each with the path it stands for: `("element", "base::element")`.
+fn aliases(src: &Path) -> Vec<(String, String)> {
+    let lib = std::fs::read_to_string(src.join("lib.rs")).unwrap();
+    let text: String = code(&lib).into_iter().map(|(_, l)| l + "\n").collect();
+    let mut out = Vec::new();
+    for statement in text.split(';').map(str::trim).filter_map(|s| s.strip_prefix("pub use ")) {
+        let statement: String = statement.split_whitespace().collect::<Vec<_>>().join(" ");
+        let (base, items) = match statement.split_once("::{") {
+            Some((base, rest)) => (base.to_string(), rest.trim_end_matches('}').split(',').map(str::trim).map(String::from).collect()),
+            None => match statement.rsplit_once("::") {
+                Some((base, item)) => (base.to_string(), vec![item.to_string()]),
+                None => (String::new(), vec![statement.clone()]),
+            },
+        };
+        for item in items.iter().filter(|i| !i.is_empty()) {
+            let (name, alias) = item.split_once(" as ").unwrap_or((item, item));
+            let full = if base.is_empty() { name.to_string() } else { format!("{base}::{name}") };
+            out.push((alias.trim().to_string(), full.trim_start_matches("self::").to_string()));
+        }
+    }
+    out
+}
+
+/// The file (relative to src/) a module path resolves to: the longest prefix that is a module
+/// (a short name of lib.rs stands for its module).
+fn resolve(path: &[&str], modules: &BTreeMap<String, String>, aliases: &[(String, String)]) -> Option<String> {
     let mut segs: Vec<String> = path.iter().map(|s| s.to_string()).collect();
-    if let Some((_, to)) = ALIASES.iter().find(|(a, _)| Some(*a) == path.first().copied()) {
+    if let Some((_, to)) = aliases.iter().find(|(a, _)| Some(a.as_str()) == path.first().copied()) {
         let mut expanded: Vec<String> = to.split("::").map(String::from).collect();
         expanded.extend(segs.drain(1..));
         segs = expanded;
@@ -95,18 +106,53 @@ fn resolve(path: &[&str], modules: &BTreeMap<String, String>) -> Option<String> 
     (1..=segs.len()).rev().find_map(|k| modules.get(&segs[..k].join("::")).cloned())
 }
 
-/// Every file's references to other files: (target, line). With `children: false`, a module's
-/// references to the modules it declares are left out (see the module docs).
-fn references_with(children_too: bool) -> BTreeMap<String, BTreeMap<String, usize>> {
+/// What [`scan`] finds: every file's references to other files (target, line), and the
+/// `crate::` paths that are not a module's canonical path (through a short name of lib.rs) or
+/// that resolve to no module.
+struct Scan {
+    refs: BTreeMap<String, BTreeMap<String, usize>>,
+    bad_paths: Vec<String>,
+}
+
+/// The paths of a `use` tree after `crate::` at `at` of `text`: one path, or one per item of a
+/// group `crate::{a::b, c}` (nested groups stop at their module); segments, empty ones dropped.
+fn crate_paths(text: &str, at: usize) -> Vec<Vec<String>> {
+    let segments = |s: &str| -> Vec<String> {
+        let path = s.trim_start().split(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':')).next().unwrap_or("");
+        path.split("::").filter(|s| !s.is_empty()).map(String::from).collect()
+    };
+    let Some(group) = text[at..].strip_prefix('{') else { return vec![segments(&text[at..])] };
+    let (mut depth, mut items, mut item) = (0usize, Vec::new(), String::new());
+    for c in group.chars() {
+        match c {
+            '}' if depth == 0 => break,
+            ',' if depth == 0 => {
+                items.push(std::mem::take(&mut item));
+                continue;
+            }
+            '{' => depth += 1,
+            '}' => depth -= 1,
+            _ => {}
+        }
+        item.push(c);
+    }
+    items.push(item);
+    items.iter().map(|i| segments(i)).filter(|p| !p.is_empty()).collect()
+}
+
+/// Scan the crate at `src`. With `children_too: false`, a module's references to the modules it
+/// declares are left out (see the module docs).
+fn scan(src: &Path, children_too: bool) -> Scan {
     let mut files = Vec::new();
-    rust_files(&src(), &mut files);
-    let rel = |p: &PathBuf| p.strip_prefix(src()).unwrap().to_string_lossy().replace('\\', "/");
+    rust_files(src, &mut files);
+    let rel = |p: &PathBuf| p.strip_prefix(src).unwrap().to_string_lossy().replace('\\', "/");
     let modules: BTreeMap<String, String> =
         files.iter().map(rel).filter(|r| r != "lib.rs" && r != "main.rs" && !r.starts_with("bin/")).map(|r| (module_of(&r), r)).collect();
+    let aliases = aliases(src);
     let path_re = |s: &str, at: usize| -> Vec<String> {
         s[at..].split(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':')).next().unwrap_or("").split("::").map(String::from).collect()
     };
-    let mut out = BTreeMap::new();
+    let mut out = Scan { refs: BTreeMap::new(), bad_paths: Vec::new() };
     for f in &files {
         let r = rel(f);
         if r == "lib.rs" {
@@ -126,12 +172,33 @@ fn references_with(children_too: bool) -> BTreeMap<String, BTreeMap<String, usiz
             })
             .collect();
         let mut refs: BTreeMap<String, usize> = BTreeMap::new();
-        for (line, c) in code(&text) {
-            let mut targets = Vec::new();
-            for (at, _) in c.match_indices("crate::") {
-                let segs = path_re(&c, at + "crate::".len());
-                targets.push(resolve(&segs.iter().map(String::as_str).collect::<Vec<_>>(), &modules));
+        let add = |refs: &mut BTreeMap<String, usize>, target: Option<String>, line: usize| {
+            if let Some(t) = target.filter(|t| *t != r) {
+                refs.entry(t).or_insert(line);
             }
+        };
+        // `crate::` paths over the whole code (a `use crate::{...}` group spans lines)
+        let lines = code(&text);
+        let joined: String = lines.iter().map(|(_, l)| format!("{l}\n")).collect();
+        for (at, _) in joined.match_indices("crate::").filter(|(at, _)| !joined[..*at].ends_with('$')) {
+            let line = lines[joined[..at].matches('\n').count()].0;
+            for segs in crate_paths(&joined, at + "crate::".len()) {
+                let shown = format!("crate::{}", segs.join("::"));
+                let first = segs[0].as_str();
+                if !modules.keys().any(|m| m.split("::").next() == Some(first))
+                    && let Some((_, to)) = aliases.iter().find(|(a, _)| a == first)
+                {
+                    out.bad_paths
+                        .push(format!("src/{r}:{line}: `{shown}` goes through lib.rs's short name `{first}`: write `crate::{to}`"));
+                }
+                let target = resolve(&segs.iter().map(String::as_str).collect::<Vec<_>>(), &modules, &aliases);
+                if target.is_none() {
+                    out.bad_paths.push(format!("src/{r}:{line}: `{shown}` resolves to no module of src/"));
+                }
+                add(&mut refs, target, line);
+            }
+        }
+        for (line, c) in lines {
             for (at, _) in c.match_indices("super::") {
                 if at > 0 && c[..at].ends_with("::") {
                     continue;
@@ -139,29 +206,84 @@ fn references_with(children_too: bool) -> BTreeMap<String, BTreeMap<String, usiz
                 let parent = me.rsplit_once("::").map_or(String::new(), |(p, _)| p.to_string());
                 let mut segs: Vec<String> = if parent.is_empty() { Vec::new() } else { parent.split("::").map(String::from).collect() };
                 segs.extend(path_re(&c, at + "super::".len()));
-                targets.push(resolve(&segs.iter().map(String::as_str).collect::<Vec<_>>(), &modules));
+                add(&mut refs, resolve(&segs.iter().map(String::as_str).collect::<Vec<_>>(), &modules, &aliases), line);
             }
             for child in children.iter().filter(|_| children_too) {
                 let used = c
                     .match_indices(&format!("{child}::"))
                     .any(|(at, _)| at == 0 || !c[..at].ends_with(|ch: char| ch.is_alphanumeric() || ch == '_' || ch == ':'));
                 if used {
-                    targets.push(modules.get(&format!("{me}::{child}")).cloned());
-                }
-            }
-            for t in targets.into_iter().flatten() {
-                if t != r {
-                    refs.entry(t).or_insert(line);
+                    add(&mut refs, modules.get(&format!("{me}::{child}")).cloned(), line);
                 }
             }
         }
-        out.insert(r, refs);
+        out.refs.insert(r, refs);
     }
     out
 }
 
+fn references_with(children_too: bool) -> BTreeMap<String, BTreeMap<String, usize>> {
+    scan(&src(), children_too).refs
+}
+
 fn references() -> BTreeMap<String, BTreeMap<String, usize>> {
     references_with(true)
+}
+
+#[test]
+fn every_crate_path_is_canonical_and_resolves() {
+    let bad = scan(&src(), true).bad_paths;
+    assert!(bad.is_empty(), "crate:: paths that are not a module's canonical path:\n{}", bad.join("\n"));
+}
+
+/// A scratch crate of two floors (`mesh/` below `study/`) whose lib.rs has `extra` added, and
+/// whose `mesh/io.rs` holds `code`: what [`scan`] says about it.
+fn scan_scratch(name: &str, extra: &str, code: &str) -> Scan {
+    let dir = std::env::temp_dir().join(format!("signorini-layers-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let files = [
+        ("lib.rs", format!("pub mod mesh;\npub mod study;\n{extra}\n")),
+        ("mesh/mod.rs", "pub mod io;\n".to_string()),
+        ("mesh/io.rs", format!("{code}\n")),
+        ("study/mod.rs", "pub mod store;\n".to_string()),
+        ("study/store.rs", "pub struct StudyDir;\n".to_string()),
+    ];
+    for (path, text) in files {
+        std::fs::create_dir_all(dir.join(path).parent().unwrap()).unwrap();
+        std::fs::write(dir.join(path), text).unwrap();
+    }
+    let out = scan(&dir, true);
+    std::fs::remove_dir_all(&dir).unwrap();
+    out
+}
+
+/// An upward reference through a short name of lib.rs (`pub use study::store;`, then
+/// `crate::store::X` in `mesh/`) is found: as a path that is not canonical, and as the
+/// upward reference it is.
+#[test]
+fn a_path_through_a_short_name_of_lib_rs_fails() {
+    let scan = scan_scratch("alias", "pub use study::store;", "use crate::store::StudyDir;");
+    assert_eq!(
+        scan.bad_paths,
+        ["src/mesh/io.rs:1: `crate::store::StudyDir` goes through lib.rs's short name `store`: write `crate::study::store`"],
+        "{:?}",
+        scan.bad_paths
+    );
+    assert_eq!(scan.refs["mesh/io.rs"].get("study/store.rs"), Some(&1), "{:?}", scan.refs);
+    // the canonical path is found as the upward reference, and is no bad path
+    let canonical = scan_scratch("canonical", "pub use study::store;", "use crate::study::store::StudyDir;");
+    assert!(canonical.bad_paths.is_empty(), "{:?}", canonical.bad_paths);
+    assert_eq!(canonical.refs["mesh/io.rs"].get("study/store.rs"), Some(&1));
+}
+
+/// A `crate::` path that resolves to no module is an error, not dropped; in a group too.
+#[test]
+fn a_path_that_resolves_to_no_module_fails() {
+    let scan = scan_scratch("unresolved", "", "use crate::nowhere::Thing;");
+    assert_eq!(scan.bad_paths, ["src/mesh/io.rs:1: `crate::nowhere::Thing` resolves to no module of src/"]);
+    let group = scan_scratch("group", "", "use crate::{\n    study::store::StudyDir,\n    nowhere,\n};");
+    assert_eq!(group.bad_paths, ["src/mesh/io.rs:1: `crate::nowhere` resolves to no module of src/"]);
+    assert_eq!(group.refs["mesh/io.rs"].get("study/store.rs"), Some(&1));
 }
 
 #[test]

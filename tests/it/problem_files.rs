@@ -6,9 +6,8 @@
 use crate::common;
 use common::*;
 use signorini::adapt::{self, AdaptConfig};
-use signorini::mesh::{Curve, Part};
 use signorini::norms;
-use signorini::problems::{self, FileProblem, Material, Problem};
+use signorini::problems::{self, Curve, FileProblem, Material, Part, Problem};
 use std::path::Path;
 
 fn file(name: &str) -> FileProblem {

@@ -6,7 +6,7 @@
 //! [`Criterion::Reported`]: it says so and neither passes nor fails.
 
 use super::Verdict;
-use crate::verdict::{self, Abscissa, RateFit, RateVerdict, Trend};
+use crate::analysis::verdict::{self, Abscissa, RateFit, RateVerdict, Trend};
 
 /// What a criterion is judged on.
 #[derive(Clone, Debug)]
@@ -277,7 +277,7 @@ impl Criterion {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::verdict::LineFit;
+    use crate::base::stats::LineFit;
 
     fn fit(slope: f64, half_width: f64, decades: f64, abscissa: Abscissa) -> RateFit {
         RateFit {

@@ -7,8 +7,8 @@ use super::{
     Claim, Criterion, Ctx, EX72_NU, Evidence, Kind, OPTIMAL, Q, REFINE_REACH, Summary, estimator_text, fragility, growth_text,
     halving_exponents, latest_mesh, rate_headline, rate_text, run, slowest_headline, source,
 };
+use crate::analysis::verdict::{self, Abscissa, RateReport, refinement};
 use crate::records::{RunRecord, StudyDir};
-use crate::verdict::{self, Abscissa, RateReport, refinement};
 
 /// A corner is a refinement centre when its smallest element within this distance of it ...
 const CORNER_NEAR: f64 = 0.02;
@@ -287,7 +287,7 @@ fn eta6_eta7(a72: Option<&RunRecord>) -> Claim {
         let fit = |f: fn(&crate::records::LevelRecord) -> f64| {
             let pts: Vec<(f64, f64)> =
                 plateaus.iter().map(|p| (p.0, f(&r.levels[p.2]))).filter(|p| p.1 > 1e-14).map(|p| (p.0.ln(), p.1.ln())).collect();
-            verdict::fit_line(&pts)
+            crate::base::stats::fit_line(&pts)
         };
         // largest change of eta_6 + eta_7 within a plateau of at least two levels
         let within = plateaus

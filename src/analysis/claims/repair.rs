@@ -24,9 +24,9 @@ use super::criterion::Outcome;
 use super::{
     Claim, Criterion, Ctx, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, deep_or, growth_text, rate_text, run, short_range, source,
 };
+use crate::analysis::verdict::{self, Abscissa};
 use crate::base::stats::line_value_at;
 use crate::records::{RunRecord, StudyDir};
-use crate::verdict::{self, Abscissa};
 
 /// (ln NDF, ln error) at the levels of `r`'s error-rate fit (every other level of its window).
 fn fit_points(ctx: &Ctx, r: &RunRecord) -> Option<Vec<(f64, f64)>> {

@@ -4,12 +4,12 @@
 //! (eta_3, eta_4, eta_5, eta_6, eta_7) and the interior traction jumps (eta_2).
 
 use super::{EDGE_GAUSS, EstimatorConfig, StressFrame};
-use crate::assembly::edge_basis;
-use crate::element::{self, Affine, EDGE_VERTICES, N_NODES};
-use crate::mesh::{Mesh, Part};
-use crate::norms::Sampling;
-use crate::problems::{Material, Problem};
-use crate::solve::DiscreteSolution;
+use crate::base::element::{self, Affine, EDGE_VERTICES, N_NODES};
+use crate::contact::norms::Sampling;
+use crate::contact::solve::DiscreteSolution;
+use crate::fem::assembly::edge_basis;
+use crate::mesh::Mesh;
+use crate::problems::{Material, Part, Problem};
 use rayon::prelude::*;
 
 /// Local (per element) quantities before they are gathered on patches.
@@ -80,7 +80,9 @@ fn inf_norm(v: [f64; 2]) -> f64 {
 pub(super) fn edge_samples(sampling: Sampling) -> Vec<f64> {
     match sampling {
         Sampling::Quadrature => element::gauss_legendre(EDGE_GAUSS).points.iter().map(|p| p[0]).collect(),
-        Sampling::Dense => (0..=crate::norms::LATTICE_ORDER).map(|k| k as f64 / crate::norms::LATTICE_ORDER as f64).collect(),
+        Sampling::Dense => {
+            (0..=crate::contact::norms::LATTICE_ORDER).map(|k| k as f64 / crate::contact::norms::LATTICE_ORDER as f64).collect()
+        }
     }
 }
 
@@ -150,7 +152,7 @@ fn boundary_edge(
     let be = mesh.boundary[bi];
     // the boundary edge runs counter-clockwise from be.v[0] to be.v[1]
     let (a, b) = (mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
-    let (normal, _) = crate::assembly::edge_normal(a, b);
+    let (normal, _) = crate::fem::assembly::edge_normal(a, b);
     // element stress at the boundary edge's start and end
     let (sa, sb) = if el[i] == be.v[0] { (stress[i], stress[j]) } else { (stress[j], stress[i]) };
     let bn = nodes.boundary_nodes[bi];
@@ -209,7 +211,7 @@ pub(super) fn interior_jumps(mesh: &Mesh, sol: &DiscreteSolution, stress: &[[[f6
                 continue;
             }
             let (a, b) = (mesh.vertices[el[*i]], mesh.vertices[el[*j]]);
-            let (n, _) = crate::assembly::edge_normal(a, b); // outward for t (counter-clockwise)
+            let (n, _) = crate::fem::assembly::edge_normal(a, b); // outward for t (counter-clockwise)
             let el2 = &nodes.elements[t2];
             let k2 = |v: usize| (0..3).find(|&k| el2[k] == v).expect("neighbour shares the edge");
             let (s1a, s1b) = (stress[t][*i], stress[t][*j]);

@@ -32,8 +32,9 @@
 //! its sign on full-contact patches once the compressive normal stress is moved into the contact
 //! force; the studies test it numerically (`estimator_repair`), they do not prove it.
 
-use crate::mesh::{Mesh, Part};
-use crate::solve::DiscreteSolution;
+use crate::contact::solve::DiscreteSolution;
+use crate::mesh::Mesh;
+use crate::problems::Part;
 
 /// Lambda_h^C,r per boundary edge of `mesh` (in `Mesh::boundary` order): a contact edge whose
 /// three nodes are all active (a full-contact edge), or one through a node with positive
