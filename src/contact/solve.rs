@@ -25,7 +25,7 @@ pub enum SolveError {
     #[error(transparent)]
     ContactData(#[from] Box<super::plausible::ContactDataError>),
     #[error(transparent)]
-    Exact(#[from] crate::problems::consistent::ExactError),
+    Exact(#[from] super::consistent::ExactError),
     /// No boundary edge of the mesh is in the contact part.
     #[error("the problem's contact part matches no boundary edge of the mesh: there is nothing to be in contact (the problem declares: {})", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") })]
     NoContact { declared: Vec<String> },
@@ -123,7 +123,7 @@ pub fn solve(
     let dofs = DofMap::new(&nodes, problem);
     certify::check_held(mesh, &nodes, &dofs, problem)?;
     super::plausible::check_contact_data(mesh, &nodes, &dofs, problem)?;
-    crate::problems::consistent::check_exact(problem, mesh)?;
+    super::consistent::check_exact(problem, mesh)?;
     if dofs.contact.is_empty() {
         return Err(SolveError::NoContact { declared: problem.declared_parts() });
     }

@@ -7,7 +7,6 @@
 //! expressions in x and y. [`by_name`] takes either.
 
 pub mod builtin;
-pub mod consistent;
 pub mod file;
 
 pub use builtin::{Ex71, Ex72, Fb, Patch, contact_bottom_dirichlet_top};
