@@ -353,7 +353,16 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
                 std::ops::ControlFlow::Continue(())
             }
         })?;
-        let level = result.records.last().context("the adaptive loop solved no level")?.level;
+        let last = result.records.last().context("the adaptive loop solved no level")?;
+        if let Some(min) = args.adapt_min_ndof.filter(|&min| last.ndof < min) {
+            let why = result.termination.note(&config).unwrap_or_else(|| "the last level --adapt-levels allows".into());
+            bail!(
+                "the adaptive loop ended at level {} with {} unknowns ({why}), short of --adapt-min-ndof {min}: raise --adapt-levels, or lower --adapt-min-ndof",
+                last.level,
+                last.ndof
+            );
+        }
+        let level = last.level;
         mesh = result.mesh;
         mesh_name = format!("{spec} refined adaptively to level {level} (theta {theta})");
     }
@@ -772,6 +781,11 @@ fn run_report(
 
 /// `export`: solve, write the case files, say where.
 fn run_export(args: &SolveArgs, out: &std::path::Path) -> Result<()> {
+    // before solving: export writes a folder (mesh.vtu, case.json), so a file there is an error
+    // now, not the operating system's "File exists" after the solve
+    if out.exists() && !out.is_dir() {
+        bail!("--out {}: this is a file; export writes a folder there (mesh.vtu, case.json): give a folder's path", out.display());
+    }
     let (mesh, sol, indicator, r) = run_solve(args)?;
     for f in report::export_case(out, &mesh, &sol, &indicator, &r)? {
         println!("wrote {}", f.display());

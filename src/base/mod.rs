@@ -2,9 +2,10 @@
 //! the reference triangle ([`element`]: P2 basis, affine maps, Gauss rules, sampling lattices) and
 //! the memory a solve needs and may still allocate ([`memory`]), least-squares lines with
 //! confidence intervals ([`stats`]), and notes to standard error that a failed write cannot stop
-//! ([`note`]).
+//! ([`note`]), and TOML errors in the files' words ([`toml_text`]).
 
 pub mod element;
 pub mod memory;
 pub mod note;
 pub mod stats;
+pub mod toml_text;

@@ -261,6 +261,7 @@ type Triangles = (Vec<[usize; 3]>, Vec<Option<usize>>);
 pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     check_size(path)?;
     let bytes = std::fs::read(path).map_err(|e| error(path, None, format!("cannot read the mesh file: {e}")))?;
+    let bytes = single_spaced(bytes);
     let names = physical_names(path, &bytes)?;
     let msh = parse(path, &bytes)?;
     let binary = msh.header.file_type != 0;
@@ -275,6 +276,39 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     check_folds(path, &vertices, &triangles, &tri_nodes, &line_of)?;
     let (edges, groups) = group_edges(path, line_elems, &used, &node_at, &names, &line_of)?;
     Ok(GmshFile { path: path.to_path_buf(), vertices, triangles, triangle_lines, edges, groups })
+}
+
+/// An ASCII file with every run of blanks (spaces, tabs, a carriage return) between two fields
+/// made one space and none at the ends of a line, outside double quotes (a physical name keeps
+/// its spaces); lines stay where they are, so every line number still names the file's line.
+/// MSH separates fields by white space of any length, as Gmsh reads it, but `mshio` takes one
+/// space only: a valid file written with aligned columns was refused, naming a line far from
+/// the first double space. A binary file is returned as it is (its data are bytes, not text).
+fn single_spaced(bytes: Vec<u8>) -> Vec<u8> {
+    if msh_nodes::Encoding::of(&bytes).is_none_or(|e| e.binary) {
+        return bytes;
+    }
+    let blank = |b: u8| matches!(b, b' ' | b'\t' | b'\r');
+    let mut out = Vec::with_capacity(bytes.len());
+    for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        if i > 0 {
+            out.push(b'\n');
+        }
+        let (mut quoted, mut gap) = (false, false);
+        for &b in line {
+            if !quoted && blank(b) {
+                gap = true;
+                continue;
+            }
+            if gap && out.last().is_some_and(|&c| c != b'\n') {
+                out.push(b' ');
+            }
+            gap = false;
+            quoted ^= b == b'"';
+            out.push(b);
+        }
+    }
+    out
 }
 
 /// The file parsed by `mshio`; its error turned into one naming the line. `mshio` has a few

@@ -680,7 +680,11 @@ impl FileProblem {
     pub fn parse_with(path: &Path, text: &str, overrides: &BTreeMap<String, f64>) -> Result<Self, ProblemFileError> {
         let mut raw: FileToml = toml::from_str(text).map_err(|e| {
             let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
-            ProblemFileError::Syntax { file: path.to_path_buf(), line, column, message: e.message().trim_end().to_string() }
+            let (file, message) = (path.to_path_buf(), crate::base::toml_text::plain(e.message().trim_end()));
+            match crate::base::toml_text::key_of(&e) {
+                Some(key) => ProblemFileError::Invalid { file, key, line, column, message },
+                None => ProblemFileError::Syntax { file, line, column, message },
+            }
         })?;
         let mut r = Reader { file: path, text, constants: BTreeMap::new() };
         r.override_constants(&mut raw, overrides)?;

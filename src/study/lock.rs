@@ -63,13 +63,10 @@ fn open(path: &Path) -> Result<std::fs::File> {
 /// Take the lock on `file`: at once if free; if held, refused naming the holder, or with `wait`
 /// after waiting for it.
 fn claim(mut file: std::fs::File, path: &Path, what: &str, wait: bool) -> Result<Lock> {
-    use std::io::Read;
     match file.try_lock() {
         Ok(()) => {}
         Err(std::fs::TryLockError::WouldBlock) => {
-            let mut holder = String::new();
-            let _ = file.read_to_string(&mut holder);
-            let holder = if holder.trim().is_empty() { "another process".to_string() } else { holder.trim().to_string() };
+            let holder = holder(&mut file);
             if !wait {
                 bail!(
                     "{what} is being written by {holder}; wait for it to finish, or pass --wait to wait for it (the lock is {})",
@@ -82,6 +79,46 @@ fn claim(mut file: std::fs::File, path: &Path, what: &str, wait: bool) -> Result
         Err(std::fs::TryLockError::Error(e)) => return Err(e).with_context(|| format!("locking {}", path.display())),
     }
     own(file, path)
+}
+
+/// Who holds the lock on `file`, as its text says. A new holder takes the lock first and writes
+/// its name just after, so for a moment the text still names the previous holder, whose process
+/// has ended (a refusal once named a dead process): the text is read again, for up to a second,
+/// until the process it names is running; if it never is, that is said.
+fn holder(file: &mut std::fs::File) -> String {
+    use std::io::{Read, Seek};
+    let mut text = String::new();
+    for attempt in 0..20 {
+        if attempt > 0 {
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+        text.clear();
+        let _ = file.rewind().and_then(|_| file.read_to_string(&mut text));
+        match named_pid(&text) {
+            Some(pid) if !running(pid) => continue,
+            _ => break,
+        }
+    }
+    let text = text.trim();
+    match named_pid(text) {
+        _ if text.is_empty() => "another process".to_string(),
+        Some(pid) if !running(pid) => format!("another process (the lock file still names process {pid}, which has ended)"),
+        _ => text.to_string(),
+    }
+}
+
+/// The process id a lock file's text names (`process PID (...`), as [`own`] writes it.
+fn named_pid(text: &str) -> Option<u32> {
+    text.trim().strip_prefix("process ")?.split_whitespace().next()?.parse().ok()
+}
+
+/// Whether process `pid` exists (signal 0 checks without sending; EPERM: it exists, owned by
+/// another user).
+fn running(pid: u32) -> bool {
+    let Ok(pid) = libc::pid_t::try_from(pid) else { return false };
+    // SAFETY: kill with signal 0 sends nothing; it only reports whether the process exists
+    let r = unsafe { libc::kill(pid, 0) };
+    r == 0 || std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM)
 }
 
 /// A locked file made this process's lock: its text names the process, its command and since when.
@@ -123,4 +160,29 @@ pub fn runs_of(dir: &StudyDir, declared: impl Iterator<Item = String>) -> Vec<St
     ids.sort();
     ids.dedup();
     ids
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_holder_is_named_only_while_its_process_runs() {
+        let me = std::process::id();
+        assert_eq!(named_pid(&format!("process {me} (signorini run x.toml) since now")), Some(me));
+        assert_eq!(named_pid("another text"), None);
+        assert!(running(me));
+        // a pid above the kernel's limit (pid_max is at most 2^22) names no process
+        assert!(!running(1 << 23));
+        let path = std::env::temp_dir().join(format!("signorini-lock-holder-{me}"));
+        std::fs::write(&path, format!("process {} (gone) since then", 1 << 23)).unwrap();
+        let mut file = std::fs::File::open(&path).unwrap();
+        let started = std::time::Instant::now();
+        let said = holder(&mut file);
+        assert!(said.contains("still names process 8388608, which has ended"), "{said}");
+        assert!(started.elapsed() < std::time::Duration::from_secs(3));
+        std::fs::write(&path, format!("process {me} (signorini run) since now")).unwrap();
+        assert_eq!(holder(&mut std::fs::File::open(&path).unwrap()), format!("process {me} (signorini run) since now"));
+        std::fs::remove_file(&path).ok();
+    }
 }

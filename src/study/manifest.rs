@@ -255,7 +255,7 @@ impl Manifest {
     pub fn parse(path: &Path, text: &str) -> Result<Self, ManifestError> {
         let file = path.to_path_buf();
         let raw: ManifestToml = toml::from_str(text)
-            .map_err(|e| ManifestError::Syntax { file: file.clone(), message: plain_words(e.to_string().trim_end()) })?;
+            .map_err(|e| ManifestError::Syntax { file: file.clone(), message: crate::base::toml_text::plain(e.to_string().trim_end()) })?;
         let study = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         let invalid = Invalid(&file);
         if raw.run.is_empty() {
@@ -652,19 +652,4 @@ pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
         }
     }
     Ok(all.into_iter().filter(|m| only.is_empty() || only.contains(&m.study)).collect())
-}
-
-/// Serde's messages name Rust types (`expected usize`); a manifest's reader knows TOML values.
-fn plain_words(message: &str) -> String {
-    [
-        ("expected usize", "expected a non-negative integer"),
-        ("expected u64", "expected a non-negative integer"),
-        ("expected f64", "expected a number"),
-        ("expected i64", "expected an integer"),
-        ("expected a sequence", "expected an array"),
-        ("expected a map", "expected a table"),
-        ("expected struct Tolerance", "expected a table { rel = .., floor = .. }"),
-    ]
-    .iter()
-    .fold(message.to_string(), |m, (rust, toml)| m.replace(rust, toml))
 }

@@ -261,3 +261,48 @@ fn bad_physical_name_given_to_two_groups_is_refused() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The unclear messages the third battery left: a pair of the wrong length names its key, a
+/// huge number in a manifest is printed short, `export --out FILE` says what is wrong before
+/// solving, and `--adapt-min-ndof` that the loop does not reach is an error, not a silent mesh.
+#[test]
+fn bad_lengths_huge_numbers_export_files_and_unreached_minimums_are_named() {
+    let ex71 = std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("experiments/problems/ex71.toml")).unwrap();
+    let dir = tmp("named");
+    let cases = [
+        ("body_force", ex71.replacen("body_force = [", "body_force = [\"0\", ", 1)),
+        ("exact.u", ex71.replace(r#"u = ["y^2*(y - 1)", "#, "u = [")),
+        ("contact.normal", ex71.replace(r#"normal = "outward""#, "normal = [0, -1, 0]")),
+    ];
+    for (key, text) in cases {
+        std::fs::write(dir.join("v.toml"), text).unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
+            .current_dir(&dir)
+            .args(["solve", "--problem", "v.toml", "--mesh", "structured:4"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{key}: {err}");
+        assert!(err.contains("v.toml:") && err.contains(&format!("key `{key}`")), "{key}: {err}");
+    }
+    let err = common::parse_err(&fixture("tiny.toml").replacen("levels = 5", "levels = 1e300", 1));
+    assert!(err.contains("`1e300`") && err.contains("expected a non-negative integer") && err.len() < 600, "{err}");
+    std::fs::write(dir.join("taken"), "a file").unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["export", "--problem", "ex71", "--mesh", "structured:4", "--out", "taken"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("--out taken: this is a file; export writes a folder there"), "{err}");
+    let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["solve", "--problem", "ex71", "--mesh", "structured:4", "--adapt-levels", "2", "--adapt-min-ndof", "100000"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("the adaptive loop ended at level 2 with") && err.contains("short of --adapt-min-ndof 100000"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

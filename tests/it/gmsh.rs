@@ -112,6 +112,39 @@ fn hand_written_square_is_read_tagged_and_oriented() {
     assert_eq!(m.boundary.iter().filter(|e| e.part == Part::Dirichlet).count(), 3);
 }
 
+/// MSH separates fields by white space of any length (Gmsh reads aligned columns): runs of
+/// spaces, tabs, blanks at the start and end of a line and CRLF line ends read as the same mesh
+/// as the plain file; a physical name keeps the spaces inside its quotes; an error in such a
+/// file still names its own line.
+#[test]
+fn white_space_of_any_length_between_fields_reads_as_the_plain_file() {
+    let plain = MeshSpec::Gmsh(write("plain.msh", SQUARE)).build(&square_problem()).unwrap();
+    let forms: [(&str, String); 4] = [
+        ("runs.msh", SQUARE.replace(' ', "   ")),
+        ("tabs.msh", SQUARE.replace(' ', " \t ")),
+        ("blank-ends.msh", SQUARE.lines().map(|l| format!("  {l}\t ")).collect::<Vec<_>>().join("\n")),
+        ("crlf.msh", SQUARE.replace('\n', "\r\n")),
+    ];
+    for (name, text) in &forms {
+        let m = MeshSpec::Gmsh(write(name, text)).build(&square_problem()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!((&m.vertices, &m.triangles), (&plain.vertices, &plain.triangles), "{name}");
+        assert_eq!(
+            m.boundary.iter().map(|e| (e.v, e.part)).collect::<Vec<_>>(),
+            plain.boundary.iter().map(|e| (e.v, e.part)).collect::<Vec<_>>()
+        );
+    }
+    // inside quotes the spaces are the name's: "bottom  face" is not "bottom face"
+    let spaced = SQUARE.replace("\"bottom\"", "\"bottom  face\"");
+    let problem = Named { groups: vec![("bottom  face", Part::Contact, None), ("sides", Part::Dirichlet, None)] };
+    MeshSpec::Gmsh(write("quoted.msh", &spaced.replace(' ', "  ").replace("bottom    face", "bottom  face"))).build(&problem).unwrap();
+    // an error names the same line as in the plain file (a misspelt section end)
+    let broken = SQUARE.replacen("$EndNodes", "$EndNodez", 1);
+    let plain_err = build_err(&write("plain-broken.msh", &broken), &square_problem());
+    let spaced_err = build_err(&write("spaced-broken.msh", &broken.replace(' ', "   ")), &square_problem());
+    let line = |e: &str| e.split("line ").nth(1).and_then(|r| r.split(':').next()).map(str::to_string);
+    assert!(line(&plain_err).is_some() && line(&plain_err) == line(&spaced_err), "{plain_err}\n{spaced_err}");
+}
+
 #[test]
 fn truncated_file_is_an_error_naming_file_and_line() {
     let cut = &SQUARE[..SQUARE.find("5 1 2 3").unwrap() + 4];
