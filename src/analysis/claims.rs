@@ -13,6 +13,7 @@
 pub mod criterion;
 mod ex72;
 pub mod repair;
+mod rollers;
 
 use crate::records::{MeshSnapshot, RunRecord, StudyDir};
 use crate::verdict::{self, Abscissa, RateReport, RateVerdict, refinement};
@@ -950,6 +951,7 @@ pub fn claims_with(results: &Path, sampling: ErrorSampling) -> std::io::Result<V
     ex71_claims(&ctx, &mut out)?;
     c0_claim(&ctx, &mut out)?;
     ex72::claims(&ctx, &mut out)?;
+    rollers::claims(&ctx, &mut out)?;
     efficiency_size_claim(&ctx, &mut out)?;
     log_factor_claim(&ctx, &mut out)?;
     theta_claim(&ctx, &mut out)?;
