@@ -7,9 +7,11 @@
 //! [`super::ex72::error`]) and the uniform rate that shows the corners gone.
 
 use super::ex72::{Errors, Labels, error, rates};
-use super::{Claim, Ctx, EX72_NU, OPTIMAL, Q, Summary, Verdict, c0_text, growth_text, judge, rate_headline, rate_text, run, source};
+use super::{
+    Claim, Criterion, Ctx, EX72_NU, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, growth_text, rate_headline, rate_text, run, source,
+};
 use crate::records::{RunRecord, StudyDir};
-use crate::verdict::{self, RateReport, Trend};
+use crate::verdict::{self, Abscissa, RateReport};
 
 /// The study.
 const STUDY: &str = "ex72_rollers";
@@ -101,6 +103,12 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 fn uniform(ctx: &Ctx, u: Option<&RunRecord>) -> Claim {
     let lambda = verdict::clamped_free_corner_exponent(EX72_NU);
     let rep = ctx.rate(u, Q::Error);
+    // the fit is in h_min (uniform): the corners' NDF^-(lambda/2) is h^-lambda there
+    let test = Criterion::FasterThan {
+        what: format!("the uniform error ({})", source(u)),
+        than: lambda / 2.0,
+        abscissa: u.map_or(Abscissa::InverseHMin, verdict::abscissa_of),
+    };
     Claim {
         fragile: None,
         id: "7.2r-uniform (beyond the paper)",
@@ -118,13 +126,9 @@ fn uniform(ctx: &Ctx, u: Option<&RunRecord>) -> Claim {
             .as_ref()
             .map(|r| format!("{}: {}", source(u), rate_text("uniform error rate", Some(r), Some(lambda / 2.0))))
             .unwrap_or_default(),
-        // the fit is in h_min (uniform): the corners' NDF^-(lambda/2) is h^-lambda there
-        verdict: match rep.as_ref().map(|r| (r.main.rate, r.main.claim_in_abscissa(lambda / 2.0).0)) {
-            None => Verdict::NoData,
-            Some((rate, corner)) if rate.lo() > corner => Verdict::Holds,
-            Some((rate, corner)) if rate.hi() < corner => Verdict::Fails,
-            Some(_) => Verdict::Inconclusive,
-        },
+        verdict: test.verdict(Kind::Beyond, Evidence::rate(rep.as_ref()).as_ref()),
+        criterion: test,
+        kind: Kind::Beyond,
     }
 }
 
@@ -136,6 +140,7 @@ fn error_rate(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> 
         .iter()
         .map(|(n, f)| rate_text(n, ctx.rate(r, Q::Field(f)).as_ref(), Some(OPTIMAL)))
         .collect();
+    let test = Criterion::rate(format!("the true error ({})", source(r)), OPTIMAL, Abscissa::Ndof);
     Claim {
         fragile: super::fragility(rep.as_ref(), OPTIMAL),
         id: labels.id,
@@ -159,7 +164,9 @@ fn error_rate(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> 
                 )
             })
             .unwrap_or_default(),
-        verdict: if r.is_none() { Verdict::NoData } else { judge(rep.as_ref(), OPTIMAL) },
+        verdict: test.verdict(Kind::Paper, r.and(Evidence::rate(rep.as_ref())).as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     }
 }
 
@@ -168,6 +175,7 @@ fn error_rate(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> 
 fn refinement(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> Claim {
     let rep: Option<RateReport> = ctx.rate(r, Q::Field("h_free_boundary"));
     let last = r.and_then(|r| r.levels.iter().rev().find_map(|l| l.h_free_boundary.map(|h| (h, l.h_min, l.ndof))));
+    let test = Criterion::FasterThan { what: format!("h_fb ({})", source(r)), than: 0.5, abscissa: Abscissa::Ndof };
     Claim {
         fragile: super::fragility(rep.as_ref(), 0.5),
         id: labels.id,
@@ -190,12 +198,9 @@ fn refinement(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> 
                 )
             })
             .unwrap_or_default(),
-        verdict: match rep.as_ref().filter(|_| r.is_some()).map(|x| (x.main.rate, x.main.claim_in_abscissa(0.5).0)) {
-            None => Verdict::NoData,
-            Some((rate, uniform)) if rate.lo() > uniform => Verdict::Reproduced,
-            Some((rate, uniform)) if rate.hi() < uniform => Verdict::NotReproduced,
-            Some(_) => Verdict::Inconclusive,
-        },
+        verdict: test.verdict(Kind::Paper, r.and(Evidence::rate(rep.as_ref())).as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     }
 }
 
@@ -203,7 +208,7 @@ fn refinement(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> 
 /// estimate / error / l_h bounded (or falling); with l_h = 1 and the reliability beside it.
 fn efficiency(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> Claim {
     let over_lh = ctx.growth(r, Q::EfficiencyOverLh);
-    let trend = over_lh.as_ref().map(verdict::judge_trend);
+    let test = Criterion::NotGrowing { what: format!("estimate / error / l_h ({})", source(r)) };
     Claim {
         fragile: None,
         id: labels.id,
@@ -231,11 +236,8 @@ fn efficiency(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> 
                 )
             })
             .unwrap_or_default(),
-        verdict: match (r, trend) {
-            (None, _) | (_, None) => Verdict::NoData,
-            (_, Some(Trend::Bounded | Trend::Falling)) => Verdict::Reproduced,
-            (_, Some(Trend::Growing)) => Verdict::NotReproduced,
-            _ => Verdict::Inconclusive,
-        },
+        verdict: test.verdict(Kind::Paper, r.and(Evidence::fit(over_lh.as_ref())).as_ref()),
+        criterion: test,
+        kind: Kind::Paper,
     }
 }
