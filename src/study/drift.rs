@@ -539,6 +539,31 @@ pub struct DriftReport {
     pub not_compared: Vec<String>,
 }
 
+impl DriftReport {
+    /// The studies this report checked (its `studies` entries' names).
+    pub fn checked(&self) -> Vec<String> {
+        self.studies.iter().filter_map(|s| s.get("study").and_then(Value::as_str).map(str::to_string)).collect()
+    }
+
+    /// `older` with this report's studies in place of theirs: their entries, rows and changes
+    /// replaced, every other study's kept as it was (a round-off measurement of some studies
+    /// merged into the reports of all of them). Date, quick and against are this report's.
+    pub fn merged_into(self, older: DriftReport) -> DriftReport {
+        let mine = self.checked();
+        let theirs = |s: &str| !mine.iter().any(|m| m == s);
+        let mut studies: Vec<Value> =
+            older.studies.into_iter().filter(|s| s.get("study").and_then(Value::as_str).is_none_or(theirs)).collect();
+        studies.extend(self.studies);
+        studies.sort_by(|a, b| a.get("study").and_then(Value::as_str).cmp(&b.get("study").and_then(Value::as_str)));
+        let mut rows: Vec<DriftRow> = older.rows.into_iter().filter(|r| theirs(&r.study)).collect();
+        rows.extend(self.rows);
+        let mut changes = older.changes;
+        changes.retain(|s, _| theirs(s));
+        changes.extend(self.changes);
+        DriftReport { date: self.date, quick: self.quick, against: self.against, studies, rows, changes, not_compared: self.not_compared }
+    }
+}
+
 /// The declared studies a results folder holds (a folder `DIR/STUDY`), those it does not, and
 /// its other folders (not declared studies).
 #[derive(Clone, Debug)]

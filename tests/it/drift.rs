@@ -310,6 +310,38 @@ fn manifest_tolerances_are_the_measured_round_off_times_the_margin() {
     }
 }
 
+/// `drift --merge` (`make roundoff STUDIES=...`): the measured studies' entries, rows and
+/// changes replace theirs in the stored report, every other study's are kept as they were, and
+/// merging a report into itself changes nothing.
+#[test]
+fn a_round_off_report_merged_in_replaces_only_the_studies_it_measured() {
+    use signorini::study::drift::DriftReport;
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/roundoff/nested-dissection-2-threads.json");
+    let older: DriftReport = serde_json::from_str(&std::fs::read_to_string(file).unwrap()).unwrap();
+    let all = older.checked();
+    assert!(all.len() >= 10 && all.iter().any(|s| s == "hertz"), "{all:?}");
+    // a fresh measurement of hertz alone, every change of it doubled
+    let mut fresh = older.clone();
+    fresh.studies.retain(|s| s["study"] == "hertz");
+    fresh.rows.retain(|r| r.study == "hertz");
+    fresh.changes.retain(|s, _| s == "hertz");
+    for c in fresh.changes.get_mut("hertz").unwrap().values_mut() {
+        c.max_rel = 2.0 * c.max_rel + 1e-30;
+    }
+    fresh.date = "later".into();
+    let merged = fresh.clone().merged_into(older.clone());
+    assert_eq!(merged.checked(), all, "every study once, in order");
+    assert_eq!(merged.date, "later");
+    for s in &all {
+        let want = if s == "hertz" { &fresh } else { &older };
+        let (a, b) = (serde_json::to_value(&merged.changes[s]).unwrap(), serde_json::to_value(&want.changes[s]).unwrap());
+        assert_eq!(a, b, "{s}");
+    }
+    assert_eq!(merged.rows.len(), older.rows.len());
+    let same = older.clone().merged_into(older.clone());
+    assert_eq!(serde_json::to_value(&same).unwrap(), serde_json::to_value(&older).unwrap());
+}
+
 /// roundoff_floor passes a factor 5 (another ordering moves it by up to 79%) and is drift at a
 /// factor 20, on every level, floors of the tiny first meshes included.
 #[test]
