@@ -687,19 +687,21 @@ struct ReportFile<'a> {
 /// The report already at `file` that `--merge` merges into: None without `--merge` or where
 /// there is none yet; read before anything is rerun, so that a file that is not a drift report
 /// is an error naming it at once (and is never overwritten).
-fn report_to_merge_into(file: Option<ReportFile>) -> Result<Option<study::drift::DriftReport>> {
+fn report_to_merge_into(file: Option<ReportFile>) -> Result<Option<serde_json::Value>> {
     let Some(ReportFile { path, merge: true }) = file else { return Ok(None) };
     if !path.exists() {
         return Ok(None);
     }
     let text = std::fs::read_to_string(path).with_context(|| format!("reading the drift report {} to merge into", path.display()))?;
-    let older = serde_json::from_str(&text).with_context(|| {
+    let not_one = || {
         format!(
             "{}: not a drift report (expected the JSON `signorini drift --report` writes); nothing was rerun or written",
             path.display()
         )
-    })?;
-    Ok(Some(older))
+    };
+    // checked as a report, merged as JSON: the other studies' entries are kept as written
+    serde_json::from_str::<study::drift::DriftReport>(&text).with_context(not_one)?;
+    Ok(Some(serde_json::from_str(&text).with_context(not_one)?))
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -738,8 +740,8 @@ fn run_drift(
     println!("\nlargest change of each float field (whether within tolerance or not):\n{}", study::drift::changes_table(&report));
     let file = report_file.map(|r| r.path.to_path_buf()).unwrap_or_else(|| default_report(quick, against, only));
     let written = match older {
-        Some(older) => report.clone().merged_into(older),
-        None => report.clone(),
+        Some(older) => report.merged_into(older).with_context(|| format!("merging into the drift report {}", file.display()))?,
+        None => serde_json::to_value(&report)?,
     };
     signorini::records::write_json(&file, &written).with_context(|| format!("writing the drift report {}", file.display()))?;
     println!("report: {}", file.display());
