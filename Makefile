@@ -77,14 +77,15 @@ bench: build
 # results/ (automatic ordering, all threads; it must be current: `make drift` first); its report
 # lists per study and float field the largest relative change and the largest change relative to
 # the field's largest value in its run. Reports: results/roundoff/*.json, the basis of the
-# manifests' [drift] tolerances.
+# manifests' [drift] tolerances. `make roundoff STUDIES="ex72_rollers hertz"` measures only those
+# studies and merges them into the reports (`drift --merge`: the other studies' entries kept).
 ROUNDOFF_VARIANTS := nested-dissection:$(shell nproc) minimum-degree:$(shell nproc) auto:1
 roundoff: build
 	@mkdir -p results/roundoff
 	@set -e; for v in $(ROUNDOFF_VARIANTS); do \
 		ordering=$${v%%:*}; jobs=$${v##*:}; name=$$ordering-$$jobs-threads; \
 		echo "== $$name"; \
-		SIGNORINI_ORDERING=$$ordering RAYON_NUM_THREADS=$$jobs $(BIN) drift --report results/roundoff/$$name.json || true; \
+		SIGNORINI_ORDERING=$$ordering RAYON_NUM_THREADS=$$jobs $(BIN) drift $(if $(STUDIES),$(foreach s,$(STUDIES),--study $(s)) --merge) --report results/roundoff/$$name.json || true; \
 	done
 
 # Regenerate every experiments/meshes/*.msh from its .geo with gmsh's Python module, installed in

@@ -131,9 +131,14 @@ enum Command {
         /// with --against DIR: DIR/drift-report.json).
         #[arg(long, value_name = "FILE")]
         report: Option<std::path::PathBuf>,
+        /// With --study and --report FILE: merge into FILE, replacing the checked studies'
+        /// entries and keeping every other study's (`make roundoff STUDIES=...` measures some
+        /// studies into the reports of all).
+        #[arg(long, requires_all = ["report", "study"])]
+        merge: bool,
         /// Accept a deliberate change: rerun STUDY in full and rewrite its stored results (in
         /// --results); nothing is compared, so --quick, --against, --report and --study do not apply.
-        #[arg(long, value_name = "STUDY", conflicts_with_all = ["quick", "against", "report", "study"])]
+        #[arg(long, value_name = "STUDY", conflicts_with_all = ["quick", "against", "report", "study", "merge"])]
         accept: Vec<String>,
         /// Check only these studies (default: every experiments/*.toml).
         #[arg(long, value_name = "STUDY")]
@@ -657,12 +662,39 @@ fn drift_outcome(report: &study::drift::DriftReport, against: Option<&std::path:
     }
 }
 
+/// Where `drift --report` writes, and whether it merges into what is there (`--merge`).
+#[derive(Clone, Copy)]
+struct ReportFile<'a> {
+    path: &'a std::path::Path,
+    merge: bool,
+}
+
+/// The report already at `file` that `--merge` merges into: None without `--merge` or where
+/// there is none yet; read before anything is rerun, so that a file that is not a drift report
+/// is an error naming it at once (and is never overwritten).
+fn report_to_merge_into(file: Option<ReportFile>) -> Result<Option<serde_json::Value>> {
+    let Some(ReportFile { path, merge: true }) = file else { return Ok(None) };
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(path).with_context(|| format!("reading the drift report {} to merge into", path.display()))?;
+    let not_one = || {
+        format!(
+            "{}: not a drift report (expected the JSON `signorini drift --report` writes); nothing was rerun or written",
+            path.display()
+        )
+    };
+    // checked as a report, merged as JSON: the other studies' entries are kept as written
+    serde_json::from_str::<study::drift::DriftReport>(&text).with_context(not_one)?;
+    Ok(Some(serde_json::from_str(&text).with_context(not_one)?))
+}
+
 #[allow(clippy::too_many_arguments)]
 fn run_drift(
     quick: bool,
     deep: bool,
     against: Option<&std::path::Path>,
-    report_file: Option<&std::path::Path>,
+    report_file: Option<ReportFile>,
     accept: &[String],
     only: &[String],
     experiments: &std::path::Path,
@@ -673,6 +705,7 @@ fn run_drift(
     }
     let results = if is_tracked_results(results) { std::path::Path::new("results") } else { results };
     let manifests = study::manifest::declared(experiments, only)?;
+    let older = report_to_merge_into(report_file)?;
     let scratch = std::path::PathBuf::from("target/drift").join(if quick { "quick" } else { "full" });
     let options = study::drift::DriftOptions {
         quick,
@@ -690,8 +723,12 @@ fn run_drift(
         print!("{}", study::drift::table(&report.rows));
     }
     println!("\nlargest change of each float field (whether within tolerance or not):\n{}", study::drift::changes_table(&report));
-    let file = report_file.map(|p| p.to_path_buf()).unwrap_or_else(|| default_report(quick, against, only));
-    signorini::records::write_json(&file, &report).with_context(|| format!("writing the drift report {}", file.display()))?;
+    let file = report_file.map(|r| r.path.to_path_buf()).unwrap_or_else(|| default_report(quick, against, only));
+    let written = match older {
+        Some(older) => report.merged_into(older).with_context(|| format!("merging into the drift report {}", file.display()))?,
+        None => serde_json::to_value(&report)?,
+    };
+    signorini::records::write_json(&file, &written).with_context(|| format!("writing the drift report {}", file.display()))?;
     println!("report: {}", file.display());
     drift_outcome(&report, against, results)
 }
@@ -840,8 +877,9 @@ fn main() -> ExitCode {
         Command::Figures { results, figures, experiments, study } => {
             run_figures(results.as_deref(), figures.as_deref(), experiments, study)
         }
-        Command::Drift { quick, deep, against, report, accept, study, experiments, results } => {
-            run_drift(*quick, *deep, against.as_deref(), report.as_deref(), accept, study, experiments, results)
+        Command::Drift { quick, deep, against, report, merge, accept, study, experiments, results } => {
+            let report = report.as_deref().map(|f| ReportFile { path: f, merge: *merge });
+            run_drift(*quick, *deep, against.as_deref(), report, accept, study, experiments, results)
         }
         Command::Run { manifests, quick, jobs, shard, fresh, replace, results, wait } => {
             let flags = RunFlags { quick: *quick, fresh: *fresh, replace: *replace, wait: *wait };

@@ -13,6 +13,7 @@
 pub mod criterion;
 mod ex72;
 pub mod repair;
+mod rollers;
 
 use crate::analysis::verdict::{self, Abscissa, RateReport, RateVerdict, refinement};
 use crate::records::{MeshSnapshot, RunRecord, StudyDir};
@@ -549,13 +550,16 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 /// and spread over the levels of the error-rate fit, and how far the smallest reliable C_0 of
 /// one problem is from another's.
 fn efficiency_size_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let (deep, large) = (StudyDir::new(ctx.results, "deep").read_runs()?, StudyDir::new(ctx.results, "ex72_large").read_runs()?);
+    let load = |s: &str| StudyDir::new(ctx.results, s).read_runs();
+    let (deep, large, rollers, hertz) = (load("deep")?, load("ex72_large")?, load("ex72_rollers")?, load("hertz")?);
     let mut rows = Vec::new();
     let mut per_problem: Vec<(&str, f64)> = Vec::new();
     for (problem, runs, ids) in [
         ("ex71", &deep, ["ex71_as_written", "ex71_without_full_contact", "ex71_repaired"]),
         ("fb", &deep, ["fb_as_written", "fb_without_full_contact", "fb_repaired"]),
         ("ex72", &large, ["adaptive", "without_full_contact", "repaired"]),
+        ("ex72_rollers", &rollers, ["adaptive", "without_full_contact", "repaired"]),
+        ("hertz", &hertz, ["adaptive", "adaptive_light", "repaired"]),
     ] {
         for id in ids {
             let Some(r) = run(runs, id) else { continue };
@@ -950,6 +954,7 @@ pub fn claims_with(results: &Path, sampling: ErrorSampling) -> std::io::Result<V
     ex71_claims(&ctx, &mut out)?;
     c0_claim(&ctx, &mut out)?;
     ex72::claims(&ctx, &mut out)?;
+    rollers::claims(&ctx, &mut out)?;
     efficiency_size_claim(&ctx, &mut out)?;
     log_factor_claim(&ctx, &mut out)?;
     theta_claim(&ctx, &mut out)?;

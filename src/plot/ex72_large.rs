@@ -1,27 +1,60 @@
-//! The figure of the `ex72_large` study (Example 7.2 to about 1e6 unknowns, errors against a
-//! reference solution of 4.5e6), from its records only.
+//! The error figures of the Example 7.2 studies with a reference solution: `ex72_large` (to about
+//! 1e6 unknowns, reference 4.5e6) and `ex72_rollers` (the left side on rollers, to about 3.7e5,
+//! reference 1.4e6), from their records only.
 //!
 //! | figure | study / runs | shows |
 //! |---|---|---|
 //! | `ex72_large_error` | `ex72_large`, all runs | two panels against NDF: the error `err_quadrature` on the whole square, and `err_contact` on Gamma_C, for eta_5 as written, without full-contact nodes, repaired (adaptive) and uniform refinement, NDF^-3/2 below all; the rows `7.2-error` and `7.2-error-away-from-corners` of CLAIMS fit them |
+//! | `ex72_rollers_error` | `ex72_rollers`, all runs | the same two panels on rollers (no corners); the rows `7.2r-*` fit them |
 
 use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, Figure, NDF_DESC, PALETTE, Style, runs, series, slope};
 use std::path::Path;
 
-const STUDY: &str = "ex72_large";
+/// One Example 7.2 study's error figure: its study, the problem's name in the panels and the title.
+struct Labels {
+    study: &'static str,
+    problem: &'static str,
+    /// The second panel's region: Gamma_C ("away from the corners" where there are corners).
+    contact: &'static str,
+    title: &'static str,
+}
 
 pub(super) fn ex72_large_error(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, STUDY)? {
+    error_figure(
+        results,
+        Labels {
+            study: "ex72_large",
+            problem: "Example 7.2",
+            contact: "Gamma_C, away from the corners",
+            title: "Example 7.2 deep: the error against a reference of 4.5e6 unknowns",
+        },
+    )
+}
+
+pub(super) fn ex72_rollers_error(results: &Path) -> anyhow::Result<Built> {
+    error_figure(
+        results,
+        Labels {
+            study: "ex72_rollers",
+            problem: "Example 7.2 on rollers",
+            contact: "Gamma_C",
+            title: "Example 7.2 on rollers: the error against a reference of 1.4e6 unknowns",
+        },
+    )
+}
+
+fn error_figure(results: &Path, labels: Labels) -> anyhow::Result<Built> {
+    let runs = match runs(results, labels.study)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
     type Field = fn(&crate::records::LevelRecord) -> Option<f64>;
     let panels_of: [(&str, &str, Field); 2] =
-        [("the whole square", "", |l| l.err_quadrature), ("Gamma_C, away from the corners", " on Γ_{C}", |l| l.err_contact)];
+        [("the whole square", "", |l| l.err_quadrature), (labels.contact, " on Γ_{C}", |l| l.err_contact)];
     let mut panels = Vec::new();
     for (title, axis, field) in panels_of {
-        let mut p = Panel::new(format!("Example 7.2, error on {title}"), NDF_DESC, format!("error {ERR}{axis}"));
+        let mut p = Panel::new(format!("{}, error on {title}", labels.problem), NDF_DESC, format!("error {ERR}{axis}"));
         for (k, r) in runs.iter().enumerate() {
             let style = Style {
                 color: PALETTE[k % PALETTE.len()],
@@ -38,11 +71,7 @@ pub(super) fn ex72_large_error(results: &Path) -> anyhow::Result<Built> {
         }
     }
     if panels.is_empty() {
-        return Ok(Err(format!("study {STUDY} has no errors")));
+        return Ok(Err(format!("study {} has no errors", labels.study)));
     }
-    Ok(Ok(Figure::Lines(LineFigure {
-        title: Some("Example 7.2 deep: the error against a reference of 4.5e6 unknowns".to_string()),
-        panels,
-        columns: None,
-    })))
+    Ok(Ok(Figure::Lines(LineFigure { title: Some(labels.title.to_string()), panels, columns: None })))
 }

@@ -30,6 +30,7 @@
 //! | `hertz_pressure`, `hertz_mesh` | `hertz` | see `plot/hertz.rs`: the contact pressure against Hertz's, and the mesh near the contact |
 //! | `deep_error`, `deep_floor` | `deep` | see `plot/deep.rs`: the error of the deep runs to 1e7 unknowns, and error, estimate and round-off floor together |
 //! | `ex72_large_error` | `ex72_large` | see `plot/ex72_large.rs`: Example 7.2's error on the square and on Gamma_C against the reference, every run |
+//! | `ex72_rollers_error` | `ex72_rollers` | the same for Example 7.2 on rollers (`plot/ex72_large.rs`) |
 //! | `estimator_repair` | the runs the CLAIMS row `estimator-repair` reads (`claims::repair::Stored::fitted`: `deep`, `ex72_large`, `estimator_repair`), a 2 x 2 grid, a panel per problem | `err_quadrature` (solid, filled) and `estimate` (dashed, hollow) vs NDF for the repaired run, eta_5 as written, uniform refinement and the repaired run with l_h = 1; the run without full-contact nodes drawn only where it differs from the repaired one (else a note says it coincides) |
 //!
 //! Style: log axes labelled at the decades (`10⁻⁴`; also 2x and 5x when less than two decades
@@ -75,7 +76,7 @@ use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// Every figure, in the order drawn.
-pub const FIGURES: [&str; 19] = [
+pub const FIGURES: [&str; 20] = [
     "fig2a",
     "fig2b",
     "fig3a",
@@ -95,6 +96,7 @@ pub const FIGURES: [&str; 19] = [
     "deep_error",
     "deep_floor",
     "ex72_large_error",
+    "ex72_rollers_error",
 ];
 
 /// The study a figure is drawn from (the table above).
@@ -111,6 +113,7 @@ pub fn study_of(figure: &str) -> Option<&'static str> {
         "estimator_repair" => "estimator_repair",
         "deep_error" | "deep_floor" => "deep",
         "ex72_large_error" => "ex72_large",
+        "ex72_rollers_error" => "ex72_rollers",
         _ => return None,
     })
 }
@@ -256,6 +259,7 @@ fn build(name: &str, results: &Path) -> anyhow::Result<Built> {
         "deep_error" => deep::deep_error(results),
         "deep_floor" => deep::deep_floor(results),
         "ex72_large_error" => ex72_large::ex72_large_error(results),
+        "ex72_rollers_error" => ex72_large::ex72_rollers_error(results),
         other => anyhow::bail!("unknown figure {other}"),
     }
 }

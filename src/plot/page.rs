@@ -25,13 +25,14 @@ pub fn claim_studies(id: &str) -> &'static [&'static str] {
         "c0" => &["c0_sweep"],
         "sampling" => &["ex71", "ex72", "contact_term_ablation"],
         "hertz" => &["hertz"],
-        "efficiency-size" => &["deep", "ex72_large"],
+        "efficiency-size" => &["deep", "ex72_large", "ex72_rollers", "hertz"],
         _ if id.starts_with("theta") => &["theta_ablation"],
         _ if id.starts_with("7.1-") => &["deep", "ex71", "contact_term_ablation"],
         _ if id.starts_with("7.2-") => &["ex72", "ex72_large"],
+        _ if id.starts_with("7.2r-") => &["ex72_rollers"],
         _ if id.starts_with("log-factor") => &["log_ablation"],
         _ if id.starts_with("fb-") => &["deep", "fb"],
-        _ if id.starts_with("estimator-repair") => &["deep", "estimator_repair"],
+        _ if id.starts_with("estimator-repair") => &["deep", "estimator_repair", "hertz"],
         _ => &[],
     }
 }

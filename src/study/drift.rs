@@ -538,6 +538,51 @@ pub struct DriftReport {
     pub not_compared: Vec<String>,
 }
 
+impl DriftReport {
+    /// The studies this report checked (its `studies` entries' names).
+    pub fn checked(&self) -> Vec<String> {
+        self.studies.iter().filter_map(|s| s.get("study").and_then(Value::as_str).map(str::to_string)).collect()
+    }
+
+    /// `older` (a report as JSON, other studies' entries kept byte for byte and in their order)
+    /// with this report's studies in place of theirs: their `studies` entries (each with this
+    /// report's date), rows and changes replaced, a study it did not hold added at the end
+    /// (a round-off measurement of some studies merged into the reports of all of them). The
+    /// other top-level fields stay `older`'s.
+    pub fn merged_into(&self, mut older: Value) -> serde_json::Result<Value> {
+        let mine = self.checked();
+        let ours = |v: &Value| v.get("study").and_then(Value::as_str).is_some_and(|s| mine.iter().any(|m| m == s));
+        let mut fresh = Vec::new();
+        for entry in &self.studies {
+            let mut e = entry.clone();
+            if let Some(o) = e.as_object_mut() {
+                o.insert("date".into(), Value::String(self.date.clone()));
+            }
+            fresh.push(e);
+        }
+        let mut studies: Vec<Value> = older.get("studies").and_then(Value::as_array).cloned().unwrap_or_default();
+        for e in fresh {
+            match studies.iter().position(|o| o.get("study") == e.get("study")) {
+                Some(i) => studies[i] = e,
+                None => studies.push(e),
+            }
+        }
+        let mut rows: Vec<Value> = older.get("rows").and_then(Value::as_array).cloned().unwrap_or_default();
+        rows.retain(|r| !ours(r));
+        rows.extend(self.rows.iter().map(serde_json::to_value).collect::<serde_json::Result<Vec<_>>>()?);
+        let mut changes = older.get("changes").and_then(Value::as_object).cloned().unwrap_or_default();
+        for (study, fields) in &self.changes {
+            changes.insert(study.clone(), serde_json::to_value(fields)?);
+        }
+        if let Some(o) = older.as_object_mut() {
+            o.insert("studies".into(), Value::Array(studies));
+            o.insert("rows".into(), Value::Array(rows));
+            o.insert("changes".into(), Value::Object(changes));
+        }
+        Ok(older)
+    }
+}
+
 /// The declared studies a results folder holds (a folder `DIR/STUDY`), those it does not, and
 /// its other folders (not declared studies).
 #[derive(Clone, Debug)]

@@ -59,6 +59,28 @@ fn bad_accept_with_flags_it_would_ignore_is_refused_before_anything_runs() {
     }
 }
 
+/// `drift --merge` (a round-off measurement of some studies merged into the reports of all)
+/// needs --study and --report; a --report file that is not a drift report is an error naming
+/// it before anything is rerun, and the file is left as it was.
+#[test]
+fn bad_merge_without_its_flags_or_into_another_file_is_refused_before_anything_runs() {
+    for (extra, missing) in [(&["--study", "hertz"][..], "--report"), (&["--report", "x.json"][..], "--study")] {
+        let mut args = vec!["drift", "--merge"];
+        args.extend_from_slice(extra);
+        let (code, _, err) = signorini(&args);
+        assert_eq!(code, 2, "{extra:?}: {err}");
+        assert!(err.contains(missing) && err.contains("required"), "{extra:?}: {err}");
+    }
+    let d = tmp("merge");
+    let file = d.join("notes.json");
+    std::fs::write(&file, "{\"these\": \"are notes\"}").unwrap();
+    let (code, out, err) = signorini(&["drift", "--study", "hertz", "--merge", "--report", file.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(err.contains("notes.json") && err.contains("not a drift report") && err.contains("nothing was rerun"), "{err}");
+    assert!(!out.contains("hertz/"), "nothing is rerun: {out}");
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "{\"these\": \"are notes\"}");
+}
+
 #[test]
 fn bad_empty_experiments_folder_is_an_error_and_claims_nothing() {
     let d = tmp("empty-exp");

@@ -69,9 +69,14 @@ fn every_row_states_what_would_fail_it_and_claims_md_is_what_the_records_render(
 #[test]
 fn a_rate_outside_the_stated_band_fails_the_rate_rows() {
     let c = stored();
-    for (id, abscissa) in
-        [("7.1-error-rate", Abscissa::Ndof), ("fb-error-rate", Abscissa::Ndof), ("7.2-corners (beyond the paper)", Abscissa::InverseHMin)]
-    {
+    for (id, abscissa) in [
+        ("7.1-error-rate", Abscissa::Ndof),
+        ("fb-error-rate", Abscissa::Ndof),
+        ("7.2-corners (beyond the paper)", Abscissa::InverseHMin),
+        ("7.2r-error-rate (as written)", Abscissa::Ndof),
+        ("7.2r-error-rate (without full-contact nodes)", Abscissa::Ndof),
+        ("7.2r-error-rate (repaired)", Abscissa::Ndof),
+    ] {
         let r = row(&c, id);
         let f = r.criterion.fails_if();
         let (lo, hi) = (number_after(&f, "lies below "), number_after(&f, "or above "));
@@ -105,6 +110,41 @@ fn a_growing_efficiency_and_a_c0_beyond_its_limit_fail_their_rows() {
     assert_eq!(s.criterion.verdict(s.kind(), Some(&Evidence::Value(0.0))), Verdict::Holds);
 }
 
+/// The rows of Example 7.2 on rollers that judge a rate against a limit (the uniform rate against
+/// the clamped corners' h^0.711, h_fb against uniform refinement's NDF^-1/2): a rate below the
+/// stated limit fails, one above it passes, one whose interval contains it is not decided; and
+/// the efficiency rows fail on a growing estimate / error / l_h, pass on a bounded or falling one.
+#[test]
+fn the_rollers_rows_fail_below_their_stated_limits() {
+    let c = stored();
+    for (id, abscissa, limit) in [
+        ("7.2r-uniform (beyond the paper)", Abscissa::InverseHMin, 0.711),
+        ("7.2r-refinement (as written)", Abscissa::Ndof, 0.5),
+        ("7.2r-refinement (without full-contact nodes)", Abscissa::Ndof, 0.5),
+        ("7.2r-refinement (repaired)", Abscissa::Ndof, 0.5),
+    ] {
+        let r = row(&c, id);
+        let f = r.criterion.fails_if();
+        let stated = number_after(&f, "lies below ");
+        assert!((stated - limit).abs() < 1e-3, "{id}: {f}");
+        let v = |slope: f64| r.criterion.verdict(r.kind(), Some(&fit(slope, 0.02, abscissa)));
+        assert!(fails(v(stated - 0.05)), "{id}: a rate below {stated} must fail: {f}");
+        assert!(passes(v(stated + 0.05)), "{id}: a rate above {stated} passes");
+        assert!(!fails(v(stated)) && !passes(v(stated)), "{id}: an interval containing {stated} is not decided");
+        if abscissa == Abscissa::InverseHMin {
+            let other = r.criterion.verdict(r.kind(), Some(&fit(stated + 0.05, 0.02, Abscissa::Ndof)));
+            assert!(!passes(other) && !fails(other), "{id}: a fit against NDF decides nothing");
+        }
+    }
+    for id in ["7.2r-efficiency (as written)", "7.2r-efficiency (without full-contact nodes)", "7.2r-efficiency (repaired)"] {
+        let r = row(&c, id);
+        assert!(r.criterion.fails_if().contains("lies above 0 (growing)"), "{id}: {}", r.criterion.fails_if());
+        let v = |slope: f64| r.criterion.verdict(r.kind(), Some(&fit(slope, 0.04, Abscissa::Ndof)));
+        assert!(fails(v(0.2)), "{id}: growing");
+        assert!(passes(v(0.0)) && passes(v(-0.2)), "{id}: bounded or falling");
+    }
+}
+
 /// The repair row: passes on evidence where every criterion of every problem holds and one
 /// separates; one problem's reliability beyond 0.45 fails it; no separating criterion leaves it
 /// undecided.
@@ -114,7 +154,7 @@ fn one_failing_criterion_fails_the_repair_row() {
     let r = row(&c, "estimator-repair (beyond the paper)");
     let Criterion::All(parts) = &r.criterion else { panic!("{:?}", r.criterion) };
     let Criterion::Each { of, .. } = &parts[0] else { panic!("{:?}", parts[0]) };
-    assert_eq!(of, &["ex71", "fb", "ex72"], "the problems judged");
+    assert_eq!(of, &["ex71", "fb", "ex72", "hertz"], "the problems judged (Hertz's errors against its reference)");
     let f = r.criterion.fails_if();
     assert!(f.contains("exceeds 0.45") && f.contains("not decided unless"), "{f}");
     let problem = |c0: f64| {
@@ -125,10 +165,11 @@ fn one_failing_criterion_fails_the_repair_row() {
             Some(Evidence::Unknowns { uniform_rate_hi: 1.499, lines: None }),
         ]))
     };
-    let evidence = |c0s: [f64; 3], separates: bool| {
+    let evidence = |c0s: [f64; 4], separates: bool| {
         Evidence::All(vec![Some(Evidence::All(c0s.iter().map(|c| problem(*c)).collect())), Some(Evidence::Bool(separates))])
     };
-    assert_eq!(r.criterion.verdict(r.kind(), Some(&evidence([4e-4, 4e-4, 4e-6], true))), Verdict::Holds);
-    assert_eq!(r.criterion.verdict(r.kind(), Some(&evidence([4e-4, 0.5, 4e-6], true))), Verdict::Fails);
-    assert_eq!(r.criterion.verdict(r.kind(), Some(&evidence([4e-4, 4e-4, 4e-6], false))), Verdict::Inconclusive);
+    assert_eq!(r.criterion.verdict(r.kind(), Some(&evidence([4e-4, 4e-4, 4e-6, 9e-7], true))), Verdict::Holds);
+    assert_eq!(r.criterion.verdict(r.kind(), Some(&evidence([4e-4, 0.5, 4e-6, 9e-7], true))), Verdict::Fails);
+    assert_eq!(r.criterion.verdict(r.kind(), Some(&evidence([4e-4, 4e-4, 4e-6, 0.5], true))), Verdict::Fails, "Hertz's reliability counts");
+    assert_eq!(r.criterion.verdict(r.kind(), Some(&evidence([4e-4, 4e-4, 4e-6, 9e-7], false))), Verdict::Inconclusive);
 }

@@ -316,6 +316,48 @@ fn manifest_tolerances_are_the_measured_round_off_times_the_margin() {
     }
 }
 
+/// `drift --merge` (`make roundoff STUDIES=...`): the measured studies' entries, rows and
+/// changes replace theirs in the stored report, every other study's are kept as written, byte
+/// for byte and in their order, and the merged file reads back as a report.
+#[test]
+fn a_round_off_report_merged_in_replaces_only_the_studies_it_measured() {
+    use signorini::study::drift::DriftReport;
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/roundoff/nested-dissection-2-threads.json");
+    let text = std::fs::read_to_string(file).unwrap();
+    let (older, raw): (DriftReport, serde_json::Value) = (serde_json::from_str(&text).unwrap(), serde_json::from_str(&text).unwrap());
+    let all = older.checked();
+    assert!(all.len() >= 10 && all.iter().any(|s| s == "hertz"), "{all:?}");
+    // a fresh measurement of hertz alone, every change of it doubled
+    let mut fresh = older.clone();
+    fresh.studies.retain(|s| s["study"] == "hertz");
+    fresh.rows.retain(|r| r.study == "hertz");
+    fresh.changes.retain(|s, _| s == "hertz");
+    for c in fresh.changes.get_mut("hertz").unwrap().values_mut() {
+        c.max_rel = 2.0 * c.max_rel + 1e-30;
+    }
+    fresh.date = "later".into();
+    let merged = fresh.merged_into(raw.clone()).unwrap();
+    let entries = |v: &serde_json::Value| v["studies"].as_array().unwrap().clone();
+    let names: Vec<String> = entries(&merged).iter().map(|s| s["study"].as_str().unwrap().to_string()).collect();
+    assert_eq!(names, all, "every study once, in the stored order");
+    assert_eq!(merged["date"], raw["date"], "the top-level fields stay the stored report's");
+    for (i, s) in all.iter().enumerate() {
+        if s == "hertz" {
+            assert_eq!(merged["changes"][s], serde_json::to_value(&fresh.changes[s]).unwrap());
+            assert_eq!(entries(&merged)[i]["date"], "later", "a merged study's entry carries its date");
+        } else {
+            assert_eq!(merged["changes"][s].to_string(), raw["changes"][s].to_string(), "{s}: kept as written");
+            assert_eq!(entries(&merged)[i].to_string(), entries(&raw)[i].to_string(), "{s}: its entry kept as written");
+        }
+    }
+    let rows = |v: &serde_json::Value, hertz: bool| {
+        v["rows"].as_array().unwrap().iter().filter(|r| (r["study"] == "hertz") == hertz).cloned().collect::<Vec<_>>()
+    };
+    assert_eq!(rows(&merged, false), rows(&raw, false), "the other studies' rows kept");
+    assert_eq!(rows(&merged, true).len(), fresh.rows.len());
+    serde_json::from_value::<DriftReport>(merged).unwrap();
+}
+
 /// roundoff_floor passes a factor 5 (another ordering moves it by up to 79%) and is drift at a
 /// factor 20, on every level, floors of the tiny first meshes included.
 #[test]

@@ -264,6 +264,11 @@ fn full_results(results: &Path) {
         "ex72_large",
         &[ex72("adaptive", Adaptive), without(ex72("without_full_contact", Adaptive)), ex72("uniform", Uniform)],
     );
+    write_study(
+        results,
+        "ex72_rollers",
+        &[ex72("adaptive", Adaptive), without(ex72("without_full_contact", Adaptive)), ex72("uniform", Uniform)],
+    );
 }
 
 /// The hertz study: one run of the repository's Hertz problem file (found through the provenance's

@@ -50,13 +50,14 @@ fn tracked_state() -> Vec<(PathBuf, String)> {
     out
 }
 
-/// The declared study `hertz` rerun from experiments/hertz.toml into a scratch folder, once
-/// (its manifest, problem file and mesh stay where they are: nothing is copied).
-fn hertz_rerun() -> &'static PathBuf {
+/// The declared study `ex71` (no reference solution: the shortest to rerun) rerun from
+/// experiments/ex71.toml into a scratch folder, once (its manifest stays where it is: nothing is
+/// copied).
+fn ex71_rerun() -> &'static PathBuf {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = tmp("hertz");
-        let (code, _, err) = signorini_in(repo(), &["run", "experiments/hertz.toml", "--results", dir.to_str().unwrap()]);
+        let dir = tmp("ex71");
+        let (code, _, err) = signorini_in(repo(), &["run", "experiments/ex71.toml", "--results", dir.to_str().unwrap()]);
         assert_eq!(code, 0, "{err}");
         dir
     })
@@ -65,7 +66,7 @@ fn hertz_rerun() -> &'static PathBuf {
 /// A copy of the rerun for one test (tests run concurrently and write into their folder).
 fn scratch_copy(name: &str) -> PathBuf {
     let dir = tmp(name);
-    copy_dir(&hertz_rerun().join("hertz"), &dir.join("hertz"));
+    copy_dir(&ex71_rerun().join("ex71"), &dir.join("ex71"));
     dir
 }
 
@@ -78,14 +79,18 @@ fn drift_against_a_one_study_folder_compares_that_study_and_names_the_others() {
     let d = dir.display();
     assert!(out.contains(&format!("drift: none (1 study of {d} compared with results at every level")), "{out}");
     assert!(
-        out.contains(&format!("not compared (not in {d}): c0_sweep, contact_term_ablation, deep, estimator_repair, ex71, ex72")),
+        out.contains(&format!("not compared (not in {d}): c0_sweep, contact_term_ablation, deep, estimator_repair, ex72, ex72_large")),
         "{out}"
     );
     assert!(!out.contains("--accept") && !err.contains("--accept"), "{out}{err}");
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("drift-report.json")).unwrap()).unwrap();
     assert_eq!(report["studies"].as_array().unwrap().len(), 1, "{report}");
-    assert_eq!(report["studies"][0]["study"], "hertz");
-    assert_eq!(report["not_compared"].as_array().unwrap().len(), 10, "{report}");
+    assert_eq!(report["studies"][0]["study"], "ex71");
+    let declared = std::fs::read_dir(repo().join("experiments"))
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "toml"))
+        .count();
+    assert_eq!(report["not_compared"].as_array().unwrap().len(), declared - 1, "{report}");
     assert!(report["rows"].as_array().unwrap().is_empty());
     assert_eq!(tracked_state(), before, "drift --against changed results/, figures/ or target/drift/");
 }
@@ -94,23 +99,24 @@ fn drift_against_a_one_study_folder_compares_that_study_and_names_the_others() {
 fn figures_of_one_study_are_drawn_into_its_scratch_folder_only() {
     let dir = scratch_copy("figures");
     let before = tracked_state();
-    let (code, out, err) = signorini_in(repo(), &["figures", "--results", dir.to_str().unwrap(), "--study", "hertz"]);
+    let (code, out, err) = signorini_in(repo(), &["figures", "--results", dir.to_str().unwrap(), "--study", "ex71"]);
     assert_eq!(code, 0, "{out}{err}");
     let mut top: Vec<String> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     top.sort();
-    assert_eq!(top, ["CLAIMS.md", "figures", "hertz"]);
+    assert_eq!(top, ["CLAIMS.md", "ex71", "figures"]);
     let mut figs: Vec<String> =
         std::fs::read_dir(dir.join("figures")).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     figs.sort();
-    assert_eq!(figs, ["hertz_mesh.png", "hertz_mesh.svg", "hertz_pressure.png", "hertz_pressure.svg"]);
+    assert_eq!(figs, ["fig2a.png", "fig2a.svg", "fig2b.png", "fig2b.svg", "fig4a.png", "fig4a.svg"]);
     let claims = std::fs::read_to_string(dir.join("CLAIMS.md")).unwrap();
     assert!(claims.contains(&format!("from the records in `{}/`", dir.display())), "{claims}");
-    let hertz = claims.lines().find(|l| l.starts_with("| [**hertz**]")).unwrap();
-    assert!(hertz.ends_with("| holds (beyond the paper) |"), "{hertz}");
+    // the row of the study it holds, judged on its runs (the deep study is not in the folder)
+    let rate = claims.lines().find(|l| l.starts_with("| [**7.1-error-rate**]")).unwrap();
+    assert!(rate.contains("ex71/adaptive") && !rate.contains("| no data |"), "{rate}");
     assert!(out.contains(&format!("wrote {}", dir.join("CLAIMS.md").display())), "{out}");
     assert_eq!(tracked_state(), before, "figures --results DIR changed results/, figures/ or target/drift/");
     // a study the folder does not hold is an error whose advice writes into that folder
-    let (code, _, err) = signorini_in(repo(), &["figures", "--results", dir.to_str().unwrap(), "--study", "ex71"]);
+    let (code, _, err) = signorini_in(repo(), &["figures", "--results", dir.to_str().unwrap(), "--study", "hertz"]);
     assert_eq!(code, 1);
     assert!(err.contains("does not hold it") && err.contains(&format!("--results {}", dir.display())), "{err}");
 }

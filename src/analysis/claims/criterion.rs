@@ -88,6 +88,12 @@ pub enum Criterion {
     Rate { what: String, claim: f64, abscissa: Abscissa },
     /// The trend of `what` is bounded: [`verdict::judge_trend`].
     Bounded { what: String },
+    /// The trend of `what` does not grow: bounded or falling ([`verdict::judge_trend`]), as an
+    /// upper bound (an efficiency up to a factor) claims.
+    NotGrowing { what: String },
+    /// `what` decays faster than NDF^-than beyond its interval (a rate against a limit, not a
+    /// band): fitted against `abscissa`, the limit converted to it as for [`Criterion::Rate`].
+    FasterThan { what: String, than: f64, abscissa: Abscissa },
     /// `what` decays at all: the 95% interval of its rate in NDF above 0 (an interval reaching 0
     /// over two decades shows no decay: it fails).
     Decays { what: String },
@@ -162,6 +168,23 @@ impl Criterion {
                 Trend::Growing | Trend::Falling => Outcome::Fail,
                 Trend::Inconclusive | Trend::Short => Outcome::Open,
             },
+            (Criterion::NotGrowing { .. }, Evidence::Fit(f)) => match verdict::judge_trend(f) {
+                Trend::Bounded | Trend::Falling => Outcome::Pass,
+                Trend::Growing => Outcome::Fail,
+                Trend::Inconclusive | Trend::Short => Outcome::Open,
+            },
+            (Criterion::FasterThan { than, abscissa, .. }, Evidence::Fit(f)) if f.abscissa == *abscissa => {
+                let limit = f.claim_in_abscissa(*than).0;
+                if !f.spans_enough() {
+                    Outcome::Open
+                } else if f.rate.lo() > limit {
+                    Outcome::Pass
+                } else if f.rate.hi() < limit {
+                    Outcome::Slower
+                } else {
+                    Outcome::Open
+                }
+            }
             (Criterion::Decays { .. }, Evidence::Fit(f)) => {
                 if !f.spans_enough() {
                     Outcome::Open
@@ -254,6 +277,21 @@ impl Criterion {
                 "fails if the 95% interval of the slope of log({what}) against log NDF over the window excludes 0 (growing or falling); not decided if it contains 0 but is wider than {} or the window spans less than {d} decades of NDF",
                 verdict::MAX_WIDTH
             ),
+            Criterion::NotGrowing { what } => format!(
+                "fails if the 95% interval of the slope of log({what}) against log NDF over the window lies above 0 (growing); not decided if it contains 0 but is wider than {} or the window spans less than {d} decades of NDF",
+                verdict::MAX_WIDTH
+            ),
+            Criterion::FasterThan { what, than, abscissa } => {
+                let (limit, var) = match abscissa {
+                    Abscissa::Ndof => (*than, "its rate in NDF (NDF^-rate)".to_string()),
+                    Abscissa::InverseHMin => {
+                        (2.0 * than, format!("its exponent in h_min (h_min^rate; NDF^-{} is h^{})", number(*than), number(2.0 * than)))
+                    }
+                };
+                format!(
+                    "fails if the 95% interval of {what}: {var} over the window lies below {limit:.3} (not faster); not decided if it contains {limit:.3} or the window spans less than {d} decades of NDF"
+                )
+            }
             Criterion::Decays { what } => format!(
                 "fails unless the 95% interval of the rate of {what} in NDF lies above 0 (a decay); not decided if the window spans less than {d} decades of NDF"
             ),
@@ -333,6 +371,29 @@ mod tests {
         assert_eq!(u(0.4, Some(((0.0, 0.1), (5.0, 0.1)))), Outcome::Pass);
         assert_eq!(u(0.4, Some(((5.0, 0.1), (0.0, 0.1)))), Outcome::Fail);
         assert_eq!(u(0.4, Some(((0.0, 0.1), (0.1, 0.1)))), Outcome::Open);
+    }
+
+    #[test]
+    fn faster_than_and_not_growing_fail_as_stated() {
+        let f = Criterion::FasterThan { what: "h_fb".into(), than: 0.5, abscissa: Abscissa::Ndof };
+        assert!(f.fails_if().contains("below 0.500"), "{}", f.fails_if());
+        let j = |s, w, dec| f.judge(Some(&Evidence::Fit(fit(s, w, dec, Abscissa::Ndof))));
+        assert_eq!(j(0.7, 0.1, 2.5), Outcome::Pass);
+        assert_eq!(j(0.3, 0.1, 2.5), Outcome::Slower);
+        assert_eq!(j(0.55, 0.1, 2.5), Outcome::Open, "an interval containing the limit");
+        assert_eq!(j(0.7, 0.1, 1.5), Outcome::Open, "a short window");
+        // in h_min the limit doubles: h^0.711 is NDF^-0.356
+        let h = Criterion::FasterThan { what: "e".into(), than: 0.3556, abscissa: Abscissa::InverseHMin };
+        assert!(h.fails_if().contains("below 0.711"), "{}", h.fails_if());
+        assert_eq!(h.judge(Some(&Evidence::Fit(fit(0.9, 0.05, 2.5, Abscissa::InverseHMin)))), Outcome::Pass);
+        assert_eq!(h.judge(Some(&Evidence::Fit(fit(0.6, 0.05, 2.5, Abscissa::InverseHMin)))), Outcome::Slower);
+        assert_eq!(h.judge(Some(&Evidence::Fit(fit(0.9, 0.05, 2.5, Abscissa::Ndof)))), Outcome::Open, "another variable");
+        let g = Criterion::NotGrowing { what: "e".into() };
+        assert!(g.fails_if().contains("lies above 0"), "{}", g.fails_if());
+        assert_eq!(g.judge(Some(&Evidence::Fit(fit(0.2, 0.04, 2.5, Abscissa::Ndof)))), Outcome::Fail);
+        assert_eq!(g.judge(Some(&Evidence::Fit(fit(-0.2, 0.04, 2.5, Abscissa::Ndof)))), Outcome::Pass, "falling");
+        assert_eq!(g.judge(Some(&Evidence::Fit(fit(0.0, 0.04, 2.5, Abscissa::Ndof)))), Outcome::Pass);
+        assert_eq!(g.judge(Some(&Evidence::Fit(fit(0.0, 0.04, 1.5, Abscissa::Ndof)))), Outcome::Open, "a short window");
     }
 
     #[test]

@@ -24,8 +24,8 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let wfc = ctx.pick(&ct, "ex72_without_full_contact");
     let aw = run(&ct, "ex72_as_written");
     let errors = Errors::of(&large).unwrap_or(Errors { study: "ex72", adaptive: a72, without_full_contact: None, uniform: u72 });
-    out.push(rates(ctx, errors.adaptive));
-    out.push(error(ctx, &errors, aw, wfc));
+    out.push(rates(ctx, errors.adaptive, Labels { id: "7.2-rates", topic: "Ex. 7.2: estimator rates" }));
+    out.push(error(ctx, &errors, aw, wfc, Labels { id: "7.2-error (beyond the paper)", topic: "Ex. 7.2: true error" }));
     out.push(corners(ctx, a72, &errors));
     out.push(away(ctx, &errors));
     out.push(eta6_eta7(a72));
@@ -36,12 +36,20 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 /// The runs the true-error rows (and the estimator's rates) fit: the deep study `ex72_large`
 /// (reference of at least 4e6 unknowns, runs to about 1e6) where it holds errors, else `ex72`
 /// (reference 2.5e5).
-struct Errors<'a> {
-    study: &'static str,
-    adaptive: Option<&'a RunRecord>,
-    /// eta_5 without full-contact nodes (only in `ex72_large`)
-    without_full_contact: Option<&'a RunRecord>,
-    uniform: Option<&'a RunRecord>,
+pub(super) struct Errors<'a> {
+    pub(super) study: &'static str,
+    pub(super) adaptive: Option<&'a RunRecord>,
+    /// eta_5 without full-contact nodes (only in `ex72_large` and `ex72_rollers`)
+    pub(super) without_full_contact: Option<&'a RunRecord>,
+    pub(super) uniform: Option<&'a RunRecord>,
+}
+
+/// The id and summary topic of a row written for more than one study (Example 7.2 clamped and
+/// on rollers).
+#[derive(Clone, Copy)]
+pub(super) struct Labels {
+    pub(super) id: &'static str,
+    pub(super) topic: &'static str,
 }
 
 impl<'a> Errors<'a> {
@@ -66,7 +74,7 @@ impl<'a> Errors<'a> {
 }
 
 /// Row of Example 7.2: the estimator and its terms against NDF^(-3/2) (Fig. 3a, 4b).
-fn rates(ctx: &Ctx, a72: Option<&RunRecord>) -> Claim {
+pub(super) fn rates(ctx: &Ctx, a72: Option<&RunRecord>, labels: Labels) -> Claim {
     let names = ["eta_h", "eta1", "eta2", "eta3", "eta4", "eta5", "eta6", "eta7"];
     let reps: Vec<Option<RateReport>> = names.iter().map(|n| ctx.rate(a72, Q::Field(n))).collect();
     let test = Criterion::Each {
@@ -76,9 +84,9 @@ fn rates(ctx: &Ctx, a72: Option<&RunRecord>) -> Claim {
     let ev = a72.map(|_| Evidence::All(reps.iter().map(|r| Evidence::rate(r.as_ref())).collect()));
     Claim {
         fragile: None,
-        id: "7.2-rates",
+        id: labels.id,
         summary: Summary {
-            topic: "Ex. 7.2: estimator rates",
+            topic: labels.topic,
             paper: "eta_h and eta_1..eta_7 at NDF^-1.5 (Fig. 3a, 4b)",
             headline: format!(
                 "{}; {}",
@@ -105,7 +113,7 @@ fn rates(ctx: &Ctx, a72: Option<&RunRecord>) -> Claim {
 }
 
 /// Row of Example 7.2: the true error against the reference, and eta_5 as written against without full-contact nodes.
-fn error(ctx: &Ctx, errors: &Errors, aw: Option<&RunRecord>, wfc: Option<&RunRecord>) -> Claim {
+pub(super) fn error(ctx: &Ctx, errors: &Errors, aw: Option<&RunRecord>, wfc: Option<&RunRecord>, labels: Labels) -> Claim {
     // the true error against the reference, whose own error is estimated from the measured rate
     let a72 = errors.adaptive;
     let err = ctx.rate(a72, Q::Error);
@@ -141,8 +149,8 @@ fn error(ctx: &Ctx, errors: &Errors, aw: Option<&RunRecord>, wfc: Option<&RunRec
     let reported = Criterion::Reported { why: "the paper does not measure Example 7.2's error".into() };
     Claim {
         fragile: None,
-        id: "7.2-error (beyond the paper)",
-        summary: Summary { topic: "Ex. 7.2: true error", paper: "not measured in the paper", headline: rate_headline("", err.as_ref(), a72) },
+        id: labels.id,
+        summary: Summary { topic: labels.topic, paper: "not measured in the paper", headline: rate_headline("", err.as_ref(), a72) },
         claim: "Ex. 7.2 (not in the paper): the true error against a finer reference solution, and the efficiency index".into(),
         measured: a72
             .map(|_| {
@@ -158,7 +166,8 @@ fn error(ctx: &Ctx, errors: &Errors, aw: Option<&RunRecord>, wfc: Option<&RunRec
                     growth_text("efficiency", ctx.growth(a72, Q::Efficiency).as_ref()),
                     same.map(|(rel, ndf, n)| {
                         format!(
-                            "eta_5 as written vs without full-contact nodes (contact_term_ablation): errors differ by at most {rel:.1e} (relative) at levels 8–{} while the NDF differ by up to {ndf:.2}x{}",
+                            "eta_5 as written vs without full-contact nodes ({}): errors differ by at most {rel:.1e} (relative) at levels 8–{} while the NDF differ by up to {ndf:.2}x{}",
+                            source(aw).split('/').next().unwrap_or_default(),
                             n - 1,
                             if rel < 1e-3 && ndf > 1.2 { ": the error does not see the contact refinement (next rows)" } else { "" }
                         )
