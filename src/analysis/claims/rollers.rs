@@ -10,8 +10,8 @@ use super::ex72::{Errors, Labels, error, rates};
 use super::{
     Claim, Criterion, Ctx, EX72_NU, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, growth_text, rate_headline, rate_text, run, source,
 };
+use crate::analysis::verdict::{self, Abscissa, RateReport};
 use crate::records::{RunRecord, StudyDir};
-use crate::verdict::{self, Abscissa, RateReport};
 
 /// The study.
 const STUDY: &str = "ex72_rollers";
