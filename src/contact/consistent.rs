@@ -111,39 +111,56 @@ fn points(mesh: &Mesh) -> Vec<([f64; 2], f64)> {
         .collect()
 }
 
-/// The first contradicting sample of each list (by key, then point), with how many contradict.
+/// The first contradicting sample of a list (by point), with how many contradict.
 fn first_contradiction(samples: &[Sample]) -> Option<(&Sample, usize)> {
     let scale = samples.iter().flat_map(|s| [s.declared.abs(), s.fine.abs()]).filter(|v| v.is_finite()).fold(0.0, f64::max);
     let bad: Vec<&Sample> = samples.iter().filter(|s| s.contradicts(scale)).collect();
     bad.first().map(|s| (*s, bad.len()))
 }
 
+/// What a problem states (`declared`) against a difference quotient (`differenced` at a point
+/// with a step) at every sampled point: the first contradiction, if any.
+struct Mismatch {
+    at: [f64; 2],
+    declared: f64,
+    differenced: f64,
+    step: f64,
+    spread: f64,
+    count: usize,
+}
+
+fn compare(pts: &[([f64; 2], f64)], declared: &dyn Fn([f64; 2]) -> f64, differenced: &dyn Fn([f64; 2], f64) -> f64) -> Option<Mismatch> {
+    let samples: Vec<Sample> = pts
+        .iter()
+        .map(|&(at, s)| Sample { at, declared: declared(at), coarse: differenced(at, s), fine: differenced(at, s / 2.0), step: s })
+        .collect();
+    first_contradiction(&samples).map(|(s, count)| Mismatch {
+        at: s.at,
+        declared: s.declared,
+        differenced: s.fine,
+        step: s.step,
+        spread: (s.coarse - s.fine).abs(),
+        count,
+    })
+}
+
 /// Check `problem`'s exact solution, if it has one, on `mesh` (see the module docs).
 pub fn check_exact(problem: &dyn Problem, mesh: &Mesh) -> Result<(), ExactError> {
     let Some(exact) = problem.exact() else { return Ok(()) };
-    let name = match problem.source() {
+    let problem_name = || match problem.source() {
         Some(file) => format!("problem file {}", file.display()),
         None => format!("problem {}", problem.name()),
     };
     let pts = points(mesh);
+    let sampled = pts.len();
     for i in 0..2 {
         for j in 0..2 {
             let u = |x: [f64; 2]| exact.u(x)[i];
-            let samples: Vec<Sample> = pts
-                .iter()
-                .map(|&(at, s)| Sample {
-                    at,
-                    declared: exact.grad(at)[i][j],
-                    coarse: central(&u, at, j, s),
-                    fine: central(&u, at, j, s / 2.0),
-                    step: s,
-                })
-                .collect();
-            if let Some((s, count)) = first_contradiction(&samples) {
-                let (declared, differenced, step, spread) = (s.declared, s.fine, s.step, (s.coarse - s.fine).abs());
+            if let Some(m) = compare(&pts, &|at| exact.grad(at)[i][j], &|at, s| central(&u, at, j, s)) {
+                let Mismatch { at, declared, differenced, step, spread, count } = m;
                 return Err(ExactError::Gradient {
-                    problem: name,
-                    at: s.at,
+                    problem: problem_name(),
+                    at,
                     i,
                     j,
                     declared,
@@ -151,7 +168,7 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh) -> Result<(), ExactError>
                     step,
                     spread,
                     count,
-                    sampled: pts.len(),
+                    sampled,
                 });
             }
         }
@@ -169,29 +186,9 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh) -> Result<(), ExactError>
                 .sum();
             -div
         };
-        let samples: Vec<Sample> = pts
-            .iter()
-            .map(|&(at, s)| Sample {
-                at,
-                declared: problem.body_force(at)[i],
-                coarse: minus_div(at, s),
-                fine: minus_div(at, s / 2.0),
-                step: s,
-            })
-            .collect();
-        if let Some((s, count)) = first_contradiction(&samples) {
-            let (declared, differenced, step, spread) = (s.declared, s.fine, s.step, (s.coarse - s.fine).abs());
-            return Err(ExactError::BodyForce {
-                problem: name,
-                at: s.at,
-                i,
-                declared,
-                differenced,
-                step,
-                spread,
-                count,
-                sampled: pts.len(),
-            });
+        if let Some(m) = compare(&pts, &|at| problem.body_force(at)[i], &minus_div) {
+            let Mismatch { at, declared, differenced, step, spread, count } = m;
+            return Err(ExactError::BodyForce { problem: problem_name(), at, i, declared, differenced, step, spread, count, sampled });
         }
     }
     Ok(())
