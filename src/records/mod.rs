@@ -416,15 +416,10 @@ impl StudyDir {
         serde_json::from_str(&text).map_err(RecordError::parse(f))
     }
 
-    /// Rewrite `levels.csv` from the run records: columns `run`, `problem`, `refine`, `theta`,
-    /// `contact_term`, `log_factor`, `sampling`, then every `LevelRecord` field in its order.
-    /// (The csv crate cannot serialise flattened structs, so rows go through serde_json values,
-    /// whose maps keep field order.)
-    pub fn write_csv(&self, runs: &[RunRecord]) -> std::io::Result<()> {
-        write_atomic(&self.csv_file(), &self.csv_bytes(runs)?)
-    }
-
-    /// The bytes of `levels.csv` for these runs (what [`StudyDir::write_csv`] writes).
+    /// The bytes of `levels.csv` for these runs (written by the study's store): columns `run`,
+    /// `problem`, `refine`, `theta`, `contact_term`, `log_factor`, `sampling`, then every
+    /// `LevelRecord` field in its order. (The csv crate cannot serialise flattened structs, so
+    /// rows go through serde_json values, whose maps keep field order.)
     pub fn csv_bytes(&self, runs: &[RunRecord]) -> std::io::Result<Vec<u8>> {
         let mut w = csv::Writer::from_writer(Vec::new());
         let mut header_written = false;
@@ -493,8 +488,7 @@ mod tests {
             reference_ndof: None,
             history: None,
         };
-        study.write_csv(&[run]).unwrap();
-        let text = std::fs::read_to_string(study.csv_file()).unwrap();
+        let text = String::from_utf8(study.csv_bytes(&[run]).unwrap()).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines.len(), 3);
         assert!(lines[0].starts_with("run,problem,refine,theta,contact_term,log_factor,sampling,level,ndof"), "{}", lines[0]);

@@ -33,7 +33,8 @@
 
 use super::manifest::DERIVED;
 use super::manifest::{DriftSpec, Manifest, Tolerance};
-use crate::records::{LevelRecord, RunRecord, StudyDir};
+use super::store::Store;
+use crate::records::{LevelRecord, RunRecord};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -385,7 +386,7 @@ fn first_history_difference(s: &crate::records::History, f: &crate::records::His
 /// NDF. Rows under run `reference KEY`. (Without `--deep` the fresh side is the stored one
 /// rebuilt in one solve, its meshes checked by their fingerprints on the way, so only a missing
 /// file shows here; `--deep` computes it by the adaptive loop and compares every level.)
-fn compare_references(study: &str, stored: &StudyDir, fresh: &StudyDir, runs: &[RunRecord]) -> Vec<DriftRow> {
+fn compare_references(study: &str, stored: &Store, fresh: &Store, runs: &[RunRecord]) -> Vec<DriftRow> {
     let mut out = Vec::new();
     let keys: std::collections::BTreeSet<String> = runs.iter().filter_map(|r| crate::records::ReferenceRecord::key_of(&r.run)).collect();
     let describe = |r: &Option<crate::records::ReferenceRecord>| {
@@ -393,7 +394,7 @@ fn compare_references(study: &str, stored: &StudyDir, fresh: &StudyDir, runs: &[
     };
     for key in keys {
         let label = format!("reference {key}");
-        let (s, f) = (stored.read_reference(&key).ok().flatten(), fresh.read_reference(&key).ok().flatten());
+        let (s, f) = (stored.reference(&key).ok().flatten(), fresh.reference(&key).ok().flatten());
         match (&s, &f) {
             (Some(a), Some(b)) => {
                 if let Some((level, field, sv, fv)) = first_history_difference(&a.rebuild.history, &b.rebuild.history) {
@@ -481,16 +482,17 @@ pub fn table(rows: &[DriftRow]) -> String {
 use super::store::first_difference;
 
 /// The views of a study's stored records, checked against what the records render
-/// ([`super::store::summary_faults`]): `levels.csv` byte for byte and `provenance.json`'s list of
-/// runs. A hand edit, a bad merge or a study interrupted before its summaries were rewritten is
-/// drift.
-pub fn check_derived(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<DriftRow> {
-    super::store::summary_faults(dir, study, runs).iter().map(|f| fault_row(dir, study, f)).collect()
+/// ([`super::store::check::summary_faults`]): `levels.csv` byte for byte and `provenance.json`'s
+/// list of runs. A hand edit, a bad merge or a study interrupted before its summaries were
+/// rewritten is drift.
+pub fn check_derived(store: &Store, runs: &[RunRecord]) -> Vec<DriftRow> {
+    super::store::check::summary_faults(store.dir(), store.study(), runs).iter().map(|f| fault_row(store, f)).collect()
 }
 
 /// A fault of the stored folder ([`super::store::Store::check`]) as a row of drift: the file
 /// (relative to the study folder) and what is wrong with it.
-fn fault_row(dir: &StudyDir, study: &str, f: &super::store::Fault) -> DriftRow {
+fn fault_row(store: &Store, f: &super::store::Fault) -> DriftRow {
+    let (study, dir) = (store.study(), store.dir());
     let file = f.file.strip_prefix(&dir.root).unwrap_or(&f.file).display().to_string();
     let field = if f.record.is_some() { "store".to_string() } else { file.clone() };
     row(
@@ -638,9 +640,9 @@ pub fn select_against(dir: &Path, manifests: &[Manifest], named: bool) -> anyhow
 /// The provenance of a study in `fresh` against the stored one: the manifest, problem files and
 /// meshes the runs were made with (by hash). Records made from an edited manifest or problem
 /// file differ even where every number agrees.
-pub fn compare_provenance(study: &str, stored: &StudyDir, fresh: &StudyDir) -> Vec<DriftRow> {
+pub fn compare_provenance(study: &str, stored: &Store, fresh: &Store) -> Vec<DriftRow> {
     use super::provenance::Provenance;
-    let read = |d: &StudyDir| std::fs::read_to_string(d.provenance_file()).ok().and_then(|t| serde_json::from_str::<Provenance>(&t).ok());
+    let read = |d: &Store| d.provenance().ok();
     let tol = "exact (what the runs were made with)";
     let (Some(s), Some(f)) = (read(stored), read(fresh)) else {
         // a stored provenance that cannot be read is drift of the store already (check_derived)
@@ -651,7 +653,7 @@ pub fn compare_provenance(study: &str, stored: &StudyDir, fresh: &StudyDir) -> V
                 None,
                 "provenance.json",
                 "present".into(),
-                format!("(missing or unreadable: {})", fresh.provenance_file().display()),
+                format!("(missing or unreadable: {})", fresh.dir().provenance_file().display()),
                 None,
                 tol.into(),
             )],
@@ -733,7 +735,7 @@ pub fn check(
             None => {
                 if !opts.deep {
                     // a stored reference replayed in one solve; --deep computes it anew
-                    super::preload_references(m, &StudyDir::new(&opts.results, &m.study), opts.progress)?;
+                    super::preload_references(m, &Store::new(&opts.results, &m.study), opts.progress)?;
                 }
                 let options = super::RunOptions {
                     quick,
@@ -748,28 +750,28 @@ pub fn check(
                 opts.scratch.clone()
             }
         };
-        let stored_store = super::store::Store::new(&opts.results, &m.study);
-        let stored_dir = stored_store.dir.clone();
+        let stored_store = Store::new(&opts.results, &m.study);
+        let fresh_store = Store::new(&fresh_root, &m.study);
         let checked = stored_store.check().with_context(|| format!("reading the stored runs of {}", m.study))?;
         stored_store.note_leftovers(&checked.leftovers);
         let stored = checked.runs;
         let fresh = match &opts.against {
             // another folder's records are read through the same check; a fault there is an error
-            Some(_) => super::store::Store::new(&fresh_root, &m.study)
+            Some(_) => fresh_store
                 .read()
                 .with_context(|| format!("--against {}: the study {}", fresh_root.display(), m.study))?,
-            None => StudyDir::new(&fresh_root, &m.study)
-                .read_runs()
+            None => fresh_store
+                .records()
                 .with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?,
         };
         let mut c = compare(m, &stored, &fresh, quick);
         if quick && !opts.quick && opts.against.is_none() {
             replay_tier(m, &stored, opts.progress, &mut c)?;
         }
-        c.rows.extend(checked.faults.iter().map(|f| fault_row(&stored_dir, &m.study, f)));
-        c.rows.extend(compare_references(&m.study, &stored_dir, &StudyDir::new(&fresh_root, &m.study), &stored));
+        c.rows.extend(checked.faults.iter().map(|f| fault_row(&stored_store, f)));
+        c.rows.extend(compare_references(&m.study, &stored_store, &fresh_store, &stored));
         if opts.against.is_some() {
-            c.rows.extend(compare_provenance(&m.study, &stored_dir, &StudyDir::new(&fresh_root, &m.study)));
+            c.rows.extend(compare_provenance(&m.study, &stored_store, &fresh_store));
         }
         if opts.progress {
             crate::base::note::line(format_args!(

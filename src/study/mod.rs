@@ -12,25 +12,21 @@
 //! what a killed process leaves is removed by the next run; a run that executes nothing changes
 //! no file; a stored run whose spec differs from the manifest's is replaced only when asked
 //! (`replace`). `--fresh` with `--shard K/N` removes only shard K's runs; the study lock
-//! ([`StudyLock`], held while shared files change) and one lock per run (held while it is
-//! computed) let shards of one study compute side by side while no run is computed twice;
+//! ([`store::Store::lock`], held while shared files change) and one lock per run (held while it
+//! is computed) let shards of one study compute side by side while no run is computed twice;
 //! an interrupt stops after the current level and keeps every finished run ([`Interrupted`]).
 
-pub mod checkpoint;
 pub mod drift;
-mod lock;
 pub mod manifest;
 pub mod progress;
 pub mod provenance;
 pub mod reference;
 pub mod store;
 
-pub use lock::StudyLock;
-
 use crate::adapt::{self, AdaptConfig, Level};
 use crate::mesh::MeshSpec;
 use crate::problems;
-use crate::records::{Batch, MeshSnapshot, RunRecord, RunSpec, StudyDir};
+use crate::records::{Batch, MeshSnapshot, RunRecord, RunSpec};
 use anyhow::{Context, Result, bail};
 use manifest::Manifest;
 use progress::Progress;
@@ -38,6 +34,7 @@ use reference::ReferenceField;
 use std::collections::HashMap;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
+use store::{RunWriter, Store};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -119,9 +116,9 @@ pub fn effective_spec(planned: &manifest::PlannedRun, quick: bool) -> RunSpec {
 }
 
 /// Run a study; returns the ids of the runs executed (not resumed). Holds the study's lock
-/// throughout. First removes what an unfinished run left ([`store::remove_orphans`]) and refuses
-/// stale stored runs unless `replace` ([`store::refusal`]); every finished run is then stored
-/// together with the summaries listing it ([`store::commit_run`]). On an interrupt
+/// throughout. First removes what an unfinished run left ([`store::Writer::remove_orphans`]) and
+/// refuses stale stored runs unless `replace` ([`store::stale::refusal`]); every finished run is
+/// then stored together with the summaries listing it ([`store::Writer::commit_run`]). On an interrupt
 /// ([`interrupt`]) the run in progress is dropped and an [`Interrupted`] error says what was kept.
 ///
 /// ```rust
@@ -151,19 +148,19 @@ pub fn effective_spec(planned: &manifest::PlannedRun, quick: bool) -> RunSpec {
 /// std::fs::remove_dir_all(&results).unwrap();
 /// ```
 pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> {
-    let dir = StudyDir::new(&opts.results, &manifest.study);
+    let store = Store::new(&opts.results, &manifest.study);
     let in_shard = |i: usize| opts.shard.is_none_or(|(k, n)| i % n == k - 1);
     let planned: Vec<RunSpec> =
         manifest.runs.iter().enumerate().filter(|(i, _)| in_shard(*i)).map(|(_, p)| effective_spec(p, opts.quick)).collect();
-    set_up(manifest, &dir, &planned, opts)?;
-    run_planned(manifest, &dir, &planned, opts).map_err(|e| {
+    set_up(manifest, &store, &planned, opts)?;
+    run_planned(manifest, &store, &planned, opts).map_err(|e| {
         if e.downcast_ref::<Interrupted>().is_some() {
             return e;
         }
         // a removal or rename may have failed part-way: leave the folder consistent
-        match StudyLock::acquire(&dir, true).and_then(|_lock| store::repair(manifest, &dir, opts.quick)) {
+        match store.lock(true).and_then(|w| w.repair(manifest, opts.quick)) {
             Ok(()) => e,
-            Err(r) => e.context(format!("and bringing {} in line with its runs failed too: {r:#}", dir.root.display())),
+            Err(r) => e.context(format!("and bringing {} in line with its runs failed too: {r:#}", store.dir().root.display())),
         }
     })
 }
@@ -171,115 +168,52 @@ pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> 
 /// Under the study lock: `--fresh`, the orphans of unfinished runs removed, stored runs whose
 /// spec differs refused (or with `--replace` undeclared ones removed), the summaries in line
 /// with the runs stored.
-fn set_up(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &RunOptions) -> Result<()> {
-    let (_lock, _run_locks) =
-        if opts.fresh { hold_every_run(manifest, dir, planned, opts)? } else { (StudyLock::acquire(dir, opts.wait_for_lock)?, Vec::new()) };
-    if opts.fresh {
-        start_over(dir, opts.shard.is_some(), planned)?;
-    }
-    let checked = store::Store { dir: dir.clone(), study: manifest.study.clone() }.check()?;
+fn set_up(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &RunOptions) -> Result<()> {
+    let declared: Vec<String> = manifest.runs.iter().map(|p| p.spec.id.clone()).collect();
+    let (writer, _held) = if opts.fresh {
+        let shard: Option<Vec<String>> = opts.shard.map(|_| planned.iter().map(|s| s.id.clone()).collect());
+        let (writer, held) = store.lock_every_run(shard.as_deref(), &declared, opts.wait_for_lock)?;
+        // with a shard only its runs (the other shards' are someone else's); without, the whole
+        // study, also runs no longer declared
+        writer.start_over(&held, opts.shard.is_none())?;
+        (writer, held)
+    } else {
+        (store.lock(opts.wait_for_lock)?, Vec::new())
+    };
+    let checked = store.check()?;
     let mut runs = checked.runs;
-    store::remove_orphans(&manifest.study, dir, &runs)?;
-    let mut stale = store::damaged(&checked.faults);
-    stale.extend(store::stale_runs(manifest, &runs, planned));
+    writer.remove_orphans(&runs)?;
+    let mut stale = store::stale::damaged(&checked.faults);
+    stale.extend(store::stale::stale_runs(manifest, &runs, planned));
     if !stale.is_empty() && !opts.replace && !opts.fresh {
-        return Err(store::refusal(manifest, dir, &stale));
+        return Err(store::stale::refusal(manifest, store.dir(), &stale));
     }
     for s in &stale {
-        match s {
-            store::Stale::Undeclared { id } => {
-                crate::base::note::line(format_args!(
-                    "{}/{id}: removing the stored run, not declared in {}",
-                    manifest.study,
-                    manifest.file.display()
-                ));
-                store::remove_run(dir, id)?;
-            }
-            store::Stale::Damaged { file, what } => {
-                crate::base::note::line(format_args!(
-                    "{}/{file}: removing the damaged record and its snapshots ({})",
-                    manifest.study,
-                    what.join("; ")
-                ));
-                store::remove_run(dir, file)?;
-                runs = store::read_runs(dir)?;
-            }
-            store::Stale::Differs { .. } => {}
-        }
-    }
-    runs.retain(|r| manifest.runs.iter().any(|p| p.spec.id == r.run.id));
-    store::sync_summaries(manifest, dir, &runs, opts.quick)
-}
-
-/// `--fresh`: the lock of every run this invocation would remove (any run of the study, or with
-/// a shard only its runs), then the study lock, so that no file of a run another process
-/// computes is removed. The run locks are taken one by one without the study lock (the owner of
-/// one takes the study lock to store its run); a run that started meanwhile is found under the
-/// study lock, and then everything is let go and taken again. Held by another process: refused
-/// naming it, or with `--wait` waited for.
-fn hold_every_run(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &RunOptions) -> Result<(StudyLock, Vec<lock::Lock>)> {
-    if !opts.wait_for_lock {
-        // refused at once if another process sets up or stores (taking the run locks below
-        // waits for the study lock briefly, as every run does)
-        drop(StudyLock::acquire(dir, false)?);
-    }
-    loop {
-        let ids = if opts.shard.is_some() {
-            planned.iter().map(|s| s.id.clone()).collect()
-        } else {
-            lock::runs_of(dir, manifest.runs.iter().map(|p| p.spec.id.clone()))
+        let (id, why) = match s {
+            store::Stale::Undeclared { id } => (id, format!("not declared in {}", manifest.file.display())),
+            store::Stale::Damaged { file, what } => (file, format!("a damaged record: {}", what.join("; "))),
+            store::Stale::Differs { .. } => continue,
         };
-        let mut held = Vec::new();
-        for id in &ids {
-            held.push(
-                StudyLock::run(dir, id, opts.wait_for_lock)
-                    .context("--fresh removes every run of the study; it waits for none without --wait")?,
-            );
-        }
-        let study = StudyLock::acquire(dir, opts.wait_for_lock)?;
-        if opts.shard.is_some() {
-            return Ok((study, held));
-        }
-        let started: Vec<String> =
-            lock::runs_of(dir, std::iter::empty()).into_iter().filter(|id| !ids.contains(id) && lock::run_in_progress(dir, id)).collect();
-        if started.is_empty() {
-            return Ok((study, held));
-        }
-        if !opts.wait_for_lock {
-            bail!("--fresh: run(s) {} of {} started meanwhile; pass --wait to wait for them", started.join(", "), dir.root.display());
-        }
+        crate::base::note::line(format_args!("{}/{id}: removing the stored run and its snapshots ({why})", manifest.study));
+        writer.remove_run(&writer.claim_run(id)?)?;
+        runs = store.records()?;
     }
-}
-
-/// `--fresh`: remove the stored runs this invocation is responsible for (with a shard, only its
-/// runs: the other shards' are someone else's; without, the whole study, also runs no longer
-/// declared).
-fn start_over(dir: &StudyDir, sharded: bool, planned: &[RunSpec]) -> Result<()> {
-    if sharded {
-        return planned.iter().try_for_each(|spec| store::remove_run(dir, &spec.id));
-    }
-    for sub in ["runs", "meshes", "references", ".partial"] {
-        let p = dir.root.join(sub);
-        if p.exists() {
-            std::fs::remove_dir_all(&p).with_context(|| format!("removing {}", p.display()))?;
-        }
-    }
-    Ok(())
+    runs.retain(|r| declared.contains(&r.run.id));
+    writer.sync_summaries(manifest, &runs, opts.quick)
 }
 
 /// Run the planned runs not stored with their spec yet, each under its run lock (another process
 /// may compute the others side by side: a shard of the same study), storing each as it finishes
 /// under the study lock.
-fn run_planned(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &RunOptions) -> Result<Vec<String>> {
+fn run_planned(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &RunOptions) -> Result<Vec<String>> {
     let mut executed = Vec::new();
-    let stored = |id: &str| dir.read_run(id).with_context(|| format!("reading the stored run {id}"));
     for spec in planned {
         // a finished run is final: kept without taking its lock (a run that executes nothing
         // writes nothing)
         let done = |r: &Option<RunRecord>| r.as_ref().is_some_and(|r| r.run == *spec);
-        let _run_lock = if done(&stored(&spec.id)?) { None } else { Some(StudyLock::run(dir, &spec.id, opts.wait_for_lock)?) };
+        let run_lock = if done(&store.record(&spec.id)?) { None } else { Some(store.lock_run(&spec.id, opts.wait_for_lock)?) };
         // read again: another process may have finished the run while this one waited for it
-        match stored(&spec.id)? {
+        match store.record(&spec.id)? {
             Some(r) if r.run == *spec => {
                 if opts.progress {
                     crate::base::note::line(format_args!(
@@ -287,7 +221,7 @@ fn run_planned(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &
                         manifest.study, spec.id
                     ));
                 }
-                store_missing_reference(manifest, dir, spec, opts)?;
+                store_missing_reference(manifest, store, spec, opts)?;
                 continue;
             }
             // stored by another process while this one waited for the run: the same check as
@@ -297,26 +231,29 @@ fn run_planned(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &
                  The runs this process finished before it are kept. Pass --replace to replace it",
                 manifest.file.display(),
                 spec.id,
-                dir.root.display(),
-                store::spec_differences(&r.run, spec).join("; ")
+                store.dir().root.display(),
+                store::stale::spec_differences(&r.run, spec).join("; ")
             ),
             Some(r) => crate::base::note::line(format_args!(
                 "{}/{}: replacing the stored run when the new one has finished ({})",
                 manifest.study,
                 spec.id,
-                store::spec_differences(&r.run, spec).join("; ")
+                store::stale::spec_differences(&r.run, spec).join("; ")
             )),
             None => {}
         }
+        // computed only under its lock (taken now if the run was replaced since the first look)
+        let run = match run_lock {
+            Some(run) => run,
+            None => store.lock_run(&spec.id, opts.wait_for_lock)?,
+        };
         let mut meshes = Batch::default();
-        let Some(record) = run_one(&manifest.study, spec, &manifest.file, dir, &mut meshes, opts.progress)? else {
+        let Some(record) = run_one(&manifest.study, spec, &manifest.file, &run, &mut meshes, opts.progress)? else {
             // interrupted: what the unfinished run wrote goes with `meshes`; the finished ones stay
             drop(meshes);
-            return Err(interruption(manifest, dir, opts));
+            return Err(interruption(manifest, store, opts));
         };
-        let _lock = StudyLock::acquire(dir, true)?;
-        store::commit_run(manifest, dir, &record, meshes, opts.quick)?;
-        checkpoint::remove(dir, &spec.id)?;
+        store.lock(true)?.commit_run(&run, manifest, &record, meshes, opts.quick)?;
         executed.push(spec.id.clone());
     }
     Ok(executed)
@@ -326,22 +263,22 @@ fn run_planned(manifest: &Manifest, dir: &StudyDir, planned: &[RunSpec], opts: &
 /// references were stored, or a deleted file): computed once by the adaptive loop and stored
 /// with its history, after checking that it is the reference the run was measured against
 /// (the same NDF; the errors the drift check compares tell the rest).
-fn store_missing_reference(manifest: &Manifest, dir: &StudyDir, spec: &RunSpec, opts: &RunOptions) -> Result<()> {
+fn store_missing_reference(manifest: &Manifest, store: &Store, spec: &RunSpec, opts: &RunOptions) -> Result<()> {
     let Some(key) = crate::records::ReferenceRecord::key_of(spec) else { return Ok(()) };
-    if matches!(dir.read_reference(&key), Ok(Some(_))) {
+    if matches!(store.reference(&key), Ok(Some(_))) {
         return Ok(());
     }
     crate::base::note::line(format_args!(
         "{}/{}: the history of its reference solution is not stored in {}; computing it once",
         manifest.study,
         spec.id,
-        dir.root.display()
+        store.dir().root.display()
     ));
     let Some(prepared) = prepare(&manifest.study, spec, &manifest.file, opts.progress)? else {
-        return Err(interruption(manifest, dir, opts));
+        return Err(interruption(manifest, store, opts));
     };
     let reference = prepared.reference.expect("a run with a reference spec is prepared with its reference");
-    let stored = dir.read_run(&spec.id)?.and_then(|r| r.reference_ndof);
+    let stored = store.record(&spec.id)?.and_then(|r| r.reference_ndof);
     if stored != Some(reference.ndof) {
         bail!(
             "{}/{}: the reference solution computed now has {} unknowns, the stored run was measured against one of {}; rerun it with --replace",
@@ -351,15 +288,12 @@ fn store_missing_reference(manifest: &Manifest, dir: &StudyDir, spec: &RunSpec, 
             stored.map_or("none".to_string(), |n| n.to_string())
         );
     }
-    let _lock = StudyLock::acquire(dir, true)?;
-    let mut batch = Batch::default();
-    store::stage_reference(dir, &crate::records::ReferenceRecord::new(spec, &reference.spec, reference.rebuild.clone()), &mut batch)?;
-    Ok(batch.commit()?)
+    store.lock(true)?.commit_reference(&crate::records::ReferenceRecord::new(spec, &reference.spec, reference.rebuild.clone()))
 }
 
 /// The error of an interrupted study: the runs kept, those missing, the command that resumes.
-fn interruption(manifest: &Manifest, dir: &StudyDir, opts: &RunOptions) -> anyhow::Error {
-    let kept: Vec<String> = match store::read_runs(dir) {
+fn interruption(manifest: &Manifest, store: &Store, opts: &RunOptions) -> anyhow::Error {
+    let kept: Vec<String> = match store.records() {
         Ok(runs) => runs.iter().map(|r| r.run.id.clone()).collect(),
         Err(e) => return e,
     };
@@ -381,9 +315,9 @@ fn interruption(manifest: &Manifest, dir: &StudyDir, opts: &RunOptions) -> anyho
 /// what figures and claims need before they draw from a study. The error names what is missing
 /// or different and how to complete the study.
 pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<()> {
-    let store = store::Store::new(results, &manifest.study);
+    let store = Store::new(results, &manifest.study);
     let runs = store.read()?;
-    let dir = store.dir;
+    let dir = store.dir();
     let mut problems = Vec::new();
     for planned in &manifest.runs {
         match runs.iter().find(|r| r.run.id == planned.spec.id) {
@@ -391,7 +325,7 @@ pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<
             Some(r) if r.run != planned.spec => problems.push(format!(
                 "run {} was computed with another spec ({})",
                 planned.spec.id,
-                store::spec_differences(&r.run, &planned.spec).join("; ")
+                store::stale::spec_differences(&r.run, &planned.spec).join("; ")
             )),
             Some(_) => {}
         }
@@ -421,10 +355,7 @@ pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<
 /// run from another folder) is looked for beside `experiments/STUDY.toml`, so a study rerun
 /// into a scratch folder is drawn without copying its manifest and problem files.
 pub fn stored_problem(results: &std::path::Path, study: &str, spec: &RunSpec) -> Result<Box<dyn problems::Problem>> {
-    let dir = StudyDir::new(results, study);
-    let file = dir.provenance_file();
-    let text = std::fs::read_to_string(&file).with_context(|| format!("reading {}", file.display()))?;
-    let prov: provenance::Provenance = serde_json::from_str(&text).with_context(|| format!("reading {}", file.display()))?;
+    let prov = Store::new(results, study).provenance()?;
     let recorded = manifest::resolve_problem(std::path::Path::new(&prov.manifest), &spec.problem);
     let declared = manifest::resolve_problem(&PathBuf::from("experiments").join(format!("{study}.toml")), &spec.problem);
     let found = |p: &String| !problems::is_file(p) || std::path::Path::new(p).exists();
@@ -511,7 +442,7 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
 /// computing it by the adaptive loop. What the drift check does, so that a 4.5e6-unknown
 /// reference costs one solve, not forty; `drift --deep` computes them anew and compares their
 /// histories with the stored ones. A run whose reference is not stored is left to [`prepare`].
-pub fn preload_references(manifest: &Manifest, stored: &StudyDir, progress: bool) -> Result<()> {
+pub fn preload_references(manifest: &Manifest, stored: &Store, progress: bool) -> Result<()> {
     for planned in &manifest.runs {
         let spec = &planned.spec;
         let problem_path = manifest::resolve_problem(&manifest.file, &spec.problem);
@@ -520,7 +451,7 @@ pub fn preload_references(manifest: &Manifest, stored: &StudyDir, progress: bool
         else {
             continue;
         };
-        let Some(record) = stored.read_reference(&file_key)? else { continue };
+        let Some(record) = stored.reference(&file_key)? else { continue };
         let study = &manifest.study;
         reference_for(&key, || {
             let started = std::time::Instant::now();
@@ -534,7 +465,7 @@ pub fn preload_references(manifest: &Manifest, stored: &StudyDir, progress: bool
             let problem = problems::load(&problem_path, &spec.constants)?;
             let mesh_spec = MeshSpec::parse(&mesh_path)?;
             let field = reference::replay(problem.as_ref(), &mesh_spec, &record.spec, &record.rebuild).with_context(|| {
-                format!("{study}/{}: replaying the stored reference {}", spec.id, stored.reference_file(&file_key).display())
+                format!("{study}/{}: replaying the stored reference {}", spec.id, stored.dir().reference_file(&file_key).display())
             })?;
             spinner.finish();
             if progress {
@@ -554,14 +485,14 @@ fn run_one(
     study: &str,
     spec: &RunSpec,
     manifest_file: &std::path::Path,
-    dir: &StudyDir,
+    run: &RunWriter,
     meshes: &mut Batch,
     progress: bool,
 ) -> Result<Option<RunRecord>> {
     let Some(prepared) = prepare(study, spec, manifest_file, progress)? else { return Ok(None) };
     let config = AdaptConfig::for_run(spec);
-    let start = start_of(study, spec, dir, meshes, &prepared, &config, progress)?;
-    let Some(result) = loop_of(study, spec, dir, meshes, &prepared, &config, start, progress)? else { return Ok(None) };
+    let start = start_of(study, spec, run, meshes, &prepared, &config, progress)?;
+    let Some(result) = loop_of(study, spec, run, meshes, &prepared, &config, start, progress)? else { return Ok(None) };
     let (levels, history) = (result.records, result.history);
     if progress {
         let last = levels.last().expect("at least one level");
@@ -575,7 +506,7 @@ fn run_one(
     }
     let reference_ndof = prepared.reference.as_ref().map(|r| r.ndof);
     if let Some(r) = &prepared.reference {
-        store::stage_reference(dir, &crate::records::ReferenceRecord::new(spec, &r.spec, r.rebuild.clone()), meshes)?;
+        run.stage_reference(&crate::records::ReferenceRecord::new(spec, &r.spec, r.rebuild.clone()), meshes)?;
     }
     Ok(Some(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof, history: Some(history) }))
 }
@@ -585,20 +516,20 @@ fn run_one(
 fn start_of(
     study: &str,
     spec: &RunSpec,
-    dir: &StudyDir,
+    run: &RunWriter,
     meshes: &mut Batch,
     prepared: &Prepared,
     config: &AdaptConfig,
     progress: bool,
 ) -> Result<adapt::Start> {
     let mesh0 = prepared.initial_mesh()?;
-    let Some(c) = checkpoint::read(dir, spec) else { return Ok(adapt::Start::new(mesh0)) };
+    let Some(c) = run.checkpoint(spec) else { return Ok(adapt::Start::new(mesh0)) };
     let done = c.levels.len();
     crate::base::note::line(format_args!(
         "{study}/{}: resuming after level {} (from {})",
         spec.id,
         done - 1,
-        checkpoint::file(dir, &spec.id).display()
+        run.checkpoint_file().display()
     ));
     let problem = prepared.problem.as_ref();
     for &l in spec.save_levels.iter().filter(|&&l| l < done) {
@@ -614,7 +545,7 @@ fn start_of(
             continues: true,
             next_active: None,
         };
-        save_level(study, spec, dir, meshes, &level, problem)?;
+        save_level(study, spec, run, meshes, &level, problem)?;
     }
     let next_active =
         c.next_active.as_ref().map(|f| f.decode()).transpose().with_context(|| format!("{study}/{}: the checkpoint", spec.id))?;
@@ -631,7 +562,7 @@ fn start_of(
 fn loop_of(
     study: &str,
     spec: &RunSpec,
-    dir: &StudyDir,
+    run: &RunWriter,
     meshes: &mut Batch,
     prepared: &Prepared,
     config: &AdaptConfig,
@@ -644,7 +575,7 @@ fn loop_of(
     let mut level_error: Option<anyhow::Error> = None;
     let mut stopped = false;
     let mut kept =
-        checkpoint::Checkpoint { run: spec.clone(), levels: start.records.clone(), history: start.history.clone(), next_active: None };
+        store::checkpoint::Checkpoint { run: spec.clone(), levels: start.records.clone(), history: start.history.clone(), next_active: None };
     let result = prepared.with_error_against(|error_against| {
         adapt::run_from(problem, start, config, error_against, &mut |level: Level| {
             let r = level.record;
@@ -656,11 +587,11 @@ fn loop_of(
                 r.err_quadrature.map(|e| format!(" error {e:.3e}")).unwrap_or_default()
             ));
             pb.inc(1);
-            let kept_level = keep_level(study, spec, dir, meshes, &level, problem).and_then(|()| {
+            let kept_level = keep_level(study, spec, run, meshes, &level, problem).and_then(|()| {
                 kept.levels.push(r.clone());
                 kept.history.levels.push(level.history.clone());
                 kept.next_active = level.next_active.map(crate::records::Flags::encode);
-                if level.continues { checkpoint::write(dir, &kept) } else { Ok(()) }
+                if level.continues { run.keep(&kept) } else { Ok(()) }
             });
             if let Err(e) = kept_level {
                 level_error = Some(e);
@@ -706,7 +637,7 @@ pub fn replay_stored_level(manifest: &Manifest, stored: &RunRecord, level: usize
 fn keep_level(
     study: &str,
     spec: &RunSpec,
-    dir: &StudyDir,
+    run: &RunWriter,
     meshes: &mut Batch,
     level: &Level,
     problem: &dyn problems::Problem,
@@ -716,7 +647,7 @@ fn keep_level(
         bail!("{study}/{}: level {}: {bad}; a record cannot hold it, so the run stops here and nothing of it is stored", spec.id, r.level);
     }
     if spec.save_levels.contains(&r.level) {
-        save_level(study, spec, dir, meshes, level, problem)?;
+        save_level(study, spec, run, meshes, level, problem)?;
     }
     Ok(())
 }
@@ -726,7 +657,7 @@ fn keep_level(
 fn save_level(
     study: &str,
     spec: &RunSpec,
-    dir: &StudyDir,
+    run: &RunWriter,
     meshes: &mut Batch,
     level: &Level,
     problem: &dyn problems::Problem,
@@ -734,7 +665,7 @@ fn save_level(
     let (mesh, sol) = (level.mesh, level.solution);
     let doc = crate::records::report::solution_vtu(mesh, sol, &level.estimate.element);
     let l = level.record.level;
-    meshes.add(&dir.mesh_file(&spec.id, l, "vtu"), doc.as_bytes())?;
+    meshes.add(&run.snapshot_file(l, "vtu"), doc.as_bytes())?;
     let snapshot = MeshSnapshot {
         study: study.to_string(),
         run: spec.id.clone(),
@@ -745,6 +676,6 @@ fn save_level(
         contact_nodes: crate::contact::solve::contact_samples(mesh, sol),
         kinks: problem.required_vertices(),
     };
-    meshes.add_json(&dir.mesh_file(&spec.id, l, "json"), &snapshot)?;
+    meshes.add_json(&run.snapshot_file(l, "json"), &snapshot)?;
     Ok(())
 }

@@ -62,7 +62,7 @@ fn edit_run(root: &Path, m: &Manifest, id: &str, edit: impl FnOnce(&mut signorin
     let r = runs.iter_mut().find(|r| r.run.id == id).unwrap();
     edit(r);
     signorini::records::write_json(&dir.run_file(id), r).unwrap();
-    store::sync_summaries(m, &dir, &runs, false).unwrap();
+    store::Store::new(&root.join("results"), &m.study).lock(false).unwrap().sync_summaries(m, &runs, false).unwrap();
 }
 
 /// Move the estimate of the last level of run `id` by a relative 1e-5, in its record and in the

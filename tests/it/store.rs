@@ -5,7 +5,8 @@
 
 use signorini::records::StudyDir;
 use signorini::study::manifest::Manifest;
-use signorini::study::{StudyLock, check_complete, drift};
+use signorini::study::store::Store;
+use signorini::study::{check_complete, drift};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -64,7 +65,7 @@ fn fresh_shard_removes_only_its_own_runs() {
     assert_eq!(ids, ["a", "b"], "shard 1's --fresh removed shard 2's run");
     // the summaries describe both
     let runs = dir.read_runs().unwrap();
-    assert!(drift::check_derived(&dir, "tiny", &runs).is_empty());
+    assert!(drift::check_derived(&Store::new(&d, "tiny"), &runs).is_empty());
 }
 
 #[test]
@@ -74,7 +75,8 @@ fn a_second_run_of_the_same_study_is_refused_or_waits_and_loses_nothing() {
     assert_eq!(signorini(&["run", &fixture(), "--quick", "--shard", "2/2", "--results", res]).0, Some(0));
     let dir = StudyDir::new(&d, "tiny");
     let before = std::fs::read(dir.run_file("b")).unwrap();
-    let lock = StudyLock::acquire(&dir, false).unwrap();
+    let store = Store::new(&d, "tiny");
+    let lock = store.lock(false).unwrap();
     // refused, naming the holder; with --fresh it must not have deleted anything
     let (code, err) = signorini(&["run", &fixture(), "--quick", "--fresh", "--results", res]);
     assert_ne!(code, Some(0));
@@ -126,7 +128,7 @@ fn an_interrupted_study_keeps_consistent_summaries_and_figures_refuse_it() {
     let runs = dir.read_runs().unwrap();
     assert!(!runs.is_empty() && runs.len() < 6, "{} runs kept", runs.len());
     // the summaries describe exactly the runs kept; no mesh of an unfinished run is left
-    assert!(drift::check_derived(&dir, "long", &runs).is_empty(), "{:?}", drift::check_derived(&dir, "long", &runs));
+    assert!(drift::check_derived(&Store::new(&res, "long"), &runs).is_empty(), "{:?}", drift::check_derived(&Store::new(&res, "long"), &runs));
     let csv = std::fs::read_to_string(dir.csv_file()).unwrap();
     assert_eq!(csv.lines().count(), 1 + runs.iter().map(|r| r.levels.len()).sum::<usize>());
     for e in std::fs::read_dir(dir.root.join("meshes")).unwrap().flatten() {
@@ -162,7 +164,8 @@ fn shards_compute_side_by_side_and_a_run_is_computed_once() {
     let res = d.to_str().unwrap();
     let dir = StudyDir::new(&d, "tiny");
     // another process computes run a now: it holds a's lock and has a temporary file staged
-    let a = StudyLock::run(&dir, "a", false).unwrap();
+    let store = Store::new(&d, "tiny");
+    let a = store.lock_run("a", false).unwrap();
     let staged = dir.root.join("meshes").join(format!(".a_level0.json.tmp{}.0", std::process::id()));
     std::fs::create_dir_all(staged.parent().unwrap()).unwrap();
     std::fs::write(&staged, "half written").unwrap();
@@ -192,5 +195,32 @@ fn shards_compute_side_by_side_and_a_run_is_computed_once() {
     assert_eq!(std::fs::read(dir.run_file("b")).unwrap(), b_before, "b was computed again");
     let runs = dir.read_runs().unwrap();
     assert_eq!(runs.iter().map(|r| r.run.id.as_str()).collect::<Vec<_>>(), ["a", "b"]);
-    assert!(drift::check_derived(&dir, "tiny", &runs).is_empty());
+    assert!(drift::check_derived(&Store::new(&d, "tiny"), &runs).is_empty());
+}
+
+#[test]
+fn a_stored_run_another_process_computes_is_not_removed_by_replace() {
+    let d = tmp("claim");
+    let res = d.to_str().unwrap();
+    assert_eq!(signorini(&["run", &fixture(), "--quick", "--results", res]).0, Some(0));
+    let dir = StudyDir::new(&d, "tiny");
+    // the stored run b is no longer declared, and another process holds b's lock (computes it
+    // under an older manifest): --replace must not remove what that process is writing
+    let exp = d.join("exp");
+    std::fs::create_dir_all(&exp).unwrap();
+    let text = std::fs::read_to_string(fixture()).unwrap();
+    let cut = text.find("[[run]]\nid = \"b\"").expect("the fixture declares run b");
+    let only_a = exp.join("tiny.toml");
+    std::fs::write(&only_a, &text[..cut]).unwrap();
+    let store = Store::new(&d, "tiny");
+    let b = store.lock_run("b", false).unwrap();
+    let before = std::fs::read(dir.run_file("b")).unwrap();
+    let (code, err) = signorini(&["run", only_a.to_str().unwrap(), "--quick", "--replace", "--results", res]);
+    assert_ne!(code, Some(0), "{err}");
+    assert!(err.contains("run b of") && err.contains("is being written by process") && err.contains("is not removed"), "{err}");
+    assert_eq!(std::fs::read(dir.run_file("b")).unwrap(), before, "the record of a run in progress was removed");
+    drop(b);
+    let (code, err) = signorini(&["run", only_a.to_str().unwrap(), "--quick", "--replace", "--results", res]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!dir.run_file("b").exists() && dir.run_file("a").exists(), "{err}");
 }

@@ -1,7 +1,7 @@
 //! A run in progress, kept after every finished level: `STUDY/.partial/RUN.json` holds the
 //! records and refinement history of the levels finished so far and the active set the next
 //! level starts from. A run that is stopped (killed, out of time on a cluster) resumes after its
-//! last finished level instead of from level 0 ([`super::run_study`]), with the same numbers:
+//! last finished level instead of from level 0 ([`crate::study::run_study`]), with the same numbers:
 //! the next mesh is rebuilt from the initial one by the stored marks (`adapt::replay`). The
 //! checkpoint is not a result: git ignores `.partial/`, and it is removed when the run lands.
 
@@ -21,13 +21,13 @@ pub struct Checkpoint {
 }
 
 /// `STUDY/.partial/RUN.json`.
-pub fn file(dir: &StudyDir, run: &str) -> PathBuf {
+pub(super) fn file(dir: &StudyDir, run: &str) -> PathBuf {
     dir.root.join(".partial").join(format!("{run}.json"))
 }
 
 /// The checkpoint of `spec`'s run, if there is one for exactly this spec (one of another spec,
 /// or one that does not parse, is ignored: the run starts over and replaces it).
-pub fn read(dir: &StudyDir, spec: &RunSpec) -> Option<Checkpoint> {
+pub(super) fn read(dir: &StudyDir, spec: &RunSpec) -> Option<Checkpoint> {
     let text = std::fs::read_to_string(file(dir, &spec.id)).ok()?;
     let c: Checkpoint = serde_json::from_str(&text).ok()?;
     let consistent = c.run == *spec && !c.levels.is_empty() && c.levels.len() == c.history.levels.len();
@@ -35,7 +35,7 @@ pub fn read(dir: &StudyDir, spec: &RunSpec) -> Option<Checkpoint> {
 }
 
 /// Write the checkpoint atomically (a temporary file, then a rename).
-pub fn write(dir: &StudyDir, checkpoint: &Checkpoint) -> Result<()> {
+pub(super) fn write(dir: &StudyDir, checkpoint: &Checkpoint) -> Result<()> {
     let path = file(dir, &checkpoint.run.id);
     let written = crate::records::write_json(&path, checkpoint);
     // another run's `remove` may take `.partial/` away between its creation and the write: once more
@@ -47,7 +47,7 @@ pub fn write(dir: &StudyDir, checkpoint: &Checkpoint) -> Result<()> {
 }
 
 /// Remove the run's checkpoint (and its temporary files), and `.partial/` once it is empty.
-pub fn remove(dir: &StudyDir, run: &str) -> Result<()> {
+pub(super) fn remove(dir: &StudyDir, run: &str) -> Result<()> {
     let path = file(dir, run);
     let partial = dir.root.join(".partial");
     let own_temporary = format!(".{run}.json.tmp");

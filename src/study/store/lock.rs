@@ -4,8 +4,11 @@
 //! array) compute their runs side by side and take turns only to commit; two processes never
 //! compute the same run (the second waits or is refused, naming the holder), and neither removes
 //! the other's files of a run in progress.
+//!
+//! Only the store hands locks out ([`super::Store::lock`], [`super::Store::lock_run`]): every
+//! write to the folder needs the guard of the lock that covers it.
 
-use super::provenance;
+use crate::study::provenance;
 use crate::records::StudyDir;
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -17,13 +20,10 @@ pub struct Lock {
     _file: std::fs::File,
 }
 
-/// The lock on a study's shared files.
-pub type StudyLock = Lock;
-
 impl Lock {
     /// The study lock of `dir`: refused (naming the holder) if another process holds it, unless
     /// `wait`, then waits for it.
-    pub fn acquire(dir: &StudyDir, wait: bool) -> Result<Lock> {
+    pub(super) fn study(dir: &StudyDir, wait: bool) -> Result<Lock> {
         let path = dir.root.join(".lock");
         claim(open(&path)?, &path, &dir.root.display().to_string(), wait)
     }
@@ -32,10 +32,10 @@ impl Lock {
     /// lock, where [`run_in_progress`] looks at it too, so that the look never makes a run's
     /// owner find its lock taken; if another process computes the run, refused (naming it)
     /// unless `wait`, then waits for it without holding the study lock.
-    pub fn run(dir: &StudyDir, id: &str, wait: bool) -> Result<Lock> {
+    pub(super) fn run(dir: &StudyDir, id: &str, wait: bool) -> Result<Lock> {
         let path = run_lock_file(dir, id);
         let file = {
-            let _study = Self::acquire(dir, true)?;
+            let _study = Self::study(dir, true)?;
             let file = open(&path)?;
             match file.try_lock() {
                 Ok(()) => return own(file, &path),
@@ -44,6 +44,15 @@ impl Lock {
             }
         };
         claim(file, &path, &format!("run {id} of {}", dir.root.display()), wait)
+    }
+
+    /// The lock of run `id` taken by a process that holds the study lock (to remove a stored
+    /// run): at once, or refused naming the process that computes the run. Never waited for: the
+    /// holder needs the study lock to store its run.
+    pub(super) fn run_now(dir: &StudyDir, id: &str) -> Result<Lock> {
+        let path = run_lock_file(dir, id);
+        claim(open(&path)?, &path, &format!("run {id} of {}", dir.root.display()), false)
+            .context("a run another process computes is not removed")
     }
 }
 
@@ -139,7 +148,7 @@ fn run_lock_file(dir: &StudyDir, id: &str) -> PathBuf {
 /// Whether another process holds the lock of run `id` (computes it now). Ask only under the
 /// study lock (see [`Lock::run`]). A lock this process holds counts too (asked through another
 /// open file); the study's own code never asks about a run it computes.
-pub fn run_in_progress(dir: &StudyDir, id: &str) -> bool {
+pub(super) fn run_in_progress(dir: &StudyDir, id: &str) -> bool {
     let Ok(file) = std::fs::OpenOptions::new().read(true).write(true).open(run_lock_file(dir, id)) else { return false };
     matches!(file.try_lock(), Err(std::fs::TryLockError::WouldBlock))
 }
@@ -147,7 +156,7 @@ pub fn run_in_progress(dir: &StudyDir, id: &str) -> bool {
 /// Every run of the study a process may compute or have left: `declared`, the stored records
 /// (`runs/RUN.json`), the run locks (`.locks/RUN.lock`) and the checkpoints
 /// (`.partial/RUN.json`), sorted, each once. What `--fresh` holds before it removes anything.
-pub fn runs_of(dir: &StudyDir, declared: impl Iterator<Item = String>) -> Vec<String> {
+pub(super) fn runs_of(dir: &StudyDir, declared: impl Iterator<Item = String>) -> Vec<String> {
     let mut ids: Vec<String> = declared.collect();
     for (sub, ext) in [("runs", "json"), (".locks", "lock"), (".partial", "json")] {
         for e in std::fs::read_dir(dir.root.join(sub)).into_iter().flatten().flatten() {

@@ -1,0 +1,209 @@
+//! The store's integrity check ([`super::Store::check`]): what in a study folder does not hold
+//! together (a record that is not its file's run, a snapshot missing or not its level, summaries
+//! that are not what the records render, a reference that is not the runs'), and the leftovers
+//! of an unfinished run ([`orphans`]).
+
+use crate::records::{self, RunRecord, StudyDir};
+use crate::study::provenance::Provenance;
+use anyhow::{Context, Result};
+use std::path::PathBuf;
+
+/// Something in a study folder that does not hold together: the file and what is wrong with it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fault {
+    pub file: PathBuf,
+    pub what: String,
+    /// The stem of the record file at fault (`runs/STEM.json`, and its snapshots); `None` for a
+    /// summary (`levels.csv`, `provenance.json`), which is rendered from the records.
+    pub record: Option<String>,
+}
+
+impl std::fmt::Display for Fault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.file.display(), self.what)
+    }
+}
+
+/// A study folder as read by [`super::Store::check`].
+#[derive(Clone, Debug, Default)]
+pub struct Checked {
+    /// The records, in file-name order.
+    pub runs: Vec<RunRecord>,
+    /// What does not hold together (empty for a sound folder).
+    pub faults: Vec<Fault>,
+    /// Files of an unfinished run no record accounts for ([`orphans`]): `run` removes them,
+    /// every reader names and ignores them.
+    pub leftovers: Vec<PathBuf>,
+}
+
+impl Checked {
+    /// The faults, one per line, for an error message.
+    pub fn faults_text(&self) -> String {
+        self.faults.iter().map(|f| format!("\n  {f}")).collect()
+    }
+}
+
+/// Whether a finished run's record accounts for the snapshot of `run` at `level`.
+fn saved(runs: &[RunRecord], run: &str, level: usize) -> bool {
+    runs.iter().any(|r| r.run.id == run && r.run.save_levels.contains(&level) && level < r.levels.len())
+}
+
+/// The files of `dir` (one level, sorted by name); none if it does not exist.
+pub(super) fn files_in(dir: &std::path::Path) -> Result<Vec<(String, PathBuf)>> {
+    let entries = match std::fs::read_dir(dir) {
+        Ok(entries) => entries,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(e).with_context(|| format!("reading the directory {}", dir.display())),
+    };
+    let mut out: Vec<(String, PathBuf)> = entries
+        .flatten()
+        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+        .map(|e| (e.file_name().to_string_lossy().into_owned(), e.path()))
+        .collect();
+    out.sort();
+    Ok(out)
+}
+
+/// The files of the study folder no finished run accounts for: temporary files (of a process
+/// killed while writing) anywhere in it, and mesh snapshots of a run without a record or of a
+/// level its record does not save (a run killed before it finished, an old binary's leftovers).
+/// Files the study never writes are left alone, and so are the temporary files of a run another
+/// process computes now (its run lock is held; ask under the study lock).
+pub(super) fn orphans(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<PathBuf>> {
+    let meshes = dir.root.join("meshes");
+    let mut out = Vec::new();
+    let runs_dir = dir.root.join("runs");
+    let references = dir.root.join("references");
+    let keys: Vec<String> = runs.iter().filter_map(|r| records::ReferenceRecord::key_of(&r.run)).collect();
+    for sub in [dir.root.clone(), runs_dir.clone(), meshes.clone(), references.clone()] {
+        for (name, path) in files_in(&sub)? {
+            let stray_mesh = sub == meshes && StudyDir::parse_mesh_name(&name).is_some_and(|(run, level)| !saved(runs, run, level));
+            // a reference no stored run is measured against (its runs replaced or removed)
+            let stray_reference = sub == references && name.strip_suffix(".json").is_some_and(|k| !keys.iter().any(|key| key == k));
+            let temporary = records::is_temporary(&name);
+            // a temporary file of a run another process computes now is not an orphan
+            let of_run = name.strip_prefix('.').and_then(|n| n.rsplit_once(".tmp")).and_then(|(target, _)| {
+                if sub == runs_dir {
+                    target.strip_suffix(".json").map(str::to_string)
+                } else {
+                    StudyDir::parse_mesh_name(target).map(|(run, _)| run.to_string()).filter(|_| sub == meshes)
+                }
+            });
+            let in_progress = temporary && of_run.is_some_and(|id| super::lock::run_in_progress(dir, &id));
+            if (temporary || stray_mesh || stray_reference) && !in_progress {
+                out.push(path);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The orphans' paths relative to the study folder, comma-separated.
+pub fn names(dir: &StudyDir, files: &[PathBuf]) -> String {
+    files.iter().map(|f| f.strip_prefix(&dir.root).unwrap_or(f).display().to_string()).collect::<Vec<_>>().join(", ")
+}
+
+/// The mesh snapshots `record` saves that are missing or do not parse as its level, each with
+/// what is wrong: the JSON (what the mesh figures read) must be the run's level with the level's
+/// NDF, the VTU a whole VTK file.
+pub(super) fn snapshot_faults(dir: &StudyDir, record: &RunRecord) -> Vec<(PathBuf, String)> {
+    let id = &record.run.id;
+    let mut out = Vec::new();
+    for &l in record.run.save_levels.iter().filter(|&&l| l < record.levels.len()) {
+        let json = dir.mesh_file(id, l, "json");
+        match dir.read_mesh(id, l) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => out.push((json, format!("missing: run {id} saves level {l}"))),
+            Err(e) => out.push((json, format!("does not parse as a mesh snapshot ({e})"))),
+            Ok(s) if s.run != *id || s.level != l || s.ndof != record.levels[l].ndof => out.push((
+                json,
+                format!(
+                    "is run {} level {} with {} unknowns, not run {id} level {l} with {}",
+                    s.run, s.level, s.ndof, record.levels[l].ndof
+                ),
+            )),
+            Ok(_) => {}
+        }
+        let vtu = dir.mesh_file(id, l, "vtu");
+        match std::fs::read(&vtu) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => out.push((vtu, format!("missing: run {id} saves level {l}"))),
+            Err(e) => out.push((vtu, format!("cannot be read ({e})"))),
+            Ok(b) if !(b.starts_with(b"<?xml") && b.trim_ascii_end().ends_with(b"</VTKFile>")) => {
+                out.push((vtu, "is not a whole VTK file (no XML header or no closing </VTKFile>)".into()))
+            }
+            Ok(_) => {}
+        }
+    }
+    out
+}
+
+/// The first line where two texts differ, shortened, as it reads in each.
+pub fn first_difference(a: &str, b: &str) -> (String, String) {
+    let (al, bl): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
+    let i = (0..al.len().max(bl.len())).find(|&i| al.get(i) != bl.get(i)).unwrap_or(al.len().min(bl.len()));
+    let cut =
+        |s: Option<&&str>| format!("line {}: {}", i + 1, s.map(|s| s.chars().take(60).collect::<String>()).unwrap_or("(none)".into()));
+    (cut(al.get(i)), cut(bl.get(i)))
+}
+
+/// The summaries of a study against what its records render: `levels.csv` byte for byte,
+/// `provenance.json` readable, of this study and listing exactly these runs. A folder with no
+/// record and no summary has nothing to disagree.
+pub fn summary_faults(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<Fault> {
+    let (csv, prov) = (dir.csv_file(), dir.provenance_file());
+    if runs.is_empty() && !csv.exists() && !prov.exists() {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    let mut fault = |file: &std::path::Path, what: String| out.push(Fault { file: file.to_path_buf(), what, record: None });
+    match (std::fs::read(&csv), dir.csv_bytes(runs)) {
+        (Ok(on_disk), Ok(rendered)) if on_disk == rendered => {}
+        (Ok(on_disk), Ok(rendered)) => {
+            let (a, b) = first_difference(&String::from_utf8_lossy(&on_disk), &String::from_utf8_lossy(&rendered));
+            fault(&csv, format!("is not what runs/*.json render: {a}, rendered {b}"));
+        }
+        (Err(e), _) => fault(&csv, format!("cannot be read ({e})")),
+        (_, Err(e)) => fault(&csv, format!("cannot be rendered from the records ({e})")),
+    }
+    let ids: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
+    match std::fs::read_to_string(&prov)
+        .map_err(|e| e.to_string())
+        .and_then(|t| serde_json::from_str::<Provenance>(&t).map_err(|e| e.to_string()))
+    {
+        Err(e) => fault(&prov, format!("cannot be read ({e})")),
+        Ok(p) if p.runs != ids => fault(&prov, format!("lists the runs {}, the records are {}", p.runs.join(" "), ids.join(" "))),
+        Ok(p) if p.study != study => fault(&prov, format!("is the provenance of study {}, not {study}", p.study)),
+        Ok(_) => {}
+    }
+    out
+}
+
+/// The stored reference solutions against the runs measured against them: each one present
+/// parses, is the reference of the runs naming it (its key) and has the NDF they record. A
+/// reference not stored is no fault here (a folder written before references were stored; the
+/// drift check computes it and names it missing); `run` stores it ([`stage_reference`]).
+pub fn reference_faults(dir: &StudyDir, runs: &[RunRecord]) -> Vec<Fault> {
+    let mut out = Vec::new();
+    let mut seen = std::collections::BTreeSet::new();
+    for r in runs {
+        let Some(key) = records::ReferenceRecord::key_of(&r.run) else { continue };
+        let file = dir.reference_file(&key);
+        let what = match dir.read_reference(&key) {
+            Ok(None) => continue,
+            Err(e) => format!("cannot be read ({e})"),
+            Ok(Some(stored)) if stored.key() != key => {
+                format!("is the reference of {} on {}, not of run {}", stored.problem, stored.mesh, r.run.id)
+            }
+            Ok(Some(stored)) if Some(stored.rebuild.ndof) != r.reference_ndof => format!(
+                "has {} unknowns; run {} was measured against a reference of {}",
+                stored.rebuild.ndof,
+                r.run.id,
+                r.reference_ndof.map_or("none".to_string(), |n| n.to_string())
+            ),
+            Ok(Some(_)) => continue,
+        };
+        if seen.insert(file.clone()) {
+            out.push(Fault { file, what, record: None });
+        }
+    }
+    out
+}

@@ -1,0 +1,198 @@
+//! The study folder `results/STUDY/` kept readable and consistent whatever happens, behind one
+//! door: [`Store`]. Every reader and writer of a study folder goes through it; the folder's
+//! invariants live in its modules and nowhere else:
+//! - [`check`]: the integrity check every reader runs first (`run`, `drift` on both sides of
+//!   `--against`, `figures`, `report`): each record's run id is its file name, every snapshot it
+//!   saves exists and parses, the summaries and references match the records; a folder at fault
+//!   is refused naming the file (`run --replace` replaces the records at fault). What a killed
+//!   process leaves (temporary files, snapshots of a run without a record) is a leftover: named
+//!   and ignored by readers, removed by the next run.
+//! - [`write`]: every change needs the guard of a lock ([`Store::lock`] for the shared files,
+//!   [`Store::lock_run`] for a run being computed). A finished run lands in one [`Batch`](crate::records::Batch): its
+//!   mesh snapshots (written while it ran), its record and the summaries listing it
+//!   (`levels.csv`, `provenance.json`) are written in full to temporary files, then renamed into
+//!   place ([`Writer::commit_run`]); a run that stops leaves nothing. The summaries are rewritten
+//!   only when their content would change: a run that executes nothing changes no file.
+//! - [`stale`]: a stored run is never replaced silently; a manifest whose run differs from the
+//!   stored one, or a stored run the manifest does not declare, is refused unless told to
+//!   replace it; the runner repeats the check under the run's lock, and `--fresh` holds every run
+//!   lock of the study before it removes anything ([`Store::lock_every_run`]).
+//! - [`checkpoint`]: a run in progress kept after every level, to resume from.
+
+pub mod check;
+pub mod checkpoint;
+mod lock;
+pub mod stale;
+pub mod write;
+
+pub use check::{Checked, Fault, first_difference};
+pub use stale::Stale;
+pub use write::{RunWriter, Writer};
+
+use crate::records::{ReferenceRecord, RunRecord, StudyDir};
+use crate::study::provenance::Provenance;
+use anyhow::{Context, Result, bail};
+use std::path::PathBuf;
+
+/// The one door to a study's results folder (`results/STUDY/`): readers check it as a whole
+/// ([`Store::check`], [`Store::read`]); writers hold its locks ([`Store::lock`],
+/// [`Store::lock_run`]) and change it only through the guards they return.
+#[derive(Clone, Debug)]
+pub struct Store {
+    dir: StudyDir,
+    study: String,
+}
+
+impl Store {
+    pub fn new(results: &std::path::Path, study: &str) -> Self {
+        Store { dir: StudyDir::new(results, study), study: study.to_string() }
+    }
+
+    /// The folder's layout (paths only; reading and writing go through the store).
+    pub fn dir(&self) -> &StudyDir {
+        &self.dir
+    }
+
+    pub fn study(&self) -> &str {
+        &self.study
+    }
+
+    /// The study lock: refused naming the holder if another process holds it, unless `wait`.
+    /// Its guard is the only way to change the folder's shared files.
+    pub fn lock(&self, wait: bool) -> Result<Writer<'_>> {
+        Ok(Writer { store: self, _lock: lock::Lock::study(&self.dir, wait)? })
+    }
+
+    /// The lock of run `id`, held while this process computes it: refused naming the process
+    /// that computes it, unless `wait`. (Taken briefly under the study lock: do not hold a
+    /// [`Writer`] while asking.)
+    pub fn lock_run(&self, id: &str, wait: bool) -> Result<RunWriter<'_>> {
+        Ok(RunWriter { store: self, id: id.to_string(), _lock: lock::Lock::run(&self.dir, id, wait)? })
+    }
+
+    /// `--fresh`: the lock of every run this process would remove (`only`, a shard's runs; or
+    /// every run of the study: `declared`, and any run stored, locked or checkpointed), then the
+    /// study lock, so that no file of a run another process computes is removed. The run locks
+    /// are taken one by one without the study lock (the owner of one takes the study lock to
+    /// store its run); a run that started meanwhile is found under the study lock, and then
+    /// everything is let go and taken again. Held by another process: refused naming it, or
+    /// with `wait` waited for.
+    pub fn lock_every_run(&self, only: Option<&[String]>, declared: &[String], wait: bool) -> Result<(Writer<'_>, Vec<RunWriter<'_>>)> {
+        if !wait {
+            // refused at once if another process sets up or stores (taking the run locks below
+            // waits for the study lock briefly, as every run does)
+            drop(self.lock(false)?);
+        }
+        loop {
+            let ids = match only {
+                Some(ids) => ids.to_vec(),
+                None => lock::runs_of(&self.dir, declared.iter().cloned()),
+            };
+            let mut held = Vec::new();
+            for id in &ids {
+                held.push(self.lock_run(id, wait).context("--fresh removes every run of the study; it waits for none without --wait")?);
+            }
+            let writer = self.lock(wait)?;
+            if only.is_some() {
+                return Ok((writer, held));
+            }
+            let started: Vec<String> = lock::runs_of(&self.dir, std::iter::empty())
+                .into_iter()
+                .filter(|id| !ids.contains(id) && lock::run_in_progress(&self.dir, id))
+                .collect();
+            if started.is_empty() {
+                return Ok((writer, held));
+            }
+            if !wait {
+                bail!("--fresh: run(s) {} of {} started meanwhile; pass --wait to wait for them", started.join(", "), self.dir.root.display());
+            }
+        }
+    }
+
+    /// Every run record as it is, unchecked (an unreadable one is an error naming it): what the
+    /// writers re-read under the lock. Readers use [`Store::read`].
+    pub fn records(&self) -> Result<Vec<RunRecord>> {
+        self.dir.read_runs().with_context(|| format!("reading the runs in {}", self.dir.root.join("runs").display()))
+    }
+
+    /// The stored record of run `id`, if any.
+    pub fn record(&self, id: &str) -> Result<Option<RunRecord>> {
+        self.dir.read_run(id).with_context(|| format!("reading the stored run {id}"))
+    }
+
+    /// The stored reference solution of `key` (`references/KEY.json`), if any.
+    pub fn reference(&self, key: &str) -> Result<Option<ReferenceRecord>> {
+        let file = self.dir.reference_file(key);
+        self.dir.read_reference(key).with_context(|| format!("reading {}", file.display()))
+    }
+
+    /// `provenance.json`.
+    pub fn provenance(&self) -> Result<Provenance> {
+        let file = self.dir.provenance_file();
+        let text = std::fs::read_to_string(&file).with_context(|| format!("reading {}", file.display()))?;
+        serde_json::from_str(&text).with_context(|| format!("reading {}", file.display()))
+    }
+
+    /// Read the folder and check that it holds together: every record's run id is its file
+    /// name (so each run is stored once) and its study is this one; every mesh snapshot a record
+    /// saves exists and parses, as the level it names; `levels.csv` and `provenance.json` are
+    /// what the records render ([`check::summary_faults`]). A record that does not parse is an error
+    /// naming it.
+    pub fn check(&self) -> Result<Checked> {
+        let files = self.dir.read_run_files().with_context(|| format!("reading the runs in {}", self.dir.root.join("runs").display()))?;
+        let mut faults = Vec::new();
+        for (file, record) in &files {
+            let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            let mut fault =
+                |file: &std::path::Path, what: String| faults.push(Fault { file: file.to_path_buf(), what, record: Some(stem.clone()) });
+            if record.run.id != stem {
+                fault(
+                    file,
+                    format!("holds run {}, not {stem} (a record's run id is its file name: a copy or a renamed file?)", record.run.id),
+                );
+                continue;
+            }
+            if record.study != self.study {
+                fault(file, format!("is a record of study {}, not {}", record.study, self.study));
+            }
+            for (path, what) in check::snapshot_faults(&self.dir, record) {
+                fault(&path, what);
+            }
+        }
+        let runs: Vec<RunRecord> = files.into_iter().map(|(_, r)| r).collect();
+        faults.extend(check::summary_faults(&self.dir, &self.study, &runs));
+        faults.extend(check::reference_faults(&self.dir, &runs));
+        let leftovers = check::orphans(&self.dir, &runs)?;
+        Ok(Checked { runs, faults, leftovers })
+    }
+
+    /// [`Store::check`] for a reader: the records of a sound folder (its leftovers named on
+    /// stderr and ignored); a fault is an error naming every one.
+    pub fn read(&self) -> Result<Vec<RunRecord>> {
+        let checked = self.check()?;
+        if !checked.faults.is_empty() {
+            anyhow::bail!(
+                "{} does not hold together:{}\nRerun the runs at fault with `signorini run experiments/{}.toml --replace` (or restore the files)",
+                self.dir.root.display(),
+                checked.faults_text(),
+                self.study
+            );
+        }
+        self.note_leftovers(&checked.leftovers);
+        Ok(checked.runs)
+    }
+
+    /// Name the leftovers of an unfinished run a reader ignores, in one line.
+    pub fn note_leftovers(&self, leftovers: &[PathBuf]) {
+        if !leftovers.is_empty() {
+            crate::base::note::line(format_args!(
+                "{}: ignoring {} file(s) of an unfinished run in {} (`signorini run` removes them): {}",
+                self.study,
+                leftovers.len(),
+                self.dir.root.display(),
+                check::names(&self.dir, leftovers)
+            ));
+        }
+    }
+}
+

@@ -1,0 +1,225 @@
+//! The writers of a study folder. Every change goes through a guard of the lock that covers it,
+//! so none can be made without the lock, by construction:
+//! - [`Writer`] holds the study lock (`STUDY/.lock`): the shared files change only under it
+//!   (storing a finished run with the summaries listing it, removing a run, the leftovers of an
+//!   unfinished one, bringing the summaries in line, `--fresh`);
+//! - [`RunWriter`] holds one run's lock (`STUDY/.locks/RUN.lock`) while the run is computed: its
+//!   checkpoint and the mesh snapshots it stages are its own, and removing a stored run needs its
+//!   lock too ([`Writer::claim_run`]), so no process removes what another computes.
+
+use super::check::{files_in, orphans};
+use super::lock::Lock;
+use super::{Store, checkpoint};
+use crate::records::{self, Batch, ReferenceRecord, RunRecord, StudyDir};
+use crate::study::manifest::Manifest;
+use crate::study::provenance::{self, Provenance};
+use anyhow::{Context, Result, bail};
+
+/// The study lock, held: the only way to change a study folder's shared files.
+pub struct Writer<'a> {
+    pub(super) store: &'a Store,
+    pub(super) _lock: Lock,
+}
+
+/// One run's lock, held: the run is computed (or removed) by this process and no other.
+pub struct RunWriter<'a> {
+    pub(super) store: &'a Store,
+    pub(super) id: String,
+    pub(super) _lock: Lock,
+}
+
+impl RunWriter<'_> {
+    pub fn id(&self) -> &str {
+        &self.id
+    }
+
+    /// Where the run's snapshot of `level` goes (`meshes/RUN_levelL.EXT`): staged in the run's
+    /// batch while it computes, committed with its record ([`Writer::commit_run`]).
+    pub fn snapshot_file(&self, level: usize, ext: &str) -> std::path::PathBuf {
+        self.store.dir.mesh_file(&self.id, level, ext)
+    }
+
+    /// The run's checkpoint, if there is one for exactly `spec` ([`checkpoint::read`]).
+    pub fn checkpoint(&self, spec: &records::RunSpec) -> Option<checkpoint::Checkpoint> {
+        checkpoint::read(&self.store.dir, spec)
+    }
+
+    /// `STUDY/.partial/RUN.json`, for messages.
+    pub fn checkpoint_file(&self) -> std::path::PathBuf {
+        checkpoint::file(&self.store.dir, &self.id)
+    }
+
+    /// Keep the run's levels so far (atomically), to resume from after a stop.
+    pub fn keep(&self, kept: &checkpoint::Checkpoint) -> Result<()> {
+        if kept.run.id != self.id {
+            bail!("the checkpoint of run {} given to run {}", kept.run.id, self.id);
+        }
+        checkpoint::write(&self.store.dir, kept)
+    }
+
+    /// Add the reference solution the run is measured against to its batch, unless the study
+    /// stores it already (the same history to the same NDF): it lands with the run.
+    pub fn stage_reference(&self, reference: &ReferenceRecord, batch: &mut Batch) -> Result<()> {
+        stage_reference(&self.store.dir, reference, batch)
+    }
+}
+
+impl Writer<'_> {
+    /// The lock of a stored run this process does not compute, to remove it: at once, or
+    /// refused naming the process that computes it.
+    pub fn claim_run(&self, id: &str) -> Result<RunWriter<'_>> {
+        Ok(RunWriter { store: self.store, id: id.to_string(), _lock: Lock::run_now(&self.store.dir, id)? })
+    }
+
+    /// Remove a run's record, its mesh snapshots (`meshes/RUN_levelL.*`) and its checkpoint.
+    pub fn remove_run(&self, run: &RunWriter) -> Result<()> {
+        checkpoint::remove(&self.store.dir, &run.id)?;
+        self.remove_stored(run)
+    }
+
+    /// Remove a run's record and mesh snapshots (its checkpoint stays).
+    fn remove_stored(&self, run: &RunWriter) -> Result<()> {
+        self.same_folder(run)?;
+        let dir = &self.store.dir;
+        let file = dir.run_file(&run.id);
+        match std::fs::remove_file(&file) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(e).with_context(|| format!("removing {}", file.display())),
+        }
+        for (name, path) in files_in(&dir.root.join("meshes"))? {
+            if StudyDir::parse_mesh_name(&name).is_some_and(|(r, _)| r == run.id) {
+                std::fs::remove_file(&path).with_context(|| format!("removing {}", path.display()))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// `--fresh`: remove the runs this process holds (with a shard, only those: the other shards'
+    /// are someone else's), or with `whole` the study's records, snapshots, references and
+    /// checkpoints, every run's lock being in `held` ([`Store::lock_every_run`]).
+    pub fn start_over(&self, held: &[RunWriter], whole: bool) -> Result<()> {
+        if !whole {
+            return held.iter().try_for_each(|run| self.remove_run(run));
+        }
+        let root = &self.store.dir.root;
+        for sub in ["runs", "meshes", "references", ".partial"] {
+            let p = root.join(sub);
+            if p.exists() {
+                std::fs::remove_dir_all(&p).with_context(|| format!("removing {}", p.display()))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Remove the leftovers of unfinished runs ([`orphans`]; a run another process computes
+    /// now has none), saying so in one line that names them.
+    pub fn remove_orphans(&self, runs: &[RunRecord]) -> Result<()> {
+        let dir = &self.store.dir;
+        let found = orphans(dir, runs)?;
+        if found.is_empty() {
+            return Ok(());
+        }
+        for f in &found {
+            std::fs::remove_file(f).with_context(|| format!("removing {}", f.display()))?;
+        }
+        crate::base::note::line(format_args!(
+            "{}: removed {} file(s) of an unfinished run (no finished run accounts for them): {}",
+            self.store.study,
+            found.len(),
+            super::check::names(dir, &found)
+        ));
+        Ok(())
+    }
+
+    /// Make `levels.csv` and `provenance.json` describe exactly `runs` (the runs present), writing
+    /// only what would change: the CSV when its bytes differ, the provenance when it is missing,
+    /// unreadable or lists other runs. (A provenance records who computed the runs; a process that
+    /// computed none of them has nothing to add to it.) Both are written together.
+    pub fn sync_summaries(&self, manifest: &Manifest, runs: &[RunRecord], quick: bool) -> Result<()> {
+        let dir = &self.store.dir;
+        let mut batch = Batch::default();
+        let csv = csv_bytes(dir, runs)?;
+        if std::fs::read(dir.csv_file()).ok().as_deref() != Some(csv.as_slice()) {
+            batch.add(&dir.csv_file(), &csv)?;
+        }
+        let ids: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
+        if self.store.provenance().ok().map(|p| p.runs).as_ref() != Some(&ids) {
+            batch.add_json(&dir.provenance_file(), &provenance_of(manifest, runs, quick))?;
+        }
+        Ok(batch.commit()?)
+    }
+
+    /// Store a finished run, computed under `run`'s lock. `batch` holds its mesh snapshots,
+    /// written while it ran; its record and the summaries listing it join them, then the run's
+    /// previous record and snapshots (a replaced run) are removed and everything is renamed into
+    /// place; then its checkpoint goes. If a write fails, nothing of the run reaches the folder and
+    /// no temporary file is left.
+    pub fn commit_run(&self, run: &RunWriter, manifest: &Manifest, record: &RunRecord, mut batch: Batch, quick: bool) -> Result<()> {
+        self.same_folder(run)?;
+        if record.run.id != run.id {
+            bail!("the record of run {} committed under the lock of run {}", record.run.id, run.id);
+        }
+        let dir = &self.store.dir;
+        let mut runs = self.store.records()?;
+        runs.retain(|r| r.run.id != run.id);
+        runs.push(record.clone());
+        runs.sort_by_key(|r| dir.run_file(&r.run.id));
+        batch.add_json(&dir.run_file(&run.id), record)?;
+        batch.add(&dir.csv_file(), &csv_bytes(dir, &runs)?)?;
+        batch.add_json(&dir.provenance_file(), &provenance_of(manifest, &runs, quick))?;
+        self.remove_stored(run)?;
+        batch.commit()?;
+        checkpoint::remove(dir, &run.id)
+    }
+
+    /// Store a reference solution of finished runs that the study does not hold yet.
+    pub fn commit_reference(&self, reference: &ReferenceRecord) -> Result<()> {
+        let mut batch = Batch::default();
+        stage_reference(&self.store.dir, reference, &mut batch)?;
+        Ok(batch.commit()?)
+    }
+
+    /// After a failure part-way through changing the folder (a removal or a rename that failed):
+    /// remove the orphans and bring the summaries in line with the runs present.
+    pub fn repair(&self, manifest: &Manifest, quick: bool) -> Result<()> {
+        let runs = self.store.records()?;
+        self.remove_orphans(&runs)?;
+        self.sync_summaries(manifest, &runs, quick)
+    }
+
+    /// A run's lock is of this folder (two stores of one process must not mix their guards).
+    fn same_folder(&self, run: &RunWriter) -> Result<()> {
+        if run.store.dir.root != self.store.dir.root {
+            bail!("run {} of {} changed under the lock of {}", run.id, run.store.dir.root.display(), self.store.dir.root.display());
+        }
+        Ok(())
+    }
+}
+
+/// The provenance of the study as it is now, for these runs.
+fn provenance_of(manifest: &Manifest, runs: &[RunRecord], quick: bool) -> Provenance {
+    let meshes = manifest.mesh_files();
+    let meshes: Vec<&std::path::Path> = meshes.iter().map(|p| p.as_path()).collect();
+    let ids = runs.iter().map(|r| r.run.id.clone()).collect();
+    let mut prov = provenance::collect(&manifest.study, &manifest.file, &manifest.bytes, quick, ids, &meshes);
+    prov.problem_files = manifest.problem_files().iter().map(|f| provenance::ProblemFile::of(f)).collect();
+    prov
+}
+
+fn csv_bytes(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<u8>> {
+    dir.csv_bytes(runs).with_context(|| format!("rendering {}", dir.csv_file().display()))
+}
+
+/// Add `reference` to `batch` unless the study stores it already (the same history to the
+/// same NDF).
+fn stage_reference(dir: &StudyDir, reference: &ReferenceRecord, batch: &mut Batch) -> Result<()> {
+    let file = dir.reference_file(&reference.key());
+    let same = |s: &ReferenceRecord| {
+        s.rebuild.history == reference.rebuild.history && s.rebuild.ndof == reference.rebuild.ndof && s.key() == reference.key()
+    };
+    if !matches!(dir.read_reference(&reference.key()), Ok(Some(s)) if same(&s)) {
+        batch.add_json(&file, reference)?;
+    }
+    Ok(())
+}
