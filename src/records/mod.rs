@@ -36,6 +36,15 @@ pub fn is_temporary(name: &str) -> bool {
     !tail.is_empty() && tail.split('.').all(|part| !part.is_empty() && part.bytes().all(|b| b.is_ascii_digit()))
 }
 
+/// The process that writes a temporary file ([`is_temporary`]: `.NAME.tmpPID.N`), from its name.
+pub fn temporary_writer(name: &str) -> Option<u32> {
+    if !is_temporary(name) {
+        return None;
+    }
+    let (_, tail) = name.rsplit_once(".tmp")?;
+    tail.split('.').next()?.parse().ok()
+}
+
 /// A temporary file next to `path`, unique within this process.
 fn temporary_for(path: &Path) -> std::path::PathBuf {
     static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);

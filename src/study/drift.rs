@@ -750,8 +750,8 @@ pub fn check(
                 opts.scratch.clone()
             }
         };
-        let stored_store = Store::new(&opts.results, &m.study);
-        let fresh_store = Store::new(&fresh_root, &m.study);
+        let stored_store = Store::of(&opts.results, m);
+        let fresh_store = Store::of(&fresh_root, m);
         let checked = stored_store.check().with_context(|| format!("reading the stored runs of {}", m.study))?;
         stored_store.note_leftovers(&checked.leftovers);
         let stored = checked.runs;

@@ -148,7 +148,7 @@ pub fn effective_spec(planned: &manifest::PlannedRun, quick: bool) -> RunSpec {
 /// std::fs::remove_dir_all(&results).unwrap();
 /// ```
 pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> {
-    let store = Store::new(&opts.results, &manifest.study);
+    let store = Store::of(&opts.results, manifest);
     let in_shard = |i: usize| opts.shard.is_none_or(|(k, n)| i % n == k - 1);
     let planned: Vec<RunSpec> =
         manifest.runs.iter().enumerate().filter(|(i, _)| in_shard(*i)).map(|(_, p)| effective_spec(p, opts.quick)).collect();
@@ -192,6 +192,15 @@ fn set_up(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &RunOpt
         let (id, why) = match s {
             store::Stale::Undeclared { id } => (id, format!("not declared in {}", manifest.file.display())),
             store::Stale::Damaged { file, what } => (file, format!("a damaged record: {}", what.join("; "))),
+            store::Stale::Summary { file, .. } => {
+                // a summary is rendered again below; a reference at fault is computed again
+                if file.starts_with(store.dir().root.join("references")) {
+                    let key = file.file_stem().map(|k| k.to_string_lossy().into_owned()).unwrap_or_default();
+                    crate::base::note::line(format_args!("{}: removing {} (at fault; computed again)", manifest.study, file.display()));
+                    writer.remove_reference(&key)?;
+                }
+                continue;
+            }
             store::Stale::Differs { .. } => continue,
         };
         crate::base::note::line(format_args!("{}/{id}: removing the stored run and its snapshots ({why})", manifest.study));
@@ -315,7 +324,7 @@ fn interruption(manifest: &Manifest, store: &Store, opts: &RunOptions) -> anyhow
 /// what figures and claims need before they draw from a study. The error names what is missing
 /// or different and how to complete the study.
 pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<()> {
-    let store = Store::new(results, &manifest.study);
+    let store = Store::of(results, manifest);
     let runs = store.read()?;
     let dir = store.dir();
     let mut problems = Vec::new();

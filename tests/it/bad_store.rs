@@ -456,3 +456,53 @@ fn fresh_never_removes_a_run_in_progress_in_either_order() {
     };
     assert_eq!(numbers(&std::fs::read(study.join("runs/a.json")).unwrap()), numbers(&stored));
 }
+
+/// The bytes of every file of a study folder, by relative path (the lock files, which name
+/// their last holder, aside).
+fn contents(study: &Path) -> Vec<(String, Vec<u8>)> {
+    let locks = |f: &String| f == ".lock" || f.starts_with(".locks/");
+    files(study).into_iter().filter(|f| !locks(f)).map(|f| (f.clone(), std::fs::read(study.join(&f)).unwrap())).collect()
+}
+
+#[test]
+fn a_hand_edited_record_or_summary_is_refused_by_run_and_replace_computes_it_again() {
+    let (dir, m) = stored("edited");
+    let study = results_of(&dir);
+    let original: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(study.join("runs/a.json")).unwrap()).unwrap();
+    let mut edited = original.clone();
+    let estimate = edited["levels"][1]["estimate"].as_f64().unwrap();
+    edited["levels"][1]["estimate"] = serde_json::json!(estimate * 1.01);
+    std::fs::write(study.join("runs/a.json"), serde_json::to_string_pretty(&edited).unwrap()).unwrap();
+    // a plain run refuses, naming the run whose record and rows disagree, and changes no file
+    // (it rendered levels.csv from the edited record, and figures then drew the edited number)
+    let before = contents(&study);
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(out.contains("levels.csv") && out.contains("run a level 1") && out.contains("Nothing was run or changed"), "{out}");
+    assert!(contents(&study) == before, "a refused run changed the folder");
+    let (code, out) = signorini(&dir, &["figures", "--results", "results", "--experiments", ".", "--figures", "figs"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(out.contains("study.toml --replace`"), "the advice names the study's manifest: {out}");
+    // --replace computes run a again: the original number is back, not the edited one
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results", "--replace"]);
+    assert_eq!(code, 0, "{out}");
+    let again: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(study.join("runs/a.json")).unwrap()).unwrap();
+    assert_eq!(again["levels"][1]["estimate"], original["levels"][1]["estimate"], "{out}");
+    assert_eq!(consistent(&study), ["a", "b"]);
+    // a summary alone at fault (a row deleted, provenance.json removed): refused, then rendered
+    // again from the records with --replace (run b's rows are missing: b is computed again)
+    let csv = std::fs::read_to_string(study.join("levels.csv")).unwrap();
+    let cut: Vec<&str> = csv.lines().filter(|l| !l.starts_with("b,")).collect();
+    std::fs::write(study.join("levels.csv"), cut.join("\n") + "\n").unwrap();
+    std::fs::remove_file(study.join("provenance.json")).unwrap();
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(out.contains("has no row of run b") && out.contains("provenance.json"), "{out}");
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results", "--replace"]);
+    assert_eq!(code, 0, "{out}");
+    assert!(out.contains("1 run(s) executed"), "only b is computed again: {out}");
+    assert_eq!(consistent(&study), ["a", "b"]);
+    for (code, out) in drift_and_figures(&dir) {
+        assert_eq!(code, 0, "{out}");
+    }
+}

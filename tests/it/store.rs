@@ -224,3 +224,22 @@ fn a_stored_run_another_process_computes_is_not_removed_by_replace() {
     assert_eq!(code, Some(0), "{err}");
     assert!(!dir.run_file("b").exists() && dir.run_file("a").exists(), "{err}");
 }
+
+#[test]
+fn a_temporary_file_of_a_running_writer_is_not_a_leftover() {
+    let d = tmp("writer");
+    let res = d.to_str().unwrap();
+    assert_eq!(signorini(&["run", &fixture(), "--quick", "--shard", "2/2", "--results", res]).0, Some(0));
+    let dir = StudyDir::new(&d, "tiny");
+    // another process commits levels.csv now (its name is in the temporary's), and one that has
+    // ended left its own
+    let mut writer = Command::new("sleep").arg("30").spawn().unwrap();
+    let live = dir.root.join(format!(".levels.csv.tmp{}.0", writer.id()));
+    let dead = dir.root.join(format!(".provenance.json.tmp{}.0", 1 << 23));
+    std::fs::write(&live, "being written").unwrap();
+    std::fs::write(&dead, "left").unwrap();
+    let checked = Store::new(&d, "tiny").check().unwrap();
+    writer.kill().unwrap();
+    writer.wait().unwrap();
+    assert_eq!(checked.leftovers, [dead], "{:?}", checked.leftovers);
+}

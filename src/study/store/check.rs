@@ -68,7 +68,8 @@ pub(super) fn files_in(dir: &std::path::Path) -> Result<Vec<(String, PathBuf)>> 
 /// killed while writing) anywhere in it, and mesh snapshots of a run without a record or of a
 /// level its record does not save (a run killed before it finished, an old binary's leftovers).
 /// Files the study never writes are left alone, and so are the temporary files of a run another
-/// process computes now (its run lock is held; ask under the study lock).
+/// process computes now (its run lock is held; ask under the study lock) and those of a process
+/// that is running (a commit of another process, seen by a reader).
 pub(super) fn orphans(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<PathBuf>> {
     let meshes = dir.root.join("meshes");
     let mut out = Vec::new();
@@ -89,7 +90,10 @@ pub(super) fn orphans(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<PathBuf>
                     StudyDir::parse_mesh_name(target).map(|(run, _)| run.to_string()).filter(|_| sub == meshes)
                 }
             });
-            let in_progress = temporary && of_run.is_some_and(|id| super::lock::run_in_progress(dir, &id));
+            // nor is one whose writer (the process its name holds) is running: a summary being
+            // committed by another process now
+            let writer_alive = temporary && records::temporary_writer(&name).is_some_and(|pid| pid != std::process::id() && super::lock::running(pid));
+            let in_progress = temporary && (writer_alive || of_run.is_some_and(|id| super::lock::run_in_progress(dir, &id)));
             if (temporary || stray_mesh || stray_reference) && !in_progress {
                 out.push(path);
             }
@@ -137,11 +141,21 @@ pub(super) fn snapshot_faults(dir: &StudyDir, record: &RunRecord) -> Vec<(PathBu
 }
 
 /// The first line where two texts differ, shortened, as it reads in each.
+/// (The excerpt starts a little before the first character that differs, so a long line shows
+/// where it differs.)
 pub fn first_difference(a: &str, b: &str) -> (String, String) {
     let (al, bl): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
     let i = (0..al.len().max(bl.len())).find(|&i| al.get(i) != bl.get(i)).unwrap_or(al.len().min(bl.len()));
-    let cut =
-        |s: Option<&&str>| format!("line {}: {}", i + 1, s.map(|s| s.chars().take(60).collect::<String>()).unwrap_or("(none)".into()));
+    let (la, lb): (Vec<char>, Vec<char>) = (al.get(i).unwrap_or(&"").chars().collect(), bl.get(i).unwrap_or(&"").chars().collect());
+    let at = la.iter().zip(&lb).take_while(|(x, y)| x == y).count();
+    let from = at.saturating_sub(20);
+    let cut = |s: Option<&&str>| {
+        let text = s.map(|s| {
+            let excerpt: String = s.chars().skip(from).take(60).collect();
+            if from > 0 { format!("...{excerpt}") } else { excerpt }
+        });
+        format!("line {}: {}", i + 1, text.unwrap_or("(none)".into()))
+    };
     (cut(al.get(i)), cut(bl.get(i)))
 }
 
@@ -154,12 +168,14 @@ pub fn summary_faults(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<Fa
         return Vec::new();
     }
     let mut out = Vec::new();
+    let mut by_run = Vec::new();
     let mut fault = |file: &std::path::Path, what: String| out.push(Fault { file: file.to_path_buf(), what, record: None });
     match (std::fs::read(&csv), dir.csv_bytes(runs)) {
         (Ok(on_disk), Ok(rendered)) if on_disk == rendered => {}
         (Ok(on_disk), Ok(rendered)) => {
             let (a, b) = first_difference(&String::from_utf8_lossy(&on_disk), &String::from_utf8_lossy(&rendered));
             fault(&csv, format!("is not what runs/*.json render: {a}, rendered {b}"));
+            by_run = csv_row_faults(dir, &on_disk, runs);
         }
         (Err(e), _) => fault(&csv, format!("cannot be read ({e})")),
         (_, Err(e)) => fault(&csv, format!("cannot be rendered from the records ({e})")),
@@ -174,7 +190,38 @@ pub fn summary_faults(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<Fa
         Ok(p) if p.study != study => fault(&prov, format!("is the provenance of study {}, not {study}", p.study)),
         Ok(_) => {}
     }
+    out.extend(by_run);
     out
+}
+
+/// The runs whose rows in `levels.csv` (`on_disk`, which differs from what the records render)
+/// are not what their records render, each a fault of its record: a hand-edited record or CSV
+/// row, a run missing from the CSV. Neither side can be trusted, so `run` refuses the folder and
+/// `run --replace` computes those runs again instead of rendering the CSV from the records.
+/// Rows are compared as fields (a CSV saved with other line ends or quoting is a fault of the
+/// file alone, not of a run).
+fn csv_row_faults(dir: &StudyDir, on_disk: &[u8], runs: &[RunRecord]) -> Vec<Fault> {
+    let rows = |bytes: &[u8]| -> Vec<Vec<String>> {
+        let mut reader = csv::ReaderBuilder::new().has_headers(true).flexible(true).from_reader(bytes);
+        reader.records().filter_map(|r| r.ok()).map(|r| r.iter().map(str::to_string).collect()).collect()
+    };
+    let stored = rows(on_disk);
+    let file = dir.csv_file();
+    runs.iter()
+        .filter_map(|r| {
+            let rendered = rows(&dir.csv_bytes(std::slice::from_ref(r)).ok()?);
+            let mine: Vec<&Vec<String>> = stored.iter().filter(|row| row.first() == Some(&r.run.id)).collect();
+            let same = mine.len() == rendered.len() && mine.iter().zip(&rendered).all(|(a, b)| *a == b);
+            (!same).then(|| {
+                let what = match rendered.iter().zip(&mine).position(|(b, a)| *a != b) {
+                    _ if mine.is_empty() => format!("has no row of run {} (runs/{}.json has {} levels)", r.run.id, r.run.id, rendered.len()),
+                    Some(level) => format!("row of run {} level {level} is not what runs/{}.json renders (the record or the row was changed)", r.run.id, r.run.id),
+                    None => format!("has {} rows of run {}, runs/{}.json has {} levels", mine.len(), r.run.id, r.run.id, rendered.len()),
+                };
+                Fault { file: file.clone(), what, record: Some(r.run.id.clone()) }
+            })
+        })
+        .collect()
 }
 
 /// The stored reference solutions against the runs measured against them: each one present

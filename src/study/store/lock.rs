@@ -123,7 +123,7 @@ fn named_pid(text: &str) -> Option<u32> {
 
 /// Whether process `pid` exists (signal 0 checks without sending; EPERM: it exists, owned by
 /// another user).
-fn running(pid: u32) -> bool {
+pub(super) fn running(pid: u32) -> bool {
     let Ok(pid) = libc::pid_t::try_from(pid) else { return false };
     // SAFETY: kill with signal 0 sends nothing; it only reports whether the process exists
     let r = unsafe { libc::kill(pid, 0) };

@@ -41,11 +41,26 @@ use std::path::PathBuf;
 pub struct Store {
     dir: StudyDir,
     study: String,
+    /// The manifest the study is declared in, where known: named in the advice of a refusal.
+    manifest: Option<PathBuf>,
 }
 
 impl Store {
     pub fn new(results: &std::path::Path, study: &str) -> Self {
-        Store { dir: StudyDir::new(results, study), study: study.to_string() }
+        Store { dir: StudyDir::new(results, study), study: study.to_string(), manifest: None }
+    }
+
+    /// The store of `manifest`'s study in `results`, naming the manifest in its advice.
+    pub fn of(results: &std::path::Path, manifest: &crate::study::manifest::Manifest) -> Self {
+        Store { manifest: Some(manifest.file.clone()), ..Store::new(results, &manifest.study) }
+    }
+
+    /// The command that replaces what is at fault in this folder.
+    fn replace_command(&self) -> String {
+        let manifest = self.manifest.clone().unwrap_or_else(|| PathBuf::from("experiments").join(format!("{}.toml", self.study)));
+        let results = self.dir.root.parent().filter(|r| *r != std::path::Path::new("results"));
+        let results = results.map(|r| format!(" --results {}", r.display())).unwrap_or_default();
+        format!("signorini run {} --replace{results}", manifest.display())
     }
 
     /// The folder's layout (paths only; reading and writing go through the store).
@@ -172,10 +187,10 @@ impl Store {
         let checked = self.check()?;
         if !checked.faults.is_empty() {
             anyhow::bail!(
-                "{} does not hold together:{}\nRerun the runs at fault with `signorini run experiments/{}.toml --replace` (or restore the files)",
+                "{} does not hold together:{}\nRerun the runs at fault with `{}` (or restore the files)",
                 self.dir.root.display(),
                 checked.faults_text(),
-                self.study
+                self.replace_command()
             );
         }
         self.note_leftovers(&checked.leftovers);

@@ -56,13 +56,22 @@ pub enum Stale {
     /// A record file (`runs/FILE.json`) at fault in the store's integrity check ([`super::Store::check`]):
     /// what is wrong with it and its snapshots.
     Damaged { file: String, what: Vec<String> },
+    /// A summary (`levels.csv`, `provenance.json`) or a stored reference that is not what the
+    /// records render or name: `run --replace` renders it again once the runs at fault are
+    /// computed again (the summaries hold no number a record does not).
+    Summary { file: std::path::PathBuf, what: String },
 }
 
-/// The record files at fault among `faults` ([`super::Store::check`]), each once with all it has.
+/// Every fault of the folder ([`super::Store::check`]) as a stale entry: a record file at fault
+/// once with all it has, a summary or reference as itself. Nothing at fault is kept silently: `run`
+/// refuses all of them unless told to replace.
 pub fn damaged(faults: &[Fault]) -> Vec<Stale> {
     let mut out: Vec<Stale> = Vec::new();
     for f in faults {
-        let Some(stem) = &f.record else { continue };
+        let Some(stem) = &f.record else {
+            out.push(Stale::Summary { file: f.file.clone(), what: f.what.clone() });
+            continue;
+        };
         let text = f.to_string();
         match out.iter_mut().find(|s| matches!(s, Stale::Damaged { file, .. } if file == stem)) {
             Some(Stale::Damaged { what, .. }) => what.push(text),
@@ -99,13 +108,19 @@ pub fn refusal(manifest: &Manifest, dir: &StudyDir, stale: &[Stale]) -> anyhow::
             Stale::Differs { id, differences } => format!("run {id} is stored with another spec ({})", differences.join("; ")),
             Stale::Undeclared { id } => format!("run {id} is stored but not declared in {}", manifest.file.display()),
             Stale::Damaged { file, what } => format!("the record runs/{file}.json does not hold together ({})", what.join("; ")),
+            Stale::Summary { file, what } => format!("{} {what}", file.strip_prefix(&dir.root).unwrap_or(file).display()),
         })
         .collect();
     anyhow::anyhow!(
         "{}: not overwriting the stored results in {}: {}. Nothing was run or changed. Pass --replace to replace these runs \
-         (records and mesh snapshots; the other stored runs are kept), or --fresh to start the study over",
+         (records and mesh snapshots; the other stored runs are kept){}, or --fresh to start the study over",
         manifest.file.display(),
         dir.root.display(),
-        what.join("; ")
+        what.join("; "),
+        if stale.iter().any(|s| matches!(s, Stale::Summary { .. })) {
+            "; with --replace the summaries and references at fault are made again from the records and runs"
+        } else {
+            ""
+        }
     )
 }

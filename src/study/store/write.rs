@@ -173,6 +173,16 @@ impl Writer<'_> {
         checkpoint::remove(dir, &run.id)
     }
 
+    /// Remove a stored reference solution (`references/KEY.json` at fault): the runs measured
+    /// against it store it again, computed anew ([`Writer::commit_reference`]).
+    pub fn remove_reference(&self, key: &str) -> Result<()> {
+        let file = self.store.dir.reference_file(key);
+        match std::fs::remove_file(&file) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e).with_context(|| format!("removing {}", file.display())),
+            _ => Ok(()),
+        }
+    }
+
     /// Store a reference solution of finished runs that the study does not hold yet.
     pub fn commit_reference(&self, reference: &ReferenceRecord) -> Result<()> {
         let mut batch = Batch::default();
