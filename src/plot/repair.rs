@@ -8,6 +8,7 @@
 use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, ESTIMATE, Figure, NDF_DESC, PALETTE, Style, problem_title, series, slope};
 use crate::analysis::claims::repair::{Fitted, PROBLEMS, Stored};
+use crate::analysis::roles::Roles;
 use crate::records::RunRecord;
 use anyhow::Context;
 use std::path::Path;
@@ -66,9 +67,9 @@ fn panel(f: &Fitted) -> Option<Panel> {
     Some(p)
 }
 
-pub(super) fn estimator_repair(results: &Path) -> anyhow::Result<Built> {
-    let stored =
-        Stored::read(results).with_context(|| format!("reading the runs of the estimator-repair row under {}", results.display()))?;
+pub(super) fn estimator_repair(results: &Path, roles: &Roles) -> anyhow::Result<Built> {
+    let stored = Stored::read(results, roles)
+        .with_context(|| format!("reading the runs of the estimator-repair row under {}", results.display()))?;
     let panels: Vec<Panel> = PROBLEMS.iter().filter_map(|p| panel(&stored.fitted(p))).collect();
     if panels.is_empty() {
         return Ok(Err("no repaired run stored (studies estimator_repair, deep, ex72_large)".to_string()));
