@@ -721,7 +721,8 @@ fn run_drift(
         progress: true,
     };
     let report = study::drift::check(&manifests, only.is_empty(), &options, &|r| {
-        signorini::claims::claims(r, &roles).map(|c| signorini::claims::markdown_for(&c, r))
+        // drift's interface takes an io::Result: the typed error's message travels in it
+        signorini::claims::claims(r, &roles).map(|c| signorini::claims::markdown_for(&c, r)).map_err(std::io::Error::other)
     })?;
     // the table first: a report that cannot be written must not cost it
     if !report.rows.is_empty() {

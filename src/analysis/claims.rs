@@ -17,6 +17,9 @@ mod rollers;
 
 use crate::analysis::roles::{self, DENSE_TWINS, Role, Roles};
 use crate::analysis::verdict::{self, Abscissa, RateReport, RateVerdict, refinement};
+// the paper's C_0 (Section 7, the estimator's default): a reliability row holds when the
+// smallest reliable C_0 of its runs is at most this
+use crate::estimator::estimate::C0_PAPER;
 use crate::records::{MeshSnapshot, RunRecord, StudyDir};
 pub use criterion::{Criterion, Evidence, Kind};
 use std::fmt::Write as _;
@@ -30,11 +33,32 @@ pub const TARGET_HALF_WIDTH: f64 = 0.05;
 /// How far along Gamma_C either side of a claimed refinement location the edge lengths are
 /// compared ([`refinement::local_minimum`]).
 pub const REFINE_REACH: f64 = 0.15;
+/// eta_6 and eta_7 of Example 7.1 vanish: none above this at any level (they are 0 up to
+/// round-off).
+pub const VANISHING: f64 = 1e-12;
+/// Two runs coincide when their errors agree to this relative difference at every common level
+/// (and their NDF exactly): `estimator-repair`'s comparison and the figure `estimator_repair`.
+pub const COINCIDE_REL: f64 = 1e-12;
+/// The rate in NDF at which uniform refinement shrinks an edge (h ~ NDF^-1/2): refinement at a
+/// point is faster than this.
+pub const UNIFORM_H_RATE: f64 = 0.5;
 /// Poisson ratio of Example 7.2 (E = 500, nu = 0.3).
 pub const EX72_NU: f64 = 0.3;
 /// The free boundary of `fb`: contact exactly on [a, 1] x {0}, a = sqrt(2) - 1.
 pub fn fb_free_boundary() -> f64 {
     std::f64::consts::SQRT_2 - 1.0
+}
+
+/// What stops CLAIMS.md from being computed.
+#[derive(Debug, thiserror::Error)]
+pub enum ClaimsError {
+    /// A study's records (or CLAIMS.md itself) cannot be read or written.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// The problem of a stored run cannot be loaded (the row `hertz` needs its geometry): the
+    /// error says which run and why.
+    #[error("{0:#}")]
+    Problem(anyhow::Error),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -491,7 +515,7 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 
     let eta67 = a71.map(|r| r.levels.iter().map(|l| l.terms.eta6.max(l.terms.eta7)).fold(0.0, f64::max));
     let test =
-        Criterion::AtMost { what: format!("the largest eta_6 or eta_7 at any level ({})", source(a71)), limit: 1e-12, interval: false };
+        Criterion::AtMost { what: format!("the largest eta_6 or eta_7 at any level ({})", source(a71)), limit: VANISHING, interval: false };
     out.push(Claim {
         fragile: None,
         id: "7.1-eta6-eta7",
@@ -522,7 +546,7 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let worst = rows.iter().map(|r| r.1).fold(0.0, f64::max);
     let test = Criterion::AtMost {
         what: format!("the smallest reliable C_0 (the largest error / eta_h at any level of {} runs with an error)", rows.len()),
-        limit: 0.45,
+        limit: C0_PAPER,
         interval: false,
     };
     out.push(Claim {
@@ -534,7 +558,7 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             headline: if rows.is_empty() {
                 "n/a".into()
             } else {
-                format!("smallest reliable C_0 {worst:.1e} over {} runs: 0.45 is {:.1} decades above it", rows.len(), (0.45 / worst).log10())
+                format!("smallest reliable C_0 {worst:.1e} over {} runs: 0.45 is {:.1} decades above it", rows.len(), (C0_PAPER / worst).log10())
             },
         },
         claim: "Section 7: C_0 = 0.45 is consistent with the reliability bound (6.1): C_0 eta_h >= ||u - u_h||_Linf at every level, in all experiments".into(),
@@ -721,7 +745,7 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let rows: Vec<(String, f64)> = [ad, wfc, un].into_iter().filter_map(|r| c0_text(&source(r), r?, ctx.err_field())).collect();
     let test = Criterion::AtMost {
         what: format!("the smallest reliable C_0 (the largest error / eta_h at any level of {})", [ad, wfc, un].map(source).join(", ")),
-        limit: 0.45,
+        limit: C0_PAPER,
         interval: false,
     };
     out.push(Claim {
@@ -883,7 +907,7 @@ pub const HERTZ_TOLERANCE: f64 = 0.02;
 /// of the finest adaptive mesh of each run against Hertz's at the run's computed force. The run
 /// `adaptive` is judged; the others (a smaller load) measure how far the finite body is from
 /// Hertz's half-spaces.
-fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
+fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> Result<(), ClaimsError> {
     let study = roles::HERTZ_AS_WRITTEN.study;
     let runs = StudyDir::new(ctx.results, study).read_runs()?;
     let mut rows = Vec::new();
@@ -891,7 +915,7 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let mut headline = None;
     for r in &runs {
         let Some(snap) = latest_mesh(ctx.results, study, &r.run.id) else { continue };
-        let problem = crate::study::stored_problem(ctx.results, study, &r.run).map_err(|e| std::io::Error::other(format!("{e:#}")))?;
+        let problem = crate::study::stored_problem(ctx.results, study, &r.run).map_err(ClaimsError::Problem)?;
         let Some(h) = crate::analysis::hertz::for_problem(problem.as_ref()) else {
             rows.push(format!("{}: problem {} has no circular contact group", r.run.id, r.run.problem));
             continue;
@@ -961,7 +985,7 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 }
 
 /// Every claim with errors sampled one way.
-pub fn claims_with(results: &Path, roles: &Roles, sampling: ErrorSampling) -> std::io::Result<Vec<Claim>> {
+pub fn claims_with(results: &Path, roles: &Roles, sampling: ErrorSampling) -> Result<Vec<Claim>, ClaimsError> {
     let ctx = Ctx { sampling, results, roles };
     let mut out = Vec::new();
     ex71_claims(&ctx, &mut out)?;
@@ -980,7 +1004,7 @@ pub fn claims_with(results: &Path, roles: &Roles, sampling: ErrorSampling) -> st
 /// All claims, from the stored studies under `results` whose runs stand for the `roles`
 /// ([`roles::check`]), and the sampling row: the verdicts recomputed with the error on the dense
 /// lattice.
-pub fn claims(results: &Path, roles: &Roles) -> std::io::Result<Vec<Claim>> {
+pub fn claims(results: &Path, roles: &Roles) -> Result<Vec<Claim>, ClaimsError> {
     let mut out = claims_with(results, roles, ErrorSampling::Quadrature)?;
     let dense = claims_with(results, roles, ErrorSampling::Dense)?;
     let mut dense_runs = Vec::new();
@@ -1119,7 +1143,7 @@ pub fn markdown_for(claims: &[Claim], results: &Path) -> String {
 }
 
 /// Write `CLAIMS.md` into the results folder it is generated from.
-pub fn write(results: &Path, roles: &Roles) -> std::io::Result<()> {
+pub fn write(results: &Path, roles: &Roles) -> Result<(), ClaimsError> {
     let c = claims(results, roles)?;
-    crate::records::write_atomic(&results.join("CLAIMS.md"), markdown_for(&c, results).as_bytes())
+    Ok(crate::records::write_atomic(&results.join("CLAIMS.md"), markdown_for(&c, results).as_bytes())?)
 }

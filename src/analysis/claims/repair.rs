@@ -109,7 +109,7 @@ fn criteria_parts() -> Vec<Criterion> {
         Criterion::Bounded { what: "C_0 (Psi + eta_6 + eta_7) / error (the efficiency with l_h = 1)".into() },
         Criterion::AtMost {
             what: "the smallest reliable C_0 (largest error / eta_h at any level of the run and of its l_h = 1 twin)".into(),
-            limit: 0.45,
+            limit: super::C0_PAPER,
             interval: false,
         },
         Criterion::FewerUnknowns { claim: OPTIMAL },
@@ -165,7 +165,7 @@ fn coincidence(ctx: &Ctx, a: &RunRecord, b: &RunRecord) -> String {
     let differs = (0..n).find(|&i| {
         a.levels[i].ndof != b.levels[i].ndof
             || match (ea[i], eb[i]) {
-                (Some(x), Some(y)) => (x - y).abs() > 1e-12 * x.abs().max(y.abs()),
+                (Some(x), Some(y)) => (x - y).abs() > super::COINCIDE_REL * x.abs().max(y.abs()),
                 (x, y) => x.is_some() != y.is_some(),
             }
     });

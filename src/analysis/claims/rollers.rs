@@ -6,6 +6,7 @@
 //! the free boundary and the efficiency; with the reference's own error (the row of
 //! [`super::ex72::error`]) and the uniform rate that shows the corners gone.
 
+use super::UNIFORM_H_RATE;
 use super::ex72::{Errors, Labels, error, rates};
 use super::{Claim, Criterion, Ctx, EX72_NU, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, growth_text, rate_headline, rate_text, source};
 use crate::analysis::roles::{self, Role};
@@ -174,9 +175,9 @@ fn error_rate(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> 
 fn refinement(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> Claim {
     let rep: Option<RateReport> = ctx.rate(r, Q::Field("h_free_boundary"));
     let last = r.and_then(|r| r.levels.iter().rev().find_map(|l| l.h_free_boundary.map(|h| (h, l.h_min, l.ndof))));
-    let test = Criterion::FasterThan { what: format!("h_fb ({})", source(r)), than: 0.5, abscissa: Abscissa::Ndof };
+    let test = Criterion::FasterThan { what: format!("h_fb ({})", source(r)), than: UNIFORM_H_RATE, abscissa: Abscissa::Ndof };
     Claim {
-        fragile: super::fragility(rep.as_ref(), 0.5),
+        fragile: super::fragility(rep.as_ref(), UNIFORM_H_RATE),
         id: labels.id,
         summary: Summary {
             topic: labels.topic,
@@ -192,7 +193,7 @@ fn refinement(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> 
                 format!(
                     "{}: {}{}",
                     source(Some(r)),
-                    rate_text("h_fb decay", rep.as_ref(), Some(0.5)),
+                    rate_text("h_fb decay", rep.as_ref(), Some(UNIFORM_H_RATE)),
                     last.map(|(h, hmin, n)| format!("; last level: h_fb {h:.1e}, h_min {hmin:.1e} (NDF {n})")).unwrap_or_default()
                 )
             })
