@@ -238,9 +238,12 @@ impl<'a> Legend<'a> {
     }
 }
 
+/// A line panel's chart.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<Axis, Axis>>;
+
 /// The chart as finally built, with its y axis, the legend's corner and the slope labels' anchors.
 struct Placed<'a, DB: DrawingBackend> {
-    chart: ChartContext<'a, DB, Cartesian2d<Axis, Axis>>,
+    chart: Chart<'a, DB>,
     ya: Axis,
     legend_at: Option<(i32, i32)>,
     label_at: Vec<(i32, i32)>,
@@ -253,7 +256,7 @@ struct Placed<'a, DB: DrawingBackend> {
 #[allow(clippy::too_many_arguments)]
 fn place<'a, DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
-    build: &dyn Fn(Axis, i32, i32) -> anyhow::Result<ChartContext<'a, DB, Cartesian2d<Axis, Axis>>>,
+    build: &dyn Fn(Axis, i32, i32) -> anyhow::Result<Chart<'a, DB>>,
     p: &Panel,
     prepared: &[Prepared],
     slopes: &[PlacedSlope],
