@@ -4,7 +4,7 @@
 //! | figure | study / runs | shows |
 //! |---|---|---|
 //! | `fb_error` | `fb`, all runs | like Fig. 2(a): `err_quadrature` (solid, filled circles) and `estimate` (dashed, hollow squares) vs NDF, one colour per run, log-log; NDF^-3/2 below the first run's error; the legend gives each run's last contact zone [`zone_min`, `zone_max`] against [a, 1] |
-//! | `fb_mesh` | `fb`, the largest saved level of `adaptive_wfc` (else of `adaptive`) | the mesh as in Fig. 3(b) (same drawing), with the free boundary x = a dashed |
+//! | `fb_mesh` | `fb`, the largest saved level of the run of role `without-full-contact` (else of `as-written`) | the mesh as in Fig. 3(b) (same drawing), with the free boundary x = a dashed |
 
 use super::{
     Built, ERR, ESTIMATE, Figure, Marker, NDF_DESC, PALETTE, Panel, Slope, SlopeAnchor, Style, mesh_figure, runs, saved_levels, series,

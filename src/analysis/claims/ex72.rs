@@ -355,7 +355,7 @@ fn eta6_eta7(a72: Option<&RunRecord>) -> Claim {
 fn where_refined(ctx: &Ctx, a72: Option<&RunRecord>, wfc: Option<&RunRecord>) -> Claim {
     // where the adaptive mesh refines: local minima of h along Gamma_C = {1} x (0, 1), corners
     let mut parts = Vec::new();
-    // (free boundary, corners) of ex72/adaptive, the run judged
+    // (free boundary, corners) of the run of role ex72 `as-written`, the run judged
     let mut judged: Option<(bool, bool)> = None;
     let mut headline = Vec::new();
     let judged_role: Role = roles::EX72_AS_WRITTEN;
