@@ -190,6 +190,9 @@ enum Command {
         /// DIR/drift-report.json with --results DIR].
         #[arg(long, value_name = "FILE")]
         drift_report: Option<std::path::PathBuf>,
+        /// Folder of the study manifests, whose run roles the CLAIMS rows read.
+        #[arg(long, default_value = "experiments")]
+        experiments: std::path::PathBuf,
     },
     /// Solve as `solve` does and write the mesh and solution for the NGSolve cross-check
     /// (OUT/mesh.vtu, OUT/case.json: the report `solve --json` prints).
@@ -705,6 +708,8 @@ fn run_drift(
     }
     let results = if is_tracked_results(results) { std::path::Path::new("results") } else { results };
     let manifests = study::manifest::declared(experiments, only)?;
+    // what the CLAIMS rows need, checked before any run is rerun
+    let roles = signorini::analysis::roles::read(experiments)?;
     let older = report_to_merge_into(report_file)?;
     let scratch = std::path::PathBuf::from("target/drift").join(if quick { "quick" } else { "full" });
     let options = study::drift::DriftOptions {
@@ -716,7 +721,8 @@ fn run_drift(
         progress: true,
     };
     let report = study::drift::check(&manifests, only.is_empty(), &options, &|r| {
-        signorini::claims::claims(r).map(|c| signorini::claims::markdown_for(&c, r))
+        // drift's interface takes an io::Result: the typed error's message travels in it
+        signorini::claims::claims(r, &roles).map(|c| signorini::claims::markdown_for(&c, r)).map_err(std::io::Error::other)
     })?;
     // the table first: a report that cannot be written must not cost it
     if !report.rows.is_empty() {
@@ -784,14 +790,16 @@ fn run_figures(
         _ => std::path::PathBuf::from("results"),
     };
     let figures = figures.map(|f| f.to_path_buf()).unwrap_or_else(|| if tracked { "figures".into() } else { results.join("figures") });
+    // what the figures and CLAIMS rows need, checked when the manifests are read
+    let roles = signorini::analysis::roles::read(experiments)?;
     let (checked, drawn) = figure_studies(&results, tracked, experiments, only)?;
     for m in &checked {
         study::check_complete(m, &results)?;
     }
-    for f in signorini::plot::draw_studies(&results, &figures, drawn.as_deref())? {
+    for f in signorini::plot::draw_studies(&results, &figures, &roles, drawn.as_deref())? {
         println!("wrote {}", f.display());
     }
-    signorini::claims::write(&results).with_context(|| format!("writing {}", results.join("CLAIMS.md").display()))?;
+    signorini::claims::write(&results, &roles).with_context(|| format!("writing {}", results.join("CLAIMS.md").display()))?;
     println!("wrote {}", results.join("CLAIMS.md").display());
     Ok(())
 }
@@ -803,14 +811,16 @@ fn run_report(
     out: Option<&std::path::Path>,
     studies: &[String],
     drift_report: Option<&std::path::Path>,
+    experiments: &std::path::Path,
 ) -> Result<()> {
+    let roles = signorini::analysis::roles::read(experiments)?;
     let tracked = results.is_none_or(is_tracked_results);
     let results = results.map_or_else(|| std::path::PathBuf::from("results"), |r| r.to_path_buf());
     let under = |tracked_default: &str, scratch: &str| if tracked { tracked_default.into() } else { results.join(scratch) };
     let figures = figures.map_or_else(|| under("figures", "figures"), |f| f.to_path_buf());
     let out = out.map_or_else(|| under("target/report", "report"), |o| o.to_path_buf());
     let drift = drift_report.map_or_else(|| under("target/drift/report.json", "drift-report.json"), |d| d.to_path_buf());
-    for page in signorini::page::write_pages(&results, &figures, &out, studies, &drift)? {
+    for page in signorini::page::write_pages(&results, &figures, &out, studies, &drift, &roles)? {
         println!("wrote {}", page.display());
     }
     Ok(())
@@ -886,8 +896,8 @@ fn main() -> ExitCode {
             run_studies(manifests, *jobs, shard.as_deref(), results.clone(), flags)
         }
         Command::Export { args, out } => run_export(args, out),
-        Command::Report { results, figures, out, study, drift_report } => {
-            run_report(results.as_deref(), figures.as_deref(), out.as_deref(), study, drift_report.as_deref())
+        Command::Report { results, figures, out, study, drift_report, experiments } => {
+            run_report(results.as_deref(), figures.as_deref(), out.as_deref(), study, drift_report.as_deref(), experiments)
         }
     };
     // what was computed and kept stays; output that could not be written is an error

@@ -15,7 +15,11 @@ mod ex72;
 pub mod repair;
 mod rollers;
 
+use crate::analysis::roles::{self, DENSE_TWINS, Role, Roles};
 use crate::analysis::verdict::{self, Abscissa, RateReport, RateVerdict, refinement};
+// the paper's C_0 (Section 7, the estimator's default): a reliability row holds when the
+// smallest reliable C_0 of its runs is at most this
+use crate::estimator::estimate::C0_PAPER;
 use crate::records::{MeshSnapshot, RunRecord, StudyDir};
 pub use criterion::{Criterion, Evidence, Kind};
 use std::fmt::Write as _;
@@ -29,11 +33,32 @@ pub const TARGET_HALF_WIDTH: f64 = 0.05;
 /// How far along Gamma_C either side of a claimed refinement location the edge lengths are
 /// compared ([`refinement::local_minimum`]).
 pub const REFINE_REACH: f64 = 0.15;
+/// eta_6 and eta_7 of Example 7.1 vanish: none above this at any level (they are 0 up to
+/// round-off).
+pub const VANISHING: f64 = 1e-12;
+/// Two runs coincide when their errors agree to this relative difference at every common level
+/// (and their NDF exactly): `estimator-repair`'s comparison and the figure `estimator_repair`.
+pub const COINCIDE_REL: f64 = 1e-12;
+/// The rate in NDF at which uniform refinement shrinks an edge (h ~ NDF^-1/2): refinement at a
+/// point is faster than this.
+pub const UNIFORM_H_RATE: f64 = 0.5;
 /// Poisson ratio of Example 7.2 (E = 500, nu = 0.3).
 pub const EX72_NU: f64 = 0.3;
 /// The free boundary of `fb`: contact exactly on [a, 1] x {0}, a = sqrt(2) - 1.
 pub fn fb_free_boundary() -> f64 {
     std::f64::consts::SQRT_2 - 1.0
+}
+
+/// What stops CLAIMS.md from being computed.
+#[derive(Debug, thiserror::Error)]
+pub enum ClaimsError {
+    /// A study's records (or CLAIMS.md itself) cannot be read or written.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// The problem of a stored run cannot be loaded (the row `hertz` needs its geometry): the
+    /// error says which run and why.
+    #[error("{0:#}")]
+    Problem(anyhow::Error),
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -135,16 +160,30 @@ enum Q<'a> {
 struct Ctx<'r> {
     sampling: ErrorSampling,
     results: &'r Path,
+    /// What the stored runs stand for: every row finds its runs by role ([`Roles::find`]).
+    roles: &'r Roles,
 }
 
 impl Ctx<'_> {
-    /// The run `id` of `runs`; in the dense pass its `ID_dense` twin (estimator maxima on the
-    /// dense lattice too) where the study has one.
-    fn pick<'a>(&self, runs: &'a [RunRecord], id: &str) -> Option<&'a RunRecord> {
-        match self.sampling {
-            ErrorSampling::Dense => run(runs, &format!("{id}_dense")).or_else(|| run(runs, id)),
-            ErrorSampling::Quadrature => run(runs, id),
+    /// The run of `runs` that stands for `role` ([`Roles::find`]).
+    fn find<'a>(&self, runs: &'a [RunRecord], role: Role) -> Option<&'a RunRecord> {
+        self.roles.find(runs, role)
+    }
+
+    /// The run of `role`; in the dense pass its twin (estimator maxima on the dense lattice too,
+    /// [`DENSE_TWINS`]) where the study has one.
+    fn pick<'a>(&self, runs: &'a [RunRecord], role: Role) -> Option<&'a RunRecord> {
+        let twin = DENSE_TWINS.iter().find(|(plain, _)| *plain == role).map(|(_, twin)| *twin);
+        match (self.sampling, twin) {
+            (ErrorSampling::Dense, Some(twin)) => self.find(runs, twin).or_else(|| self.find(runs, role)),
+            _ => self.find(runs, role),
         }
+    }
+
+    /// The run of `role` in the deep study where it is stored, else `fallback` (a smaller
+    /// study's run).
+    fn deep_or<'a>(&self, deep: &'a [RunRecord], role: Role, fallback: Option<&'a RunRecord>) -> Option<&'a RunRecord> {
+        self.find(deep, role).or(fallback)
     }
 
     fn err_field(&self) -> &'static str {
@@ -202,15 +241,6 @@ impl Ctx<'_> {
     fn floor_text(&self, r: &RunRecord) -> String {
         verdict::floor_text(r, &self.values(r, Q::Error))
     }
-}
-
-fn run<'a>(runs: &'a [RunRecord], id: &str) -> Option<&'a RunRecord> {
-    runs.iter().find(|r| r.run.id == id)
-}
-
-/// The run `id` of the deep study where it is stored, else `fallback` (a smaller study's run).
-fn deep_or<'a>(deep: &'a [RunRecord], id: &str, fallback: Option<&'a RunRecord>) -> Option<&'a RunRecord> {
-    run(deep, id).or(fallback)
 }
 
 /// "study/run" of a run, for the rows to say what they fit.
@@ -362,10 +392,10 @@ fn latest_mesh(results: &Path, study: &str, run: &str) -> Option<MeshSnapshot> {
 fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let load = |s: &str| StudyDir::new(ctx.results, s).read_runs();
     let (ex71, ct, deep) = (load("ex71")?, load("contact_term_ablation")?, load("deep")?);
-    let a71 = deep_or(&deep, "ex71_as_written", ctx.pick(&ex71, "adaptive"));
-    let u71 = deep_or(&deep, "ex71_uniform", run(&ex71, "uniform"));
-    let u71c = run(&ex71, "uniform_cartesian");
-    let wfc = deep_or(&deep, "ex71_without_full_contact", ctx.pick(&ct, "ex71_without_full_contact"));
+    let a71 = ctx.deep_or(&deep, roles::DEEP_EX71_AS_WRITTEN, ctx.pick(&ex71, roles::EX71_AS_WRITTEN));
+    let u71 = ctx.deep_or(&deep, roles::DEEP_EX71_UNIFORM, ctx.find(&ex71, roles::EX71_UNIFORM));
+    let u71c = ctx.find(&ex71, roles::EX71_UNIFORM_CARTESIAN);
+    let wfc = ctx.deep_or(&deep, roles::DEEP_EX71_WFC, ctx.pick(&ct, roles::ABLATION_EX71_WFC));
 
     let err = ctx.rate(a71, Q::Error);
     let with_floor = |name: &str, r: Option<&RunRecord>| {
@@ -440,13 +470,14 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         measured: format!(
             "adaptive ({}): {}. Reading of sigma-hat (sigma n in a frame whose e_1 is the normal), the rows above: sigma-hat_1 = n . sigma n (normal stress, eta_5), sigma-hat_2 = t . sigma n (eta_4); \
              |sigma_nn| is 3 to 6 on all of Gamma_C, so eta_5 ~ h. Uniform refinement ({}), this reading: {}; {}. \
-             Read literally as Cartesian components (estimator.stress_frame = \"cartesian\", run ex71/uniform_cartesian), sigma-hat_1 = -sigma_12 (zero for the exact solution) and sigma-hat_2 = -sigma_22: {}; {}. \
+             Read literally as Cartesian components (estimator.stress_frame = \"cartesian\", run {}), sigma-hat_1 = -sigma_12 (zero for the exact solution) and sigma-hat_2 = -sigma_22: {}; {}. \
              The slower of eta_4, eta_5 decays at {} (this reading) and {} (literal reading)",
             source(a71),
             terms.join("; "),
             source(u71),
             rate_text("eta4", ctx.rate(u71, Q::Field("eta4")).as_ref(), Some(OPTIMAL)),
             rate_text("eta5", ctx.rate(u71, Q::Field("eta5")).as_ref(), Some(OPTIMAL)),
+            ctx.roles.source(roles::EX71_UNIFORM_CARTESIAN),
             rate_text("eta4", ctx.rate(u71c, Q::Field("eta4")).as_ref(), Some(OPTIMAL)),
             rate_text("eta5", ctx.rate(u71c, Q::Field("eta5")).as_ref(), Some(OPTIMAL)),
             slower(u71),
@@ -484,7 +515,7 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 
     let eta67 = a71.map(|r| r.levels.iter().map(|l| l.terms.eta6.max(l.terms.eta7)).fold(0.0, f64::max));
     let test =
-        Criterion::AtMost { what: format!("the largest eta_6 or eta_7 at any level ({})", source(a71)), limit: 1e-12, interval: false };
+        Criterion::AtMost { what: format!("the largest eta_6 or eta_7 at any level ({})", source(a71)), limit: VANISHING, interval: false };
     out.push(Claim {
         fragile: None,
         id: "7.1-eta6-eta7",
@@ -515,7 +546,7 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let worst = rows.iter().map(|r| r.1).fold(0.0, f64::max);
     let test = Criterion::AtMost {
         what: format!("the smallest reliable C_0 (the largest error / eta_h at any level of {} runs with an error)", rows.len()),
-        limit: 0.45,
+        limit: C0_PAPER,
         interval: false,
     };
     out.push(Claim {
@@ -527,7 +558,7 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             headline: if rows.is_empty() {
                 "n/a".into()
             } else {
-                format!("smallest reliable C_0 {worst:.1e} over {} runs: 0.45 is {:.1} decades above it", rows.len(), (0.45 / worst).log10())
+                format!("smallest reliable C_0 {worst:.1e} over {} runs: 0.45 is {:.1} decades above it", rows.len(), (C0_PAPER / worst).log10())
             },
         },
         claim: "Section 7: C_0 = 0.45 is consistent with the reliability bound (6.1): C_0 eta_h >= ||u - u_h||_Linf at every level, in all experiments".into(),
@@ -555,14 +586,14 @@ fn efficiency_size_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()>
     let mut rows = Vec::new();
     let mut per_problem: Vec<(&str, f64)> = Vec::new();
     for (problem, runs, ids) in [
-        ("ex71", &deep, ["ex71_as_written", "ex71_without_full_contact", "ex71_repaired"]),
-        ("fb", &deep, ["fb_as_written", "fb_without_full_contact", "fb_repaired"]),
-        ("ex72", &large, ["adaptive", "without_full_contact", "repaired"]),
-        ("ex72_rollers", &rollers, ["adaptive", "without_full_contact", "repaired"]),
-        ("hertz", &hertz, ["adaptive", "adaptive_light", "repaired"]),
+        ("ex71", &deep, [roles::DEEP_EX71_AS_WRITTEN, roles::DEEP_EX71_WFC, roles::DEEP_EX71_REPAIRED]),
+        ("fb", &deep, [roles::DEEP_FB_AS_WRITTEN, roles::DEEP_FB_WFC, roles::DEEP_FB_REPAIRED]),
+        ("ex72", &large, [roles::LARGE_AS_WRITTEN, roles::LARGE_WFC, roles::LARGE_REPAIRED]),
+        ("ex72_rollers", &rollers, [roles::ROLLERS_AS_WRITTEN, roles::ROLLERS_WFC, roles::ROLLERS_REPAIRED]),
+        ("hertz", &hertz, [roles::HERTZ_AS_WRITTEN, roles::HERTZ_LIGHT, roles::HERTZ_REPAIRED]),
     ] {
-        for id in ids {
-            let Some(r) = run(runs, id) else { continue };
+        for role in ids {
+            let Some(r) = ctx.find(runs, role) else { continue };
             let Some(rep) = ctx.rate(Some(r), Q::Error) else { continue };
             let eff = ctx.values(r, Q::Efficiency);
             let window: Vec<f64> = (rep.main.first_level..=rep.main.last_level).filter_map(|l| eff.get(l).copied().flatten()).collect();
@@ -672,9 +703,9 @@ fn log_factor_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let fb = StudyDir::new(ctx.results, "fb").read_runs()?;
     let deep = StudyDir::new(ctx.results, "deep").read_runs()?;
-    let ad = deep_or(&deep, "fb_as_written", run(&fb, "adaptive"));
-    let wfc = deep_or(&deep, "fb_without_full_contact", run(&fb, "adaptive_wfc"));
-    let un = deep_or(&deep, "fb_uniform", run(&fb, "uniform"));
+    let ad = ctx.deep_or(&deep, roles::DEEP_FB_AS_WRITTEN, ctx.find(&fb, roles::FB_AS_WRITTEN));
+    let wfc = ctx.deep_or(&deep, roles::DEEP_FB_WFC, ctx.find(&fb, roles::FB_WFC));
+    let un = ctx.deep_or(&deep, roles::DEEP_FB_UNIFORM, ctx.find(&fb, roles::FB_UNIFORM));
     let a = fb_free_boundary();
     let none = ad.is_none();
 
@@ -714,7 +745,7 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let rows: Vec<(String, f64)> = [ad, wfc, un].into_iter().filter_map(|r| c0_text(&source(r), r?, ctx.err_field())).collect();
     let test = Criterion::AtMost {
         what: format!("the smallest reliable C_0 (the largest error / eta_h at any level of {})", [ad, wfc, un].map(source).join(", ")),
-        limit: 0.45,
+        limit: C0_PAPER,
         interval: false,
     };
     out.push(Claim {
@@ -770,13 +801,14 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let mut parts = Vec::new();
     // the first mesh found decides
     let mut decides: Option<(String, bool)> = None;
-    for id in ["adaptive_wfc", "adaptive"] {
-        let Some(m) = latest_mesh(ctx.results, "fb", id) else { continue };
+    let meshes = [roles::FB_WFC, roles::FB_AS_WRITTEN];
+    for id in meshes.iter().filter_map(|&role| ctx.roles.id(role)) {
+        let Some(m) = latest_mesh(ctx.results, roles::FB_WFC.study, id) else { continue };
         let prof = refinement::profile(&m, [0.0, 0.0], [1.0, 0.0]);
         match refinement::local_minimum(&prof, a, REFINE_REACH) {
             Some(lm) => {
                 if decides.is_none() {
-                    decides = Some((format!("fb/{id} level {}", m.level), lm.holds));
+                    decides = Some((format!("{}/{id} level {}", roles::FB_WFC.study, m.level), lm.holds));
                 }
                 parts.push(format!(
                     "{id} level {} (NDF {}): at x = a {} → {}",
@@ -792,7 +824,7 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let test = Criterion::Test {
         passes_if: format!(
             "the edge length along Gamma_C on the last saved mesh of {} has a local minimum (or a plateau of its own) at x = a: no edge within {REFINE_REACH} of a on either side is smaller than the edges at a, and one on each side is larger",
-            decides.as_ref().map_or("fb/adaptive_wfc (else fb/adaptive)".into(), |d| d.0.clone())
+            decides.as_ref().map_or(format!("{} (else {})", ctx.roles.source(meshes[0]), ctx.roles.source(meshes[1])), |d| d.0.clone())
         ),
         open_if_not: false,
     };
@@ -875,14 +907,15 @@ pub const HERTZ_TOLERANCE: f64 = 0.02;
 /// of the finest adaptive mesh of each run against Hertz's at the run's computed force. The run
 /// `adaptive` is judged; the others (a smaller load) measure how far the finite body is from
 /// Hertz's half-spaces.
-fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let runs = StudyDir::new(ctx.results, "hertz").read_runs()?;
+fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> Result<(), ClaimsError> {
+    let study = roles::HERTZ_AS_WRITTEN.study;
+    let runs = StudyDir::new(ctx.results, study).read_runs()?;
     let mut rows = Vec::new();
     let mut judged: Option<Evidence> = None;
     let mut headline = None;
     for r in &runs {
-        let Some(snap) = latest_mesh(ctx.results, "hertz", &r.run.id) else { continue };
-        let problem = crate::study::stored_problem(ctx.results, "hertz", &r.run).map_err(|e| std::io::Error::other(format!("{e:#}")))?;
+        let Some(snap) = latest_mesh(ctx.results, study, &r.run.id) else { continue };
+        let problem = crate::study::stored_problem(ctx.results, study, &r.run).map_err(ClaimsError::Problem)?;
         let Some(h) = crate::analysis::hertz::for_problem(problem.as_ref()) else {
             rows.push(format!("{}: problem {} has no circular contact group", r.run.id, r.run.problem));
             continue;
@@ -909,23 +942,27 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             100.0 * c.peak_deviation(),
             c.profile_deviation
         ));
-        if r.run.id == "adaptive" {
+        if ctx.roles.id(roles::HERTZ_AS_WRITTEN) == Some(r.run.id.as_str()) {
             let a_dev = c.half_width_deviation();
             let (lo, hi) = (a_dev.abs() - res, a_dev.abs() + res);
             let p_dev = c.peak_deviation().abs();
             headline = Some(format!(
-                "a_h - a {:+.2}% to {:+.2}%, p0 {:+.2}% (NDF {}, hertz/adaptive)",
+                "a_h - a {:+.2}% to {:+.2}%, p0 {:+.2}% (NDF {}, {})",
                 100.0 * (c.half_width_deviation() - res),
                 100.0 * (c.half_width_deviation() + res),
                 100.0 * c.peak_deviation(),
-                snap.ndof
+                snap.ndof,
+                source(Some(r))
             ));
             judged = Some(Evidence::All(vec![Some(Evidence::Interval(lo, hi)), Some(Evidence::Value(p_dev))]));
         }
     }
     let test = Criterion::All(vec![
         Criterion::AtMost {
-            what: "|a_h - a| / a on hertz/adaptive's finest mesh (a_h ± half the node spacing at the zone's ends)".into(),
+            what: format!(
+                "|a_h - a| / a on {}'s finest mesh (a_h ± half the node spacing at the zone's ends)",
+                ctx.roles.source(roles::HERTZ_AS_WRITTEN)
+            ),
             limit: HERTZ_TOLERANCE,
             interval: true,
         },
@@ -948,8 +985,8 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 }
 
 /// Every claim with errors sampled one way.
-pub fn claims_with(results: &Path, sampling: ErrorSampling) -> std::io::Result<Vec<Claim>> {
-    let ctx = Ctx { sampling, results };
+pub fn claims_with(results: &Path, roles: &Roles, sampling: ErrorSampling) -> Result<Vec<Claim>, ClaimsError> {
+    let ctx = Ctx { sampling, results, roles };
     let mut out = Vec::new();
     ex71_claims(&ctx, &mut out)?;
     c0_claim(&ctx, &mut out)?;
@@ -964,17 +1001,16 @@ pub fn claims_with(results: &Path, sampling: ErrorSampling) -> std::io::Result<V
     Ok(out)
 }
 
-/// All claims, from the stored studies under `results`, and the sampling row: the verdicts
-/// recomputed with the error on the dense lattice.
-pub fn claims(results: &Path) -> std::io::Result<Vec<Claim>> {
-    let mut out = claims_with(results, ErrorSampling::Quadrature)?;
-    let dense = claims_with(results, ErrorSampling::Dense)?;
+/// All claims, from the stored studies under `results` whose runs stand for the `roles`
+/// ([`roles::check`]), and the sampling row: the verdicts recomputed with the error on the dense
+/// lattice.
+pub fn claims(results: &Path, roles: &Roles) -> Result<Vec<Claim>, ClaimsError> {
+    let mut out = claims_with(results, roles, ErrorSampling::Quadrature)?;
+    let dense = claims_with(results, roles, ErrorSampling::Dense)?;
     let mut dense_runs = Vec::new();
-    for study in ["ex71", "ex72", "contact_term_ablation"] {
-        for r in StudyDir::new(results, study).read_runs()? {
-            if r.run.id.ends_with("_dense") {
-                dense_runs.push(format!("{study}/{}", r.run.id));
-            }
+    for (_, twin) in DENSE_TWINS {
+        if let Some(r) = roles.find(&StudyDir::new(results, twin.study).read_runs()?, twin) {
+            dense_runs.push(source(Some(r)));
         }
     }
     for (q, d) in out.iter_mut().zip(&dense) {
@@ -1107,7 +1143,7 @@ pub fn markdown_for(claims: &[Claim], results: &Path) -> String {
 }
 
 /// Write `CLAIMS.md` into the results folder it is generated from.
-pub fn write(results: &Path) -> std::io::Result<()> {
-    let c = claims(results)?;
-    crate::records::write_atomic(&results.join("CLAIMS.md"), markdown_for(&c, results).as_bytes())
+pub fn write(results: &Path, roles: &Roles) -> Result<(), ClaimsError> {
+    let c = claims(results, roles)?;
+    Ok(crate::records::write_atomic(&results.join("CLAIMS.md"), markdown_for(&c, results).as_bytes())?)
 }

@@ -5,4 +5,5 @@
 
 pub mod claims;
 pub mod hertz;
+pub mod roles;
 pub mod verdict;

@@ -7,10 +7,11 @@
 
 use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, ESTIMATE, Figure, NDF_DESC, PALETTE, Style, runs, series, slope};
+use crate::analysis::roles::{self, Roles};
 use crate::analysis::verdict::FLOOR_MARGIN;
 use std::path::Path;
 
-const STUDY: &str = "deep";
+const STUDY: &str = roles::DEEP_EX71_AS_WRITTEN.study;
 
 pub(super) fn deep_error(results: &Path) -> anyhow::Result<Built> {
     let runs = match runs(results, STUDY)? {
@@ -44,18 +45,21 @@ pub(super) fn deep_error(results: &Path) -> anyhow::Result<Built> {
 
 /// Error, estimate and round-off floor together: where the error of a deep run would meet
 /// [`FLOOR_MARGIN`] x the floor, its fits end.
-pub(super) fn deep_floor(results: &Path) -> anyhow::Result<Built> {
+pub(super) fn deep_floor(results: &Path, roles: &Roles) -> anyhow::Result<Built> {
     let runs = match runs(results, STUDY)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
     let mut panels = Vec::new();
-    for (problem, title) in [("ex71", "Example 7.1"), ("fb", "free boundary (fb)")] {
+    let problems = [
+        ("Example 7.1", [(roles::DEEP_EX71_AS_WRITTEN, "as written"), (roles::DEEP_EX71_UNIFORM, "uniform")]),
+        ("free boundary (fb)", [(roles::DEEP_FB_AS_WRITTEN, "as written"), (roles::DEEP_FB_UNIFORM, "uniform")]),
+    ];
+    for (title, variants) in problems {
         let mut p =
             Panel::new(format!("{title}: error, estimate and round-off floor"), NDF_DESC, "sup-norm of the displacement".to_string());
-        for (k, variant) in ["as_written", "uniform"].into_iter().enumerate() {
-            let Some(r) = runs.iter().find(|r| r.run.id == format!("{problem}_{variant}")) else { continue };
-            let label = variant.replace('_', " ");
+        for (k, (role, label)) in variants.into_iter().enumerate() {
+            let Some(r) = roles.find(&runs, role) else { continue };
             let style = |i: usize, dashed: bool, filled: bool| Style {
                 color: PALETTE[(3 * k + i) % PALETTE.len()],
                 marker: MARKERS[(3 * k + i) % MARKERS.len()],
@@ -64,7 +68,7 @@ pub(super) fn deep_floor(results: &Path) -> anyhow::Result<Built> {
                 large: false,
             };
             p.series.push(series(r, format!("{label}: error {ERR}"), style(0, false, true), |l| l.err_quadrature));
-            if variant != "uniform" {
+            if r.run.refine != crate::records::Refine::Uniform {
                 p.series.push(series(r, format!("{label}: {ESTIMATE}"), style(1, false, false), |l| Some(l.terms.estimate)));
             }
             p.series.push(series(r, format!("{label}: {FLOOR_MARGIN} × round-off floor"), style(2, true, false), |l| {

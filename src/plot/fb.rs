@@ -4,18 +4,19 @@
 //! | figure | study / runs | shows |
 //! |---|---|---|
 //! | `fb_error` | `fb`, all runs | like Fig. 2(a): `err_quadrature` (solid, filled circles) and `estimate` (dashed, hollow squares) vs NDF, one colour per run, log-log; NDF^-3/2 below the first run's error; the legend gives each run's last contact zone [`zone_min`, `zone_max`] against [a, 1] |
-//! | `fb_mesh` | `fb`, the largest saved level of `adaptive_wfc` (else of `adaptive`) | the mesh as in Fig. 3(b) (same drawing), with the free boundary x = a dashed |
+//! | `fb_mesh` | `fb`, the largest saved level of the run of role `without-full-contact` (else of `as-written`) | the mesh as in Fig. 3(b) (same drawing), with the free boundary x = a dashed |
 
 use super::{
     Built, ERR, ESTIMATE, Figure, Marker, NDF_DESC, PALETTE, Panel, Slope, SlopeAnchor, Style, mesh_figure, runs, saved_levels, series,
     single, slope,
 };
+use crate::analysis::roles::{self, Roles};
 use crate::problems::Fb;
 use crate::records::StudyDir;
 use anyhow::Context;
 use std::path::Path;
 
-const STUDY: &str = "fb";
+const STUDY: &str = roles::FB_AS_WRITTEN.study;
 
 pub(super) fn fb_error(results: &Path) -> anyhow::Result<Built> {
     let runs = match runs(results, STUDY)? {
@@ -62,11 +63,14 @@ pub(super) fn fb_error(results: &Path) -> anyhow::Result<Built> {
     Ok(Ok(single(p)))
 }
 
-pub(super) fn fb_mesh(results: &Path) -> anyhow::Result<Built> {
+/// The finest saved mesh of the run without full-contact nodes, else of the run with eta_5 as
+/// written (the meshes the row `fb-refinement` reads).
+pub(super) fn fb_mesh(results: &Path, roles: &Roles) -> anyhow::Result<Built> {
     let dir = StudyDir::new(results, STUDY);
-    let found = ["adaptive_wfc", "adaptive"].into_iter().find_map(|run| saved_levels(&dir, run).into_iter().max().map(|l| (run, l)));
+    let ids: Vec<&str> = [roles::FB_WFC, roles::FB_AS_WRITTEN].into_iter().filter_map(|role| roles.id(role)).collect();
+    let found = ids.iter().find_map(|&run| saved_levels(&dir, run).into_iter().max().map(|l| (run, l)));
     let Some((run, level)) = found else {
-        return Ok(Err(format!("no mesh snapshot of runs adaptive_wfc or adaptive in {}", dir.root.join("meshes").display())));
+        return Ok(Err(format!("no mesh snapshot of runs {} in {}", ids.join(" or "), dir.root.join("meshes").display())));
     };
     let snap = dir.read_mesh(run, level).with_context(|| format!("reading the mesh snapshot of {run} level {level}"))?;
     let mut fig = mesh_figure(&snap, "");

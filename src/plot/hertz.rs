@@ -9,12 +9,13 @@
 use super::render::{LineFigure, Series};
 use super::{Built, Figure, Marker, PALETTE, Panel, Style, YScale, mesh_figure, runs, saved_levels};
 use crate::analysis::hertz::{self, Hertz};
+use crate::analysis::roles::{self, Roles};
 use crate::records::{MeshSnapshot, RunRecord, StudyDir};
 use anyhow::Context;
 use plotters::style::RGBColor;
 use std::path::Path;
 
-const STUDY: &str = "hertz";
+const STUDY: &str = roles::HERTZ_AS_WRITTEN.study;
 
 /// A run's Hertz solution (from its problem) and its finest saved snapshot.
 fn finest(results: &Path, r: &RunRecord) -> anyhow::Result<Option<(Hertz, MeshSnapshot)>> {
@@ -111,13 +112,13 @@ pub(super) fn hertz_pressure(results: &Path) -> anyhow::Result<Built> {
     })))
 }
 
-pub(super) fn hertz_mesh(results: &Path) -> anyhow::Result<Built> {
+pub(super) fn hertz_mesh(results: &Path, roles: &Roles) -> anyhow::Result<Built> {
     let runs = match runs(results, STUDY)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
-    let Some(r) = runs.iter().find(|r| r.run.id == "adaptive").or(runs.first()) else {
-        return Ok(Err(format!("study {STUDY} has no runs")));
+    let Some(r) = roles.find(&runs, roles::HERTZ_AS_WRITTEN) else {
+        return Ok(Err(format!("study {STUDY} has no run {}", roles.source(roles::HERTZ_AS_WRITTEN))));
     };
     let Some((h, mut snap)) = finest(results, r)? else {
         return Ok(Err(format!("no mesh snapshot of run {} of study {STUDY}", r.run.id)));

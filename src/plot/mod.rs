@@ -18,10 +18,10 @@
 //! | `fig2a` | `ex71`, all runs (the first, `adaptive`, solid; others dashed, hollow markers) | `err_quadrature` (blue circles) and `estimate` (red squares) vs NDF, log-log; NDF^-3/2 reference 2.5x below the adaptive error; a series with the same values as a later one (uniform and uniform_cartesian) gets large hollow markers around it and the later one's legend names it |
 //! | `fig2b` | `ex71`, all runs | two panels: the efficiency index `efficiency` (= estimate / err_quadrature; recomputed if absent) and the efficiency / l_h, vs NDF, log x; y log if it spans more than a decade, else linear from 0; line at 1 |
 //! | `fig3a` | `ex72`, all runs | `estimate` vs NDF, log-log, plus `err_quadrature` (against the reference solution, its NDF from `reference_ndof` noted in the legend) where present; NDF^-3/2 below the adaptive estimate |
-//! | `fig3b_variant` | `contact_term_ablation`, `meshes/ex72_without_full_contact_level20.json` | as `fig3b`, for the run marking with eta_5 without full-contact nodes: the mesh beside the paper's |
-//! | `fig3b` | `ex72`, `meshes/adaptive_level20.json` (else the finest saved level, said in the title) | the triangles, thin; equal aspect; active contact nodes red, inactive blue; the obstacle's kink (`kinks`) as a black diamond; NDF, triangle and vertex counts |
-//! | `fig4a` | `ex71`, run `adaptive` (else the first adaptive run) | `eta1`..`eta5` vs NDF, log-log, NDF^-3/2 above the data; `eta6`, `eta7` are not plotted (as in the paper) but the legend says whether they are 0 at every level or gives their maximum |
-//! | `fig4b` | `ex72`, run `adaptive` | `eta1`..`eta7` vs NDF, same style |
+//! | `fig3b_variant` | `contact_term_ablation`, the run of role `ex72-without-full-contact`, its mesh of level 20 | as `fig3b`, for the run marking with eta_5 without full-contact nodes: the mesh beside the paper's |
+//! | `fig3b` | `ex72`, the run of role `as-written`, its mesh of level 20 (else the finest saved level, said in the title) | the triangles, thin; equal aspect; active contact nodes red, inactive blue; the obstacle's kink (`kinks`) as a black diamond; NDF, triangle and vertex counts |
+//! | `fig4a` | `ex71`, the run of role `as-written` | `eta1`..`eta5` vs NDF, log-log, NDF^-3/2 above the data; `eta6`, `eta7` are not plotted (as in the paper) but the legend says whether they are 0 at every level or gives their maximum |
+//! | `fig4b` | `ex72`, the run of role `as-written` | `eta1`..`eta7` vs NDF, same style |
 //! | `c0_sweep` | `c0_sweep`, a panel per problem | efficiency C0' eta_h / err_quadrature vs NDF for C0' = 0.45 (solid) and the smallest reliable C0' = max over levels of err_quadrature / eta_h (dashed), per run; line at 1; runs without errors are named in the legend |
 //! | `log_ablation` | `log_ablation`, a panel per problem | efficiency per level (vs NDF) for each `estimator.log_factor`; line at 1 |
 //! | `contact_term_ablation` | `contact_term_ablation`, a panel per problem | `estimate` (solid) and `eta5` (dashed) vs NDF for each `estimator.contact_term` |
@@ -67,6 +67,7 @@ pub mod render;
 mod repair;
 mod rich;
 
+use crate::analysis::roles::{self, Role, Roles};
 use crate::estimator::estimate::{C0_PAPER, ContactTerm, LogFactor};
 use crate::records::{LevelRecord, MeshSnapshot, Refine, RunRecord, StudyDir};
 use anyhow::Context;
@@ -148,15 +149,16 @@ pub struct Outcome {
 }
 
 /// Draw every figure whose results exist into `figures/`; figures without results are skipped
-/// with a note on stderr. Returns the files written.
-pub fn draw_all(results: &Path, figures: &Path) -> anyhow::Result<Vec<PathBuf>> {
-    draw_studies(results, figures, None)
+/// with a note on stderr. Returns the files written. The figures find their runs by the roles
+/// the manifests declare ([`roles::check`]).
+pub fn draw_all(results: &Path, figures: &Path, roles: &Roles) -> anyhow::Result<Vec<PathBuf>> {
+    draw_studies(results, figures, roles, None)
 }
 
 /// [`draw_all`] for the figures of some studies only (`None`: every figure).
-pub fn draw_studies(results: &Path, figures: &Path, studies: Option<&[String]>) -> anyhow::Result<Vec<PathBuf>> {
+pub fn draw_studies(results: &Path, figures: &Path, roles: &Roles, studies: Option<&[String]>) -> anyhow::Result<Vec<PathBuf>> {
     let keep = |figure: &str| studies.is_none_or(|s| study_of(figure).is_some_and(|st| s.iter().any(|x| x == st)));
-    let outcome = draw_figures_where(results, figures, &keep)?;
+    let outcome = draw_figures_where(results, figures, roles, &keep)?;
     for (name, why) in &outcome.skipped {
         crate::base::note::line(format_args!("figures: skipped {name}: {why}"));
     }
@@ -166,18 +168,18 @@ pub fn draw_studies(results: &Path, figures: &Path, studies: Option<&[String]>) 
 /// Draw every figure whose results exist; report the files written and the figures skipped.
 /// A figure that fails (unreadable record, drawing error) does not stop the others; the errors
 /// are reported together at the end.
-pub fn draw_figures(results: &Path, figures: &Path) -> anyhow::Result<Outcome> {
-    draw_figures_where(results, figures, &|_| true)
+pub fn draw_figures(results: &Path, figures: &Path, roles: &Roles) -> anyhow::Result<Outcome> {
+    draw_figures_where(results, figures, roles, &|_| true)
 }
 
 /// [`draw_figures`] for the figures `keep` accepts.
-pub fn draw_figures_where(results: &Path, figures: &Path, keep: &dyn Fn(&str) -> bool) -> anyhow::Result<Outcome> {
+pub fn draw_figures_where(results: &Path, figures: &Path, roles: &Roles, keep: &dyn Fn(&str) -> bool) -> anyhow::Result<Outcome> {
     register_font()?;
     std::fs::create_dir_all(figures).with_context(|| format!("creating {}", figures.display()))?;
     let mut outcome = Outcome::default();
     let mut errors = Vec::new();
     for name in FIGURES.into_iter().filter(|f| keep(f)) {
-        match build(name, results).and_then(|b| match b {
+        match build(name, results, roles).and_then(|b| match b {
             Ok(fig) => write_figure(&fig, figures, name).map(Ok),
             Err(why) => Ok(Err(why)),
         }) {
@@ -227,9 +229,9 @@ fn write_figure(fig: &Figure, dir: &Path, name: &str) -> anyhow::Result<Vec<Path
 
 /// The y range of every line panel of figure `name` drawn from `results` against the range of
 /// its data (what a test holds the axes to); empty for a mesh figure or one without results.
-pub fn y_ranges(name: &str, results: &Path) -> anyhow::Result<Vec<render::YRange>> {
+pub fn y_ranges(name: &str, results: &Path, roles: &Roles) -> anyhow::Result<Vec<render::YRange>> {
     register_font()?;
-    let Ok(fig) = build(name, results)? else { return Ok(Vec::new()) };
+    let Ok(fig) = build(name, results, roles)? else { return Ok(Vec::new()) };
     let mut text = String::new();
     let root = SVGBackend::with_string(&mut text, fig.size()).into_drawing_area();
     fig.render(&root, rich::SVG)
@@ -238,26 +240,26 @@ pub fn y_ranges(name: &str, results: &Path) -> anyhow::Result<Vec<render::YRange
 /// A figure, or the reason it cannot be drawn yet.
 type Built = Result<Figure, String>;
 
-fn build(name: &str, results: &Path) -> anyhow::Result<Built> {
+fn build(name: &str, results: &Path, roles: &Roles) -> anyhow::Result<Built> {
     match name {
         "fig2a" => fig2a(results),
         "fig2b" => fig2b(results),
         "fig3a" => fig3a(results),
-        "fig3b" => mesh_at_level_20(results, "ex72", "adaptive"),
-        "fig3b_variant" => mesh_at_level_20(results, "contact_term_ablation", "ex72_without_full_contact"),
-        "fig4a" => fig4(results, "ex71", "4a", 5),
-        "fig4b" => fig4(results, "ex72", "4b", 7),
+        "fig3b" => mesh_at_level_20(results, roles, roles::EX72_AS_WRITTEN),
+        "fig3b_variant" => mesh_at_level_20(results, roles, roles::ABLATION_EX72_WFC),
+        "fig4a" => fig4(results, roles, roles::EX71_AS_WRITTEN, "4a", 5),
+        "fig4b" => fig4(results, roles, roles::EX72_AS_WRITTEN, "4b", 7),
         "c0_sweep" => c0_sweep(results),
         "log_ablation" => log_ablation(results),
         "contact_term_ablation" => contact_term_ablation(results),
-        "estimator_repair" => repair::estimator_repair(results),
+        "estimator_repair" => repair::estimator_repair(results, roles),
         "theta_ablation" => theta_ablation(results),
         "fb_error" => fb::fb_error(results),
-        "fb_mesh" => fb::fb_mesh(results),
+        "fb_mesh" => fb::fb_mesh(results, roles),
         "hertz_pressure" => hertz::hertz_pressure(results),
-        "hertz_mesh" => hertz::hertz_mesh(results),
+        "hertz_mesh" => hertz::hertz_mesh(results, roles),
         "deep_error" => deep::deep_error(results),
-        "deep_floor" => deep::deep_floor(results),
+        "deep_floor" => deep::deep_floor(results, roles),
         "ex72_large_error" => ex72_large::ex72_large_error(results),
         "ex72_rollers_error" => ex72_large::ex72_rollers_error(results),
         other => anyhow::bail!("unknown figure {other}"),
@@ -293,11 +295,6 @@ fn by_problem(runs: &[RunRecord]) -> BTreeMap<String, Vec<&RunRecord>> {
         m.entry(r.run.problem.clone()).or_default().push(r);
     }
     m
-}
-
-/// The adaptive run of a study: id `adaptive`, else the first adaptive run.
-fn adaptive_run(runs: &[RunRecord]) -> Option<&RunRecord> {
-    runs.iter().find(|r| r.run.id == "adaptive").or_else(|| runs.iter().find(|r| r.run.refine == Refine::Adaptive))
 }
 
 fn problem_title(problem: &str) -> String {
@@ -489,13 +486,15 @@ fn fig3a(results: &Path) -> anyhow::Result<Built> {
     Ok(Ok(single(p)))
 }
 
-fn fig4(results: &Path, study: &str, fig: &str, terms: usize) -> anyhow::Result<Built> {
+/// Fig. 4: the terms eta_1 .. eta_`terms` of the run of `role`.
+fn fig4(results: &Path, roles: &Roles, role: Role, fig: &str, terms: usize) -> anyhow::Result<Built> {
+    let study = role.study;
     let runs = match runs(results, study)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
-    let Some(r) = adaptive_run(&runs) else {
-        return Ok(Err(format!("study {study} has no adaptive run yet")));
+    let Some(r) = roles.find(&runs, role) else {
+        return Ok(Err(format!("study {study} has no run {} yet", roles.source(role))));
     };
     let etas = |l: &LevelRecord| [l.terms.eta1, l.terms.eta2, l.terms.eta3, l.terms.eta4, l.terms.eta5, l.terms.eta6, l.terms.eta7];
     let mut p = Panel::new(
@@ -526,8 +525,9 @@ fn fig4(results: &Path, study: &str, fig: &str, terms: usize) -> anyhow::Result<
 
 /// Fig. 3(b): a run's mesh at level 20 (`fig3b`: the paper's run, eta_5 as written; `fig3b_variant`:
 /// eta_5 without full-contact nodes, where the free-boundary points are refinement centres).
-fn mesh_at_level_20(results: &Path, study: &str, run: &str) -> anyhow::Result<Built> {
-    let dir = StudyDir::new(results, study);
+fn mesh_at_level_20(results: &Path, roles: &Roles, role: Role) -> anyhow::Result<Built> {
+    let dir = StudyDir::new(results, role.study);
+    let Some(run) = roles.id(role) else { return Ok(Err(format!("no run of {} declares role {}", role.study, role.name))) };
     let mut level = MESH_LEVEL;
     let mut note = String::new();
     if !dir.mesh_file(run, level, "json").exists() {

@@ -266,7 +266,14 @@ pub fn studies_in(results: &Path) -> std::io::Result<Vec<String>> {
 /// Write `out/STUDY.html` for each of `studies` (every study under `results` if empty), and with
 /// every study also `out/index.html` ([`index_page`]), atomically; returns the pages written,
 /// the index last. A named study without records is an error.
-pub fn write_pages(results: &Path, figures: &Path, out: &Path, studies: &[String], drift_report: &Path) -> anyhow::Result<Vec<PathBuf>> {
+pub fn write_pages(
+    results: &Path,
+    figures: &Path,
+    out: &Path,
+    studies: &[String],
+    drift_report: &Path,
+    roles: &crate::analysis::roles::Roles,
+) -> anyhow::Result<Vec<PathBuf>> {
     use anyhow::Context;
     let present = studies_in(results)?;
     let chosen: Vec<String> = if studies.is_empty() { present.clone() } else { studies.to_vec() };
@@ -281,7 +288,7 @@ pub fn write_pages(results: &Path, figures: &Path, out: &Path, studies: &[String
         crate::study::store::Store::new(results, study).read()?;
     }
     let claims =
-        crate::analysis::claims::claims(results).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
+        crate::analysis::claims::claims(results, roles).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
     let drift = match std::fs::read_to_string(drift_report) {
         Ok(t) => Some(serde_json::from_str(&t).with_context(|| format!("reading the drift report {}", drift_report.display()))?),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,

@@ -7,7 +7,9 @@
 
 use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, ESTIMATE, Figure, NDF_DESC, PALETTE, Style, problem_title, series, slope};
+use crate::analysis::claims::COINCIDE_REL;
 use crate::analysis::claims::repair::{Fitted, PROBLEMS, Stored};
+use crate::analysis::roles::Roles;
 use crate::records::RunRecord;
 use anyhow::Context;
 use std::path::Path;
@@ -17,14 +19,15 @@ fn name(r: &RunRecord) -> String {
     format!("{}/{}", r.study, r.run.id)
 }
 
-/// Same NDF and errors at every common level (to 1e-12 relative), and at least one level.
+/// Same NDF and errors at every common level (to [`COINCIDE_REL`] relative, as the CLAIMS row
+/// compares them), and at least one level.
 fn coincide(a: &RunRecord, b: &RunRecord) -> bool {
     let n = a.levels.len().min(b.levels.len());
     n > 0
         && a.levels.iter().zip(&b.levels).all(|(x, y)| {
             x.ndof == y.ndof
                 && match (x.err_quadrature, y.err_quadrature) {
-                    (Some(p), Some(q)) => (p - q).abs() <= 1e-12 * p.abs().max(q.abs()),
+                    (Some(p), Some(q)) => (p - q).abs() <= COINCIDE_REL * p.abs().max(q.abs()),
                     (p, q) => p.is_none() && q.is_none(),
                 }
         })
@@ -66,9 +69,9 @@ fn panel(f: &Fitted) -> Option<Panel> {
     Some(p)
 }
 
-pub(super) fn estimator_repair(results: &Path) -> anyhow::Result<Built> {
-    let stored =
-        Stored::read(results).with_context(|| format!("reading the runs of the estimator-repair row under {}", results.display()))?;
+pub(super) fn estimator_repair(results: &Path, roles: &Roles) -> anyhow::Result<Built> {
+    let stored = Stored::read(results, roles)
+        .with_context(|| format!("reading the runs of the estimator-repair row under {}", results.display()))?;
     let panels: Vec<Panel> = PROBLEMS.iter().filter_map(|p| panel(&stored.fitted(p))).collect();
     if panels.is_empty() {
         return Ok(Err("no repaired run stored (studies estimator_repair, deep, ex72_large)".to_string()));

@@ -27,6 +27,8 @@
 //!
 //! [[run]]                    # each run overrides what it names
 //! id = "adaptive"
+//! role = "paper-adaptive"    # optional: what the run stands for to CLAIMS and the figures
+//!                            # (analysis::roles), once per study, on a line of its own
 //! [[run]]
 //! id = "uniform"
 //! refine = "uniform"
@@ -103,6 +105,9 @@ struct ReferenceToml {
 #[serde(deny_unknown_fields, expecting = "a table of run settings")]
 struct RunToml {
     id: Option<String>,
+    /// What the run stands for to CLAIMS.md and the figures ([`crate::analysis`] finds its runs
+    /// by role, never by id): unique within the study.
+    role: Option<String>,
     problem: Option<String>,
     mesh: Option<String>,
     levels: Option<usize>,
@@ -222,8 +227,12 @@ pub struct Manifest {
     pub description: String,
     pub runs: Vec<PlannedRun>,
     pub drift: DriftSpec,
-    /// The manifest's bytes (hashed into the provenance).
+    /// The manifest's bytes without its `role = "..."` lines ([`without_roles`]): hashed into
+    /// the provenance.
     pub bytes: Vec<u8>,
+    /// What runs stand for (role -> run id, from `role = "..."` in the [[run]] tables): how
+    /// CLAIMS.md and the figures find their runs ([`crate::analysis::roles`]).
+    pub roles: BTreeMap<String, String>,
 }
 
 impl Manifest {
@@ -247,7 +256,7 @@ impl Manifest {
         let bytes = std::fs::read(path).map_err(|error| ManifestError::Read { file: path.to_path_buf(), error })?;
         let text = String::from_utf8_lossy(&bytes);
         Self::parse(path, &text).map(|mut m| {
-            m.bytes = bytes.clone();
+            m.bytes = without_roles(&bytes);
             m
         })
     }
@@ -263,12 +272,76 @@ impl Manifest {
         }
         let d = raw.defaults.clone().unwrap_or_default();
         check_defaults(&d, &invalid)?;
-        let mut ids = std::collections::BTreeSet::new();
-        let runs = raw.run.iter().enumerate().map(|(i, r)| parse_run(path, i, r, &d, &mut ids, &invalid)).collect::<Result<Vec<_>, _>>()?;
+        let (mut ids, mut roles) = (std::collections::BTreeSet::new(), BTreeMap::new());
+        let runs = raw
+            .run
+            .iter()
+            .enumerate()
+            .map(|(i, r)| parse_run(path, i, r, &d, (&mut ids, &mut roles), &invalid))
+            .collect::<Result<Vec<_>, _>>()?;
+        let (runs, declared): (Vec<PlannedRun>, Vec<Option<String>>) = runs.into_iter().unzip();
         let drift = raw.drift.unwrap_or_default();
         check_drift(&drift, &runs, &invalid)?;
-        Ok(Manifest { study, file, description: raw.description.unwrap_or_default(), runs, drift, bytes: text.as_bytes().to_vec() })
+        check_role_lines(&declared, text, &invalid)?;
+        let bytes = without_roles(text.as_bytes());
+        Ok(Manifest { study, file, description: raw.description.unwrap_or_default(), runs, drift, bytes, roles })
     }
+
+    /// The id of the run that declares `role`, if one does.
+    pub fn run_with_role(&self, role: &str) -> Option<&str> {
+        self.roles.get(role).map(String::as_str)
+    }
+}
+
+/// Whether `line` (without its end) declares a role: `role = "NAME"` and nothing else.
+fn is_role_line(line: &[u8]) -> bool {
+    let line = line.strip_suffix(b"\r").unwrap_or(line);
+    line.strip_prefix(b"role = \"").and_then(|r| r.strip_suffix(b"\"")).is_some_and(|name| name.iter().all(|&b| is_role_byte(b)))
+}
+
+fn is_role_byte(b: u8) -> bool {
+    b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-'
+}
+
+/// The manifest's bytes without its `role = "..."` lines: what the provenance hashes. A role
+/// says what a run stands for to CLAIMS and the figures and changes no number, so declaring or
+/// renaming one does not make the stored runs stale (their `manifest_sha256` stays); everything
+/// else in the file does.
+pub fn without_roles(bytes: &[u8]) -> Vec<u8> {
+    bytes.split_inclusive(|&b| b == b'\n').filter(|l| !is_role_line(l.strip_suffix(b"\n").unwrap_or(l))).flatten().copied().collect()
+}
+
+/// Every role declared as a line of its own (`role = "NAME"`, which [`without_roles`] leaves out
+/// of the hash): as many such lines in `text` as declared roles. A role written otherwise (an
+/// inline table, a comment after it) would be hashed, and declaring or renaming it would look
+/// like a change of the runs; it is refused here.
+fn check_role_lines(roles: &[Option<String>], text: &str, invalid: &Invalid) -> Result<(), ManifestError> {
+    let lines = text.as_bytes().split(|&b| b == b'\n').filter(|l| is_role_line(l)).count();
+    let declared: Vec<(usize, &str)> = roles.iter().enumerate().filter_map(|(i, r)| Some((i, r.as_deref()?))).collect();
+    match declared.first() {
+        Some(&(i, role)) if lines != declared.len() => Err(invalid.at(
+            format!("run[{i}].role"),
+            "every role as role = \"NAME\" on a line of its own in its [[run]] table, NAME of lower-case letters, digits and '-' (the provenance hashes the manifest without these lines)",
+            format!("{} role(s) declared, {lines} such line(s) (the first role: {role:?})", declared.len()),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// A run's role: a name of lower-case letters, digits and '-' not declared by an earlier run of
+/// the study (`roles`: the earlier runs' roles and ids). The error's (expected, got).
+fn check_role(role: &str, id: &str, roles: &mut BTreeMap<String, String>) -> Result<(), (String, String)> {
+    if role.is_empty() || !role.bytes().all(is_role_byte) {
+        return Err(("a role of lower-case letters, digits and '-'".into(), format!("{role:?}")));
+    }
+    if let Some(other) = roles.get(role) {
+        return Err((
+            "a role declared once in the study (the CLAIMS rows and figures that need it read one run)".into(),
+            format!("role {role:?} twice, by runs {other:?} and {id:?}"),
+        ));
+    }
+    roles.insert(role.to_string(), id.to_string());
+    Ok(())
 }
 
 /// Builds the error for a key of the manifest `.0` that does not hold what is expected.
@@ -289,6 +362,13 @@ fn check_defaults(d: &RunToml, invalid: &Invalid) -> Result<(), ManifestError> {
             format!("{:?}", d.id.clone().unwrap_or_default()),
         ));
     }
+    if let Some(role) = &d.role {
+        return Err(invalid.at(
+            "defaults.role".into(),
+            "no role in [defaults] (a role is one run's, in its [[run]] table)",
+            format!("{role:?}"),
+        ));
+    }
     if d.no_reference.is_some() {
         return Err(invalid.at(
             "defaults.no_reference".into(),
@@ -300,15 +380,15 @@ fn check_defaults(d: &RunToml, invalid: &Invalid) -> Result<(), ManifestError> {
 }
 
 /// `[[run]]` number `i`, completed from `[defaults]` `d` and checked key by key; `ids` holds the
-/// names of the runs before it.
+/// names of the runs before it, `roles` their roles (role -> id).
 fn parse_run(
     path: &Path,
     i: usize,
     r: &RunToml,
     d: &RunToml,
-    ids: &mut std::collections::BTreeSet<String>,
+    (ids, roles): (&mut std::collections::BTreeSet<String>, &mut BTreeMap<String, String>),
     invalid: &Invalid,
-) -> Result<PlannedRun, ManifestError> {
+) -> Result<(PlannedRun, Option<String>), ManifestError> {
     let key = |k: &str| format!("run[{i}].{k}");
     let id = r.id.clone().ok_or_else(|| invalid.at(key("id"), "a run name (string)", "nothing".into()))?;
     // the first character a letter or digit: a record runs/.ID.json would be a hidden file, and
@@ -327,6 +407,10 @@ fn parse_run(
         return Err(invalid.at(key("id"), "a name unique within the study (ignoring case: the records' file names)", got));
     }
     ids.insert(id.clone());
+    let role = r.role.clone();
+    if let Some(role) = &role {
+        check_role(role, &id, roles).map_err(|(expected, got)| invalid.at(key("role"), &expected, got))?;
+    }
     let problem = r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid.at(key("problem"), "a problem name", "nothing".into()))?;
     let mut constants = d.constants.clone().unwrap_or_default();
     constants.extend(r.constants.clone().unwrap_or_default());
@@ -411,7 +495,7 @@ fn parse_run(
     if spec.reference.as_ref().is_some_and(|rf| rf.min_ndof == 0) {
         return Err(invalid.at(key("reference.min_ndof"), "a number of unknowns >= 1", "0".into()));
     }
-    Ok(PlannedRun { spec, quick_levels })
+    Ok((PlannedRun { spec, quick_levels }, role))
 }
 
 /// `[drift]`: tolerances in range for float fields of the records (not the derived ones, which

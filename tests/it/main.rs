@@ -11,6 +11,7 @@ mod bad_data;
 mod bad_edges;
 mod bad_input;
 mod bad_physics;
+mod bad_roles;
 mod bad_settings;
 mod bad_slurm;
 mod bad_store;

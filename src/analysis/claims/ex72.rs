@@ -5,8 +5,9 @@
 
 use super::{
     Claim, Criterion, Ctx, EX72_NU, Evidence, Kind, OPTIMAL, Q, REFINE_REACH, Summary, estimator_text, fragility, growth_text,
-    halving_exponents, latest_mesh, rate_headline, rate_text, run, slowest_headline, source,
+    halving_exponents, latest_mesh, rate_headline, rate_text, slowest_headline, source,
 };
+use crate::analysis::roles::{self, Role};
 use crate::analysis::verdict::{self, Abscissa, RateReport, refinement};
 use crate::records::{RunRecord, StudyDir};
 
@@ -19,11 +20,16 @@ const CORNER_RING: f64 = 0.1;
 pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let load = |s: &str| StudyDir::new(ctx.results, s).read_runs();
     let (ex72, ct, large) = (load("ex72")?, load("contact_term_ablation")?, load("ex72_large")?);
-    let a72 = ctx.pick(&ex72, "adaptive");
-    let u72 = run(&ex72, "uniform");
-    let wfc = ctx.pick(&ct, "ex72_without_full_contact");
-    let aw = run(&ct, "ex72_as_written");
-    let errors = Errors::of(&large).unwrap_or(Errors { study: "ex72", adaptive: a72, without_full_contact: None, uniform: u72 });
+    let a72 = ctx.pick(&ex72, roles::EX72_AS_WRITTEN);
+    let u72 = ctx.find(&ex72, roles::EX72_UNIFORM);
+    let wfc = ctx.pick(&ct, roles::ABLATION_EX72_WFC);
+    let aw = ctx.find(&ct, roles::ABLATION_EX72_AS_WRITTEN);
+    let errors = Errors::of(ctx, &large).unwrap_or(Errors {
+        study: roles::EX72_AS_WRITTEN.study,
+        adaptive: a72,
+        without_full_contact: None,
+        uniform: u72,
+    });
     out.push(rates(ctx, errors.adaptive, Labels { id: "7.2-rates", topic: "Ex. 7.2: estimator rates" }));
     out.push(error(ctx, &errors, aw, wfc, Labels { id: "7.2-error (beyond the paper)", topic: "Ex. 7.2: true error" }));
     out.push(corners(ctx, a72, &errors));
@@ -53,13 +59,13 @@ pub(super) struct Labels {
 }
 
 impl<'a> Errors<'a> {
-    fn of(large: &'a [RunRecord]) -> Option<Errors<'a>> {
-        let adaptive = run(large, "adaptive").filter(|r| r.levels.iter().any(|l| l.err_quadrature.is_some()))?;
+    fn of(ctx: &Ctx, large: &'a [RunRecord]) -> Option<Errors<'a>> {
+        let adaptive = ctx.find(large, roles::LARGE_AS_WRITTEN).filter(|r| r.levels.iter().any(|l| l.err_quadrature.is_some()))?;
         Some(Errors {
-            study: "ex72_large",
+            study: roles::LARGE_AS_WRITTEN.study,
             adaptive: Some(adaptive),
-            without_full_contact: run(large, "without_full_contact"),
-            uniform: run(large, "uniform"),
+            without_full_contact: ctx.find(large, roles::LARGE_WFC),
+            uniform: ctx.find(large, roles::LARGE_UNIFORM),
         })
     }
 
@@ -349,13 +355,15 @@ fn eta6_eta7(a72: Option<&RunRecord>) -> Claim {
 fn where_refined(ctx: &Ctx, a72: Option<&RunRecord>, wfc: Option<&RunRecord>) -> Claim {
     // where the adaptive mesh refines: local minima of h along Gamma_C = {1} x (0, 1), corners
     let mut parts = Vec::new();
-    // (free boundary, corners) of ex72/adaptive, the run judged
+    // (free boundary, corners) of the run of role ex72 `as-written`, the run judged
     let mut judged: Option<(bool, bool)> = None;
     let mut headline = Vec::new();
-    for (study, id, record) in [("ex72", "adaptive", a72), ("contact_term_ablation", "ex72_without_full_contact", wfc)] {
+    let judged_role: Role = roles::EX72_AS_WRITTEN;
+    for (role, record) in [(judged_role, a72), (roles::ABLATION_EX72_WFC, wfc)] {
+        let (study, id) = (role.study, ctx.roles.id(role).unwrap_or(role.name));
         let (Some(m), Some(r)) = (latest_mesh(ctx.results, study, id), record) else { continue };
         let Some((z0, z1)) = r.levels.get(m.level).and_then(|l| l.zone_min.zip(l.zone_max)) else { continue };
-        if study == "ex72" {
+        if role == judged_role {
             judged = Some((true, true));
         }
         let prof = refinement::profile(&m, [1.0, 0.0], [1.0, 1.0]);
@@ -364,16 +372,16 @@ fn where_refined(ctx: &Ctx, a72: Option<&RunRecord>, wfc: Option<&RunRecord>) ->
             [("free boundary y = zone start", z0, true), ("free boundary y = zone end", z1, true), ("wedge tip y = 0.5", 0.5, false)]
         {
             if let Some(lm) = refinement::local_minimum(&prof, s, REFINE_REACH) {
-                if let (true, Some(j)) = (claimed, judged.as_mut().filter(|_| study == "ex72")) {
+                if let (true, Some(j)) = (claimed, judged.as_mut().filter(|_| role == judged_role)) {
                     j.0 &= lm.holds;
-                    headline.push(format!("ex72/{id} {name}: {}", if lm.holds { "local minimum" } else { "no local minimum" }));
+                    headline.push(format!("{study}/{id} {name}: {}", if lm.holds { "local minimum" } else { "no local minimum" }));
                 }
                 pts.push(format!("{name} ({s:.4}): {} → {}", lm.text(), if lm.holds { "local minimum" } else { "no local minimum" }));
             }
         }
         for (name, p) in [("corner (0, 0)", [0.0, 0.0]), ("corner (0, 1)", [0.0, 1.0])] {
             let (inner, ring) = refinement::corner(&m, p, CORNER_NEAR, CORNER_RING);
-            if let Some(j) = judged.as_mut().filter(|_| study == "ex72") {
+            if let Some(j) = judged.as_mut().filter(|_| role == judged_role) {
                 j.1 &= inner < ring;
             }
             pts.push(format!(
@@ -386,7 +394,8 @@ fn where_refined(ctx: &Ctx, a72: Option<&RunRecord>, wfc: Option<&RunRecord>) ->
     let test = Criterion::All(vec![
         Criterion::Test {
             passes_if: format!(
-                "on ex72/adaptive's last saved mesh the edge length along Gamma_C has a local minimum (or a plateau of its own) at both ends of the contact zone (the free boundary): no edge within {REFINE_REACH} on either side smaller than the edges there, and one on each side larger"
+                "on {}'s last saved mesh the edge length along Gamma_C has a local minimum (or a plateau of its own) at both ends of the contact zone (the free boundary): no edge within {REFINE_REACH} on either side smaller than the edges there, and one on each side larger",
+                ctx.roles.source(judged_role)
             ),
             open_if_not: false,
         },

@@ -21,9 +21,8 @@
 //! where they are stored; otherwise on the runs of `estimator_repair`.
 
 use super::criterion::Outcome;
-use super::{
-    Claim, Criterion, Ctx, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, deep_or, growth_text, rate_text, run, short_range, source,
-};
+use super::{Claim, Criterion, Ctx, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, growth_text, rate_text, short_range, source};
+use crate::analysis::roles::{self, Role, Roles};
 use crate::analysis::verdict::{self, Abscissa};
 use crate::base::stats::line_value_at;
 use crate::records::{RunRecord, StudyDir};
@@ -110,7 +109,7 @@ fn criteria_parts() -> Vec<Criterion> {
         Criterion::Bounded { what: "C_0 (Psi + eta_6 + eta_7) / error (the efficiency with l_h = 1)".into() },
         Criterion::AtMost {
             what: "the smallest reliable C_0 (largest error / eta_h at any level of the run and of its l_h = 1 twin)".into(),
-            limit: 0.45,
+            limit: super::C0_PAPER,
             interval: false,
         },
         Criterion::FewerUnknowns { claim: OPTIMAL },
@@ -166,7 +165,7 @@ fn coincidence(ctx: &Ctx, a: &RunRecord, b: &RunRecord) -> String {
     let differs = (0..n).find(|&i| {
         a.levels[i].ndof != b.levels[i].ndof
             || match (ea[i], eb[i]) {
-                (Some(x), Some(y)) => (x - y).abs() > 1e-12 * x.abs().max(y.abs()),
+                (Some(x), Some(y)) => (x - y).abs() > super::COINCIDE_REL * x.abs().max(y.abs()),
                 (x, y) => x.is_some() != y.is_some(),
             }
     });
@@ -201,52 +200,117 @@ pub struct Fitted<'a> {
     pub l1: Option<&'a RunRecord>,
 }
 
-/// The studies the row reads: `estimator_repair`, `deep`, `ex72_large` and `hertz`.
+/// The studies the row reads: `estimator_repair`, `deep`, `ex72_large` and `hertz`, with the
+/// roles their runs declare.
 pub struct Stored {
     pub estimator_repair: Vec<RunRecord>,
     pub deep: Vec<RunRecord>,
     pub ex72_large: Vec<RunRecord>,
     pub hertz: Vec<RunRecord>,
+    roles: Roles,
+}
+
+/// The roles one problem's runs are found by: in the deep study (`deep`, `ex72_large` or
+/// `hertz`) and in `estimator_repair` (`small_*`), each where the problem has one.
+struct ProblemRoles {
+    repaired: Role,
+    as_written: Role,
+    without_full_contact: Option<Role>,
+    uniform: Option<Role>,
+    small_repaired: Role,
+    small_l1: Option<Role>,
+    small_uniform: Option<Role>,
+}
+
+/// The roles of `problem` (one of [`PROBLEMS`]).
+fn problem_roles(problem: &str) -> ProblemRoles {
+    use roles::*;
+    match problem {
+        "ex72" => ProblemRoles {
+            repaired: LARGE_REPAIRED,
+            as_written: LARGE_AS_WRITTEN,
+            without_full_contact: Some(LARGE_WFC),
+            uniform: Some(LARGE_UNIFORM),
+            small_repaired: REPAIR_EX72,
+            small_l1: None,
+            small_uniform: None,
+        },
+        "hertz" => ProblemRoles {
+            repaired: HERTZ_REPAIRED,
+            as_written: HERTZ_AS_WRITTEN,
+            without_full_contact: None,
+            uniform: None,
+            small_repaired: REPAIR_HERTZ,
+            small_l1: None,
+            small_uniform: None,
+        },
+        "fb" => ProblemRoles {
+            repaired: DEEP_FB_REPAIRED,
+            as_written: DEEP_FB_AS_WRITTEN,
+            without_full_contact: Some(DEEP_FB_WFC),
+            uniform: Some(DEEP_FB_UNIFORM),
+            small_repaired: REPAIR_FB,
+            small_l1: Some(REPAIR_FB_L1),
+            small_uniform: Some(REPAIR_FB_UNIFORM),
+        },
+        _ => ProblemRoles {
+            repaired: DEEP_EX71_REPAIRED,
+            as_written: DEEP_EX71_AS_WRITTEN,
+            without_full_contact: Some(DEEP_EX71_WFC),
+            uniform: Some(DEEP_EX71_UNIFORM),
+            small_repaired: REPAIR_EX71,
+            small_l1: Some(REPAIR_EX71_L1),
+            small_uniform: Some(REPAIR_EX71_UNIFORM),
+        },
+    }
 }
 
 impl Stored {
-    pub fn read(results: &std::path::Path) -> std::io::Result<Stored> {
+    pub fn read(results: &std::path::Path, roles: &Roles) -> std::io::Result<Stored> {
         let load = |s: &str| StudyDir::new(results, s).read_runs();
         Ok(Stored {
-            estimator_repair: load("estimator_repair")?,
-            deep: load("deep")?,
-            ex72_large: load("ex72_large")?,
-            hertz: load("hertz")?,
+            estimator_repair: load(roles::REPAIR_EX71.study)?,
+            deep: load(roles::DEEP_EX71_REPAIRED.study)?,
+            ex72_large: load(roles::LARGE_REPAIRED.study)?,
+            hertz: load(roles::HERTZ_REPAIRED.study)?,
+            roles: roles.clone(),
         })
+    }
+
+    /// The stored runs of `role`'s study.
+    fn runs_of(&self, role: Role) -> &[RunRecord] {
+        match role.study {
+            s if s == roles::REPAIR_EX71.study => &self.estimator_repair,
+            s if s == roles::DEEP_EX71_REPAIRED.study => &self.deep,
+            s if s == roles::LARGE_REPAIRED.study => &self.ex72_large,
+            s if s == roles::HERTZ_REPAIRED.study => &self.hertz,
+            _ => &[],
+        }
+    }
+
+    /// The run of `role` ([`Roles::find`]); none for no role.
+    fn find(&self, role: Option<Role>) -> Option<&RunRecord> {
+        role.and_then(|role| self.roles.find(self.runs_of(role), role))
     }
 
     /// The runs of `problem`: Examples 7.1 and fb from `deep`, 7.2 from `ex72_large`, where
     /// stored, Hertz from `hertz` (its repaired run; eta_5 as written: its adaptive run); else
     /// those of `estimator_repair`.
     pub fn fitted(&self, problem: &'static str) -> Fitted<'_> {
-        let small = |s: &str| run(&self.estimator_repair, &format!("{problem}_{s}"));
-        let (deep, large) = (&self.deep, &self.ex72_large);
-        let (repaired, as_written, without_full_contact, uniform) = match problem {
-            "ex72" => (
-                deep_or(large, "repaired", small("adaptive")),
-                run(large, "adaptive"),
-                run(large, "without_full_contact"),
-                deep_or(large, "uniform", small("uniform")),
-            ),
-            "hertz" => (deep_or(&self.hertz, "repaired", small("adaptive")), run(&self.hertz, "adaptive"), None, small("uniform")),
-            _ => (
-                deep_or(deep, &format!("{problem}_repaired"), small("adaptive")),
-                run(deep, &format!("{problem}_as_written")),
-                run(deep, &format!("{problem}_without_full_contact")),
-                deep_or(deep, &format!("{problem}_uniform"), small("uniform")),
-            ),
-        };
-        Fitted { problem, repaired, as_written, without_full_contact, uniform, l1: small("adaptive_l1") }
+        let p = problem_roles(problem);
+        Fitted {
+            problem,
+            repaired: self.find(Some(p.repaired)).or(self.find(Some(p.small_repaired))),
+            as_written: self.find(Some(p.as_written)),
+            without_full_contact: self.find(p.without_full_contact),
+            uniform: self.find(p.uniform).or(self.find(p.small_uniform)),
+            l1: self.find(p.small_l1),
+        }
     }
 }
 
 pub(super) fn estimator_repair_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let stored = Stored::read(ctx.results)?;
+    let stored = Stored::read(ctx.results, ctx.roles)?;
     let names = ["error rate", "efficiency", "reliability", "unknowns"];
     let (mut parts, mut headline) = (Vec::new(), Vec::new());
     let (mut judged_problems, mut per_problem, mut separating) = (Vec::new(), Vec::new(), 0usize);

@@ -6,26 +6,26 @@
 //! the free boundary and the efficiency; with the reference's own error (the row of
 //! [`super::ex72::error`]) and the uniform rate that shows the corners gone.
 
+use super::UNIFORM_H_RATE;
 use super::ex72::{Errors, Labels, error, rates};
-use super::{
-    Claim, Criterion, Ctx, EX72_NU, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, growth_text, rate_headline, rate_text, run, source,
-};
+use super::{Claim, Criterion, Ctx, EX72_NU, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, growth_text, rate_headline, rate_text, source};
+use crate::analysis::roles::{self, Role};
 use crate::analysis::verdict::{self, Abscissa, RateReport};
 use crate::records::{RunRecord, StudyDir};
 
 /// The study.
-const STUDY: &str = "ex72_rollers";
+const STUDY: &str = roles::ROLLERS_AS_WRITTEN.study;
 
-/// One contact term: its run and its rows' labels (rates, error rate, refinement, efficiency).
+/// One contact term: its run's role and its rows' labels (rates, error rate, refinement, efficiency).
 struct Term {
-    run: &'static str,
+    role: Role,
     name: &'static str,
     rows: [Labels; 4],
 }
 
 const TERMS: [Term; 3] = [
     Term {
-        run: "adaptive",
+        role: roles::ROLLERS_AS_WRITTEN,
         name: "eta_5 as written",
         rows: [
             Labels { id: "7.2r-rates (as written)", topic: "Ex. 7.2 on rollers, eta_5 as written: estimator rates" },
@@ -35,7 +35,7 @@ const TERMS: [Term; 3] = [
         ],
     },
     Term {
-        run: "without_full_contact",
+        role: roles::ROLLERS_WFC,
         name: "without full-contact nodes",
         rows: [
             Labels {
@@ -57,7 +57,7 @@ const TERMS: [Term; 3] = [
         ],
     },
     Term {
-        run: "repaired",
+        role: roles::ROLLERS_REPAIRED,
         name: "repaired",
         rows: [
             Labels { id: "7.2r-rates (repaired)", topic: "Ex. 7.2 on rollers, repaired: estimator rates" },
@@ -74,9 +74,9 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let runs = StudyDir::new(ctx.results, STUDY).read_runs()?;
     let errors = Errors {
         study: STUDY,
-        adaptive: run(&runs, "adaptive"),
-        without_full_contact: run(&runs, "without_full_contact"),
-        uniform: run(&runs, "uniform"),
+        adaptive: ctx.find(&runs, roles::ROLLERS_AS_WRITTEN),
+        without_full_contact: ctx.find(&runs, roles::ROLLERS_WFC),
+        uniform: ctx.find(&runs, roles::ROLLERS_UNIFORM),
     };
     let mut reference = error(
         ctx,
@@ -89,7 +89,7 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(reference);
     out.push(uniform(ctx, errors.uniform));
     for term in &TERMS {
-        let r = ctx.pick(&runs, term.run);
+        let r = ctx.pick(&runs, term.role);
         out.push(rates(ctx, r, term.rows[0]));
         out.push(error_rate(ctx, r, term, term.rows[1]));
         out.push(refinement(ctx, r, term, term.rows[2]));
@@ -175,9 +175,9 @@ fn error_rate(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> 
 fn refinement(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> Claim {
     let rep: Option<RateReport> = ctx.rate(r, Q::Field("h_free_boundary"));
     let last = r.and_then(|r| r.levels.iter().rev().find_map(|l| l.h_free_boundary.map(|h| (h, l.h_min, l.ndof))));
-    let test = Criterion::FasterThan { what: format!("h_fb ({})", source(r)), than: 0.5, abscissa: Abscissa::Ndof };
+    let test = Criterion::FasterThan { what: format!("h_fb ({})", source(r)), than: UNIFORM_H_RATE, abscissa: Abscissa::Ndof };
     Claim {
-        fragile: super::fragility(rep.as_ref(), 0.5),
+        fragile: super::fragility(rep.as_ref(), UNIFORM_H_RATE),
         id: labels.id,
         summary: Summary {
             topic: labels.topic,
@@ -193,7 +193,7 @@ fn refinement(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> 
                 format!(
                     "{}: {}{}",
                     source(Some(r)),
-                    rate_text("h_fb decay", rep.as_ref(), Some(0.5)),
+                    rate_text("h_fb decay", rep.as_ref(), Some(UNIFORM_H_RATE)),
                     last.map(|(h, hmin, n)| format!("; last level: h_fb {h:.1e}, h_min {hmin:.1e} (NDF {n})")).unwrap_or_default()
                 )
             })

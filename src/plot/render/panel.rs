@@ -110,25 +110,10 @@ pub(super) fn render_panel<DB: DrawingBackend>(
     if !p.has_data() {
         return message(root, &area, "no results yet", m).map(|()| None);
     }
-
-    // y scale
-    let ys: Vec<f64> = p
-        .series
-        .iter()
-        .flat_map(|s| s.points.iter().filter(|(x, _)| *x > 0.0 || !p.x_log).filter_map(|p| p.1))
-        .filter(|v| v.is_finite())
-        .collect();
-    let y_log = match p.y_scale {
-        YScale::Log => true,
-        YScale::Auto => {
-            let pos: Vec<f64> = ys.iter().cloned().filter(|&v| v > 0.0).collect();
-            let (lo, hi) = pos.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
-            pos.len() == ys.len() && !pos.is_empty() && hi / lo > 10.0
-        }
-    };
+    let y_log = y_is_log(p);
     let prepared: Vec<Prepared> = p.series.iter().map(|s| prepare(s, p.x_log, y_log)).collect();
     let xs: Vec<f64> = prepared.iter().flat_map(|s| s.points().map(|p| p.0)).collect();
-    let mut yv: Vec<f64> = prepared.iter().flat_map(|s| s.points().map(|p| p.1)).collect();
+    let yv: Vec<f64> = prepared.iter().flat_map(|s| s.points().map(|p| p.1)).collect();
     if xs.is_empty() {
         let msg = prepared.iter().map(|s| s.legend_label()).collect::<Vec<_>>().join("; ");
         return message(root, &area, &msg, m).map(|()| None);
@@ -137,9 +122,67 @@ pub(super) fn render_panel<DB: DrawingBackend>(
     let guides = p.hlines.iter().map(|h| h.y).filter(|y| !y_log || *y > 0.0);
     let (data_lo, data_hi) = yv.iter().cloned().chain(guides).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
     let xa = padded(&xs, p.x_log, 0.06, 1.0);
-
     let slopes = place_slopes(p, &prepared, &xs, y_log);
-    for (_, l, above) in &slopes {
+    let ya = y_axis(p, yv, &slopes, y_log);
+    let legend = Legend::of(root, p, &prepared, m)?;
+
+    let build = |ya: Axis, right: i32, bottom: i32| {
+        ChartBuilder::on(&area)
+            .margin(14)
+            .margin_right(right)
+            .margin_bottom(bottom)
+            .x_label_area_size(X_LABEL_AREA)
+            .y_label_area_size(Y_LABEL_AREA)
+            .build_cartesian_2d(xa, ya)
+            .drawn()
+    };
+    let Placed { mut chart, ya, legend_at, label_at } = place(root, &build, p, &prepared, &slopes, &legend, (xa, ya), m)?;
+
+    chart
+        .configure_mesh()
+        .x_labels(12)
+        .y_labels(12)
+        .max_light_lines(10)
+        .label_style(font(FS_TICK))
+        .axis_desc_style(font(FS_DESC))
+        .bold_line_style(BLACK.mix(0.16))
+        .light_line_style(BLACK.mix(0.06))
+        .set_all_tick_mark_size(6)
+        .draw()
+        .drawn()?;
+    axis_descs(root, &chart, &p.x_desc, &p.y_desc, m)?;
+
+    draw_guides(root, &mut chart, &p.hlines, (xa, ya), m)?;
+    draw_slopes(root, &mut chart, &slopes, &label_at, m)?;
+    draw_curves(root, &mut chart, &prepared)?;
+
+    draw_legend(root, &legend.entries, legend_at, (legend.w, legend.h), (legend.pad, legend.swatch, legend.row), m)?;
+    Ok(Some(YRange { title_index: 0, axis_lo: ya.lo, axis_hi: ya.hi, data_lo, data_hi, log: y_log }))
+}
+
+/// Whether the panel's y axis is logarithmic: always for [`YScale::Log`]; for [`YScale::Auto`]
+/// when every value is positive and they span more than a decade.
+fn y_is_log(p: &Panel) -> bool {
+    let ys: Vec<f64> = p
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().filter(|(x, _)| *x > 0.0 || !p.x_log).filter_map(|p| p.1))
+        .filter(|v| v.is_finite())
+        .collect();
+    match p.y_scale {
+        YScale::Log => true,
+        YScale::Auto => {
+            let pos: Vec<f64> = ys.iter().cloned().filter(|&v| v > 0.0).collect();
+            let (lo, hi) = pos.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &v| (a.min(v), b.max(v)));
+            pos.len() == ys.len() && !pos.is_empty() && hi / lo > 10.0
+        }
+    }
+}
+
+/// The y axis around the values `yv`, with room for the slope labels and triangles and for the
+/// guide lines' labels below them.
+fn y_axis(p: &Panel, mut yv: Vec<f64>, slopes: &[PlacedSlope], y_log: bool) -> Axis {
+    for (_, l, above) in slopes {
         // room for the label on its side of the line, and for the triangle's labels
         let room = if *above { 3.0 } else { 1.0 / 3.0 };
         yv.extend([l[1], l[3], l[1] * room]);
@@ -156,44 +199,74 @@ pub(super) fn render_panel<DB: DrawingBackend>(
             yv.push(h.y - 0.08 * (ymax.max(h.y) - ymin.min(h.y)).max(1e-12));
         }
     }
-    let mut ya = padded(&yv, y_log, 0.05, 1.0);
+    padded(&yv, y_log, 0.05, 1.0)
+}
 
-    // legend entries
-    let mut entries: Vec<Entry> = Vec::new();
-    for s in &prepared {
-        if s.segments.is_empty() {
-            entries.push(Entry::Text(s.legend_label()));
-        } else {
-            entries.push(Entry::Curve(s.series.style, s.legend_label()));
+/// The legend: its entries (a curve per series with points, a text for one without, the
+/// panel's notes) and its box's size.
+struct Legend<'a> {
+    entries: Vec<Entry<'a>>,
+    w: i32,
+    h: i32,
+    pad: i32,
+    swatch: i32,
+    row: i32,
+}
+
+impl<'a> Legend<'a> {
+    fn of<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, p: &'a Panel, prepared: &[Prepared], m: Metrics) -> anyhow::Result<Self> {
+        let mut entries: Vec<Entry> = Vec::new();
+        for s in prepared {
+            if s.segments.is_empty() {
+                entries.push(Entry::Text(s.legend_label()));
+            } else {
+                entries.push(Entry::Curve(s.series.style, s.legend_label()));
+            }
         }
+        for n in &p.notes {
+            entries.push(Entry::Note(n));
+        }
+        let mut text_w = 0;
+        for e in &entries {
+            text_w = text_w.max(rich::width(root, e.text(), FS_LEGEND, m)?);
+        }
+        let row = ((FS_LEGEND * 1.45) as i32).max(20);
+        let (pad, swatch) = (8, 44);
+        let w = pad + swatch + 8 + text_w + pad;
+        let h = pad * 2 + row * entries.len() as i32;
+        Ok(Legend { entries, w, h, pad, swatch, row })
     }
-    for n in &p.notes {
-        entries.push(Entry::Note(n));
-    }
-    let mut text_w = 0;
-    for e in &entries {
-        text_w = text_w.max(rich::width(root, e.text(), FS_LEGEND, m)?);
-    }
-    let row = ((FS_LEGEND * 1.45) as i32).max(20);
-    let (pad, swatch) = (8, 44);
-    let legend_w = pad + swatch + 8 + text_w + pad;
-    let legend_h = pad * 2 + row * entries.len() as i32;
+}
 
-    let build = |ya: Axis, right: i32, bottom: i32| {
-        ChartBuilder::on(&area)
-            .margin(14)
-            .margin_right(right)
-            .margin_bottom(bottom)
-            .x_label_area_size(X_LABEL_AREA)
-            .y_label_area_size(Y_LABEL_AREA)
-            .build_cartesian_2d(xa, ya)
-            .drawn()
-    };
+/// A line panel's chart.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<Axis, Axis>>;
 
-    // place the slope labels beside their lines and the legend where it covers nothing (as near
-    // a corner as possible, upper right first); if there is no such place, make room at the top
+/// The chart as finally built, with its y axis, the legend's corner and the slope labels' anchors.
+struct Placed<'a, DB: DrawingBackend> {
+    chart: Chart<'a, DB>,
+    ya: Axis,
+    legend_at: Option<(i32, i32)>,
+    label_at: Vec<(i32, i32)>,
+}
+
+/// The chart built by `build` (y axis, right and bottom margins), the slope labels placed beside
+/// their lines and the legend where it covers nothing (as near a corner as possible, upper right
+/// first); if there is no such place, room is made at the top, and failing that the legend goes
+/// beside or under the plot.
+#[allow(clippy::too_many_arguments)]
+fn place<'a, DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    build: &dyn Fn(Axis, i32, i32) -> anyhow::Result<Chart<'a, DB>>,
+    p: &Panel,
+    prepared: &[Prepared],
+    slopes: &[PlacedSlope],
+    legend: &Legend,
+    (xa, mut ya): (Axis, Axis),
+    m: Metrics,
+) -> anyhow::Result<Placed<'a, DB>> {
+    let (legend_w, legend_h) = (legend.w, legend.h);
     let mut slope_labels = Vec::new();
-    for (s, _, _) in &slopes {
+    for (s, _, _) in slopes {
         slope_labels.push((rich::width(root, &s.label, FS_SLOPE, m)?, 20));
     }
     let hline_label_w: Vec<i32> = p.hlines.iter().map(|h| rich::width(root, &h.label, FS_LEGEND, m)).collect::<anyhow::Result<_>>()?;
@@ -207,23 +280,11 @@ pub(super) fn render_panel<DB: DrawingBackend>(
     for attempt in 0..3 {
         let (xr, yr) = chart.plotting_area().get_pixel_range();
         let mut grid = Occupancy::new(xr.clone(), yr.clone());
-        for q in obstacle_samples(&chart, &prepared, &slopes, &p.hlines, xa, ya) {
+        for q in obstacle_samples(&chart, prepared, slopes, &p.hlines, xa, ya) {
             grid.add_point(q);
         }
         let data = grid.clone().finish();
-        // slope labels: the first position along the line where the label covers no data
-        label_at.clear();
-        for ((_, l, above), &(w, h)) in slopes.iter().zip(&slope_labels) {
-            let (a, b) = (chart.backend_coord(&(l[0], l[1])), chart.backend_coord(&(l[2], l[3])));
-            let rect = |t: f64| {
-                let (px, py) = ((a.0 as f64 + t * (b.0 - a.0) as f64) as i32, (a.1 as f64 + t * (b.1 - a.1) as f64) as i32);
-                if *above { (px + 6, py - 6 - h, w, h) } else { (px - 6 - w, py + 6, w, h) }
-            };
-            let t = [0.55, 0.4, 0.7, 0.25, 0.85].into_iter().find(|&t| !data.hits(rect(t), 2)).unwrap_or(0.55);
-            let r = rect(t);
-            grid.add_rect(r);
-            label_at.push(if *above { (r.0, r.1 + r.3) } else { (r.0 + r.2, r.1) });
-        }
+        label_at = slope_label_anchors(&chart, slopes, &slope_labels, &data, &mut grid);
         for (hl, w) in p.hlines.iter().zip(&hline_label_w) {
             if ya.contains(hl.y) {
                 let (px, py) = chart.backend_coord(&(xa.hi, hl.y));
@@ -231,9 +292,7 @@ pub(super) fn render_panel<DB: DrawingBackend>(
             }
         }
         let taken = grid.finish();
-        let (left, right) = (xr.start + inset, xr.end - inset - legend_w);
-        let (top, bottom) = (yr.start + inset, yr.end - inset - legend_h);
-        if entries.is_empty() {
+        if legend.entries.is_empty() {
             break;
         }
         if beside {
@@ -245,21 +304,9 @@ pub(super) fn render_panel<DB: DrawingBackend>(
             });
             break;
         }
-        if right >= left && bottom >= top {
-            let xs_: Vec<i32> = (left..=right).step_by(6).chain([right]).collect();
-            let ys_: Vec<i32> = (top..=bottom).step_by(6).chain([bottom]).collect();
-            let best = ys_
-                .iter()
-                .flat_map(|&y| xs_.iter().map(move |&x| (x, y)))
-                .filter(|&(x, y)| !taken.hits((x, y, legend_w, legend_h), LEGEND_CLEARANCE))
-                .min_by_key(|&(x, y)| {
-                    let (dx, dy) = ((x - left).min(right - x), (y - top).min(bottom - y));
-                    (dx + dy, (y - top > bottom - y) as u8, (x - left < right - x) as u8)
-                });
-            if let Some(c) = best {
-                legend_at = Some(c);
-                break;
-            }
+        if let Some(c) = free_corner(&taken, (&xr, &yr), inset, (legend_w, legend_h)) {
+            legend_at = Some(c);
+            break;
         }
         if attempt == 0 {
             // once: room at the top, at most half a decade (a quarter of a linear range)
@@ -280,27 +327,56 @@ pub(super) fn render_panel<DB: DrawingBackend>(
             chart = if below { build(ya, 24, 14 + legend_h + 12)? } else { build(ya, 24 + legend_w + 16, 14)? };
         }
     }
+    Ok(Placed { chart, ya, legend_at, label_at })
+}
 
-    chart
-        .configure_mesh()
-        .x_labels(12)
-        .y_labels(12)
-        .max_light_lines(10)
-        .label_style(font(FS_TICK))
-        .axis_desc_style(font(FS_DESC))
-        .bold_line_style(BLACK.mix(0.16))
-        .light_line_style(BLACK.mix(0.06))
-        .set_all_tick_mark_size(6)
-        .draw()
-        .drawn()?;
-    axis_descs(root, &chart, &p.x_desc, &p.y_desc, m)?;
+/// Each slope label at the first position along its line where it covers no `data`, its box
+/// added to `grid`; the labels' anchors.
+fn slope_label_anchors<DB: DrawingBackend>(
+    chart: &ChartContext<DB, Cartesian2d<Axis, Axis>>,
+    slopes: &[PlacedSlope],
+    slope_labels: &[(i32, i32)],
+    data: &Occupancy,
+    grid: &mut Occupancy,
+) -> Vec<(i32, i32)> {
+    let mut label_at = Vec::new();
+    for ((_, l, above), &(w, h)) in slopes.iter().zip(slope_labels) {
+        let (a, b) = (chart.backend_coord(&(l[0], l[1])), chart.backend_coord(&(l[2], l[3])));
+        let rect = |t: f64| {
+            let (px, py) = ((a.0 as f64 + t * (b.0 - a.0) as f64) as i32, (a.1 as f64 + t * (b.1 - a.1) as f64) as i32);
+            if *above { (px + 6, py - 6 - h, w, h) } else { (px - 6 - w, py + 6, w, h) }
+        };
+        let t = [0.55, 0.4, 0.7, 0.25, 0.85].into_iter().find(|&t| !data.hits(rect(t), 2)).unwrap_or(0.55);
+        let r = rect(t);
+        grid.add_rect(r);
+        label_at.push(if *above { (r.0, r.1 + r.3) } else { (r.0 + r.2, r.1) });
+    }
+    label_at
+}
 
-    draw_guides(root, &mut chart, &p.hlines, (xa, ya), m)?;
-    draw_slopes(root, &mut chart, &slopes, &label_at, m)?;
-    draw_curves(root, &mut chart, &prepared)?;
-
-    draw_legend(root, &entries, legend_at, (legend_w, legend_h), (pad, swatch, row), m)?;
-    Ok(Some(YRange { title_index: 0, axis_lo: ya.lo, axis_hi: ya.hi, data_lo, data_hi, log: y_log }))
+/// The legend's corner inside the plot (pixel ranges `xr`, `yr`, `inset` from the border)
+/// where it keeps [`LEGEND_CLEARANCE`] from everything `taken`, as near a corner as possible
+/// (upper right first); none if there is no such place.
+fn free_corner(
+    taken: &Occupancy,
+    (xr, yr): (&std::ops::Range<i32>, &std::ops::Range<i32>),
+    inset: i32,
+    (legend_w, legend_h): (i32, i32),
+) -> Option<(i32, i32)> {
+    let (left, right) = (xr.start + inset, xr.end - inset - legend_w);
+    let (top, bottom) = (yr.start + inset, yr.end - inset - legend_h);
+    if !(right >= left && bottom >= top) {
+        return None;
+    }
+    let xs_: Vec<i32> = (left..=right).step_by(6).chain([right]).collect();
+    let ys_: Vec<i32> = (top..=bottom).step_by(6).chain([bottom]).collect();
+    ys_.iter()
+        .flat_map(|&y| xs_.iter().map(move |&x| (x, y)))
+        .filter(|&(x, y)| !taken.hits((x, y, legend_w, legend_h), LEGEND_CLEARANCE))
+        .min_by_key(|&(x, y)| {
+            let (dx, dy) = ((x - left).min(right - x), (y - top).min(bottom - y));
+            (dx + dy, (y - top > bottom - y) as u8, (x - left < right - x) as u8)
+        })
 }
 
 /// The reference slopes of a log-log panel, each a line (x0, y0, x1, y1) over the right half of

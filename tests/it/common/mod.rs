@@ -62,3 +62,10 @@ pub fn signorini_in(dir: &std::path::Path, args: &[&str]) -> (i32, String, Strin
     assert!(!stderr.contains("panicked"), "{stderr}");
     (out.status.code().unwrap_or(-1), stdout, stderr)
 }
+
+/// The run roles the repository's manifests (`experiments/`) declare, checked against what the
+/// CLAIMS rows and figures need: the roles every test reading results with them uses.
+pub fn roles() -> &'static signorini::analysis::roles::Roles {
+    static ROLES: std::sync::OnceLock<signorini::analysis::roles::Roles> = std::sync::OnceLock::new();
+    ROLES.get_or_init(|| signorini::analysis::roles::read(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments")).unwrap())
+}
