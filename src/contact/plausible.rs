@@ -79,15 +79,12 @@ fn contact_part(problem: &dyn Problem) -> String {
     problem.declared_parts().into_iter().find(|d| d.starts_with("parts.contact")).unwrap_or_else(|| "Gamma_C".into())
 }
 
-/// The outward unit normal of every contact edge of the mesh (by index into `mesh.boundary`),
+/// The outward unit normal of every boundary edge of the mesh (by index into `mesh.boundary`),
 /// away from the third vertex of the triangle that holds the edge.
-fn outward_normals(mesh: &Mesh, nodes: &P2Nodes) -> Vec<Option<[f64; 2]>> {
-    let mut out = vec![None; mesh.boundary.len()];
+pub(super) fn outward_normals(mesh: &Mesh, nodes: &P2Nodes) -> Vec<[f64; 2]> {
+    let mut out = vec![[0.0; 2]; mesh.boundary.len()];
     for (t, local) in nodes.element_boundary.iter().enumerate() {
         for &b in local.iter().flatten() {
-            if mesh.boundary[b].part != Part::Contact {
-                continue;
-            }
             let [p, q] = mesh.boundary[b].v.map(|v| mesh.vertices[v]);
             let inside = mesh.triangles[t].iter().map(|&v| mesh.vertices[v]).find(|&x| x != p && x != q).unwrap_or(p);
             let (tx, ty) = (q[0] - p[0], q[1] - p[1]);
@@ -97,7 +94,7 @@ fn outward_normals(mesh: &Mesh, nodes: &P2Nodes) -> Vec<Option<[f64; 2]>> {
             if n[0] * m[0] + n[1] * m[1] < 0.0 {
                 n = [-n[0], -n[1]];
             }
-            out[b] = Some(n);
+            out[b] = n;
         }
     }
     out
@@ -110,7 +107,8 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
     if problem.bad_datum().is_some() {
         return Ok(());
     }
-    let outward = outward_normals(mesh, nodes);
+    let outward: Vec<Option<[f64; 2]>> =
+        outward_normals(mesh, nodes).into_iter().zip(&mesh.boundary).map(|(n, e)| (e.part == Part::Contact).then_some(n)).collect();
     let cos_max = MAX_NORMAL_ANGLE_DEGREES.to_radians().cos();
     // per contact node, the most favourable of its contact edges: (n . n_out, edge)
     let mut best: Vec<Option<(f64, usize)>> = vec![None; dofs.contact.len()];

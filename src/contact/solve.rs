@@ -123,7 +123,7 @@ pub fn solve(
     let dofs = DofMap::new(&nodes, problem);
     certify::check_held(mesh, &nodes, &dofs, problem)?;
     super::plausible::check_contact_data(mesh, &nodes, &dofs, problem)?;
-    super::consistent::check_exact(problem, mesh)?;
+    super::consistent::check_exact(problem, mesh, &nodes)?;
     if dofs.contact.is_empty() {
         return Err(SolveError::NoContact { declared: problem.declared_parts() });
     }

@@ -227,3 +227,23 @@ fn prescribed_displacements_that_start_the_body_inside_the_obstacle_are_refused(
     assert_ne!(code, 0, "{err}");
     assert!(err.contains("point constraint") && err.contains("(free, -0.2)"), "{err}");
 }
+
+/// An exact solution that does not satisfy the problem's boundary or contact conditions
+/// (battery: a mistyped gap or traction in Example 7.1) measured errors that never converge,
+/// certified: refused naming the condition, the point and the values. The file as it is passes.
+#[test]
+fn an_exact_solution_that_breaks_a_boundary_or_contact_condition_is_refused() {
+    let solve = &["solve", "--problem", "v.toml", "--mesh", "structured:8"];
+    let cases = [
+        ("chi-below", "chi = 0\n", "chi = -0.05\n", "u . n <= chi"),
+        ("chi-above", "chi = 0\n", "chi = 0.05\n", "complementarity"),
+        ("traction", r#"traction = "exact""#, r#"traction = ["0", "0"]"#, "the traction on Gamma_N"),
+    ];
+    for (name, from, to, what) in cases {
+        let (code, err) = run_experiment(name, "ex71.toml", from, to, solve);
+        assert_ne!(code, 0, "{name}: {err}");
+        assert!(err.contains("the exact solution does not satisfy") && err.contains(what), "{name}: {err}");
+    }
+    let (code, err) = run_experiment("as-is", "ex71.toml", "chi = 0\n", "chi = 0\n", solve);
+    assert_eq!(code, 0, "{err}");
+}

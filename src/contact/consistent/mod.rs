@@ -14,8 +14,13 @@
 //! the data falls inside the stencil (fb's (x - a)_+^(1/2) in f, at x = a) the two steps
 //! disagree by about as much as the mismatch, and the point proves nothing either way: it is
 //! passed over, not refused.
+//!
+//! The boundary and contact conditions are checked too ([`boundary`]): an exact solution must
+//! satisfy them as well as the equations.
 
-use crate::mesh::Mesh;
+mod boundary;
+
+use crate::mesh::{Mesh, P2Nodes};
 use crate::problems::Problem;
 
 /// Triangles sampled (spread evenly over the mesh's numbering).
@@ -61,6 +66,11 @@ pub enum ExactError {
         count: usize,
         sampled: usize,
     },
+    #[error(
+        "{problem}: the exact solution does not satisfy {what}: at ({x}, {y}) {detail}, at {count} of {sampled} sampled boundary points; an exact solution must satisfy the problem's boundary and contact conditions (paper eq. 1.1-1.8), or the errors are measured against the solution of another problem",
+        x = .at[0], y = .at[1]
+    )]
+    Boundary { problem: String, what: String, at: [f64; 2], detail: String, count: usize, sampled: usize },
 }
 
 /// One comparison at one point: what the problem states, the difference quotient with the
@@ -145,7 +155,7 @@ fn compare(pts: &[([f64; 2], f64)], declared: &dyn Fn([f64; 2]) -> f64, differen
 }
 
 /// Check `problem`'s exact solution, if it has one, on `mesh` (see the module docs).
-pub fn check_exact(problem: &dyn Problem, mesh: &Mesh) -> Result<(), ExactError> {
+pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Result<(), ExactError> {
     let Some(exact) = problem.exact() else { return Ok(()) };
     let problem_name = || match problem.source() {
         Some(file) => format!("problem file {}", file.display()),
@@ -191,7 +201,7 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh) -> Result<(), ExactError>
             return Err(ExactError::BodyForce { problem: problem_name(), at, i, declared, differenced, step, spread, count, sampled });
         }
     }
-    Ok(())
+    boundary::check_boundary(problem, exact, mesh, nodes, &problem_name())
 }
 
 #[cfg(test)]
@@ -219,7 +229,7 @@ mod tests {
             let p = crate::problems::by_name(problem).unwrap();
             for n in [4, 16] {
                 let mesh = crate::mesh::MeshSpec::parse(&format!("structured:{n}")).unwrap().build(p.as_ref()).unwrap();
-                assert_eq!(check_exact(p.as_ref(), &mesh), Ok(()), "{problem} on structured:{n}");
+                assert_eq!(check_exact(p.as_ref(), &mesh, &P2Nodes::new(&mesh)), Ok(()), "{problem} on structured:{n}");
             }
         }
     }
