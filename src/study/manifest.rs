@@ -412,6 +412,7 @@ fn parse_run(
         check_role(role, &id, roles).map_err(|(expected, got)| invalid.at(key("role"), &expected, got))?;
     }
     let problem = r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid.at(key("problem"), "a problem name", "nothing".into()))?;
+    let problem = if crate::problems::is_file(&problem) { spelled(&problem) } else { problem };
     let mut constants = d.constants.clone().unwrap_or_default();
     constants.extend(r.constants.clone().unwrap_or_default());
     if let Err(e) = crate::problems::load(&resolve_problem(path, &problem), &constants) {
@@ -432,6 +433,10 @@ fn parse_run(
         return Err(invalid.at(key("problem"), &expected, format!("{problem:?}")));
     }
     let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| MeshSpec::DEFAULT.into());
+    let mesh = match mesh.strip_prefix("gmsh:") {
+        Some(file) => format!("gmsh:{}", spelled(file.trim())),
+        None => mesh,
+    };
     MeshSpec::parse(&resolve_mesh(path, &mesh))
         .map_err(|_| invalid.at(key("mesh"), "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'", format!("{mesh:?}")))?;
     let levels = r.levels.or(d.levels).ok_or_else(|| invalid.at(key("levels"), "a number of levels >= 1", "nothing".into()))?;
@@ -615,6 +620,30 @@ pub fn resolve_mesh(manifest: &Path, mesh: &str) -> String {
         }
         _ => mesh.to_string(),
     }
+}
+
+/// A relative path as the spec holds it, whatever way the manifest spells it: `.` components
+/// dropped and `dir/..` collapsed lexically (`./problems/../problems/p.toml` is
+/// `problems/p.toml`), so that one file spelt two ways is one spec, not a changed input. An
+/// absolute path, or one that climbs above the manifest's folder, keeps its leading part.
+pub fn spelled(path: &str) -> String {
+    if path.is_empty() {
+        return String::new();
+    }
+    let absolute = path.starts_with('/');
+    let mut parts: Vec<&str> = Vec::new();
+    for part in path.split('/') {
+        match part {
+            "" | "." => {}
+            ".." if parts.last().is_some_and(|p| *p != "..") => {
+                parts.pop();
+            }
+            ".." if absolute => {}
+            other => parts.push(other),
+        }
+    }
+    let joined = parts.join("/");
+    if absolute { format!("/{joined}") } else if joined.is_empty() { ".".into() } else { joined }
 }
 
 /// The SHA-256 of every file a run with `problem` and `mesh` reads (a problem file, a Gmsh

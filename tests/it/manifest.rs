@@ -124,3 +124,22 @@ fn every_declared_study_still_parses() {
         }
     }
 }
+
+/// One file spelt two ways in a manifest (`./p.toml`, `problems/../p.toml`) is one spec: the
+/// battery found `./p.toml` refused as a changed input against a run stored with `p.toml`.
+#[test]
+fn a_path_spelt_another_way_is_the_same_spec() {
+    use signorini::study::manifest::spelled;
+    assert_eq!(spelled("./problems/hertz.toml"), "problems/hertz.toml");
+    assert_eq!(spelled("problems/./../problems//hertz.toml"), "problems/hertz.toml");
+    assert_eq!(spelled("../shared/p.toml"), "../shared/p.toml");
+    assert_eq!(spelled("/abs/./dir/../p.toml"), "/abs/p.toml");
+    let dir = std::env::temp_dir().join(format!("signorini-spelled-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/problems/ex71.toml"), dir.join("p.toml")).unwrap();
+    let text = |problem: &str| format!("description = \"d\"\n[defaults]\nproblem = \"{problem}\"\nmesh = \"structured:2\"\n[[run]]\nid = \"a\"\nlevels = 2\n");
+    let a = Manifest::parse(&dir.join("s.toml"), &text("p.toml")).unwrap();
+    let b = Manifest::parse(&dir.join("s.toml"), &text("./p.toml")).unwrap();
+    assert_eq!(a.runs[0].spec, b.runs[0].spec);
+    std::fs::remove_dir_all(&dir).ok();
+}
