@@ -757,12 +757,8 @@ pub fn check(
         let stored = checked.runs;
         let fresh = match &opts.against {
             // another folder's records are read through the same check; a fault there is an error
-            Some(_) => fresh_store
-                .read()
-                .with_context(|| format!("--against {}: the study {}", fresh_root.display(), m.study))?,
-            None => fresh_store
-                .records()
-                .with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?,
+            Some(_) => fresh_store.read().with_context(|| format!("--against {}: the study {}", fresh_root.display(), m.study))?,
+            None => fresh_store.records().with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?,
         };
         let mut c = compare(m, &stored, &fresh, quick);
         if quick && !opts.quick && opts.against.is_none() {

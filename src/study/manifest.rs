@@ -643,7 +643,13 @@ pub fn spelled(path: &str) -> String {
         }
     }
     let joined = parts.join("/");
-    if absolute { format!("/{joined}") } else if joined.is_empty() { ".".into() } else { joined }
+    if absolute {
+        format!("/{joined}")
+    } else if joined.is_empty() {
+        ".".into()
+    } else {
+        joined
+    }
 }
 
 /// The SHA-256 of every file a run with `problem` and `mesh` reads (a problem file, a Gmsh

@@ -34,9 +34,9 @@ use reference::ReferenceField;
 use std::collections::HashMap;
 use std::ops::ControlFlow;
 use std::path::PathBuf;
-use store::{RunWriter, Store};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
+use store::{RunWriter, Store};
 
 /// Reference solutions computed in this process, shared by every run and study that declares
 /// the same one (they are deterministic, so sharing changes no number).
@@ -583,8 +583,12 @@ fn loop_of(
     pb.inc(start.level as u64);
     let mut level_error: Option<anyhow::Error> = None;
     let mut stopped = false;
-    let mut kept =
-        store::checkpoint::Checkpoint { run: spec.clone(), levels: start.records.clone(), history: start.history.clone(), next_active: None };
+    let mut kept = store::checkpoint::Checkpoint {
+        run: spec.clone(),
+        levels: start.records.clone(),
+        history: start.history.clone(),
+        next_active: None,
+    };
     let result = prepared.with_error_against(|error_against| {
         adapt::run_from(problem, start, config, error_against, &mut |level: Level| {
             let r = level.record;

@@ -137,7 +137,9 @@ fn a_path_spelt_another_way_is_the_same_spec() {
     let dir = std::env::temp_dir().join(format!("signorini-spelled-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::copy(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/problems/ex71.toml"), dir.join("p.toml")).unwrap();
-    let text = |problem: &str| format!("description = \"d\"\n[defaults]\nproblem = \"{problem}\"\nmesh = \"structured:2\"\n[[run]]\nid = \"a\"\nlevels = 2\n");
+    let text = |problem: &str| {
+        format!("description = \"d\"\n[defaults]\nproblem = \"{problem}\"\nmesh = \"structured:2\"\n[[run]]\nid = \"a\"\nlevels = 2\n")
+    };
     let a = Manifest::parse(&dir.join("s.toml"), &text("p.toml")).unwrap();
     let b = Manifest::parse(&dir.join("s.toml"), &text("./p.toml")).unwrap();
     assert_eq!(a.runs[0].spec, b.runs[0].spec);

@@ -128,7 +128,11 @@ fn an_interrupted_study_keeps_consistent_summaries_and_figures_refuse_it() {
     let runs = dir.read_runs().unwrap();
     assert!(!runs.is_empty() && runs.len() < 6, "{} runs kept", runs.len());
     // the summaries describe exactly the runs kept; no mesh of an unfinished run is left
-    assert!(drift::check_derived(&Store::new(&res, "long"), &runs).is_empty(), "{:?}", drift::check_derived(&Store::new(&res, "long"), &runs));
+    assert!(
+        drift::check_derived(&Store::new(&res, "long"), &runs).is_empty(),
+        "{:?}",
+        drift::check_derived(&Store::new(&res, "long"), &runs)
+    );
     let csv = std::fs::read_to_string(dir.csv_file()).unwrap();
     assert_eq!(csv.lines().count(), 1 + runs.iter().map(|r| r.levels.len()).sum::<usize>());
     for e in std::fs::read_dir(dir.root.join("meshes")).unwrap().flatten() {

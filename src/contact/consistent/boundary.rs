@@ -25,7 +25,8 @@ fn sample(mesh: &Mesh, nodes: &P2Nodes) -> Vec<Point> {
     let normals = super::super::plausible::outward_normals(mesh, nodes);
     let mut out = Vec::new();
     for part in [Part::Dirichlet, Part::Neumann, Part::Contact] {
-        let edges: Vec<usize> = (0..mesh.boundary.len()).filter(|&b| mesh.boundary[b].part == part && mesh.boundary[b].curve.is_none()).collect();
+        let edges: Vec<usize> =
+            (0..mesh.boundary.len()).filter(|&b| mesh.boundary[b].part == part && mesh.boundary[b].curve.is_none()).collect();
         let picks = SAMPLES.min(edges.len());
         out.extend((0..picks).map(|k| {
             let b = edges[k * edges.len() / picks];
@@ -61,13 +62,23 @@ pub fn check_boundary(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, nod
                 let g = problem.dirichlet(p.at);
                 for i in (0..2).filter(|&i| problem.dirichlet_components()[i]) {
                     let detail = format!("u_{} = {:.6e}, `dirichlet[{i}]` = {:.6e}", i + 1, u[i], g[i]);
-                    found.push((Violation { at: p.at, off: (u[i] - g[i]).abs(), what: "the Dirichlet data on Gamma_D".into(), detail }, scale_u));
+                    found.push((
+                        Violation { at: p.at, off: (u[i] - g[i]).abs(), what: "the Dirichlet data on Gamma_D".into(), detail },
+                        scale_u,
+                    ));
                 }
             }
             Part::Neumann => {
                 let (g, s) = (problem.traction(p.at, n), sigma_n(p.at, n));
                 for i in 0..2 {
-                    let detail = format!("(sigma(u) n)_{} = {:.6e}, the traction `traction[{i}]` = {:.6e} (n = ({:.4}, {:.4}))", i + 1, s[i], g[i], n[0], n[1]);
+                    let detail = format!(
+                        "(sigma(u) n)_{} = {:.6e}, the traction `traction[{i}]` = {:.6e} (n = ({:.4}, {:.4}))",
+                        i + 1,
+                        s[i],
+                        g[i],
+                        n[0],
+                        n[1]
+                    );
                     found.push((Violation { at: p.at, off: (s[i] - g[i]).abs(), what: "the traction on Gamma_N".into(), detail }, scale_s));
                 }
             }
@@ -79,7 +90,8 @@ pub fn check_boundary(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, nod
                 let s = sigma_n(p.at, n);
                 let snn = s[0] * cn[0] + s[1] * cn[1];
                 let state = format!("u . n = {un:.6e}, the gap chi = {chi:.6e}, sigma_nn = {snn:.6e}");
-                let contact = |what: &str, off: f64, scale: f64| (Violation { at: p.at, off, what: what.into(), detail: state.clone() }, scale);
+                let contact =
+                    |what: &str, off: f64, scale: f64| (Violation { at: p.at, off, what: what.into(), detail: state.clone() }, scale);
                 found.push(contact("the contact condition u . n <= chi on Gamma_C", (un - chi).max(0.0), scale_u));
                 found.push(contact("the contact condition sigma_nn <= 0 on Gamma_C (no tension)", snn.max(0.0), scale_s));
                 // open (chi - u . n > 0) and pressed (sigma_nn < 0) at once: the smaller of the two
@@ -94,7 +106,10 @@ pub fn check_boundary(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, nod
         for (i, v) in c.u.iter().enumerate() {
             if let Some(v) = v {
                 let detail = format!("u_{} = {:.6e}, prescribed {v:.6e}", i + 1, u[i]);
-                found.push((Violation { at: c.at, off: (u[i] - v).abs(), what: "a point constraint (`point_constraints`)".into(), detail }, scale_u));
+                found.push((
+                    Violation { at: c.at, off: (u[i] - v).abs(), what: "a point constraint (`point_constraints`)".into(), detail },
+                    scale_u,
+                ));
             }
         }
     }

@@ -92,7 +92,8 @@ pub(super) fn orphans(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<PathBuf>
             });
             // nor is one whose writer (the process its name holds) is running: a summary being
             // committed by another process now
-            let writer_alive = temporary && records::temporary_writer(&name).is_some_and(|pid| pid != std::process::id() && super::lock::running(pid));
+            let writer_alive =
+                temporary && records::temporary_writer(&name).is_some_and(|pid| pid != std::process::id() && super::lock::running(pid));
             let in_progress = temporary && (writer_alive || of_run.is_some_and(|id| super::lock::run_in_progress(dir, &id)));
             if (temporary || stray_mesh || stray_reference) && !in_progress {
                 out.push(path);
@@ -214,8 +215,13 @@ fn csv_row_faults(dir: &StudyDir, on_disk: &[u8], runs: &[RunRecord]) -> Vec<Fau
             let same = mine.len() == rendered.len() && mine.iter().zip(&rendered).all(|(a, b)| *a == b);
             (!same).then(|| {
                 let what = match rendered.iter().zip(&mine).position(|(b, a)| *a != b) {
-                    _ if mine.is_empty() => format!("has no row of run {} (runs/{}.json has {} levels)", r.run.id, r.run.id, rendered.len()),
-                    Some(level) => format!("row of run {} level {level} is not what runs/{}.json renders (the record or the row was changed)", r.run.id, r.run.id),
+                    _ if mine.is_empty() => {
+                        format!("has no row of run {} (runs/{}.json has {} levels)", r.run.id, r.run.id, rendered.len())
+                    }
+                    Some(level) => format!(
+                        "row of run {} level {level} is not what runs/{}.json renders (the record or the row was changed)",
+                        r.run.id, r.run.id
+                    ),
                     None => format!("has {} rows of run {}, runs/{}.json has {} levels", mine.len(), r.run.id, r.run.id, rendered.len()),
                 };
                 Fault { file: file.clone(), what, record: Some(r.run.id.clone()) }

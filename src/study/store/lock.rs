@@ -8,8 +8,8 @@
 //! Only the store hands locks out ([`super::Store::lock`], [`super::Store::lock_run`]): every
 //! write to the folder needs the guard of the lock that covers it.
 
-use crate::study::provenance;
 use crate::records::StudyDir;
+use crate::study::provenance;
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 

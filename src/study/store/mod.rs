@@ -119,7 +119,11 @@ impl Store {
                 return Ok((writer, held));
             }
             if !wait {
-                bail!("--fresh: run(s) {} of {} started meanwhile; pass --wait to wait for them", started.join(", "), self.dir.root.display());
+                bail!(
+                    "--fresh: run(s) {} of {} started meanwhile; pass --wait to wait for them",
+                    started.join(", "),
+                    self.dir.root.display()
+                );
             }
         }
     }
@@ -210,4 +214,3 @@ impl Store {
         }
     }
 }
-
