@@ -14,6 +14,7 @@ mod bad_physics;
 mod bad_settings;
 mod bad_slurm;
 mod bad_store;
+mod bad_trust;
 mod cholesky;
 mod claims_criteria;
 mod cli_output;
