@@ -525,6 +525,12 @@ fn run_studies(
     for manifest in &parsed {
         manifest.check_runs()?;
     }
+    check_one_declaration(&parsed, quick)?;
+    if quick && !replace && !fresh {
+        for manifest in &parsed {
+            check_quick_beside_full(manifest, &results)?;
+        }
+    }
     if let Some(shard) = shard {
         check_shard(&parsed, shard)?;
     }
@@ -532,6 +538,52 @@ fn run_studies(
         let options = study::RunOptions { quick, shard, fresh, replace, results: results.clone(), progress: true, wait_for_lock: wait };
         let executed = study::run_study(manifest, &options)?;
         say!("{}: {} run(s) executed, results in {}", manifest.study, executed.len(), results.join(&manifest.study).display());
+    }
+    Ok(())
+}
+
+/// Manifests given together that declare the same study declare the same runs: otherwise the
+/// second would be refused (or with --replace would replace the first's runs) only after the
+/// first had computed, so the conflict is refused before anything is, naming both files.
+fn check_one_declaration(manifests: &[study::manifest::Manifest], quick: bool) -> Result<()> {
+    let runs = |m: &study::manifest::Manifest| {
+        let mut specs: Vec<_> = m.runs.iter().map(|p| study::effective_spec(p, quick)).collect();
+        specs.sort_by(|a, b| a.id.cmp(&b.id));
+        specs
+    };
+    for (i, a) in manifests.iter().enumerate() {
+        if let Some(b) = manifests[..i].iter().find(|b| b.study == a.study && runs(b) != runs(a)) {
+            bail!(
+                "{} and {} both declare study {} with different runs: given together, the second would find the first's runs stored with                  another spec; nothing was run. Run one of them (or give them different file names: the study is the file's name)",
+                b.file.display(),
+                a.file.display(),
+                a.study
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `run --quick` into a folder that holds the full form of a run: its quick form (the first
+/// `quick_levels` levels) is another spec, and replacing the full run with it would throw the
+/// full run away, so the refusal says so and points at another folder rather than at --replace.
+fn check_quick_beside_full(manifest: &study::manifest::Manifest, results: &std::path::Path) -> Result<()> {
+    let store = study::store::Store::new(results, &manifest.study);
+    let stored = store.records().unwrap_or_default();
+    let full = manifest.runs.iter().find(|p| {
+        let (full, quick) = (study::effective_spec(p, false), study::effective_spec(p, true));
+        full != quick && stored.iter().any(|r| r.run == full)
+    });
+    if let Some(p) = full {
+        bail!(
+            "{}: {} holds the full form of study {} (run {} with its {} levels); --quick computes only the first {} levels of each run,              another spec, and storing it there would replace the full runs. Nothing was run or changed. Give the quick runs another              folder: --results target/quick-results (the default of --quick) or any other",
+            manifest.file.display(),
+            store.dir().root.display(),
+            manifest.study,
+            p.spec.id,
+            p.spec.levels,
+            p.quick_levels
+        );
     }
     Ok(())
 }
@@ -734,7 +786,9 @@ fn run_drift(
         Some(older) => report.merged_into(older).with_context(|| format!("merging into the drift report {}", file.display()))?,
         None => serde_json::to_value(&report)?,
     };
-    signorini::records::write_json(&file, &written).with_context(|| format!("writing the drift report {}", file.display()))?;
+    signorini::records::write_json(&file, &written).with_context(|| {
+        format!("writing the drift report {} (--report FILE writes it elsewhere; the comparison above stands)", file.display())
+    })?;
     println!("report: {}", file.display());
     drift_outcome(&report, against, results)
 }

@@ -58,6 +58,11 @@ fn error(path: &Path, line: Option<usize>, message: impl Into<String>) -> MeshEr
     MeshError::Gmsh { file: path.to_path_buf(), line, message: message.into() }
 }
 
+/// A mesh file that cannot be read, in the words the reader always used.
+fn error_io(path: &Path, e: &std::io::Error) -> MeshError {
+    error(path, None, format!("cannot read the mesh file: {e}"))
+}
+
 /// 1-based line of byte `offset` of `bytes`.
 fn line_at(bytes: &[u8], offset: usize) -> usize {
     1 + bytes[..offset.min(bytes.len())].iter().filter(|&&b| b == b'\n').count()
@@ -125,30 +130,11 @@ fn element_lines(bytes: &[u8]) -> HashMap<u64, usize> {
     out
 }
 
-/// Refuse what is not a regular file (`/dev/zero`, a pipe: they have no end to read to) and a
-/// file too large for the memory this process can allocate (parsing holds the file and its
-/// nodes and elements: about eight times its size).
-fn check_size(path: &Path) -> Result<(), MeshError> {
-    let meta = std::fs::metadata(path).map_err(|e| error(path, None, format!("cannot read the mesh file: {e}")))?;
-    if !meta.is_file() {
-        return Err(error(path, None, "not a regular file: a mesh is read from a file of known size"));
-    }
-    let needed = 8.0 * meta.len() as f64;
-    let available = crate::base::memory::available_memory().unwrap_or(crate::base::memory::UNKNOWN_MEMORY_LIMIT);
-    if needed > available {
-        return Err(error(
-            path,
-            None,
-            format!(
-                "the file has {}: reading it needs about {}, more than the {} this process can allocate",
-                crate::base::memory::human_bytes(meta.len() as f64),
-                crate::base::memory::human_bytes(needed),
-                crate::base::memory::human_bytes(available)
-            ),
-        ));
-    }
-    Ok(())
-}
+/// A mesh file as [`crate::base::input::read`] reads it: a regular file (not `/dev/zero` or a
+/// pipe: they have no end to read to) no larger than the memory this process can allocate
+/// allows (parsing holds the file and its nodes and elements: about eight times its size).
+pub const MESH_FILE: crate::base::input::Kind =
+    crate::base::input::Kind { what: "a mesh", limit: crate::base::input::Limit::MemoryPerByte(8.0) };
 
 /// A triangulation, not a folded or overlapping set of triangles: with every triangle turned
 /// counter-clockwise, an edge inside the mesh is run through once in each direction by the two
@@ -259,8 +245,10 @@ type Triangles = (Vec<[usize; 3]>, Vec<Option<usize>>);
 /// Read and check a Gmsh file (everything that does not depend on the problem), phase by phase:
 /// parse, nodes by tag, elements by kind, vertices, triangles, the boundary groups' edges.
 pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
-    check_size(path)?;
-    let bytes = std::fs::read(path).map_err(|e| error(path, None, format!("cannot read the mesh file: {e}")))?;
+    let bytes = crate::base::input::read(path, MESH_FILE).map_err(|e| match e {
+        crate::base::input::InputError::Io { error, .. } => error_io(path, &error),
+        other => error(path, None, other.to_string()),
+    })?;
     let bytes = single_spaced(bytes);
     let names = physical_names(path, &bytes)?;
     let msh = parse(path, &bytes)?;

@@ -40,14 +40,10 @@ pub struct Mesh {
 /// What is wrong with a mesh.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
-    #[error(
-        "malformed mesh description '{0}': expected 'structured:N' or 'symmetric:N' with N a positive integer (N even keeps y = 0.5 a vertex), or 'gmsh:PATH.msh'"
-    )]
+    #[error("malformed mesh description '{}': expected {SPEC_FORMS}", crate::base::input::excerpt(.0))]
     BadSpec(String),
     /// `symmetric:N` with N odd (or 0): the mirror line y = 0.5 must be a grid line.
-    #[error(
-        "malformed mesh description '{spec}': symmetric:N needs N even (it mirrors the lower N/2 rows of squares onto the upper half about y = 0.5, so y = 0.5 must be a grid line): use {suggest}, or structured:N for any N"
-    )]
+    #[error("malformed mesh description '{spec}': symmetric:N needs {}", even_symmetric(suggest))]
     OddSymmetric { spec: String, suggest: String },
     #[error("triangle {t} has non-positive area {area:e} (vertices must be counter-clockwise and distinct)")]
     NonPositiveArea { t: usize, area: f64 },
@@ -63,12 +59,40 @@ pub enum MeshError {
         "the problem gives its boundary parts by Gmsh physical group ({groups}), but {mesh} is a built-in mesh without groups, and no Dirichlet edge is left: use a Gmsh mesh (gmsh:PATH.msh) or give the parts as predicates in x and y"
     )]
     GroupsOnBuiltIn { mesh: String, groups: String },
-    #[error("required vertex ({x}, {y}) (a kink of the obstacle) is not a mesh vertex")]
-    MissingVertex { x: f64, y: f64 },
+    /// A point the problem requires to be a vertex (`origin`: where it declares it) is not one;
+    /// `outside` says so with the mesh's extent when it lies outside the mesh's bounding box.
+    #[error("{origin}: ({x}, {y}) is not a vertex of the mesh{}", outside.as_ref().map(|o| format!(" (it lies outside the mesh, {o})")).unwrap_or_default())]
+    MissingVertex { origin: String, x: f64, y: f64, outside: Option<String> },
+    /// A load break line x = c that no element crosses (`origin`: where the problem declares it).
+    #[error("{origin}: the line x = {c} does not cross the mesh ({extent}): a load break is a line x = c inside the body")]
+    LoadBreakOutside { origin: String, c: f64, extent: String },
     /// A Gmsh file that cannot be read, is malformed or does not fit the problem; `line` is the
     /// 1-based line of the file where that shows (None for a binary file or a missing section).
-    #[error("{}{}: {message}", file.display(), line.map(|l| format!(", line {l}")).unwrap_or_default())]
+    #[error("{}{}: {}", file.display(), line.map(|l| format!(", line {l}")).unwrap_or_default(), crate::base::input::excerpt(message))]
     Gmsh { file: PathBuf, line: Option<usize>, message: String },
+}
+
+/// The forms of a mesh description.
+const SPEC_FORMS: &str = "'structured:N' or 'symmetric:N' with N a positive integer (N even keeps y = 0.5 a vertex), or 'gmsh:PATH.msh'";
+
+/// Why symmetric:N needs N even, and what to use (`suggest`).
+fn even_symmetric(suggest: &str) -> String {
+    format!(
+        "N even (it mirrors the lower N/2 rows of squares onto the upper half about y = 0.5, so y = 0.5 must be a grid line): use {suggest}, or structured:N for any N"
+    )
+}
+
+impl MeshError {
+    /// What a mesh description [`MeshSpec::parse`] refused should be, in the parser's own words
+    /// without the description (a manifest's "key `run[0].mesh`: expected .., got .." names it);
+    /// for any other error its message.
+    pub fn expected(&self) -> String {
+        match self {
+            MeshError::BadSpec(_) => SPEC_FORMS.to_string(),
+            MeshError::OddSymmetric { suggest, .. } => format!("symmetric:N with {}", even_symmetric(suggest)),
+            other => other.to_string(),
+        }
+    }
 }
 
 /// How a mesh is described on the command line and in manifests.
@@ -135,14 +159,18 @@ impl MeshSpec {
         let mesh = match self {
             MeshSpec::Structured(n) => Mesh::unit_square(*n, false, &part_of),
             MeshSpec::Symmetric(n) => Mesh::unit_square(*n, true, &part_of),
-            MeshSpec::Gmsh(path) => return gmsh::read(path)?.mesh(problem),
+            MeshSpec::Gmsh(path) => gmsh::read(path)?.mesh(problem)?,
         };
         // a problem written for a Gmsh mesh (parts by physical group) on a built-in mesh, which has
         // no groups: without this its predicates tag nothing Dirichlet and the system is singular
         let groups = problem.groups();
-        if !groups.is_empty() && !mesh.boundary.iter().any(|e| e.part == Part::Dirichlet) {
+        if self.file().is_none() && !groups.is_empty() && !mesh.boundary.iter().any(|e| e.part == Part::Dirichlet) {
             return Err(MeshError::GroupsOnBuiltIn { mesh: self.to_string(), groups: groups.join(", ") });
         }
+        // what the problem declares of its mesh, named where it declares it (refinement keeps
+        // the vertices: the initial mesh is where they are checked)
+        mesh.check_declared_vertices(&problem.required_vertices_declared())?;
+        mesh.check_load_breaks(&problem.load_breaks_declared())?;
         Ok(mesh)
     }
 }
@@ -327,12 +355,48 @@ impl Mesh {
 
     /// Check that each given point is a mesh vertex (e.g. the kink of the obstacle).
     pub fn check_vertices(&self, points: &[[f64; 2]]) -> Result<(), MeshError> {
-        for p in points {
+        let declared: Vec<_> = points.iter().map(|&p| ("a required vertex".to_string(), p)).collect();
+        self.check_declared_vertices(&declared)
+    }
+
+    /// [`Mesh::check_vertices`] for points with where they are declared (`origin`, p), which the
+    /// error names; a point outside the mesh's bounding box is said to be so.
+    pub fn check_declared_vertices(&self, points: &[(String, [f64; 2])]) -> Result<(), MeshError> {
+        let ([x0, y0], [x1, y1]) = self.bounding_box();
+        for (origin, p) in points {
             if !self.vertices.iter().any(|v| dist(*v, *p) < 1e-12) {
-                return Err(MeshError::MissingVertex { x: p[0], y: p[1] });
+                let inside = (x0..=x1).contains(&p[0]) && (y0..=y1).contains(&p[1]);
+                let outside = (!inside).then(|| format!("which spans x in [{x0}, {x1}], y in [{y0}, {y1}]"));
+                return Err(MeshError::MissingVertex { origin: origin.clone(), x: p[0], y: p[1], outside });
             }
         }
         Ok(())
+    }
+
+    /// Check that each load break line x = c (with where it is declared) crosses the mesh:
+    /// strictly between its smallest and largest x, or no element is cut by it and the value
+    /// has no effect (an error, not a silently ignored input).
+    pub fn check_load_breaks(&self, breaks: &[(String, f64)]) -> Result<(), MeshError> {
+        let ([x0, _], [x1, _]) = self.bounding_box();
+        match breaks.iter().find(|(_, c)| !(*c > x0 && *c < x1)) {
+            Some((origin, c)) => {
+                Err(MeshError::LoadBreakOutside { origin: origin.clone(), c: *c, extent: format!("which spans x in [{x0}, {x1}]") })
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// The smallest and the largest coordinates of the vertices.
+    fn bounding_box(&self) -> ([f64; 2], [f64; 2]) {
+        let mut lo = [f64::INFINITY; 2];
+        let mut hi = [f64::NEG_INFINITY; 2];
+        for v in &self.vertices {
+            for k in 0..2 {
+                lo[k] = lo[k].min(v[k]);
+                hi[k] = hi[k].max(v[k]);
+            }
+        }
+        (lo, hi)
     }
 }
 

@@ -123,6 +123,9 @@ impl Problem for Ex72 {
     fn required_vertices(&self) -> Vec<[f64; 2]> {
         vec![[1.0, 0.5]]
     }
+    fn required_vertices_declared(&self) -> Vec<(String, [f64; 2])> {
+        vec![("the kink of problem ex72's obstacle".into(), [1.0, 0.5])]
+    }
 }
 
 /// `fb`: a free boundary with an exact solution (beyond the paper). Example 7.1 is in contact on

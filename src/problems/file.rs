@@ -28,15 +28,20 @@ use toml::Spanned;
 
 mod tables;
 
+/// A problem file as [`crate::base::input::read`] reads it: a regular file of at most
+/// [`TEXT_LIMIT`](crate::base::input::TEXT_LIMIT) bytes.
+pub const PROBLEM_FILE: crate::base::input::Kind =
+    crate::base::input::Kind { what: "the problem file", limit: crate::base::input::Limit::Bytes(crate::base::input::TEXT_LIMIT) };
+
 /// What is wrong with a problem file.
 #[derive(Debug, thiserror::Error)]
 pub enum ProblemFileError {
-    #[error("{file}: cannot read the problem file: {error}")]
-    Read { file: PathBuf, error: std::io::Error },
+    #[error("{file}: {error}")]
+    Read { file: PathBuf, error: crate::base::input::InputError },
     /// TOML syntax, an unknown or missing key, a value of the wrong type (toml's message).
-    #[error("{file}:{line}:{column}: {message}")]
+    #[error("{file}:{line}:{column}: {}", crate::base::input::excerpt(message))]
     Syntax { file: PathBuf, line: usize, column: usize, message: String },
-    #[error("{file}:{line}:{column}: key `{key}`: {message}")]
+    #[error("{file}:{line}:{column}: key `{key}`: {}", crate::base::input::excerpt(message))]
     Invalid { file: PathBuf, key: String, line: usize, column: usize, message: String },
 }
 
@@ -667,7 +672,8 @@ impl FileProblem {
     /// `constants` table: the same problem at another load). Constants defined from an
     /// overridden one follow it; naming a constant the file does not declare is an error.
     pub fn load_with(path: &Path, overrides: &BTreeMap<String, f64>) -> Result<Self, ProblemFileError> {
-        let text = std::fs::read_to_string(path).map_err(|error| ProblemFileError::Read { file: path.to_path_buf(), error })?;
+        let text = crate::base::input::read_text(path, PROBLEM_FILE)
+            .map_err(|error| ProblemFileError::Read { file: path.to_path_buf(), error })?;
         Self::parse_with(path, &text, overrides)
     }
 
@@ -852,6 +858,15 @@ impl Problem for FileProblem {
     }
     fn load_breaks(&self) -> Vec<f64> {
         self.load_breaks.clone()
+    }
+    fn required_vertices_declared(&self) -> Vec<(String, [f64; 2])> {
+        let key = |k: String| format!("{}: key `{k}`", self.file.display());
+        let declared = self.required_vertices.iter().enumerate().map(|(i, &p)| (key(format!("required_vertices[{i}]")), p));
+        let points = self.point_constraints.iter().enumerate().map(|(i, c)| (key(format!("point_constraints[{i}].at")), c.at));
+        declared.chain(points).collect()
+    }
+    fn load_breaks_declared(&self) -> Vec<(String, f64)> {
+        self.load_breaks.iter().enumerate().map(|(i, &c)| (format!("{}: key `load_breaks[{i}]`", self.file.display()), c)).collect()
     }
     fn exact(&self) -> Option<&dyn Exact> {
         self.exact.as_ref().map(|e| e as &dyn Exact)

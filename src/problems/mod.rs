@@ -117,6 +117,16 @@ pub trait Problem: Send + Sync {
     fn load_breaks(&self) -> Vec<f64> {
         Vec::new()
     }
+    /// [`Problem::required_vertices`], each with where the problem declares it, in an error's
+    /// words (a problem file's key); by default "a required vertex of problem NAME".
+    fn required_vertices_declared(&self) -> Vec<(String, [f64; 2])> {
+        self.required_vertices().into_iter().map(|p| (format!("a required vertex of problem {}", self.name()), p)).collect()
+    }
+    /// [`Problem::load_breaks`], each with where the problem declares it (as
+    /// [`Problem::required_vertices_declared`]).
+    fn load_breaks_declared(&self) -> Vec<(String, f64)> {
+        self.load_breaks().into_iter().map(|c| (format!("a load break of problem {}", self.name()), c)).collect()
+    }
     fn exact(&self) -> Option<&dyn Exact> {
         None
     }

@@ -73,13 +73,18 @@ pub type Definition = fn(&crate::records::LevelRecord) -> Option<f64>;
 /// tolerance on the index itself could be honest about while still seeing a change of 1e-5.
 pub const DERIVED: [(&str, Definition); 1] = [("efficiency", |l| l.err_quadrature.map(|e| l.terms.estimate / e))];
 
+/// A manifest as [`crate::base::input::read`] reads it: a regular file of at most
+/// [`TEXT_LIMIT`](crate::base::input::TEXT_LIMIT) bytes.
+const MANIFEST: crate::base::input::Kind =
+    crate::base::input::Kind { what: "the manifest", limit: crate::base::input::Limit::Bytes(crate::base::input::TEXT_LIMIT) };
+
 #[derive(Debug, thiserror::Error)]
 pub enum ManifestError {
-    #[error("{file}: cannot read the manifest: {error}")]
-    Read { file: PathBuf, error: std::io::Error },
-    #[error("{file}: {message}")]
+    #[error("{file}: {error}")]
+    Read { file: PathBuf, error: crate::base::input::InputError },
+    #[error("{file}: {}", crate::base::input::excerpt(message))]
     Syntax { file: PathBuf, message: String },
-    #[error("{file}: key `{key}`: expected {expected}, got {got}")]
+    #[error("{file}: key `{key}`: expected {expected}, got {}", crate::base::input::excerpt(got))]
     Invalid { file: PathBuf, key: String, expected: String, got: String },
 }
 
@@ -253,7 +258,7 @@ impl Manifest {
     }
 
     pub fn load(path: &Path) -> Result<Self, ManifestError> {
-        let bytes = std::fs::read(path).map_err(|error| ManifestError::Read { file: path.to_path_buf(), error })?;
+        let bytes = crate::base::input::read(path, MANIFEST).map_err(|error| ManifestError::Read { file: path.to_path_buf(), error })?;
         let text = String::from_utf8_lossy(&bytes);
         Self::parse(path, &text).map(|mut m| {
             m.bytes = without_roles(&bytes);
@@ -379,6 +384,12 @@ fn check_defaults(d: &RunToml, invalid: &Invalid) -> Result<(), ManifestError> {
     Ok(())
 }
 
+/// The longest run id: the longest file name the store makes from an id is a snapshot's
+/// temporary `.ID_levelL.json.tmpPID.N` (`records::temporary_for`, `StudyDir::mesh_file`), which
+/// adds at most 67 bytes to the id (a level and a counter of 20 digits, a process id of 10), and
+/// a file name has at most 255 bytes (NAME_MAX). 128 leaves room for what a later name may add.
+pub const RUN_ID_MAX: usize = 128;
+
 /// `[[run]]` number `i`, completed from `[defaults]` `d` and checked key by key; `ids` holds the
 /// names of the runs before it, `roles` their roles (role -> id).
 fn parse_run(
@@ -398,6 +409,13 @@ fn parse_run(
             key("id"),
             "a name of letters, digits, '_', '-', '.' that starts with a letter or digit",
             format!("{id:?}"),
+        ));
+    }
+    if id.len() > RUN_ID_MAX {
+        return Err(invalid.at(
+            key("id"),
+            &format!("a name of at most {RUN_ID_MAX} characters (the store's file names made from it must fit in 255 bytes)"),
+            format!("{} characters", id.len()),
         ));
     }
     // unique ignoring case too: runs/A.json and runs/a.json are one file where the results folder
@@ -437,8 +455,7 @@ fn parse_run(
         Some(file) => format!("gmsh:{}", spelled(file.trim())),
         None => mesh,
     };
-    MeshSpec::parse(&resolve_mesh(path, &mesh))
-        .map_err(|_| invalid.at(key("mesh"), "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'", format!("{mesh:?}")))?;
+    MeshSpec::parse(&resolve_mesh(path, &mesh)).map_err(|e| invalid.at(key("mesh"), &e.expected(), format!("{mesh:?}")))?;
     let levels = r.levels.or(d.levels).ok_or_else(|| invalid.at(key("levels"), "a number of levels >= 1", "nothing".into()))?;
     let defaults = AdaptConfig::default();
     let theta = r.theta.or(d.theta).unwrap_or(defaults.theta);
@@ -658,7 +675,8 @@ pub fn spelled(path: &str) -> String {
 pub fn input_hashes(manifest: &Path, problem: &str, mesh: &str) -> Result<BTreeMap<String, String>, (&'static str, String)> {
     let mut out = BTreeMap::new();
     let mut add = |key: &'static str, written: &str, resolved: &Path| {
-        let bytes = std::fs::read(resolved).map_err(|e| (key, format!("{}: {e}", resolved.display())))?;
+        let kind = if key == "mesh" { crate::mesh::gmsh::MESH_FILE } else { crate::problems::file::PROBLEM_FILE };
+        let bytes = crate::base::input::read(resolved, kind).map_err(|e| (key, format!("{}: {e}", resolved.display())))?;
         out.insert(written.to_string(), super::provenance::sha256_hex(&bytes));
         Ok(())
     };
@@ -724,7 +742,7 @@ impl Manifest {
         let problem = crate::problems::load(&resolve_problem(&self.file, &spec.problem), &spec.constants)
             .map_err(|e| invalid("problem", "a problem that loads".into(), format!("{:?}: {e}", spec.problem)))?;
         let mesh_spec = MeshSpec::parse(&resolve_mesh(&self.file, &spec.mesh))
-            .map_err(|e| invalid("mesh", "'structured:N', 'symmetric:N' or 'gmsh:PATH.msh'".into(), format!("{:?}: {e}", spec.mesh)))?;
+            .map_err(|e| invalid("mesh", e.expected(), format!("{:?}", spec.mesh)))?;
         let ndof = mesh_spec.ndof().map_err(|e| invalid("mesh", "a readable mesh file".into(), format!("{:?}: {e}", spec.mesh)))?;
         crate::base::memory::check_memory(&format!("the initial mesh {}", spec.mesh), ndof)
             .map_err(|e| invalid("mesh", "an initial mesh that fits in this machine's memory".into(), e.to_string()))?;
@@ -753,7 +771,12 @@ impl Manifest {
 pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
     use anyhow::Context;
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .with_context(|| format!("reading the study manifests in {}", dir.display()))?
+        .with_context(|| {
+            format!(
+                "reading the study manifests in {} (relative to the current folder; pass --experiments DIR where they are elsewhere)",
+                dir.display()
+            )
+        })?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
         .collect();

@@ -46,7 +46,10 @@ pub struct ProblemFile {
 
 impl ProblemFile {
     pub fn of(path: &Path) -> Self {
-        ProblemFile { path: path.display().to_string(), sha256: std::fs::read(path).ok().map(|b| sha256_hex(&b)) }
+        ProblemFile {
+            path: path.display().to_string(),
+            sha256: crate::base::input::read(path, crate::problems::file::PROBLEM_FILE).ok().map(|b| sha256_hex(&b)),
+        }
     }
 }
 
@@ -128,7 +131,14 @@ pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: 
         date: utc_now(),
         mesh_sha256: meshes
             .iter()
-            .map(|m| (m.display().to_string(), std::fs::read(m).map(|b| sha256_hex(&b)).unwrap_or_else(|e| format!("(cannot read: {e})"))))
+            .map(|m| {
+                (
+                    m.display().to_string(),
+                    crate::base::input::read(m, crate::mesh::gmsh::MESH_FILE)
+                        .map(|b| sha256_hex(&b))
+                        .unwrap_or_else(|e| format!("(cannot read: {e})")),
+                )
+            })
             .collect(),
         runs,
         problem_files: Vec::new(),

@@ -15,6 +15,7 @@ mod bad_roles;
 mod bad_settings;
 mod bad_slurm;
 mod bad_store;
+mod bad_trust;
 mod cholesky;
 mod claims_criteria;
 mod cli_output;

@@ -1,0 +1,172 @@
+//! The one reader of a user's input file (a problem file, a study manifest, a Gmsh mesh): what is
+//! not a regular file (a named pipe, a device such as `/dev/zero`, a directory) is refused before
+//! a byte is read, so it can neither hang nor grow a buffer without end, and so is a file larger
+//! than its kind may be. The handle is opened without blocking (a named pipe with no writer
+//! would block `open` itself) and checked by `fstat` on that same handle, so what is checked is
+//! what is read.
+
+use std::io::Read;
+use std::path::Path;
+
+/// What a kind of input file may be.
+#[derive(Clone, Copy, Debug)]
+pub struct Kind {
+    /// The file in a message's words: "the problem file", "the manifest", "the mesh file".
+    pub what: &'static str,
+    pub limit: Limit,
+}
+
+/// How large a file of a kind may be.
+#[derive(Clone, Copy, Debug)]
+pub enum Limit {
+    /// At most this many bytes (a text file a person writes: a problem file, a manifest).
+    Bytes(u64),
+    /// Reading it takes about this many bytes of memory per byte of file, which must be
+    /// available ([`available_memory`](super::memory::available_memory)): a mesh file, which
+    /// parsing holds together with its nodes and elements.
+    MemoryPerByte(f64),
+}
+
+/// A problem file or a manifest: at most 16 MiB (the largest the project declares is a few KiB;
+/// a file beyond this is not a problem or a study written by a person).
+pub const TEXT_LIMIT: u64 = 16 * 1024 * 1024;
+
+/// Why an input file was not read. The caller's error names the path.
+#[derive(Debug, thiserror::Error)]
+pub enum InputError {
+    #[error("cannot read {what}: {error}")]
+    Io { what: &'static str, error: std::io::Error },
+    #[error("not a regular file ({found}): {what} is read from a file of known size")]
+    NotRegular { what: &'static str, found: &'static str },
+    #[error("{what} has {size}, more than the {limit} it may have (is this the file you meant?)")]
+    TooLarge { what: &'static str, size: String, limit: String },
+    #[error("the file has {size}: reading it needs about {needed}, more than the {available} this process can allocate")]
+    Memory { size: String, needed: String, available: String },
+}
+
+/// The bytes of the input file at `path` of kind `kind`, or why not (see the module's doc).
+pub fn read(path: &Path, kind: Kind) -> Result<Vec<u8>, InputError> {
+    use std::os::unix::fs::OpenOptionsExt;
+    let io = |error| InputError::Io { what: kind.what, error };
+    let file = std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK).open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    if !meta.is_file() {
+        return Err(InputError::NotRegular { what: kind.what, found: file_type(&meta.file_type()) });
+    }
+    let size = meta.len();
+    check_size(size, kind)?;
+    let mut bytes = Vec::with_capacity(size as usize);
+    // no more than was checked, should the file grow meanwhile
+    file.take(size).read_to_end(&mut bytes).map_err(io)?;
+    Ok(bytes)
+}
+
+/// The text of the input file at `path`, which must be UTF-8 ([`read`], then the encoding).
+pub fn read_text(path: &Path, kind: Kind) -> Result<String, InputError> {
+    String::from_utf8(read(path, kind)?).map_err(|e| InputError::Io {
+        what: kind.what,
+        error: std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("not UTF-8 text (byte {} is not valid UTF-8)", e.utf8_error().valid_up_to() + 1),
+        ),
+    })
+}
+
+/// `size` bytes within `kind`'s limit.
+fn check_size(size: u64, kind: Kind) -> Result<(), InputError> {
+    use super::memory::{UNKNOWN_MEMORY_LIMIT, available_memory, human_bytes};
+    match kind.limit {
+        Limit::Bytes(limit) if size > limit => {
+            Err(InputError::TooLarge { what: kind.what, size: human_bytes(size as f64), limit: human_bytes(limit as f64) })
+        }
+        Limit::MemoryPerByte(per_byte) => {
+            let needed = per_byte * size as f64;
+            let available = available_memory().unwrap_or(UNKNOWN_MEMORY_LIMIT);
+            if needed > available {
+                return Err(InputError::Memory {
+                    size: human_bytes(size as f64),
+                    needed: human_bytes(needed),
+                    available: human_bytes(available),
+                });
+            }
+            Ok(())
+        }
+        Limit::Bytes(_) => Ok(()),
+    }
+}
+
+/// A file type that is not a regular file, in words.
+fn file_type(t: &std::fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    match () {
+        _ if t.is_dir() => "a directory",
+        _ if t.is_fifo() => "a named pipe",
+        _ if t.is_char_device() => "a character device",
+        _ if t.is_block_device() => "a block device",
+        _ if t.is_socket() => "a socket",
+        _ => "not a file",
+    }
+}
+
+/// The longest line of an error message that quotes a user's input in full.
+pub const EXCERPT_LINE: usize = 2000;
+
+/// `message` with every line longer than [`EXCERPT_LINE`] characters cut to its first 1000 and
+/// the count of the rest: what every error that quotes a user's input shows of it (a manifest
+/// of one 200 MB line must not come back as a 200 MB message). Errors of manifests, problem
+/// files and meshes format their text through it.
+pub fn excerpt(message: &str) -> String {
+    if message.lines().all(|l| l.chars().count() <= EXCERPT_LINE) {
+        return message.to_string();
+    }
+    let short = |l: &str| {
+        let n = l.chars().count();
+        if n <= EXCERPT_LINE {
+            l.to_string()
+        } else {
+            format!("{}... ({} more characters)", l.chars().take(1000).collect::<String>(), n - 1000)
+        }
+    };
+    message.split('\n').map(short).collect::<Vec<_>>().join("\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_excerpt_is_bounded_and_short_lines_are_kept() {
+        assert_eq!(excerpt("a\nb c"), "a\nb c");
+        let long = format!("got \"{}\"\nnext", "x".repeat(10_000));
+        let e = excerpt(&long);
+        assert!(e.len() < 1100 && e.ends_with("... (9006 more characters)\nnext"), "{e}");
+        assert!(e.starts_with("got \"xxx"));
+    }
+
+    const TEXT: Kind = Kind { what: "the test file", limit: Limit::Bytes(8) };
+
+    #[test]
+    fn a_regular_file_within_its_limit_is_read_and_others_are_refused() {
+        let dir = std::env::temp_dir().join(format!("signorini-input-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let small = dir.join("small");
+        std::fs::write(&small, "12345678").unwrap();
+        assert_eq!(read_text(&small, TEXT).unwrap(), "12345678");
+        std::fs::write(&small, "123456789").unwrap();
+        let e = read(&small, TEXT).unwrap_err().to_string();
+        assert!(e.starts_with("the test file has 9 B, more than the 8 B"), "{e}");
+        std::fs::write(&small, [b'a', 0xff]).unwrap();
+        assert!(read_text(&small, TEXT).unwrap_err().to_string().contains("byte 2 is not valid UTF-8"));
+        let e = read(&dir, TEXT).unwrap_err().to_string();
+        assert_eq!(e, "not a regular file (a directory): the test file is read from a file of known size");
+        let e = read(Path::new("/dev/zero"), TEXT).unwrap_err().to_string();
+        assert!(e.starts_with("not a regular file (a character device)"), "{e}");
+        let fifo = dir.join("fifo");
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        // SAFETY: mkfifo reads the NUL-terminated path it is given
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let e = read(&fifo, TEXT).unwrap_err().to_string();
+        assert!(e.starts_with("not a regular file (a named pipe)"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
