@@ -48,7 +48,7 @@ own="$cases/own-geo"
 mkdir -p "$own" && cp "$root/experiments/meshes/quarter_disc.geo" "$own/disc.geo"
 cat > "$own/disc.toml" <<'TOML'
 description = "quarter disc pressed down onto y = 0 (cross-check of meshing a .geo of one's own)"
-dirichlet = [0, -0.01]
+dirichlet = ["0", "-0.01 * y"]   # 0 at (1, 0), where the arc meets the contact part
 [material]
 E = 1
 nu = 0.3

@@ -18,6 +18,16 @@
 //!   diameter of the mesh's bounding box, asks the body to move by more than its own size at p:
 //!   outside linear (small-strain) elasticity everywhere it happens, and in practice a sign or
 //!   unit mistake.
+//! * **Prescribed displacements do not push the body into the obstacle.** A node of the closure
+//!   of Gamma_C whose displacement is prescribed (a corner shared with Gamma_D, a point
+//!   constraint) is not a contact node, so the constraint is not imposed there; yet a prescribed
+//!   u with u . n > chi puts that point of the body inside the obstacle, which no solution of the
+//!   contact problem does. Where the prescribed components determine u . n (both prescribed, or
+//!   the one along n), u . n - chi must not exceed [`PRESCRIBED_PENETRATION`] times the body's
+//!   size. Such data leave the continuous problem without a solution: the trace of u on the
+//!   boundary lies in H^{1/2}, which holds no function with a jump, yet u . n would have to jump
+//!   from its prescribed value to at most chi at that end of Gamma_C; the discrete problems are
+//!   solvable only because the node is not constrained, and their solutions converge to nothing.
 //!
 //! Not repeated here: a normal of length 0 or a gap that is not a finite number is refused by
 //! the data watch (`problems::BadDatum`, after assembly); a declared normal is normalised where
@@ -30,6 +40,10 @@ use crate::problems::{Part, Problem};
 
 /// The largest angle, in degrees, a declared contact normal may make with the outward normal.
 pub const MAX_NORMAL_ANGLE_DEGREES: f64 = 80.0;
+
+/// How far (relative to the diameter of the mesh's bounding box) a prescribed displacement at a
+/// node of the closure of Gamma_C may pass the obstacle: round-off of data that touch it.
+pub const PRESCRIBED_PENETRATION: f64 = 1e-9;
 
 /// Contact data without physical sense on this mesh.
 #[derive(Debug, thiserror::Error)]
@@ -47,6 +61,12 @@ pub enum ContactDataError {
         x = .at[0], y = .at[1]
     )]
     Gap { problem: String, part: String, at: [f64; 2], chi: f64, diameter: f64 },
+    #[error(
+        "{problem}: the displacement prescribed at ({x}, {y}) on the closure of the contact part ({part}) by {by} is ({ux}, {uy}); along the contact normal ({nx:.6}, {ny:.6}) that is u . n = {un}, past the gap chi = {chi} by {over:.3e}: the body would start inside the obstacle there. Prescribe a displacement with u . n <= chi at the contact part's ends (or end the contact part before them)",
+        x = .at[0], y = .at[1], ux = .u[0], uy = .u[1], nx = .normal[0], ny = .normal[1], over = .un - .chi
+    )]
+    /// `u`: the prescribed components, "free" for one that is not.
+    Prescribed { problem: String, part: String, by: String, at: [f64; 2], u: [String; 2], normal: [f64; 2], un: f64, chi: f64 },
 }
 
 /// The problem as errors name it: its file, or its built-in name.
@@ -123,6 +143,57 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
         if c.gap < -diameter {
             let (problem, part) = (problem_name(problem), contact_part(problem));
             return Err(Box::new(ContactDataError::Gap { problem, part, at, chi: c.gap, diameter }));
+        }
+    }
+    check_prescribed(nodes, dofs, problem, &outward, diameter)
+}
+
+/// The prescribed nodes of the closure of Gamma_C against the obstacle (see the module docs).
+fn check_prescribed(
+    nodes: &P2Nodes,
+    dofs: &DofMap,
+    problem: &dyn Problem,
+    outward: &[Option<[f64; 2]>],
+    diameter: f64,
+) -> Result<(), Box<ContactDataError>> {
+    let on_closure: std::collections::BTreeSet<usize> = nodes
+        .boundary_nodes
+        .iter()
+        .zip(outward)
+        .filter(|(_, o)| o.is_some())
+        .flat_map(|(three, _)| three.iter().copied())
+        .filter(|&p| dofs.contact_index[p].is_none())
+        .collect();
+    if on_closure.is_empty() {
+        return Ok(());
+    }
+    let values = dofs.prescribed(nodes, problem);
+    let fixed = |p: usize, i: usize| dofs.dof[p][i] == crate::fem::assembly::FIXED;
+    for p in on_closure {
+        let x = nodes.coords[p];
+        let n = problem.contact_normal(x);
+        let len = n[0].hypot(n[1]);
+        let (chi, u) = (problem.gap(x), values[p]);
+        if !(len > 0.0) || !chi.is_finite() {
+            continue; // the data watch names it
+        }
+        let n = [n[0] / len, n[1] / len];
+        // u . n is known where both components are prescribed, or the one n lies along
+        let un = match (fixed(p, 0), fixed(p, 1)) {
+            (true, true) => u[0] * n[0] + u[1] * n[1],
+            (true, false) if n[1].abs() < 1e-12 => u[0] * n[0],
+            (false, true) if n[0].abs() < 1e-12 => u[1] * n[1],
+            _ => continue,
+        };
+        if un - chi > PRESCRIBED_PENETRATION * diameter {
+            let by = if nodes.part[p] == Some(Part::Dirichlet) {
+                "the Dirichlet data (`dirichlet`)"
+            } else {
+                "a point constraint (`point_constraints`)"
+            };
+            let (problem, part) = (problem_name(problem), contact_part(problem));
+            let u = [0, 1].map(|i| if fixed(p, i) { u[i].to_string() } else { "free".to_string() });
+            return Err(Box::new(ContactDataError::Prescribed { problem, part, by: by.into(), at: x, u, normal: n, un, chi }));
         }
     }
     Ok(())

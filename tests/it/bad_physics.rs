@@ -194,6 +194,35 @@ fn a_body_force_that_the_exact_solution_does_not_satisfy_is_refused() {
     }
 }
 
+/// Prescribed displacements at the ends of the contact part that start the body inside the
+/// obstacle (battery: a Dirichlet side pushed 0.5 into the foundation at its corners, a point
+/// constraint past the gap) were solved and certified "penetration 0": the constraint is not
+/// imposed at a prescribed node. Refused, naming the node, the source, u . n and the gap; the same
+/// data touching the obstacle (u . n = chi) pass.
+#[test]
+fn prescribed_displacements_that_start_the_body_inside_the_obstacle_are_refused() {
+    let sides = r#"dirichlet = "x < 1e-12 || x > 1 - 1e-12""#;
+    let pushed = format!("{sides}\n");
+    let variant = |name: &str, dirichlet: &str| {
+        let dir = tmp(name);
+        let text = fixture(SQUARE).replace(r#"dirichlet = "y > 1 - 1e-12""#, &pushed).replace(r#"dirichlet = ["0", "-0.01"]"#, dirichlet);
+        std::fs::write(dir.join("v.toml"), text).unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_signorini")).current_dir(&dir).args(SOLVE).output().unwrap();
+        (o.status.code().unwrap_or(-1), String::from_utf8_lossy(&o.stderr).into_owned())
+    };
+    let (code, err) = variant("corner-in", r#"dirichlet = ["0", "-0.5"]"#);
+    assert_ne!(code, 0, "{err}");
+    assert!(err.contains("at (0, 0)") && err.contains("Dirichlet data") && err.contains("past the gap chi = 0.001"), "{err}");
+    // touching the obstacle (u . n = 0.001 = chi) is sense
+    let (code, err) = variant("corner-touch", r#"dirichlet = ["0", "-0.001"]"#);
+    assert_eq!(code, 0, "{err}");
+    // a point constraint on Gamma_C past the gap
+    let (code, err) =
+        run("point-in", SQUARE, "[contact]", "[[point_constraints]]\nat = [0.5, 0]\nu = [\"free\", -0.2]\n\n[contact]", SOLVE);
+    assert_ne!(code, 0, "{err}");
+    assert!(err.contains("point constraint") && err.contains("(free, -0.2)"), "{err}");
+}
+
 /// An exact solution that does not satisfy the problem's boundary or contact conditions
 /// (battery: a mistyped gap or traction in Example 7.1) measured errors that never converge,
 /// certified: refused naming the condition, the point and the values. The file as it is passes.

@@ -393,8 +393,10 @@ fn contact_zone_arc_length_along_a_curve() {
         fn traction(&self, _x: [f64; 2], _n: [f64; 2]) -> [f64; 2] {
             [0.0, 0.0]
         }
-        fn dirichlet(&self, _x: [f64; 2]) -> [f64; 2] {
-            [0.0, 0.0]
+        fn dirichlet(&self, x: [f64; 2]) -> [f64; 2] {
+            // the left side moves with the ring: at (0, 1), where it meets the contact part,
+            // u . n = chi (held at 0 there, the body would start inside the ring)
+            [0.0, -0.01 * x[1]]
         }
         fn contact_normal(&self, x: [f64; 2]) -> [f64; 2] {
             let r = x[0].hypot(x[1]);
