@@ -392,12 +392,13 @@ impl StudyDir {
 
     /// Every finished run of the study, in file-name order.
     pub fn read_runs(&self) -> std::io::Result<Vec<RunRecord>> {
-        Ok(self.read_run_files()?.into_iter().map(|(_, r)| r).collect())
+        Ok(self.read_run_files()?.into_iter().map(|(_, _, r)| r).collect())
     }
 
-    /// Every record file `runs/*.json` with the run it holds, in file-name order (what the
-    /// store's integrity check reads: a record's run id must be its file name).
-    pub fn read_run_files(&self) -> std::io::Result<Vec<(PathBuf, RunRecord)>> {
+    /// Every record file `runs/*.json` with its text and the run it holds, in file-name order
+    /// (what the store's integrity check reads: a record's run id must be its file name, its
+    /// text what [`json_bytes`] writes for it).
+    pub fn read_run_files(&self) -> std::io::Result<Vec<(PathBuf, String, RunRecord)>> {
         let dir = self.root.join("runs");
         let mut files: Vec<PathBuf> = match std::fs::read_dir(&dir) {
             Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|e| e == "json")).collect(),
@@ -410,7 +411,7 @@ impl StudyDir {
             .map(|f| {
                 let text = read_text(&f)?;
                 let record = serde_json::from_str(&text).map_err(RecordError::parse(&f))?;
-                Ok((f, record))
+                Ok((f, text, record))
             })
             .collect()
     }

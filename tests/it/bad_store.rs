@@ -508,3 +508,34 @@ fn a_hand_edited_record_or_summary_is_refused_by_run_and_replace_computes_it_aga
         assert_eq!(code, 0, "{out}");
     }
 }
+
+/// A record is what the harness writes for the run it holds, byte for byte (battery finding 15:
+/// `"bogus": 1` in a level passed `drift`, `figures` and `run`, since serde drops an unknown
+/// field): an unknown field or a record another program reformatted is a fault of its run,
+/// refused by every reader and computed again by `run --replace`.
+#[test]
+fn a_record_with_an_unknown_field_or_another_format_is_a_fault_of_its_run() {
+    let (dir, m) = stored("unknown-field");
+    let study = results_of(&dir);
+    let file = study.join("runs/a.json");
+    let original = std::fs::read_to_string(&file).unwrap();
+    let mut bogus: serde_json::Value = serde_json::from_str(&original).unwrap();
+    bogus["levels"][1]["bogus"] = serde_json::json!(1);
+    let compact = serde_json::to_string(&serde_json::from_str::<serde_json::Value>(&original).unwrap()).unwrap();
+    for (case, text) in [("unknown field", serde_json::to_string_pretty(&bogus).unwrap() + "\n"), ("compact", compact + "\n")] {
+        std::fs::write(&file, &text).unwrap();
+        for (code, out) in drift_and_figures(&dir) {
+            assert_ne!(code, 0, "{case}: {out}");
+            assert!(out.contains("runs/a.json: is not what the harness writes"), "{case}: {out}");
+        }
+        let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+        assert_ne!(code, 0, "{case}: {out}");
+        assert!(out.contains("is not what the harness writes") && out.contains("Nothing was run or changed"), "{case}: {out}");
+        let (code, out) = signorini(&dir, &["run", m, "--results", "results", "--replace"]);
+        assert_eq!(code, 0, "{case}: {out}");
+        assert!(out.contains("1 run(s) executed"), "{case}: only a is computed again: {out}");
+        for (code, out) in drift_and_figures(&dir) {
+            assert_eq!(code, 0, "{case}: {out}");
+        }
+    }
+}

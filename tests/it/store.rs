@@ -77,11 +77,20 @@ fn a_second_run_of_the_same_study_is_refused_or_waits_and_loses_nothing() {
     let before = std::fs::read(dir.run_file("b")).unwrap();
     let store = Store::new(&d, "tiny");
     let lock = store.lock(false).unwrap();
-    // refused, naming the holder; with --fresh it must not have deleted anything
-    let (code, err) = signorini(&["run", &fixture(), "--quick", "--fresh", "--results", res]);
+    // refused after the lock's patience (1 s here, 30 by default), naming the holder; with
+    // --fresh it must not have deleted anything
+    let out = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["run", &fixture(), "--quick", "--fresh", "--results", res])
+        .env("SIGNORINI_LOCK_PATIENCE", "1")
+        .output()
+        .unwrap();
+    let (code, err) = (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned());
     assert_ne!(code, Some(0));
     assert!(
-        err.contains("is being written by process") && err.contains(&std::process::id().to_string()) && err.contains("--wait"),
+        err.contains("is being written by process")
+            && err.contains(&std::process::id().to_string())
+            && err.contains("--wait")
+            && err.contains("held for more than 1 s"),
         "{err}"
     );
     assert_eq!(std::fs::read(dir.run_file("b")).unwrap(), before, "the refused run touched the other's run");
@@ -246,4 +255,27 @@ fn a_temporary_file_of_a_running_writer_is_not_a_leftover() {
     writer.kill().unwrap();
     writer.wait().unwrap();
     assert_eq!(checked.leftovers, [dead], "{:?}", checked.leftovers);
+}
+
+/// The study lock is held only to set up and to commit: a run that finds it taken waits for it
+/// (up to 30 s) without --wait, so two shards started at the same moment both run (battery
+/// finding 12: the second was refused).
+#[test]
+fn a_study_lock_held_briefly_is_waited_for_without_wait() {
+    let d = tmp("brief-lock");
+    let res = d.to_str().unwrap();
+    let store = Store::new(&d, "tiny");
+    let lock = store.lock(false).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["run", &fixture(), "--quick", "--shard", "1/2", "--results", res])
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1000));
+    drop(lock);
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(StudyDir::new(&d, "tiny").run_file("a").exists(), "{err}");
 }

@@ -13,6 +13,27 @@ use crate::study::provenance;
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 
+/// How long a process waits for a study lock another process holds before it is refused
+/// (without `--wait`): setting up and committing take seconds. `SIGNORINI_LOCK_PATIENCE`
+/// (seconds) sets another.
+pub const STUDY_LOCK_PATIENCE: std::time::Duration = std::time::Duration::from_secs(30);
+
+/// [`STUDY_LOCK_PATIENCE`], or `SIGNORINI_LOCK_PATIENCE` seconds where that is set to a number
+/// in 0 ..= 3600 (otherwise the default, with a note).
+fn patience() -> std::time::Duration {
+    let Ok(text) = std::env::var("SIGNORINI_LOCK_PATIENCE") else { return STUDY_LOCK_PATIENCE };
+    match text.trim().parse::<f64>() {
+        Ok(s) if (0.0..=3600.0).contains(&s) => std::time::Duration::from_secs_f64(s),
+        _ => {
+            crate::base::note::line(format_args!(
+                "SIGNORINI_LOCK_PATIENCE={text:?} is not a number of seconds in 0 ..= 3600; waiting the default {} s",
+                STUDY_LOCK_PATIENCE.as_secs()
+            ));
+            STUDY_LOCK_PATIENCE
+        }
+    }
+}
+
 /// An exclusive lock on a file holding the owner's process id and command line. Released when
 /// dropped (or when the process dies: the operating system drops the lock with the file
 /// descriptor).
@@ -21,11 +42,29 @@ pub struct Lock {
 }
 
 impl Lock {
-    /// The study lock of `dir`: refused (naming the holder) if another process holds it, unless
-    /// `wait`, then waits for it.
+    /// The study lock of `dir`. It is held only while shared files change (setting up,
+    /// committing: seconds), so a process that finds it taken waits up to
+    /// [`STUDY_LOCK_PATIENCE`] ([`patience`]) even without `wait` (two shards started at the same moment
+    /// both run); past that it is refused naming the holder, unless `wait`, then waits for it.
     pub(super) fn study(dir: &StudyDir, wait: bool) -> Result<Lock> {
         let path = dir.root.join(".lock");
-        claim(open(&path)?, &path, &dir.root.display().to_string(), wait)
+        let file = open(&path)?;
+        let patience = patience();
+        let deadline = std::time::Instant::now() + patience;
+        while !wait && std::time::Instant::now() < deadline {
+            match file.try_lock() {
+                Ok(()) => return own(file, &path),
+                Err(std::fs::TryLockError::WouldBlock) => std::thread::sleep(std::time::Duration::from_millis(50)),
+                Err(std::fs::TryLockError::Error(e)) => return Err(e).with_context(|| format!("locking {}", path.display())),
+            }
+        }
+        let claimed = claim(file, &path, &dir.root.display().to_string(), wait);
+        if wait {
+            return claimed;
+        }
+        claimed.with_context(|| {
+            format!("the study lock was held for more than {} s (it is held only to set up and to commit)", patience.as_secs_f64())
+        })
     }
 
     /// The lock of run `id` of `dir`, held while it is computed. Tried first under the study

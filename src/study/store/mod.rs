@@ -160,7 +160,7 @@ impl Store {
     pub fn check(&self) -> Result<Checked> {
         let files = self.dir.read_run_files().with_context(|| format!("reading the runs in {}", self.dir.root.join("runs").display()))?;
         let mut faults = Vec::new();
-        for (file, record) in &files {
+        for (file, text, record) in &files {
             let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
             let mut fault =
                 |file: &std::path::Path, what: String| faults.push(Fault { file: file.to_path_buf(), what, record: Some(stem.clone()) });
@@ -171,6 +171,20 @@ impl Store {
                 );
                 continue;
             }
+            // what the harness writes for this record, byte for byte: an unknown field (which
+            // serde would drop silently), a hand edit that reformats, or a record of another
+            // version of the format is a fault of its run
+            if let Ok(written) = crate::records::json_bytes(file, record)
+                && written != text.as_bytes()
+            {
+                let (stored, expected) = check::first_difference(text, &String::from_utf8_lossy(&written));
+                fault(
+                    file,
+                    format!(
+                        "is not what the harness writes for the run it holds: {stored}, written {expected} (an unknown field or a hand edit?)"
+                    ),
+                );
+            }
             if record.study != self.study {
                 fault(file, format!("is a record of study {}, not {}", record.study, self.study));
             }
@@ -178,7 +192,7 @@ impl Store {
                 fault(&path, what);
             }
         }
-        let runs: Vec<RunRecord> = files.into_iter().map(|(_, r)| r).collect();
+        let runs: Vec<RunRecord> = files.into_iter().map(|(_, _, r)| r).collect();
         faults.extend(check::summary_faults(&self.dir, &self.study, &runs));
         faults.extend(check::reference_faults(&self.dir, &runs));
         let leftovers = check::orphans(&self.dir, &runs)?;
