@@ -17,6 +17,8 @@
 //!   block (sparse tags too); a tag listed twice is an error. Nodes must lie in the plane z = 0.
 //!   Nodes not used by any triangle are dropped; the others become the mesh's vertices in
 //!   ascending tag order (for a file Gmsh wrote without renumbering, the file's order).
+//! * A partitioned file (`$PartitionedEntities`) is refused by name: its elements sit on
+//!   partition entities, whose groups are their parents' ([`refuse_partitioned`]).
 //!
 //! `mshio` parses the `$MeshFormat`, `$Entities`, `$Nodes` and `$Elements` sections but not
 //! `$PhysicalNames`, so that small section (`dim tag "name"` per line, ASCII in binary files too)
@@ -250,6 +252,7 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
         other => error(path, None, other.to_string()),
     })?;
     let bytes = single_spaced(bytes);
+    refuse_partitioned(path, &bytes)?;
     let names = physical_names(path, &bytes)?;
     let msh = parse(path, &bytes)?;
     let binary = msh.header.file_type != 0;
@@ -264,6 +267,22 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     check_folds(path, &vertices, &triangles, &tri_nodes, &line_of)?;
     let (edges, groups) = group_edges(path, line_elems, &used, &node_at, &names, &line_of)?;
     Ok(GmshFile { path: path.to_path_buf(), vertices, triangles, triangle_lines, edges, groups })
+}
+
+/// A partitioned file (Gmsh's `Mesh.partition`) puts its elements on partition entities, listed
+/// in `$PartitionedEntities` with their parents' physical groups, which `mshio` does not read:
+/// its boundary lines would come out in no group, and the problem's groups reported missing.
+/// Refused, naming the section's line and how to write the mesh whole.
+fn refuse_partitioned(path: &Path, bytes: &[u8]) -> Result<(), MeshError> {
+    let at = bytes.split(|&b| b == b'\n').position(|l| l.trim_ascii_end() == b"$PartitionedEntities");
+    match at {
+        None => Ok(()),
+        Some(i) => Err(error(
+            path,
+            Some(i + 1),
+            "a partitioned mesh ($PartitionedEntities): its elements sit on partition entities, which this reader does not follow; write the mesh unpartitioned (without gmsh.model.mesh.partition, or `gmsh.model.mesh.unpartition()` before writing)",
+        )),
+    }
 }
 
 /// An ASCII file with every run of blanks (spaces, tabs, a carriage return) between two fields

@@ -18,6 +18,7 @@
 //! * `adapt --save DIR/` computed every level, then failed to write (`check_writable`).
 //! * standard output on a full device panicked (exit 101): `stdout_write` in main.rs.
 //! * one name given to two physical groups merged them into one part (`physical_names`).
+//! * a partitioned mesh was read as if whole, its groups empty (`refuse_partitioned`).
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -304,5 +305,26 @@ fn bad_lengths_huge_numbers_export_files_and_unreached_minimums_are_named() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("the adaptive loop ended at level 2 with") && err.contains("short of --adapt-min-ndof 100000"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A partitioned MSH 4.1 file (battery 4, finding 6) puts its elements on partition entities:
+/// read as if it were whole, its lines came out in no group and the problem was blamed ("its
+/// groups of lines: " with none). Refused naming the section, its line and how to write it whole.
+#[test]
+fn a_partitioned_mesh_is_refused_by_name() {
+    let dir = tmp("partitioned");
+    std::fs::write(dir.join("v.toml"), fixture(QD)).unwrap();
+    std::fs::write(dir.join("p.msh"), fixture("gmsh_renumbered/partitioned.msh")).unwrap();
+    for args in [["solve", "--problem", "v.toml", "--mesh", "gmsh:p.msh"], ["adapt", "--problem", "v.toml", "--mesh", "gmsh:p.msh"]] {
+        let o = Command::new(env!("CARGO_BIN_EXE_signorini")).current_dir(&dir).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains("p.msh, line 21") && err.contains("a partitioned mesh ($PartitionedEntities)") && err.contains("unpartition"),
+            "{err}"
+        );
+        assert!(!err.contains("names the physical group"), "{err}");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
