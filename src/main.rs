@@ -526,6 +526,9 @@ fn run_studies(
         manifest.check_runs()?;
     }
     check_one_declaration(&parsed, quick)?;
+    // a run CLAIMS.md or a figure needs that no manifest declares would be found missing only
+    // by `figures`, after the study was computed
+    signorini::analysis::roles::check(&parsed)?;
     if quick && !replace && !fresh {
         for manifest in &parsed {
             check_quick_beside_full(manifest, &results)?;

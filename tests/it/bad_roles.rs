@@ -1,6 +1,6 @@
 //! Run roles (`role = "..."` in a manifest's [[run]] table): CLAIMS rows and figures find their
 //! runs by role (`analysis::roles`). A role they need that a study does not declare is an error
-//! when the manifests are read, by `figures` and `drift` alike, naming the role, the study and
+//! when the manifests are read, by `figures`, `drift` and `run` alike, naming the role, the study and
 //! what needs it; a role declared twice in a study is refused; the repository's manifests declare
 //! every role needed; and a role is not part of what the provenance hashes.
 
@@ -65,6 +65,15 @@ fn a_run_renamed_without_its_role_fails_when_drift_reads_the_manifests() {
         signorini_in(&d, &["drift", "--quick", "--experiments", "experiments", "--results", "results", "--study", "ex71"]);
     assert_names_the_missing_role(code, &err);
     assert!(!out.contains("ex71/"), "reran a run before the check: {out}");
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn a_run_renamed_without_its_role_is_refused_by_run_before_anything_is_computed() {
+    let d = renamed_without_role("run");
+    let (code, out, err) = signorini_in(&d, &["run", "experiments/ex71.toml", "--quick", "--results", "results"]);
+    assert_names_the_missing_role(code, &err);
+    assert!(!d.join("results").exists() && !out.contains("ex71/"), "computed before the check: {out}");
     std::fs::remove_dir_all(&d).ok();
 }
 
