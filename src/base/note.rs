@@ -1,6 +1,6 @@
 //! Messages to standard error that cannot stop the program: `eprintln!` panics when the write
 //! fails (a full disk, a closed standard error, a file-size limit), which would turn a note
-//! about the computation into a crash of it. [`line`] writes and drops a failed write.
+//! about the computation into a crash of it. [`line()`] writes and drops a failed write.
 
 use std::io::Write;
 

@@ -235,7 +235,7 @@ impl Held {
 
 /// Check that the prescribed components (Dirichlet data and point constraints) stop the rigid
 /// motions of every body of the mesh (an edge-connected set of triangles: two triangles sharing
-/// only a vertex can turn about it), as [`Held`] decides: with both components prescribed, two
+/// only a vertex can turn about it), as `Held` decides: with both components prescribed, two
 /// distinct nodes suffice; rollers on a side need a prescribed u_2 somewhere else.
 pub fn check_held(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem) -> Result<(), RigidMotionError> {
     let bodies = bodies(nodes);

@@ -18,7 +18,7 @@
 //!   Nodes not used by any triangle are dropped; the others become the mesh's vertices in
 //!   ascending tag order (for a file Gmsh wrote without renumbering, the file's order).
 //! * A partitioned file (`$PartitionedEntities`) is refused by name: its elements sit on
-//!   partition entities, whose groups are their parents' ([`refuse_partitioned`]).
+//!   partition entities, whose groups are their parents' (`refuse_partitioned`).
 //!
 //! `mshio` parses the `$MeshFormat`, `$Entities`, `$Nodes` and `$Elements` sections but not
 //! `$PhysicalNames`, so that small section (`dim tag "name"` per line, ASCII in binary files too)

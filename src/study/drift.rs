@@ -19,7 +19,7 @@
 //! form the fresh runs are prefixes of the stored full runs and are compared level by level.
 //! The refinement histories (marks and warm starts per level, mesh fingerprints) must agree
 //! exactly as far as the fresh run went; a deep study in its tiers also replays the last level of
-//! its `replay` runs from the stored history and compares that level ([`replay_tier`]).
+//! its `replay` runs from the stored history and compares that level (`replay_tier`).
 //!
 //! Besides the numbers, the files derived from the records are checked: `levels.csv` and
 //! `provenance.json`'s run list must be exactly what the stored records give

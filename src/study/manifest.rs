@@ -235,7 +235,7 @@ pub struct Manifest {
     /// The manifest's bytes without its `role = "..."` lines ([`without_roles`]): hashed into
     /// the provenance.
     pub bytes: Vec<u8>,
-    /// What runs stand for (role -> run id, from `role = "..."` in the [[run]] tables): how
+    /// What runs stand for (role -> run id, from `role = "..."` in the `[[run]]` tables): how
     /// CLAIMS.md and the figures find their runs ([`crate::analysis::roles`]).
     pub roles: BTreeMap<String, String>,
 }

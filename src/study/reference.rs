@@ -69,7 +69,7 @@ fn config_of(spec: &ReferenceSpec) -> AdaptConfig {
 }
 
 /// Compute the reference solution `spec` declares: adaptive refinement from `mesh_spec`
-/// ([`config_of`]) until the NDF reaches `min_ndof`; the last level's solution, with the
+/// (`config_of`) until the NDF reaches `min_ndof`; the last level's solution, with the
 /// history that rebuilds it. `on_level` sees every level (progress) and may stop the loop (an
 /// interrupt): then the result is `None`. A loop that ends short of `min_ndof` (after
 /// [`REFERENCE_LEVELS`] levels) is an error saying how far it got.

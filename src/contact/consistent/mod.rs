@@ -15,7 +15,7 @@
 //! disagree by about as much as the mismatch, and the point proves nothing either way: it is
 //! passed over, not refused.
 //!
-//! The boundary and contact conditions are checked too ([`boundary`]): an exact solution must
+//! The boundary and contact conditions are checked too (module `boundary`): an exact solution must
 //! satisfy them as well as the equations.
 
 mod boundary;

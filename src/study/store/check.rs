@@ -1,7 +1,7 @@
 //! The store's integrity check ([`super::Store::check`]): what in a study folder does not hold
 //! together (a record that is not its file's run, a snapshot missing or not its level, summaries
 //! that are not what the records render, a reference that is not the runs'), and the leftovers
-//! of an unfinished run ([`orphans`]).
+//! of an unfinished run (`orphans`).
 
 use crate::records::{self, RunRecord, StudyDir};
 use crate::study::provenance::Provenance;
@@ -31,7 +31,7 @@ pub struct Checked {
     pub runs: Vec<RunRecord>,
     /// What does not hold together (empty for a sound folder).
     pub faults: Vec<Fault>,
-    /// Files of an unfinished run no record accounts for ([`orphans`]): `run` removes them,
+    /// Files of an unfinished run no record accounts for (`orphans`): `run` removes them,
     /// every reader names and ignores them.
     pub leftovers: Vec<PathBuf>,
 }
@@ -233,7 +233,7 @@ fn csv_row_faults(dir: &StudyDir, on_disk: &[u8], runs: &[RunRecord]) -> Vec<Fau
 /// The stored reference solutions against the runs measured against them: each one present
 /// parses, is the reference of the runs naming it (its key) and has the NDF they record. A
 /// reference not stored is no fault here (a folder written before references were stored; the
-/// drift check computes it and names it missing); `run` stores it ([`stage_reference`]).
+/// drift check computes it and names it missing); `run` stores it (`RunWriter::stage_reference`).
 pub fn reference_faults(dir: &StudyDir, runs: &[RunRecord]) -> Vec<Fault> {
     let mut out = Vec::new();
     let mut seen = std::collections::BTreeSet::new();

@@ -7,7 +7,7 @@
 //!   is refused naming the file (`run --replace` replaces the records at fault). What a killed
 //!   process leaves (temporary files, snapshots of a run without a record) is a leftover: named
 //!   and ignored by readers, removed by the next run.
-//! - [`write`]: every change needs the guard of a lock ([`Store::lock`] for the shared files,
+//! - [`mod@write`]: every change needs the guard of a lock ([`Store::lock`] for the shared files,
 //!   [`Store::lock_run`] for a run being computed). A finished run lands in one [`Batch`](crate::records::Batch): its
 //!   mesh snapshots (written while it ran), its record and the summaries listing it
 //!   (`levels.csv`, `provenance.json`) are written in full to temporary files, then renamed into

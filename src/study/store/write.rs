@@ -39,7 +39,7 @@ impl RunWriter<'_> {
         self.store.dir.mesh_file(&self.id, level, ext)
     }
 
-    /// The run's checkpoint, if there is one for exactly `spec` ([`checkpoint::read`]).
+    /// The run's checkpoint, if there is one for exactly `spec` (`checkpoint::read`).
     pub fn checkpoint(&self, spec: &records::RunSpec) -> Option<checkpoint::Checkpoint> {
         checkpoint::read(&self.store.dir, spec)
     }
@@ -112,7 +112,7 @@ impl Writer<'_> {
         Ok(())
     }
 
-    /// Remove the leftovers of unfinished runs ([`orphans`]; a run another process computes
+    /// Remove the leftovers of unfinished runs (`orphans`; a run another process computes
     /// now has none), saying so in one line that names them.
     pub fn remove_orphans(&self, runs: &[RunRecord]) -> Result<()> {
         let dir = &self.store.dir;
