@@ -180,6 +180,10 @@ fn set_up(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &RunOpt
     } else {
         (store.lock(opts.wait_for_lock)?, Vec::new())
     };
+    if !opts.fresh {
+        // (--fresh holds every run's lock: none is computed by another process)
+        writer.refuse_foreign_runs_in_progress(manifest)?;
+    }
     let checked = store.check()?;
     let mut runs = checked.runs;
     writer.remove_orphans(&runs)?;
@@ -217,24 +221,19 @@ fn set_up(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &RunOpt
 fn run_planned(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &RunOptions) -> Result<Vec<String>> {
     let mut executed = Vec::new();
     for spec in planned {
-        // a finished run is final: kept without taking its lock (a run that executes nothing
-        // writes nothing)
-        let done = |r: &Option<RunRecord>| r.as_ref().is_some_and(|r| r.run == *spec);
-        let run_lock = if done(&store.record(&spec.id)?) { None } else { Some(store.lock_run(&spec.id, opts.wait_for_lock)?) };
-        // read again: another process may have finished the run while this one waited for it
+        // a finished run no process computes now is kept without taking its lock (a run that
+        // executes nothing writes nothing); one being computed (replaced) is waited for or refused
+        if store.finished(spec)? {
+            keep(manifest, store, spec, opts)?;
+            continue;
+        }
+        let run = store.lock_run(&spec.id, opts.wait_for_lock)?;
+        // read again under the run's lock: another process may have stored the run meanwhile
         match store.record(&spec.id)? {
             Some(r) if r.run == *spec => {
-                if opts.progress {
-                    crate::base::note::line(format_args!(
-                        "{}/{}: finished earlier, kept (use --fresh to start over)",
-                        manifest.study, spec.id
-                    ));
-                }
-                store_missing_reference(manifest, store, spec, opts)?;
+                keep(manifest, store, spec, opts)?;
                 continue;
             }
-            // stored by another process while this one waited for the run: the same check as
-            // at the start, under the run's lock
             Some(r) if !opts.replace => bail!(
                 "{}: another process stored run {} of {} with another spec while this one waited for it ({}); not replacing it. \
                  The runs this process finished before it are kept. Pass --replace to replace it",
@@ -251,11 +250,6 @@ fn run_planned(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &R
             )),
             None => {}
         }
-        // computed only under its lock (taken now if the run was replaced since the first look)
-        let run = match run_lock {
-            Some(run) => run,
-            None => store.lock_run(&spec.id, opts.wait_for_lock)?,
-        };
         let mut meshes = Batch::default();
         let Some(record) = run_one(&manifest.study, spec, &manifest.file, &run, &mut meshes, opts.progress)? else {
             // interrupted: what the unfinished run wrote goes with `meshes`; the finished ones stay
@@ -266,6 +260,14 @@ fn run_planned(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &R
         executed.push(spec.id.clone());
     }
     Ok(executed)
+}
+
+/// Run `spec`, stored as declared: said so, and its reference stored if it is missing.
+fn keep(manifest: &Manifest, store: &Store, spec: &RunSpec, opts: &RunOptions) -> Result<()> {
+    if opts.progress {
+        crate::base::note::line(format_args!("{}/{}: finished earlier, kept (use --fresh to start over)", manifest.study, spec.id));
+    }
+    store_missing_reference(manifest, store, spec, opts)
 }
 
 /// A finished run whose reference solution the study does not store (a folder written before

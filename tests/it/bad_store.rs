@@ -539,3 +539,61 @@ fn a_record_with_an_unknown_field_or_another_format_is_a_fault_of_its_run() {
         }
     }
 }
+
+/// A stored run that another process is replacing (`--replace`, another theta) is not "finished
+/// earlier, kept" for its old manifest (battery 5, finding 1: it said so and exited 0 while the
+/// folder ended with the other's run): with --wait that run waits, then is refused naming the
+/// other spec; without it, it is refused naming the process.
+#[test]
+fn a_run_being_replaced_is_not_kept_for_its_old_manifest() {
+    let dir = tmp("being-replaced");
+    for (sub, theta) in [("one", "0.5"), ("two", "0.6")] {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+        std::fs::write(dir.join(sub).join("s.toml"), LONG.replace("theta = 0.5", &format!("theta = {theta}"))).unwrap();
+    }
+    let study = dir.join("results/s");
+    let (code, out) = signorini(&dir, &["run", "one/s.toml", "--results", "results"]);
+    assert_eq!(code, 0, "{out}");
+    for wait in [false, true] {
+        let p1 = spawn(&dir, &["run", "two/s.toml", "--results", "results", "--replace"]);
+        computing(&study);
+        let mut args = vec!["run", "one/s.toml", "--results", "results"];
+        if wait {
+            args.push("--wait");
+        }
+        let (c2, o2) = signorini(&dir, &args);
+        let (c1, o1) = finish(p1);
+        assert_eq!(c1, 0, "{o1}");
+        assert_ne!(c2, 0, "wait {wait}: {o2}");
+        assert!(!o2.contains("finished earlier, kept"), "wait {wait}: {o2}");
+        let says = if wait { "another process stored run a" } else { "is being written by process" };
+        assert!(o2.contains(says), "wait {wait}: {o2}");
+        assert_eq!(theta_of(&study), 0.6);
+        assert_eq!(consistent(&study), ["a"]);
+        // back to theta 0.5 for the next round
+        let (code, out) = signorini(&dir, &["run", "one/s.toml", "--results", "results", "--replace"]);
+        assert_eq!(code, 0, "{out}");
+    }
+}
+
+/// Two manifests of one study that declare different runs, the second started while the first
+/// computes (battery 5, finding 5: both committed, and the folder matched neither manifest):
+/// the second is refused before it computes anything, naming the run in progress; the first
+/// lands and the folder holds its runs only.
+#[test]
+fn a_second_manifest_with_other_runs_is_refused_while_the_first_computes() {
+    let dir = tmp("other-runs");
+    for (sub, id) in [("one", "a"), ("two", "b")] {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+        std::fs::write(dir.join(sub).join("s.toml"), LONG.replace("id = \"a\"", &format!("id = \"{id}\""))).unwrap();
+    }
+    let study = dir.join("results/s");
+    let p1 = spawn(&dir, &["run", "one/s.toml", "--results", "results"]);
+    computing(&study);
+    let (c2, o2) = signorini(&dir, &["run", "two/s.toml", "--results", "results"]);
+    let (c1, o1) = finish(p1);
+    assert_eq!(c1, 0, "{o1}");
+    assert_ne!(c2, 0, "{o2}");
+    assert!(o2.contains("another process computes run(s) a") && o2.contains("does not declare") && o2.contains("nothing was run"), "{o2}");
+    assert_eq!(consistent(&study), ["a"]);
+}

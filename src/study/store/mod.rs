@@ -29,7 +29,7 @@ pub use check::{Checked, Fault, first_difference};
 pub use stale::Stale;
 pub use write::{RunWriter, Writer};
 
-use crate::records::{ReferenceRecord, RunRecord, StudyDir};
+use crate::records::{ReferenceRecord, RunRecord, RunSpec, StudyDir};
 use crate::study::provenance::Provenance;
 use anyhow::{Context, Result, bail};
 use std::path::PathBuf;
@@ -132,6 +132,15 @@ impl Store {
     /// writers re-read under the lock. Readers use [`Store::read`].
     pub fn records(&self) -> Result<Vec<RunRecord>> {
         self.dir.read_runs().with_context(|| format!("reading the runs in {}", self.dir.root.join("runs").display()))
+    }
+
+    /// Whether run `spec.id` is stored with exactly `spec` and no process computes it now: a
+    /// run another process replaces is not finished, its record is about to change (a run
+    /// that called it "kept" then exited 0 while the folder ended with the other's run).
+    /// Asked under the study lock, as every look at another process's run lock is.
+    pub fn finished(&self, spec: &RunSpec) -> Result<bool> {
+        let _study = lock::Lock::study(&self.dir, true)?;
+        Ok(!lock::run_in_progress(&self.dir, &spec.id) && self.record(&spec.id)?.is_some_and(|r| r.run == *spec))
     }
 
     /// The stored record of run `id`, if any.

@@ -162,6 +162,21 @@ impl Writer<'_> {
         }
         let dir = &self.store.dir;
         let mut runs = self.store.records()?;
+        let foreign: Vec<&str> = runs.iter().map(|r| r.run.id.as_str()).filter(|id| !declares(manifest, id)).collect();
+        if !foreign.is_empty() {
+            bail!(
+                "{}: {} holds run(s) {}, which {} does not declare: another manifest of study {} stored them while run {} was computed. \
+                 Run {} is not stored beside them (the folder would match neither manifest); rerun it into another --results folder, \
+                 or with the manifest that declares every run",
+                manifest.file.display(),
+                dir.root.display(),
+                foreign.join(", "),
+                manifest.file.display(),
+                manifest.study,
+                run.id,
+                run.id
+            );
+        }
         runs.retain(|r| r.run.id != run.id);
         runs.push(record.clone());
         runs.sort_by_key(|r| dir.run_file(&r.run.id));
@@ -171,6 +186,29 @@ impl Writer<'_> {
         self.remove_stored(run)?;
         batch.commit()?;
         checkpoint::remove(dir, &run.id)
+    }
+
+    /// Refused if another process computes a run of the study that `manifest` does not declare
+    /// (another manifest of the same study, started before this one): run beside it, the
+    /// folder would end with runs of both manifests and match neither.
+    pub fn refuse_foreign_runs_in_progress(&self, manifest: &Manifest) -> Result<()> {
+        let dir = &self.store.dir;
+        let foreign: Vec<String> = super::lock::runs_of(dir, std::iter::empty())
+            .into_iter()
+            .filter(|id| !declares(manifest, id) && super::lock::run_in_progress(dir, id))
+            .collect();
+        if !foreign.is_empty() {
+            bail!(
+                "{}: another process computes run(s) {} of {}, which {} does not declare (another manifest of study {}); \
+                 nothing was run. Run this manifest into another --results folder, or wait for the other to finish",
+                manifest.file.display(),
+                foreign.join(", "),
+                dir.root.display(),
+                manifest.file.display(),
+                manifest.study
+            );
+        }
+        Ok(())
     }
 
     /// Remove a stored reference solution (`references/KEY.json` at fault): the runs measured
@@ -232,4 +270,9 @@ fn stage_reference(dir: &StudyDir, reference: &ReferenceRecord, batch: &mut Batc
         batch.add_json(&file, reference)?;
     }
     Ok(())
+}
+
+/// Whether `manifest` declares run `id`.
+fn declares(manifest: &Manifest, id: &str) -> bool {
+    manifest.runs.iter().any(|p| p.spec.id == id)
 }
