@@ -224,7 +224,8 @@ fn prescribed_displacements_that_start_the_body_inside_the_obstacle_are_refused(
 }
 
 /// An exact solution that does not satisfy the problem's boundary or contact conditions
-/// (battery: a mistyped gap or traction in Example 7.1) measured errors that never converge,
+/// (battery: a mistyped gap or traction in Example 7.1; battery 5: a contact normal the solution
+/// is not pressed along, rollers where its traction is not zero) measured errors that never converge,
 /// certified: refused naming the condition, the point and the values. The file as it is passes.
 #[test]
 fn an_exact_solution_that_breaks_a_boundary_or_contact_condition_is_refused() {
@@ -233,6 +234,16 @@ fn an_exact_solution_that_breaks_a_boundary_or_contact_condition_is_refused() {
         ("chi-below", "chi = 0\n", "chi = -0.05\n", "u . n <= chi"),
         ("chi-above", "chi = 0\n", "chi = 0.05\n", "complementarity"),
         ("traction", r#"traction = "exact""#, r#"traction = ["0", "0"]"#, "the traction on Gamma_N"),
+        // battery 5: a declared contact normal other than the one the exact solution is pressed
+        // along (its traction has a part across it: friction), and a top edge on rollers where
+        // the exact solution's traction is not zero (the point constraints hold it vertically)
+        ("oblique-normal", r#"normal = "outward""#, "normal = [0.3, -1]", "no tangential traction on Gamma_C"),
+        (
+            "rollers",
+            "dirichlet = \"exact\"    # u on the top edge\n",
+            "dirichlet = [\"y^2*(y - 1)\", \"free\"]\n[[point_constraints]]\nat = [0, 1]\nu = [\"free\", 0]\n[[point_constraints]]\nat = [1, 1]\nu = [\"free\", 0]\n",
+            "zero traction in a free component on Gamma_D",
+        ),
     ];
     for (name, from, to, what) in cases {
         let (code, err) = run_experiment(name, "ex71.toml", from, to, solve);

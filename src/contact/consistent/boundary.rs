@@ -1,7 +1,8 @@
 //! The exact solution against the boundary and contact conditions (paper eq. 1.1–1.8): on
 //! Gamma_D u is the Dirichlet data (the components it prescribes), at a point constraint u is the
-//! prescribed value, on Gamma_N sigma(u) n is the traction, on Gamma_C u . n <= chi,
-//! sigma_nn <= 0 and (chi - u . n) sigma_nn = 0. A mistyped gap or traction otherwise gives an
+//! prescribed value, on Gamma_N sigma(u) n is the traction, in a component Gamma_D leaves free
+//! (rollers) the traction is zero, on Gamma_C u . n <= chi, sigma_nn <= 0,
+//! (chi - u . n) sigma_nn = 0 and sigma(u) n has no part across the contact normal (frictionless). A mistyped gap or traction otherwise gives an
 //! exact solution of another problem, and errors that never converge (battery: chi = -0.05 in
 //! Example 7.1 kept the error at 5e-2 on every mesh, certified).
 //!
@@ -60,11 +61,32 @@ pub fn check_boundary(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, nod
         match p.part {
             Part::Dirichlet => {
                 let g = problem.dirichlet(p.at);
-                for i in (0..2).filter(|&i| problem.dirichlet_components()[i]) {
+                let prescribed = problem.dirichlet_components();
+                for i in (0..2).filter(|&i| prescribed[i]) {
                     let detail = format!("u_{} = {:.6e}, `dirichlet[{i}]` = {:.6e}", i + 1, u[i], g[i]);
                     found.push((
                         Violation { at: p.at, off: (u[i] - g[i]).abs(), what: "the Dirichlet data on Gamma_D".into(), detail },
                         scale_u,
+                    ));
+                }
+                // a component the data leave free ("free": rollers) carries zero traction
+                let s = sigma_n(p.at, n);
+                for i in (0..2).filter(|&i| !prescribed[i]) {
+                    let detail = format!(
+                        "(sigma(u) n)_{} = {:.6e} where `dirichlet[{i}]` is \"free\" (n = ({:.4}, {:.4}))",
+                        i + 1,
+                        s[i],
+                        n[0],
+                        n[1]
+                    );
+                    found.push((
+                        Violation {
+                            at: p.at,
+                            off: s[i].abs(),
+                            what: "zero traction in a free component on Gamma_D (rollers)".into(),
+                            detail,
+                        },
+                        scale_s,
                     ));
                 }
             }
@@ -94,6 +116,21 @@ pub fn check_boundary(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, nod
                     |what: &str, off: f64, scale: f64| (Violation { at: p.at, off, what: what.into(), detail: state.clone() }, scale);
                 found.push(contact("the contact condition u . n <= chi on Gamma_C", (un - chi).max(0.0), scale_u));
                 found.push(contact("the contact condition sigma_nn <= 0 on Gamma_C (no tension)", snn.max(0.0), scale_s));
+                // frictionless: the traction acts along the contact normal only
+                let tangential = norm([s[0] - snn * cn[0], s[1] - snn * cn[1]]);
+                let detail = format!(
+                    "sigma(u) n = ({:.6e}, {:.6e}), its part across the contact normal ({:.4}, {:.4}) is {tangential:.6e}",
+                    s[0], s[1], cn[0], cn[1]
+                );
+                found.push((
+                    Violation {
+                        at: p.at,
+                        off: tangential,
+                        what: "no tangential traction on Gamma_C (frictionless contact)".into(),
+                        detail,
+                    },
+                    scale_s,
+                ));
                 // open (chi - u . n > 0) and pressed (sigma_nn < 0) at once: the smaller of the two
                 // relative violations
                 let open = ((chi - un).max(0.0) / scale_u.max(f64::MIN_POSITIVE)).min((-snn).max(0.0) / scale_s.max(f64::MIN_POSITIVE));
