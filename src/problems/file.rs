@@ -269,6 +269,35 @@ fn negated_power(text: &str) -> Option<usize> {
     None
 }
 
+/// The column (1-based) of the second `^` of a chain `a^b^c` without parentheses, if `text`
+/// has one: exmex groups it `(a^b)^c` (2^3^2 is 64), where the usual reading is `a^(b^c)`
+/// (512). Refused rather than read either way silently. A chain is two `^` at one depth of
+/// parentheses with no other binary operator (`+ - * /`, a comma) between them.
+fn chained_power(text: &str) -> Option<usize> {
+    // per depth: whether a `^` was seen with no other operator after it
+    let mut open_power: Vec<bool> = vec![false];
+    for (i, ch) in text.chars().enumerate() {
+        match ch {
+            '(' => open_power.push(false),
+            ')' => {
+                if open_power.len() > 1 {
+                    open_power.pop();
+                }
+            }
+            '^' => {
+                let last = open_power.last_mut().expect("depth 0 is never popped");
+                if *last {
+                    return Some(i + 1);
+                }
+                *last = true;
+            }
+            '+' | '-' | '*' | '/' | ',' => *open_power.last_mut().expect("depth 0 is never popped") = false,
+            _ => {}
+        }
+    }
+    None
+}
+
 /// A parsed expression: exmex's default float operators, numbers with exponents.
 type Flat = FlatEx<f64, FloatOpsFactory<f64>, Number>;
 
@@ -494,6 +523,15 @@ impl Reader<'_> {
                 span,
                 format!(
                     "{text:?}: the `-` at character {column} negates the base of a power, which exmex applies before `^` (-s^2 reads (-s)^2 = s^2, not -(s^2)): write -(s^2) or 0 - s^2 for minus the power, (-s)^2 for the power of the negation"
+                ),
+            ));
+        }
+        if let Some(column) = chained_power(text) {
+            return Err(self.error(
+                key,
+                span,
+                format!(
+                    "{text:?}: the `^` at character {column} follows another without parentheses; exmex reads a^b^c as (a^b)^c (2^3^2 = 64), the usual reading is a^(b^c) (512): write the parentheses you mean"
                 ),
             ));
         }

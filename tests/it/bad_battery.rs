@@ -8,7 +8,8 @@
 //!   vertices onto it, ending in "non-positive area" or a distorted mesh
 //!   (`GmshFile::check_on_curve`);
 //! * `-s^2` is `(-s)^2` in exmex: a value every reader takes for `-(s^2)` silently changed sign
-//!   (`negated_power`, in the one expression parser of problem files);
+//!   (`negated_power`, in the one expression parser of problem files), and `2^3^2` is
+//!   `(2^3)^2` (`chained_power`, beside it);
 //! * a pair with a third value (`required_vertices = [[1, 0.5, 0]]`, an exact solution or a
 //!   circle centre of three) was read as its first two (`Two`, every pair of a problem file);
 //! * a subnormal C_0 was printed with 320 digits and called "not positive"
@@ -126,6 +127,25 @@ fn bad_minus_before_a_power_is_refused_not_read_as_the_power_of_the_negation() {
         let (code, out, err) = run("power-ok", SQUARE, CHI, &format!("chi = {chi:?}"), SOLVE_SQ);
         assert!(code == 0 && out.contains("certified:") || err.contains("overlap the body"), "{chi}: {err}");
         assert!(!err.contains("negates the base"), "{chi}: {err}");
+    }
+}
+
+/// `2^3^2` is (2^3)^2 = 64 in exmex, 512 as everyone else reads it (battery 5, finding 4: a
+/// silent answer): a chain of powers without parentheses is refused, naming the `^`; the
+/// parenthesised forms and powers apart pass.
+#[test]
+fn bad_chain_of_powers_is_refused_not_read_left_to_right() {
+    for chi in ["0.0001*2^3^2", "0.001 + x^2^2", "0.001 + 2^(x)^2", "0.001 + abs(x)^2 ^ 1"] {
+        let (code, _, err) = run("chained-power", SQUARE, CHI, &format!("chi = {chi:?}"), SOLVE_SQ);
+        assert_eq!(code, 1, "{chi}: {err}");
+        for says in ["v.toml:", "key `contact.chi`", "follows another without parentheses", "(a^b)^c"] {
+            assert!(err.contains(says), "{chi}: no {says:?} in\n{err}");
+        }
+    }
+    for chi in ["0.0001*2^(3^2)", "0.0001*(2^3)^2", "0.001 + x^2*y^2", "0.001 + 2^x - y^2", "0.001 + (x^2)^2"] {
+        let (code, out, err) = run("power-ok", SQUARE, CHI, &format!("chi = {chi:?}"), SOLVE_SQ);
+        assert!(code == 0 && out.contains("certified:") || err.contains("overlap the body"), "{chi}: {err}");
+        assert!(!err.contains("without parentheses"), "{chi}: {err}");
     }
 }
 
