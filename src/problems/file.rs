@@ -279,10 +279,8 @@ fn chained_power(text: &str) -> Option<usize> {
     for (i, ch) in text.chars().enumerate() {
         match ch {
             '(' => open_power.push(false),
-            ')' => {
-                if open_power.len() > 1 {
-                    open_power.pop();
-                }
+            ')' if open_power.len() > 1 => {
+                open_power.pop();
             }
             '^' => {
                 let last = open_power.last_mut().expect("depth 0 is never popped");
