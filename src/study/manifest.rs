@@ -451,9 +451,10 @@ fn parse_run(
         return Err(invalid.at(key("problem"), &expected, format!("{problem:?}")));
     }
     let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| MeshSpec::DEFAULT.into());
+    // one mesh, one spelling: `structured:04` and `structured: 4` are `structured:4`
     let mesh = match mesh.strip_prefix("gmsh:") {
         Some(file) => format!("gmsh:{}", spelled(file.trim())),
-        None => mesh,
+        None => MeshSpec::parse(&mesh).map(|m| m.to_string()).unwrap_or(mesh),
     };
     MeshSpec::parse(&resolve_mesh(path, &mesh)).map_err(|e| invalid.at(key("mesh"), &e.expected(), format!("{mesh:?}")))?;
     let levels = r.levels.or(d.levels).ok_or_else(|| invalid.at(key("levels"), "a number of levels >= 1", "nothing".into()))?;

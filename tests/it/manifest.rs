@@ -143,5 +143,10 @@ fn a_path_spelt_another_way_is_the_same_spec() {
     let a = Manifest::parse(&dir.join("s.toml"), &text("p.toml")).unwrap();
     let b = Manifest::parse(&dir.join("s.toml"), &text("./p.toml")).unwrap();
     assert_eq!(a.runs[0].spec, b.runs[0].spec);
+    // one mesh, one spelling (battery 5, finding 15)
+    for mesh in ["structured:02", "structured: 2", " structured:2 "] {
+        let c = Manifest::parse(&dir.join("s.toml"), &text("p.toml").replace("structured:2", mesh)).unwrap();
+        assert_eq!(c.runs[0].spec, a.runs[0].spec, "{mesh:?}");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

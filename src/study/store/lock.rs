@@ -21,17 +21,21 @@ pub const STUDY_LOCK_PATIENCE: std::time::Duration = std::time::Duration::from_s
 /// [`STUDY_LOCK_PATIENCE`], or `SIGNORINI_LOCK_PATIENCE` seconds where that is set to a number
 /// in 0 ..= 3600 (otherwise the default, with a note).
 fn patience() -> std::time::Duration {
-    let Ok(text) = std::env::var("SIGNORINI_LOCK_PATIENCE") else { return STUDY_LOCK_PATIENCE };
-    match text.trim().parse::<f64>() {
-        Ok(s) if (0.0..=3600.0).contains(&s) => std::time::Duration::from_secs_f64(s),
-        _ => {
-            crate::base::note::line(format_args!(
-                "SIGNORINI_LOCK_PATIENCE={text:?} is not a number of seconds in 0 ..= 3600; waiting the default {} s",
-                STUDY_LOCK_PATIENCE.as_secs()
-            ));
-            STUDY_LOCK_PATIENCE
+    // read once per process, so a bad value is named once
+    static PATIENCE: std::sync::OnceLock<std::time::Duration> = std::sync::OnceLock::new();
+    *PATIENCE.get_or_init(|| {
+        let Ok(text) = std::env::var("SIGNORINI_LOCK_PATIENCE") else { return STUDY_LOCK_PATIENCE };
+        match text.trim().parse::<f64>() {
+            Ok(s) if (0.0..=3600.0).contains(&s) => std::time::Duration::from_secs_f64(s),
+            _ => {
+                crate::base::note::line(format_args!(
+                    "SIGNORINI_LOCK_PATIENCE={text:?} is not a number of seconds in 0 ..= 3600; waiting the default {} s",
+                    STUDY_LOCK_PATIENCE.as_secs()
+                ));
+                STUDY_LOCK_PATIENCE
+            }
         }
-    }
+    })
 }
 
 /// An exclusive lock on a file holding the owner's process id and command line. Released when
