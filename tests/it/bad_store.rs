@@ -314,9 +314,15 @@ fn report_refuses_an_image_that_is_not_a_png() {
     std::fs::write(figs.join(format!("{name}.png")), "<html>not an image</html>").unwrap();
     let out = figs.join("out");
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let e =
-        signorini::page::write_pages(&root.join("results"), &figs, &out, &[study.into()], &figs.join("none.json"), crate::common::roles())
-            .unwrap_err();
+    let e = signorini::page::write_pages(
+        &crate::common::shelf(&root.join("results")),
+        &figs,
+        &out,
+        &[study.into()],
+        &figs.join("none.json"),
+        crate::common::roles(),
+    )
+    .unwrap_err();
     assert!(format!("{e:#}").contains(&format!("{name}.png is not a PNG image")), "{e:#}");
 }
 
