@@ -777,7 +777,12 @@ fn run_drift(
     };
     let report = study::drift::check(&manifests, only.is_empty(), &options, &|r| {
         // drift's interface takes an io::Result: the typed error's message travels in it
-        signorini::claims::claims(r, &roles).map(|c| signorini::claims::markdown_for(&c, r)).map_err(std::io::Error::other)
+        // CLAIMS.md is compared only when every study is, so a folder at fault has each fault in
+        // a row of the report already; rows drawn from records no one can trust are not compared
+        let Ok(shelf) = study::store::Shelf::open_folder(r, &manifests) else {
+            return Ok(std::fs::read_to_string(r.join("CLAIMS.md")).unwrap_or_default());
+        };
+        signorini::claims::claims(&shelf, &roles).map(|c| signorini::claims::markdown_for(&c, r)).map_err(std::io::Error::other)
     })?;
     // the table first: a report that cannot be written must not cost it
     if !report.rows.is_empty() {
@@ -853,10 +858,12 @@ fn run_figures(
     for m in &checked {
         study::check_complete(m, &results)?;
     }
-    for f in signorini::plot::draw_studies(&results, &figures, &roles, drawn.as_deref())? {
+    // what the figures and CLAIMS rows read: every study, through the integrity check
+    let shelf = study::store::Shelf::open_folder(&results, &study::manifest::declared(experiments, &[])?)?;
+    for f in signorini::plot::draw_studies(&shelf, &figures, &roles, drawn.as_deref())? {
         println!("wrote {}", f.display());
     }
-    signorini::claims::write(&results, &roles).with_context(|| format!("writing {}", results.join("CLAIMS.md").display()))?;
+    signorini::claims::write(&shelf, &roles).with_context(|| format!("writing {}", results.join("CLAIMS.md").display()))?;
     println!("wrote {}", results.join("CLAIMS.md").display());
     Ok(())
 }
@@ -877,7 +884,8 @@ fn run_report(
     let figures = figures.map_or_else(|| under("figures", "figures"), |f| f.to_path_buf());
     let out = out.map_or_else(|| under("target/report", "report"), |o| o.to_path_buf());
     let drift = drift_report.map_or_else(|| under("target/drift/report.json", "drift-report.json"), |d| d.to_path_buf());
-    for page in signorini::page::write_pages(&results, &figures, &out, studies, &drift, &roles)? {
+    let shelf = study::store::Shelf::open_folder(&results, &study::manifest::declared(experiments, &[])?)?;
+    for page in signorini::page::write_pages(&shelf, &figures, &out, studies, &drift, &roles)? {
         println!("wrote {}", page.display());
     }
     Ok(())

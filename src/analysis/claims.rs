@@ -20,7 +20,8 @@ use crate::analysis::verdict::{self, Abscissa, RateReport, RateVerdict, refineme
 // the paper's C_0 (Section 7, the estimator's default): a reliability row holds when the
 // smallest reliable C_0 of its runs is at most this
 use crate::estimator::estimate::C0_PAPER;
-use crate::records::{MeshSnapshot, RunRecord, StudyDir};
+use crate::records::{MeshSnapshot, RunRecord};
+use crate::study::store::Shelf;
 pub use criterion::{Criterion, Evidence, Kind};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -55,6 +56,9 @@ pub enum ClaimsError {
     /// A study's records (or CLAIMS.md itself) cannot be read or written.
     #[error(transparent)]
     Io(#[from] std::io::Error),
+    /// A checked study folder cannot hand out what a row asks for.
+    #[error(transparent)]
+    Shelf(#[from] crate::study::store::ShelfError),
     /// The problem of a stored run cannot be loaded (the row `hertz` needs its geometry): the
     /// error says which run and why.
     #[error("{0:#}")]
@@ -159,7 +163,8 @@ enum Q<'a> {
 
 struct Ctx<'r> {
     sampling: ErrorSampling,
-    results: &'r Path,
+    /// The checked study folders the rows are computed from.
+    shelf: &'r Shelf,
     /// What the stored runs stand for: every row finds its runs by role ([`Roles::find`]).
     roles: &'r Roles,
 }
@@ -376,21 +381,14 @@ fn halving_exponents(r: &RunRecord, err_field: &str, n: usize) -> String {
     out.join(", ")
 }
 
-/// The largest saved level of `run` under `results/STUDY/meshes`.
-fn latest_mesh(results: &Path, study: &str, run: &str) -> Option<MeshSnapshot> {
-    let dir = StudyDir::new(results, study);
-    let prefix = format!("{run}_level");
-    let level = std::fs::read_dir(dir.root.join("meshes"))
-        .ok()?
-        .filter_map(|e| e.ok()?.file_name().into_string().ok())
-        .filter_map(|n| n.strip_prefix(&prefix)?.strip_suffix(".json")?.parse::<usize>().ok())
-        .max()?;
-    dir.read_mesh(run, level).ok()
+/// The snapshot of the largest level `run` of `study` saves ([`Shelf::latest_mesh`]).
+fn latest_mesh(shelf: &Shelf, study: &str, run: &str) -> std::io::Result<Option<MeshSnapshot>> {
+    Ok(shelf.latest_mesh(study, run)?)
 }
 
 /// The claims of Example 7.1.
 fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let load = |s: &str| StudyDir::new(ctx.results, s).read_runs();
+    let load = |s: &str| ctx.shelf.runs(s);
     let (ex71, ct, deep) = (load("ex71")?, load("contact_term_ablation")?, load("deep")?);
     let a71 = ctx.deep_or(&deep, roles::DEEP_EX71_AS_WRITTEN, ctx.pick(&ex71, roles::EX71_AS_WRITTEN));
     let u71 = ctx.deep_or(&deep, roles::DEEP_EX71_UNIFORM, ctx.find(&ex71, roles::EX71_UNIFORM));
@@ -537,7 +535,7 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let mut rows = Vec::new();
     for study in ["ex71", "ex72", "c0_sweep", "fb"] {
-        for r in StudyDir::new(ctx.results, study).read_runs()? {
+        for r in ctx.shelf.runs(study)? {
             if let Some(row) = c0_text(&format!("{study}/{}", r.run.id), &r, ctx.err_field()) {
                 rows.push(row);
             }
@@ -581,7 +579,7 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 /// and spread over the levels of the error-rate fit, and how far the smallest reliable C_0 of
 /// one problem is from another's.
 fn efficiency_size_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let load = |s: &str| StudyDir::new(ctx.results, s).read_runs();
+    let load = |s: &str| ctx.shelf.runs(s);
     let (deep, large, rollers, hertz) = (load("deep")?, load("ex72_large")?, load("ex72_rollers")?, load("hertz")?);
     let mut rows = Vec::new();
     let mut per_problem: Vec<(&str, f64)> = Vec::new();
@@ -636,7 +634,7 @@ fn efficiency_size_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()>
 
 /// The marking parameter theta (the paper does not give it): the error rate per theta.
 fn theta_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let runs = StudyDir::new(ctx.results, "theta_ablation").read_runs()?;
+    let runs = ctx.shelf.runs("theta_ablation")?;
     let mut rows = Vec::new();
     let mut headline = Vec::new();
     for r in &runs {
@@ -674,7 +672,7 @@ fn theta_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 
 /// The log-factor ablation: the efficiency trend per l_h.
 fn log_factor_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let la = StudyDir::new(ctx.results, "log_ablation").read_runs()?;
+    let la = ctx.shelf.runs("log_ablation")?;
     let rows: Vec<String> =
         la.iter().map(|r| growth_text(&format!("{} efficiency", r.run.id), ctx.growth(Some(r), Q::Efficiency).as_ref())).collect();
     let reported = Criterion::Reported { why: "an ablation of eq. 6.3's factor, no claim of the paper".into() };
@@ -701,8 +699,8 @@ fn log_factor_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 
 /// The free-boundary example `fb` (beyond the paper): exact solution with contact on [a, 1].
 fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let fb = StudyDir::new(ctx.results, "fb").read_runs()?;
-    let deep = StudyDir::new(ctx.results, "deep").read_runs()?;
+    let fb = ctx.shelf.runs("fb")?;
+    let deep = ctx.shelf.runs("deep")?;
     let ad = ctx.deep_or(&deep, roles::DEEP_FB_AS_WRITTEN, ctx.find(&fb, roles::FB_AS_WRITTEN));
     let wfc = ctx.deep_or(&deep, roles::DEEP_FB_WFC, ctx.find(&fb, roles::FB_WFC));
     let un = ctx.deep_or(&deep, roles::DEEP_FB_UNIFORM, ctx.find(&fb, roles::FB_UNIFORM));
@@ -803,7 +801,7 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let mut decides: Option<(String, bool)> = None;
     let meshes = [roles::FB_WFC, roles::FB_AS_WRITTEN];
     for id in meshes.iter().filter_map(|&role| ctx.roles.id(role)) {
-        let Some(m) = latest_mesh(ctx.results, roles::FB_WFC.study, id) else { continue };
+        let Some(m) = latest_mesh(ctx.shelf, roles::FB_WFC.study, id)? else { continue };
         let prof = refinement::profile(&m, [0.0, 0.0], [1.0, 0.0]);
         match refinement::local_minimum(&prof, a, REFINE_REACH) {
             Some(lm) => {
@@ -909,13 +907,13 @@ pub const HERTZ_TOLERANCE: f64 = 0.02;
 /// Hertz's half-spaces.
 fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> Result<(), ClaimsError> {
     let study = roles::HERTZ_AS_WRITTEN.study;
-    let runs = StudyDir::new(ctx.results, study).read_runs()?;
+    let runs = ctx.shelf.runs(study)?;
     let mut rows = Vec::new();
     let mut judged: Option<Evidence> = None;
     let mut headline = None;
     for r in &runs {
-        let Some(snap) = latest_mesh(ctx.results, study, &r.run.id) else { continue };
-        let problem = crate::study::stored_problem(ctx.results, study, &r.run).map_err(ClaimsError::Problem)?;
+        let Some(snap) = latest_mesh(ctx.shelf, study, &r.run.id)? else { continue };
+        let problem = ctx.shelf.problem(study, &r.run).map_err(ClaimsError::Problem)?;
         let Some(h) = crate::analysis::hertz::for_problem(problem.as_ref()) else {
             rows.push(format!("{}: problem {} has no circular contact group", r.run.id, r.run.problem));
             continue;
@@ -985,8 +983,8 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> Result<(), ClaimsError> {
 }
 
 /// Every claim with errors sampled one way.
-pub fn claims_with(results: &Path, roles: &Roles, sampling: ErrorSampling) -> Result<Vec<Claim>, ClaimsError> {
-    let ctx = Ctx { sampling, results, roles };
+pub fn claims_with(shelf: &Shelf, roles: &Roles, sampling: ErrorSampling) -> Result<Vec<Claim>, ClaimsError> {
+    let ctx = Ctx { sampling, shelf, roles };
     let mut out = Vec::new();
     ex71_claims(&ctx, &mut out)?;
     c0_claim(&ctx, &mut out)?;
@@ -1004,12 +1002,12 @@ pub fn claims_with(results: &Path, roles: &Roles, sampling: ErrorSampling) -> Re
 /// All claims, from the stored studies under `results` whose runs stand for the `roles`
 /// ([`roles::check`]), and the sampling row: the verdicts recomputed with the error on the dense
 /// lattice.
-pub fn claims(results: &Path, roles: &Roles) -> Result<Vec<Claim>, ClaimsError> {
-    let mut out = claims_with(results, roles, ErrorSampling::Quadrature)?;
-    let dense = claims_with(results, roles, ErrorSampling::Dense)?;
+pub fn claims(shelf: &Shelf, roles: &Roles) -> Result<Vec<Claim>, ClaimsError> {
+    let mut out = claims_with(shelf, roles, ErrorSampling::Quadrature)?;
+    let dense = claims_with(shelf, roles, ErrorSampling::Dense)?;
     let mut dense_runs = Vec::new();
     for (_, twin) in DENSE_TWINS {
-        if let Some(r) = roles.find(&StudyDir::new(results, twin.study).read_runs()?, twin) {
+        if let Some(r) = roles.find(&shelf.runs(twin.study).map_err(std::io::Error::from)?, twin) {
             dense_runs.push(source(Some(r)));
         }
     }
@@ -1142,8 +1140,9 @@ pub fn markdown_for(claims: &[Claim], results: &Path) -> String {
     s
 }
 
-/// Write `CLAIMS.md` into the results folder it is generated from.
-pub fn write(results: &Path, roles: &Roles) -> Result<(), ClaimsError> {
-    let c = claims(results, roles)?;
+/// Write `CLAIMS.md` into the results folder the shelf holds.
+pub fn write(shelf: &Shelf, roles: &Roles) -> Result<(), ClaimsError> {
+    let c = claims(shelf, roles)?;
+    let results = shelf.root();
     Ok(crate::records::write_atomic(&results.join("CLAIMS.md"), markdown_for(&c, results).as_bytes())?)
 }

@@ -9,12 +9,12 @@ use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, ESTIMATE, Figure, NDF_DESC, PALETTE, Style, runs, series, slope};
 use crate::analysis::roles::{self, Roles};
 use crate::analysis::verdict::FLOOR_MARGIN;
-use std::path::Path;
+use crate::study::store::Shelf;
 
 const STUDY: &str = roles::DEEP_EX71_AS_WRITTEN.study;
 
-pub(super) fn deep_error(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, STUDY)? {
+pub(super) fn deep_error(shelf: &Shelf) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, STUDY)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -45,8 +45,8 @@ pub(super) fn deep_error(results: &Path) -> anyhow::Result<Built> {
 
 /// Error, estimate and round-off floor together: where the error of a deep run would meet
 /// [`FLOOR_MARGIN`] x the floor, its fits end.
-pub(super) fn deep_floor(results: &Path, roles: &Roles) -> anyhow::Result<Built> {
-    let runs = match runs(results, STUDY)? {
+pub(super) fn deep_floor(shelf: &Shelf, roles: &Roles) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, STUDY)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };

@@ -9,7 +9,7 @@
 
 use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, Figure, NDF_DESC, PALETTE, Style, runs, series, slope};
-use std::path::Path;
+use crate::study::store::Shelf;
 
 /// One Example 7.2 study's error figure: its study, the problem's name in the panels and the title.
 struct Labels {
@@ -20,9 +20,9 @@ struct Labels {
     title: &'static str,
 }
 
-pub(super) fn ex72_large_error(results: &Path) -> anyhow::Result<Built> {
+pub(super) fn ex72_large_error(shelf: &Shelf) -> anyhow::Result<Built> {
     error_figure(
-        results,
+        shelf,
         Labels {
             study: "ex72_large",
             problem: "Example 7.2",
@@ -32,9 +32,9 @@ pub(super) fn ex72_large_error(results: &Path) -> anyhow::Result<Built> {
     )
 }
 
-pub(super) fn ex72_rollers_error(results: &Path) -> anyhow::Result<Built> {
+pub(super) fn ex72_rollers_error(shelf: &Shelf) -> anyhow::Result<Built> {
     error_figure(
-        results,
+        shelf,
         Labels {
             study: "ex72_rollers",
             problem: "Example 7.2 on rollers",
@@ -44,8 +44,8 @@ pub(super) fn ex72_rollers_error(results: &Path) -> anyhow::Result<Built> {
     )
 }
 
-fn error_figure(results: &Path, labels: Labels) -> anyhow::Result<Built> {
-    let runs = match runs(results, labels.study)? {
+fn error_figure(shelf: &Shelf, labels: Labels) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, labels.study)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };

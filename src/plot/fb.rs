@@ -7,19 +7,17 @@
 //! | `fb_mesh` | `fb`, the largest saved level of the run of role `without-full-contact` (else of `as-written`) | the mesh as in Fig. 3(b) (same drawing), with the free boundary x = a dashed |
 
 use super::{
-    Built, ERR, ESTIMATE, Figure, Marker, NDF_DESC, PALETTE, Panel, Slope, SlopeAnchor, Style, mesh_figure, runs, saved_levels, series,
-    single, slope,
+    Built, ERR, ESTIMATE, Figure, Marker, NDF_DESC, PALETTE, Panel, Slope, SlopeAnchor, Style, mesh_figure, runs, series, single, slope,
 };
 use crate::analysis::roles::{self, Roles};
 use crate::problems::Fb;
-use crate::records::StudyDir;
+use crate::study::store::Shelf;
 use anyhow::Context;
-use std::path::Path;
 
 const STUDY: &str = roles::FB_AS_WRITTEN.study;
 
-pub(super) fn fb_error(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, STUDY)? {
+pub(super) fn fb_error(shelf: &Shelf) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, STUDY)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -65,14 +63,19 @@ pub(super) fn fb_error(results: &Path) -> anyhow::Result<Built> {
 
 /// The finest saved mesh of the run without full-contact nodes, else of the run with eta_5 as
 /// written (the meshes the row `fb-refinement` reads).
-pub(super) fn fb_mesh(results: &Path, roles: &Roles) -> anyhow::Result<Built> {
-    let dir = StudyDir::new(results, STUDY);
+pub(super) fn fb_mesh(shelf: &Shelf, roles: &Roles) -> anyhow::Result<Built> {
     let ids: Vec<&str> = [roles::FB_WFC, roles::FB_AS_WRITTEN].into_iter().filter_map(|role| roles.id(role)).collect();
-    let found = ids.iter().find_map(|&run| saved_levels(&dir, run).into_iter().max().map(|l| (run, l)));
+    let mut found = None;
+    for &run in &ids {
+        if let Some(&l) = shelf.saved_levels(STUDY, run)?.last() {
+            found = Some((run, l));
+            break;
+        }
+    }
     let Some((run, level)) = found else {
-        return Ok(Err(format!("no mesh snapshot of runs {} in {}", ids.join(" or "), dir.root.join("meshes").display())));
+        return Ok(Err(format!("no mesh snapshot of runs {} in {}", ids.join(" or "), shelf.meshes_folder(STUDY)?.display())));
     };
-    let snap = dir.read_mesh(run, level).with_context(|| format!("reading the mesh snapshot of {run} level {level}"))?;
+    let snap = shelf.mesh(STUDY, run, level).with_context(|| format!("reading the mesh snapshot of {run} level {level}"))?;
     let mut fig = mesh_figure(&snap, "");
     fig.title = format!("Free boundary (fb): {run} mesh at level {level}, NDF = {}", snap.ndof);
     fig.vlines.push((Fb::A, "free boundary x = a = √2 − 1".to_string()));

@@ -7,26 +7,25 @@
 //! | `hertz_mesh` | `hertz`, the largest saved level of run `adaptive` | the mesh near the contact, |x| <= 1.5a, 0 <= y <= 0.75a at equal scale (edges clipped at the window; contact nodes denser than the pixels as red (active) and blue (inactive) bands, the ends of the active set marked), with Hertz's half-width dashed |
 
 use super::render::{LineFigure, Series};
-use super::{Built, Figure, Marker, PALETTE, Panel, Style, YScale, mesh_figure, runs, saved_levels};
+use super::{Built, Figure, Marker, PALETTE, Panel, Style, YScale, mesh_figure, runs};
 use crate::analysis::hertz::{self, Hertz};
 use crate::analysis::roles::{self, Roles};
-use crate::records::{MeshSnapshot, RunRecord, StudyDir};
+use crate::records::{MeshSnapshot, RunRecord};
+use crate::study::store::Shelf;
 use anyhow::Context;
 use plotters::style::RGBColor;
-use std::path::Path;
 
 const STUDY: &str = roles::HERTZ_AS_WRITTEN.study;
 
 /// A run's Hertz solution (from its problem) and its finest saved snapshot.
-fn finest(results: &Path, r: &RunRecord) -> anyhow::Result<Option<(Hertz, MeshSnapshot)>> {
-    let dir = StudyDir::new(results, STUDY);
-    let Some(level) = saved_levels(&dir, &r.run.id).into_iter().max() else {
+fn finest(shelf: &Shelf, r: &RunRecord) -> anyhow::Result<Option<(Hertz, MeshSnapshot)>> {
+    let Some(&level) = shelf.saved_levels(STUDY, &r.run.id)?.last() else {
         return Ok(None);
     };
-    let problem = crate::study::stored_problem(results, STUDY, &r.run)?;
+    let problem = shelf.problem(STUDY, &r.run)?;
     let h = hertz::for_problem(problem.as_ref())
         .with_context(|| format!("problem {} has no circular contact group '{}'", r.run.problem, hertz::CONTACT_GROUP))?;
-    let snap = dir.read_mesh(&r.run.id, level).with_context(|| format!("reading the mesh snapshot of {} level {level}", r.run.id))?;
+    let snap = shelf.mesh(STUDY, &r.run.id, level).with_context(|| format!("reading the mesh snapshot of {} level {level}", r.run.id))?;
     Ok(Some((h, snap)))
 }
 
@@ -34,8 +33,8 @@ fn pct(v: f64) -> String {
     format!("{:+.2}%", 100.0 * v)
 }
 
-pub(super) fn hertz_pressure(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, STUDY)? {
+pub(super) fn hertz_pressure(shelf: &Shelf) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, STUDY)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -55,7 +54,7 @@ pub(super) fn hertz_pressure(results: &Path) -> anyhow::Result<Built> {
         roundoff: false,
     });
     for (k, r) in runs.iter().enumerate() {
-        let Some((h, snap)) = finest(results, r)? else { continue };
+        let Some((h, snap)) = finest(shelf, r)? else { continue };
         let Some(c) = hertz::compare(&h, &snap.contact_nodes) else {
             profile.notes.push(format!("{}: contact zone not resolved at level {}", r.run.id, snap.level));
             continue;
@@ -112,15 +111,15 @@ pub(super) fn hertz_pressure(results: &Path) -> anyhow::Result<Built> {
     })))
 }
 
-pub(super) fn hertz_mesh(results: &Path, roles: &Roles) -> anyhow::Result<Built> {
-    let runs = match runs(results, STUDY)? {
+pub(super) fn hertz_mesh(shelf: &Shelf, roles: &Roles) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, STUDY)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
     let Some(r) = roles.find(&runs, roles::HERTZ_AS_WRITTEN) else {
         return Ok(Err(format!("study {STUDY} has no run {}", roles.source(roles::HERTZ_AS_WRITTEN))));
     };
-    let Some((h, mut snap)) = finest(results, r)? else {
+    let Some((h, mut snap)) = finest(shelf, r)? else {
         return Ok(Err(format!("no mesh snapshot of run {} of study {STUDY}", r.run.id)));
     };
     let Some(c) = hertz::compare(&h, &snap.contact_nodes) else {

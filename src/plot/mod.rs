@@ -69,7 +69,8 @@ mod rich;
 
 use crate::analysis::roles::{self, Role, Roles};
 use crate::estimator::estimate::{C0_PAPER, ContactTerm, LogFactor};
-use crate::records::{LevelRecord, MeshSnapshot, Refine, RunRecord, StudyDir};
+use crate::records::{LevelRecord, MeshSnapshot, Refine, RunRecord};
+use crate::study::store::Shelf;
 use anyhow::Context;
 use plotters::prelude::*;
 use render::{Figure, HLine, LineFigure, Marker, MeshFigure, PALETTE, Panel, Series, Slope, SlopeAnchor, Style, YScale};
@@ -151,14 +152,14 @@ pub struct Outcome {
 /// Draw every figure whose results exist into `figures/`; figures without results are skipped
 /// with a note on stderr. Returns the files written. The figures find their runs by the roles
 /// the manifests declare ([`roles::check`]).
-pub fn draw_all(results: &Path, figures: &Path, roles: &Roles) -> anyhow::Result<Vec<PathBuf>> {
-    draw_studies(results, figures, roles, None)
+pub fn draw_all(shelf: &Shelf, figures: &Path, roles: &Roles) -> anyhow::Result<Vec<PathBuf>> {
+    draw_studies(shelf, figures, roles, None)
 }
 
 /// [`draw_all`] for the figures of some studies only (`None`: every figure).
-pub fn draw_studies(results: &Path, figures: &Path, roles: &Roles, studies: Option<&[String]>) -> anyhow::Result<Vec<PathBuf>> {
+pub fn draw_studies(shelf: &Shelf, figures: &Path, roles: &Roles, studies: Option<&[String]>) -> anyhow::Result<Vec<PathBuf>> {
     let keep = |figure: &str| studies.is_none_or(|s| study_of(figure).is_some_and(|st| s.iter().any(|x| x == st)));
-    let outcome = draw_figures_where(results, figures, roles, &keep)?;
+    let outcome = draw_figures_where(shelf, figures, roles, &keep)?;
     for (name, why) in &outcome.skipped {
         crate::base::note::line(format_args!("figures: skipped {name}: {why}"));
     }
@@ -168,18 +169,18 @@ pub fn draw_studies(results: &Path, figures: &Path, roles: &Roles, studies: Opti
 /// Draw every figure whose results exist; report the files written and the figures skipped.
 /// A figure that fails (unreadable record, drawing error) does not stop the others; the errors
 /// are reported together at the end.
-pub fn draw_figures(results: &Path, figures: &Path, roles: &Roles) -> anyhow::Result<Outcome> {
-    draw_figures_where(results, figures, roles, &|_| true)
+pub fn draw_figures(shelf: &Shelf, figures: &Path, roles: &Roles) -> anyhow::Result<Outcome> {
+    draw_figures_where(shelf, figures, roles, &|_| true)
 }
 
 /// [`draw_figures`] for the figures `keep` accepts.
-pub fn draw_figures_where(results: &Path, figures: &Path, roles: &Roles, keep: &dyn Fn(&str) -> bool) -> anyhow::Result<Outcome> {
+pub fn draw_figures_where(shelf: &Shelf, figures: &Path, roles: &Roles, keep: &dyn Fn(&str) -> bool) -> anyhow::Result<Outcome> {
     register_font()?;
     std::fs::create_dir_all(figures).with_context(|| format!("creating {}", figures.display()))?;
     let mut outcome = Outcome::default();
     let mut errors = Vec::new();
     for name in FIGURES.into_iter().filter(|f| keep(f)) {
-        match build(name, results, roles).and_then(|b| match b {
+        match build(name, shelf, roles).and_then(|b| match b {
             Ok(fig) => write_figure(&fig, figures, name).map(Ok),
             Err(why) => Ok(Err(why)),
         }) {
@@ -229,9 +230,9 @@ fn write_figure(fig: &Figure, dir: &Path, name: &str) -> anyhow::Result<Vec<Path
 
 /// The y range of every line panel of figure `name` drawn from `results` against the range of
 /// its data (what a test holds the axes to); empty for a mesh figure or one without results.
-pub fn y_ranges(name: &str, results: &Path, roles: &Roles) -> anyhow::Result<Vec<render::YRange>> {
+pub fn y_ranges(name: &str, shelf: &Shelf, roles: &Roles) -> anyhow::Result<Vec<render::YRange>> {
     register_font()?;
-    let Ok(fig) = build(name, results, roles)? else { return Ok(Vec::new()) };
+    let Ok(fig) = build(name, shelf, roles)? else { return Ok(Vec::new()) };
     let mut text = String::new();
     let root = SVGBackend::with_string(&mut text, fig.size()).into_drawing_area();
     fig.render(&root, rich::SVG)
@@ -240,28 +241,28 @@ pub fn y_ranges(name: &str, results: &Path, roles: &Roles) -> anyhow::Result<Vec
 /// A figure, or the reason it cannot be drawn yet.
 type Built = Result<Figure, String>;
 
-fn build(name: &str, results: &Path, roles: &Roles) -> anyhow::Result<Built> {
+fn build(name: &str, shelf: &Shelf, roles: &Roles) -> anyhow::Result<Built> {
     match name {
-        "fig2a" => fig2a(results),
-        "fig2b" => fig2b(results),
-        "fig3a" => fig3a(results),
-        "fig3b" => mesh_at_level_20(results, roles, roles::EX72_AS_WRITTEN),
-        "fig3b_variant" => mesh_at_level_20(results, roles, roles::ABLATION_EX72_WFC),
-        "fig4a" => fig4(results, roles, roles::EX71_AS_WRITTEN, "4a", 5),
-        "fig4b" => fig4(results, roles, roles::EX72_AS_WRITTEN, "4b", 7),
-        "c0_sweep" => c0_sweep(results),
-        "log_ablation" => log_ablation(results),
-        "contact_term_ablation" => contact_term_ablation(results),
-        "estimator_repair" => repair::estimator_repair(results, roles),
-        "theta_ablation" => theta_ablation(results),
-        "fb_error" => fb::fb_error(results),
-        "fb_mesh" => fb::fb_mesh(results, roles),
-        "hertz_pressure" => hertz::hertz_pressure(results),
-        "hertz_mesh" => hertz::hertz_mesh(results, roles),
-        "deep_error" => deep::deep_error(results),
-        "deep_floor" => deep::deep_floor(results, roles),
-        "ex72_large_error" => ex72_large::ex72_large_error(results),
-        "ex72_rollers_error" => ex72_large::ex72_rollers_error(results),
+        "fig2a" => fig2a(shelf),
+        "fig2b" => fig2b(shelf),
+        "fig3a" => fig3a(shelf),
+        "fig3b" => mesh_at_level_20(shelf, roles, roles::EX72_AS_WRITTEN),
+        "fig3b_variant" => mesh_at_level_20(shelf, roles, roles::ABLATION_EX72_WFC),
+        "fig4a" => fig4(shelf, roles, roles::EX71_AS_WRITTEN, "4a", 5),
+        "fig4b" => fig4(shelf, roles, roles::EX72_AS_WRITTEN, "4b", 7),
+        "c0_sweep" => c0_sweep(shelf),
+        "log_ablation" => log_ablation(shelf),
+        "contact_term_ablation" => contact_term_ablation(shelf),
+        "estimator_repair" => repair::estimator_repair(shelf, roles),
+        "theta_ablation" => theta_ablation(shelf),
+        "fb_error" => fb::fb_error(shelf),
+        "fb_mesh" => fb::fb_mesh(shelf, roles),
+        "hertz_pressure" => hertz::hertz_pressure(shelf),
+        "hertz_mesh" => hertz::hertz_mesh(shelf, roles),
+        "deep_error" => deep::deep_error(shelf),
+        "deep_floor" => deep::deep_floor(shelf, roles),
+        "ex72_large_error" => ex72_large::ex72_large_error(shelf),
+        "ex72_rollers_error" => ex72_large::ex72_rollers_error(shelf),
         other => anyhow::bail!("unknown figure {other}"),
     }
 }
@@ -270,12 +271,11 @@ fn build(name: &str, results: &Path, roles: &Roles) -> anyhow::Result<Built> {
 // reading and ordering records
 
 /// The runs of a study, adaptive (by theta) before uniform, then by id; `Err` if there are none.
-fn runs(results: &Path, study: &str) -> anyhow::Result<Result<Vec<RunRecord>, String>> {
-    let dir = StudyDir::new(results, study);
-    let mut runs = dir.read_runs().with_context(|| format!("reading {}", dir.root.display()))?;
+fn runs(shelf: &Shelf, study: &str) -> anyhow::Result<Result<Vec<RunRecord>, String>> {
+    let mut runs = shelf.runs(study)?;
     runs.retain(|r| !r.levels.is_empty());
     if runs.is_empty() {
-        return Ok(Err(format!("study {study} has no runs yet ({})", dir.root.join("runs").display())));
+        return Ok(Err(format!("study {study} has no runs yet ({})", shelf.runs_folder(study)?.display())));
     }
     runs.sort_by(|a, b| order_key(a).partial_cmp(&order_key(b)).unwrap_or(std::cmp::Ordering::Equal).then_with(|| a.run.id.cmp(&b.run.id)));
     Ok(Ok(runs))
@@ -425,8 +425,8 @@ fn run_of_label(label: &str) -> String {
     label.rsplit(", ").next().unwrap_or(label).to_string()
 }
 
-fn fig2a(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, "ex71")? {
+fn fig2a(shelf: &Shelf) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, "ex71")? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -437,8 +437,8 @@ fn fig2a(results: &Path) -> anyhow::Result<Built> {
     Ok(Ok(single(p)))
 }
 
-fn fig2b(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, "ex71")? {
+fn fig2b(shelf: &Shelf) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, "ex71")? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -466,8 +466,8 @@ fn fig2b(results: &Path) -> anyhow::Result<Built> {
     Ok(Ok(panels("Example 7.1: efficiency index (Fig. 2b), and with l_h divided out", out)))
 }
 
-fn fig3a(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, "ex72")? {
+fn fig3a(shelf: &Shelf) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, "ex72")? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -487,9 +487,9 @@ fn fig3a(results: &Path) -> anyhow::Result<Built> {
 }
 
 /// Fig. 4: the terms eta_1 .. eta_`terms` of the run of `role`.
-fn fig4(results: &Path, roles: &Roles, role: Role, fig: &str, terms: usize) -> anyhow::Result<Built> {
+fn fig4(shelf: &Shelf, roles: &Roles, role: Role, fig: &str, terms: usize) -> anyhow::Result<Built> {
     let study = role.study;
-    let runs = match runs(results, study)? {
+    let runs = match runs(shelf, study)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -525,36 +525,22 @@ fn fig4(results: &Path, roles: &Roles, role: Role, fig: &str, terms: usize) -> a
 
 /// Fig. 3(b): a run's mesh at level 20 (`fig3b`: the paper's run, eta_5 as written; `fig3b_variant`:
 /// eta_5 without full-contact nodes, where the free-boundary points are refinement centres).
-fn mesh_at_level_20(results: &Path, roles: &Roles, role: Role) -> anyhow::Result<Built> {
-    let dir = StudyDir::new(results, role.study);
+fn mesh_at_level_20(shelf: &Shelf, roles: &Roles, role: Role) -> anyhow::Result<Built> {
+    let study = role.study;
     let Some(run) = roles.id(role) else { return Ok(Err(format!("no run of {} declares role {}", role.study, role.name))) };
     let mut level = MESH_LEVEL;
     let mut note = String::new();
-    if !dir.mesh_file(run, level, "json").exists() {
+    let saved = shelf.saved_levels(study, run)?;
+    if !saved.contains(&level) {
         // fall back to the finest saved level of the run, saying so in the title
-        let Some(l) = saved_levels(&dir, run).into_iter().max() else {
-            return Ok(Err(format!("no mesh snapshot {}", dir.mesh_file(run, level, "json").display())));
+        let Some(&l) = saved.last() else {
+            return Ok(Err(format!("no mesh snapshot {}", shelf.mesh_path(study, run, level)?.display())));
         };
         note = format!(" (level {MESH_LEVEL} not saved)");
         level = l;
     }
-    let snap = dir.read_mesh(run, level).with_context(|| format!("reading the mesh snapshot of level {level}"))?;
+    let snap = shelf.mesh(study, run, level).with_context(|| format!("reading the mesh snapshot of level {level}"))?;
     Ok(Ok(Figure::Mesh(mesh_figure(&snap, &note))))
-}
-
-/// Levels `L` with a `meshes/RUN_levelL.json`.
-fn saved_levels(dir: &StudyDir, run: &str) -> Vec<usize> {
-    let prefix = format!("{run}_level");
-    std::fs::read_dir(dir.root.join("meshes"))
-        .map(|rd| {
-            rd.filter_map(|e| e.ok())
-                .filter_map(|e| {
-                    let name = e.file_name().to_string_lossy().into_owned();
-                    name.strip_prefix(&prefix)?.strip_suffix(".json")?.parse().ok()
-                })
-                .collect()
-        })
-        .unwrap_or_default()
 }
 
 fn mesh_figure(s: &MeshSnapshot, note: &str) -> MeshFigure {
@@ -650,8 +636,8 @@ fn panels(title: &str, panels: Vec<Panel>) -> Figure {
     }
 }
 
-fn c0_sweep(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, "c0_sweep")? {
+fn c0_sweep(shelf: &Shelf) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, "c0_sweep")? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -689,8 +675,8 @@ fn log_label(f: LogFactor) -> &'static str {
     }
 }
 
-fn log_ablation(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, "log_ablation")? {
+fn log_ablation(shelf: &Shelf) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, "log_ablation")? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -720,8 +706,8 @@ fn contact_label(c: ContactTerm) -> &'static str {
     }
 }
 
-fn contact_term_ablation(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, "contact_term_ablation")? {
+fn contact_term_ablation(shelf: &Shelf) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, "contact_term_ablation")? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -741,8 +727,8 @@ fn contact_term_ablation(results: &Path) -> anyhow::Result<Built> {
     Ok(Ok(panels("Contact term ablation: η_{5} with and without full-contact nodes", out)))
 }
 
-fn theta_ablation(results: &Path) -> anyhow::Result<Built> {
-    let runs = match runs(results, "theta_ablation")? {
+fn theta_ablation(shelf: &Shelf) -> anyhow::Result<Built> {
+    let runs = match runs(shelf, "theta_ablation")? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };

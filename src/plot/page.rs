@@ -8,7 +8,8 @@
 //! (`target/drift/report.json` by default), whose date and scope the page states.
 
 use crate::analysis::claims::Claim;
-use crate::records::{RunRecord, StudyDir};
+use crate::records::RunRecord;
+use crate::study::store::Shelf;
 use base64::Engine;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -196,9 +197,9 @@ fn figures_html(figures: &Path, study: &str) -> std::io::Result<String> {
     Ok(s)
 }
 
-fn provenance_html(study: &StudyDir) -> String {
-    let Ok(text) = std::fs::read_to_string(study.provenance_file()) else { return "<p>No provenance.json.</p>\n".into() };
-    let Ok(serde_json::Value::Object(map)) = serde_json::from_str::<serde_json::Value>(&text) else {
+fn provenance_html(text: Option<&str>) -> String {
+    let Some(text) = text else { return "<p>No provenance.json.</p>\n".into() };
+    let Ok(serde_json::Value::Object(map)) = serde_json::from_str::<serde_json::Value>(text) else {
         return "<p>provenance.json is not a JSON object.</p>\n".into();
     };
     let mut s = String::from("<table class=\"provenance\">\n");
@@ -217,17 +218,16 @@ table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:
 th{background:#f4f4f4}figure{margin:1em 0}img{max-width:100%}.bad{color:#b00}code{font-size:90%}\
 details{margin-top:4px;color:#444}summary{cursor:pointer;color:#06c}";
 
-/// The page of `study`: `results` holds its records, `figures` its PNGs, `claims` every CLAIMS
+/// The page of `study`: `shelf` holds its records, `figures` its PNGs, `claims` every CLAIMS
 /// row (those of the study are shown), `drift` the drift report if one was found.
 pub fn study_page(
-    results: &Path,
+    shelf: &Shelf,
     figures: &Path,
     study: &str,
     claims: &[Claim],
     drift: Option<&serde_json::Value>,
 ) -> std::io::Result<String> {
-    let dir = StudyDir::new(results, study);
-    let runs = dir.read_runs()?;
+    let runs = shelf.runs(study)?;
     let rows: Vec<&Claim> = claims.iter().filter(|c| claim_studies(c.id).contains(&study)).collect();
     let mut s = String::new();
     let _ = write!(
@@ -238,36 +238,23 @@ pub fn study_page(
     let _ = writeln!(
         s,
         "<p>Results from <code>{}</code>, figures from <code>{}</code>.</p>",
-        escape(&results.display().to_string()),
+        escape(&shelf.root().display().to_string()),
         escape(&figures.display().to_string())
     );
     let _ = writeln!(s, "<h2>Drift</h2><p>{}</p>", drift_status(drift, study));
     let _ = writeln!(s, "<h2>Claims</h2>\n{}", claims_table(&rows));
     let _ = writeln!(s, "<h2>Figures</h2>\n{}", figures_html(figures, study)?);
     let _ = writeln!(s, "<h2>Runs</h2>\n{}", run_table(&runs));
-    let _ = writeln!(s, "<h2>Provenance</h2>\n{}", provenance_html(&dir));
+    let _ = writeln!(s, "<h2>Provenance</h2>\n{}", provenance_html(shelf.provenance_text(study)?));
     s += "</body></html>\n";
     Ok(s)
 }
 
-/// The studies present under `results`: folders holding a `runs/` folder, by name.
-pub fn studies_in(results: &Path) -> std::io::Result<Vec<String>> {
-    let mut out = Vec::new();
-    for e in std::fs::read_dir(results).map_err(|e| std::io::Error::new(e.kind(), format!("reading {}: {e}", results.display())))? {
-        let e = e?;
-        if e.path().join("runs").is_dir() {
-            out.push(e.file_name().to_string_lossy().into_owned());
-        }
-    }
-    out.sort();
-    Ok(out)
-}
-
-/// Write `out/STUDY.html` for each of `studies` (every study under `results` if empty), and with
+/// Write `out/STUDY.html` for each of `studies` (every study the shelf's folder holds if empty), and with
 /// every study also `out/index.html` ([`index_page`]), atomically; returns the pages written,
 /// the index last. A named study without records is an error.
 pub fn write_pages(
-    results: &Path,
+    shelf: &Shelf,
     figures: &Path,
     out: &Path,
     studies: &[String],
@@ -275,7 +262,8 @@ pub fn write_pages(
     roles: &crate::analysis::roles::Roles,
 ) -> anyhow::Result<Vec<PathBuf>> {
     use anyhow::Context;
-    let present = studies_in(results)?;
+    let results = shelf.root();
+    let present = shelf.held();
     let chosen: Vec<String> = if studies.is_empty() { present.clone() } else { studies.to_vec() };
     if chosen.is_empty() {
         anyhow::bail!("{} holds no study (no STUDY/runs/ folder): nothing to report", results.display());
@@ -283,12 +271,10 @@ pub fn write_pages(
     if let Some(missing) = chosen.iter().find(|s| !present.contains(s)) {
         anyhow::bail!("study {missing} has no records in {} (studies there: {})", results.display(), present.join(", "));
     }
-    // every study shown is read through the store's integrity check first
-    for study in &chosen {
-        crate::study::store::Store::new(results, study).read()?;
-    }
+    // every study shown (and every one a CLAIMS row reads) was read through the store's
+    // integrity check when the shelf was opened
     let claims =
-        crate::analysis::claims::claims(results, roles).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
+        crate::analysis::claims::claims(shelf, roles).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
     let drift = match std::fs::read_to_string(drift_report) {
         Ok(t) => Some(serde_json::from_str(&t).with_context(|| format!("reading the drift report {}", drift_report.display()))?),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
@@ -297,7 +283,7 @@ pub fn write_pages(
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut written = Vec::new();
     for study in &chosen {
-        let page = study_page(results, figures, study, &claims, drift.as_ref())?;
+        let page = study_page(shelf, figures, study, &claims, drift.as_ref())?;
         let path = out.join(format!("{study}.html"));
         crate::records::write_atomic(&path, page.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
         written.push(path);

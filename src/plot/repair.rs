@@ -11,8 +11,8 @@ use crate::analysis::claims::COINCIDE_REL;
 use crate::analysis::claims::repair::{Fitted, PROBLEMS, Stored};
 use crate::analysis::roles::Roles;
 use crate::records::RunRecord;
+use crate::study::store::Shelf;
 use anyhow::Context;
-use std::path::Path;
 
 /// "deep/ex71_repaired"
 fn name(r: &RunRecord) -> String {
@@ -69,9 +69,9 @@ fn panel(f: &Fitted) -> Option<Panel> {
     Some(p)
 }
 
-pub(super) fn estimator_repair(results: &Path, roles: &Roles) -> anyhow::Result<Built> {
-    let stored = Stored::read(results, roles)
-        .with_context(|| format!("reading the runs of the estimator-repair row under {}", results.display()))?;
+pub(super) fn estimator_repair(shelf: &Shelf, roles: &Roles) -> anyhow::Result<Built> {
+    let stored = Stored::read(shelf, roles)
+        .with_context(|| format!("reading the runs of the estimator-repair row under {}", shelf.root().display()))?;
     let panels: Vec<Panel> = PROBLEMS.iter().filter_map(|p| panel(&stored.fitted(p))).collect();
     if panels.is_empty() {
         return Ok(Err("no repaired run stored (studies estimator_repair, deep, ex72_large)".to_string()));

@@ -110,7 +110,7 @@ fn bad_empty_experiments_folder_is_an_error_and_claims_nothing() {
 #[test]
 fn claims_from_no_data_hold_nothing() {
     let d = tmp("no-data");
-    let claims = signorini::claims::claims(&d, crate::common::roles()).unwrap();
+    let claims = signorini::claims::claims(&crate::common::shelf(&d), crate::common::roles()).unwrap();
     for c in &claims {
         assert_eq!(c.verdict, signorini::claims::Verdict::NoData, "{}: {}", c.id, c.verdict.text());
     }

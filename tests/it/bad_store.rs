@@ -314,9 +314,15 @@ fn report_refuses_an_image_that_is_not_a_png() {
     std::fs::write(figs.join(format!("{name}.png")), "<html>not an image</html>").unwrap();
     let out = figs.join("out");
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let e =
-        signorini::page::write_pages(&root.join("results"), &figs, &out, &[study.into()], &figs.join("none.json"), crate::common::roles())
-            .unwrap_err();
+    let e = signorini::page::write_pages(
+        &crate::common::shelf(&root.join("results")),
+        &figs,
+        &out,
+        &[study.into()],
+        &figs.join("none.json"),
+        crate::common::roles(),
+    )
+    .unwrap_err();
     assert!(format!("{e:#}").contains(&format!("{name}.png is not a PNG image")), "{e:#}");
 }
 
@@ -596,4 +602,67 @@ fn a_second_manifest_with_other_runs_is_refused_while_the_first_computes() {
     assert_ne!(c2, 0, "{o2}");
     assert!(o2.contains("another process computes run(s) a") && o2.contains("does not declare") && o2.contains("nothing was run"), "{o2}");
     assert_eq!(consistent(&study), ["a"]);
+}
+
+// ---- the read side of the door: what figures, report and the CLAIMS rows read is checked
+
+/// Copy `from` into `to`, folders too.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let target = to.join(e.file_name());
+        if e.path().is_dir() {
+            copy_tree(&e.path(), &target);
+        } else {
+            std::fs::copy(e.path(), &target).unwrap();
+        }
+    }
+}
+
+/// A page of one study still rests on CLAIMS rows read from every study: `report --study
+/// c0_sweep` used to check c0_sweep alone, and the Hertz row then read a folder whose mesh
+/// snapshot was deleted as "no data", exit 0. Every study is read through the integrity check
+/// now: refused, naming the file.
+#[test]
+fn report_of_one_study_refuses_another_at_fault_that_its_claims_read() {
+    let d = tmp("shelf-report");
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::os::unix::fs::symlink(repo.join("experiments"), d.join("experiments")).unwrap();
+    for study in ["c0_sweep", "hertz"] {
+        copy_tree(&repo.join("results").join(study), &d.join("results").join(study));
+    }
+    let report = ["report", "--results", "results", "--study", "c0_sweep", "--figures", "figs", "--drift-report", "none.json"];
+    let (code, out) = signorini(&d, &report);
+    assert_eq!(code, 0, "the sound copy is reported: {out}");
+    std::fs::remove_file(d.join("results/hertz/meshes/adaptive_level19.json")).unwrap();
+    let (code, out) = signorini(&d, &report);
+    assert!(code != 0 && out.contains("adaptive_level19.json") && out.contains("missing"), "{out}");
+    assert!(!out.contains("panicked"), "{out}");
+}
+
+/// The shelf hands out only what was checked: a study whose folder exists but was not opened
+/// is an error naming it, one without a folder has no runs, and a snapshot the record does not
+/// save is refused even when a file of that name is there.
+#[test]
+fn the_shelf_hands_out_only_what_the_check_read() {
+    use signorini::study::store::{Shelf, ShelfError, Store};
+    let d = tmp("shelf-lib");
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let results = d.join("results");
+    for study in ["c0_sweep", "hertz"] {
+        copy_tree(&repo.join("results").join(study), &results.join(study));
+    }
+    let shelf = Shelf::open(&results, [Store::new(&results, "hertz")]).unwrap();
+    assert!(matches!(shelf.runs("c0_sweep"), Err(ShelfError::NotOpened { .. })), "an unchecked folder is not read");
+    assert!(shelf.runs("fb").unwrap().is_empty(), "a study without a folder has no runs");
+    assert_eq!(shelf.saved_levels("hertz", "adaptive").unwrap(), vec![19]);
+    assert_eq!(shelf.mesh("hertz", "adaptive", 19).unwrap().level, 19);
+    let stray = results.join("hertz/meshes/adaptive_level3.json");
+    std::fs::copy(results.join("hertz/meshes/adaptive_level19.json"), &stray).unwrap();
+    assert!(matches!(shelf.mesh("hertz", "adaptive", 3), Err(ShelfError::NotSaved { level: 3, .. })));
+    assert!(matches!(shelf.mesh("hertz", "nope", 19), Err(ShelfError::NoRun { .. })));
+    // and the check itself stands in front: a folder at fault is no shelf
+    std::fs::remove_file(results.join("hertz/meshes/adaptive_level19.json")).unwrap();
+    let e = Shelf::open(&results, [Store::new(&results, "hertz")]).unwrap_err();
+    assert!(format!("{e:#}").contains("adaptive_level19.json"), "{e:#}");
 }

@@ -10,7 +10,7 @@ use signorini::verdict::{Abscissa, RateFit};
 use std::path::Path;
 
 fn stored() -> Vec<Claim> {
-    claims::claims(Path::new("results"), crate::common::roles()).unwrap()
+    claims::claims(&crate::common::shelf(Path::new("results")), crate::common::roles()).unwrap()
 }
 
 fn row<'a>(c: &'a [Claim], id: &str) -> &'a Claim {

@@ -225,7 +225,9 @@ fn drift_command_fails_on_perturbed_record_csv_or_claims() {
     };
     assert!(run(&["run", "experiments/tiny.toml", "--quick", "--results", "results"]).0);
     // CLAIMS.md as rendered from this results folder (drawn by `figures`, which needs no figure data here)
-    let claims = signorini::claims::markdown(&signorini::claims::claims(&res, &signorini::analysis::roles::read(&exp).unwrap()).unwrap());
+    let claims = signorini::claims::markdown(
+        &signorini::claims::claims(&crate::common::shelf(&res), &signorini::analysis::roles::read(&exp).unwrap()).unwrap(),
+    );
     std::fs::write(res.join("CLAIMS.md"), &claims).unwrap();
     let drift = || run(&["drift", "--quick", "--experiments", "experiments", "--results", "results"]);
     let (ok, text) = drift();

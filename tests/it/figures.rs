@@ -343,7 +343,7 @@ fn every_figure_is_written_from_records() {
     let figures = root.join("figures");
     full_results(&results);
 
-    let written = plot::draw_all(&results, &figures, crate::common::roles()).expect("draw_all");
+    let written = plot::draw_all(&crate::common::sealed(&results), &figures, crate::common::roles()).expect("draw_all");
     assert_eq!(written.len(), 2 * FIGURES.len(), "{written:?}");
     for name in FIGURES {
         for ext in ["svg", "png"] {
@@ -412,12 +412,13 @@ fn missing_studies_are_skipped_not_errors() {
     let figures = root.join("figures");
 
     // nothing at all
-    let written = plot::draw_all(&results, &figures, crate::common::roles()).expect("an empty results directory is not an error");
+    let written = plot::draw_all(&crate::common::sealed(&results), &figures, crate::common::roles())
+        .expect("an empty results directory is not an error");
     assert!(written.is_empty());
 
     // only Example 7.1: its figures are drawn, the others skipped with a reason
     write_study(&results, "ex71", &[run("adaptive", "ex71", Refine::Adaptive)]);
-    let outcome = plot::draw_figures(&results, &figures, crate::common::roles()).expect("draw_figures");
+    let outcome = plot::draw_figures(&crate::common::sealed(&results), &figures, crate::common::roles()).expect("draw_figures");
     let drawn: Vec<String> = outcome.written.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
     for f in ["fig2a.svg", "fig2a.png", "fig2b.svg", "fig4a.png"] {
         assert!(drawn.contains(&f.to_string()), "{f} not drawn: {drawn:?}");
@@ -429,7 +430,7 @@ fn missing_studies_are_skipped_not_errors() {
     assert!(!figures.join("fig3b.svg").exists());
     // a study present without its mesh snapshot: fig3a drawn, fig3b skipped
     write_study(&results, "ex72", &[run("adaptive", "ex72", Refine::Adaptive)]);
-    let outcome = plot::draw_figures(&results, &figures, crate::common::roles()).expect("draw_figures");
+    let outcome = plot::draw_figures(&crate::common::sealed(&results), &figures, crate::common::roles()).expect("draw_figures");
     assert!(outcome.written.iter().any(|p| p.ends_with("fig3a.svg")));
     assert!(outcome.skipped.iter().any(|(n, why)| n == "fig3b" && why.contains("mesh snapshot")), "{:?}", outcome.skipped);
 }
@@ -467,7 +468,7 @@ fn roundoff_estimator_terms_are_zeros_and_the_legend_says_so() {
         .filter(|&v| v > 0.0)
         .fold(f64::INFINITY, f64::min);
     write_json(&StudyDir::new(&results, "ex72").run_file("adaptive"), &rec).unwrap();
-    plot::draw_all(&results, &figures, crate::common::roles()).expect("draw_all");
+    plot::draw_all(&crate::common::sealed(&results), &figures, crate::common::roles()).expect("draw_all");
     let fig4b = read(&figures.join("fig4b.svg"));
     assert!(fig4b.contains("0 or below round-off at 3 of 21 levels, not drawn"), "fig4b legend");
     // the y axis is not stretched down to the round-off values
@@ -481,7 +482,7 @@ fn convergence_plots_carry_slope_triangles_labelled_with_the_rate() {
     let results = root.join("results");
     let figures = root.join("figures");
     full_results(&results);
-    plot::draw_all(&results, &figures, crate::common::roles()).expect("draw_all");
+    plot::draw_all(&crate::common::sealed(&results), &figures, crate::common::roles()).expect("draw_all");
     for name in ["fig2a", "fig3a", "fig4a", "fig4b"] {
         let svg = read(&figures.join(format!("{name}.svg")));
         // the legs' labels: run 1, rise 1.5 (the rate in NDF)
@@ -527,13 +528,14 @@ fn legends_keep_clear_of_every_curve() {
     let root = scratch("figures-clearance");
     let stored = Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
     let results = if stored.join("ex72").join("runs").is_dir() {
-        stored
+        stored.clone()
     } else {
         full_results(&root.join("results"));
         root.join("results")
     };
     let figures = root.join("figures");
-    plot::draw_figures(&results, &figures, crate::common::roles()).expect("draw_figures");
+    let shelf = if results == stored { crate::common::shelf(&results) } else { crate::common::sealed(&results) };
+    plot::draw_figures(&shelf, &figures, crate::common::roles()).expect("draw_figures");
     for name in ["fig2a", "fig3a", "fig4a", "fig4b"] {
         let Ok(svg) = std::fs::read_to_string(figures.join(format!("{name}.svg"))) else { continue };
         let (boxes, curves) = legend_and_curves(&svg);
@@ -564,8 +566,9 @@ fn legends_keep_clear_of_every_curve() {
 fn log_axes_stay_within_two_decades_of_their_data() {
     let results = Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
     let mut wide = Vec::new();
+    let shelf = crate::common::shelf(&results);
     for name in FIGURES {
-        for r in plot::y_ranges(name, &results, crate::common::roles()).unwrap() {
+        for r in plot::y_ranges(name, &shelf, crate::common::roles()).unwrap() {
             if !r.log {
                 continue;
             }

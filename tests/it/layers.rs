@@ -352,3 +352,54 @@ fn no_two_files_refer_to_each_other() {
         }
     }
 }
+
+/// What only the store reads in a results folder: its layout ([`signorini::records::StudyDir`]),
+/// its records, snapshots and summaries, and the file system itself. Each line of
+/// `src/analysis/` and `src/plot/` naming one is a reader going past the integrity check.
+const PAST_THE_DOOR: &[&str] = &[
+    "StudyDir",
+    "read_runs",
+    "read_run",
+    "read_mesh",
+    "provenance_file",
+    "mesh_file",
+    "fs::read",
+    "read_dir",
+    "Store::",
+    "stored_problem",
+];
+
+/// The files above the store read nothing but through it, except these lines (file, what):
+/// the figures' PNGs and the drift report, which are not results files.
+const NOT_RESULTS: &[(&str, &str)] = &[("plot/page.rs", "std::fs::read(&png)"), ("plot/page.rs", "std::fs::read_to_string(drift_report)")];
+
+/// The door by construction: `src/analysis/` and `src/plot/` get a study's records, mesh
+/// snapshots, provenance and problem only from a `store::Shelf` (made by the store after its
+/// integrity check); none names a results folder's layout, reads a record or opens a file of
+/// it. The check is shown to catch each name on a scratch line.
+#[test]
+fn analysis_and_plot_read_results_only_through_the_shelf() {
+    let past = |rel: &str, line: &str| -> Option<&'static str> {
+        let allowed = NOT_RESULTS.iter().any(|(f, what)| rel == *f && line.contains(what));
+        PAST_THE_DOOR.iter().copied().find(|name| line.contains(name)).filter(|_| !allowed)
+    };
+    for probe in ["let d = StudyDir::new(results, s);", "x.read_runs()?", "std::fs::read_to_string(p)", "dir.read_mesh(r, 3)"] {
+        assert!(past("plot/mod.rs", probe).is_some(), "the check misses {probe}");
+    }
+    assert!(past("plot/page.rs", "match std::fs::read(&png) {").is_none());
+    let mut files = Vec::new();
+    for floor in ["analysis", "plot"] {
+        rust_files(&src().join(floor), &mut files);
+    }
+    assert!(files.len() > 10, "{files:?}");
+    let mut bad = Vec::new();
+    for f in &files {
+        let rel = f.strip_prefix(src()).unwrap().to_string_lossy().replace('\\', "/");
+        for (n, line) in code(&std::fs::read_to_string(f).unwrap()) {
+            if let Some(name) = past(&rel, &line) {
+                bad.push(format!("src/{rel}:{n}: {name}: {}", line.trim()));
+            }
+        }
+    }
+    assert!(bad.is_empty(), "read past the store's integrity check (take a store::Shelf):\n{}", bad.join("\n"));
+}

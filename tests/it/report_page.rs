@@ -7,7 +7,7 @@ use std::path::Path;
 
 #[test]
 fn every_claims_row_belongs_to_a_study() {
-    for c in signorini::claims::claims(Path::new("results"), crate::common::roles()).unwrap() {
+    for c in signorini::claims::claims(&common::shelf(Path::new("results")), crate::common::roles()).unwrap() {
         assert!(!signorini::page::claim_studies(c.id).is_empty(), "CLAIMS row {} maps to no study (page::claim_studies)", c.id);
     }
 }
@@ -16,7 +16,7 @@ fn every_claims_row_belongs_to_a_study() {
 fn study_pages_load_in_chromium_with_every_image_and_claim() {
     let out = std::env::temp_dir().join(format!("signorini-pages-{}", std::process::id()));
     let pages = signorini::page::write_pages(
-        Path::new("results"),
+        &common::shelf(Path::new("results")),
         Path::new("figures"),
         &out,
         &[],
@@ -27,7 +27,7 @@ fn study_pages_load_in_chromium_with_every_image_and_claim() {
     assert!(pages.len() >= 10, "one page per stored study and the index: {pages:?}");
     let (index, pages) = pages.split_last().unwrap();
     assert_eq!(index.file_name().unwrap(), "index.html");
-    let claims = signorini::claims::claims(Path::new("results"), crate::common::roles()).unwrap();
+    let claims = signorini::claims::claims(&common::shelf(Path::new("results")), crate::common::roles()).unwrap();
     let Some(chromium) = common::browser::chromium() else {
         // never a silent pass: `make test` prints the same note, and CI installs chromium
         eprintln!("SKIPPED the browser check of {} study pages: no chromium on this machine (apt-get install chromium)", pages.len());

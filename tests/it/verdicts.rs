@@ -235,7 +235,7 @@ fn row<'a>(c: &'a [claims::Claim], id: &str) -> &'a claims::Claim {
 fn fb_rows_say_no_data_without_the_study() {
     let d = tmp("empty");
     std::fs::create_dir_all(&d).unwrap();
-    let c = claims::claims(&d, crate::common::roles()).unwrap();
+    let c = claims::claims(&crate::common::sealed(&d), crate::common::roles()).unwrap();
     for id in ["fb-error-rate", "fb-reliability", "fb-efficiency", "fb-refinement", "fb-contact-zone"] {
         assert_eq!(row(&c, id).verdict, Verdict::NoData, "{id}");
         assert!(row(&c, id).measured.contains("no data"), "{id}: {}", row(&c, id).measured);
@@ -258,7 +258,7 @@ fn fb_rows_on_synthetic_records() {
     // two saved levels: the larger one is graded at a, the smaller one uniform
     write_json(&dir.mesh_file("adaptive_wfc", 20, "json"), &strip(&graded_at(a, 14), 20)).unwrap();
     write_json(&dir.mesh_file("adaptive_wfc", 3, "json"), &strip(&(0..=8).map(|i| i as f64 / 8.0).collect::<Vec<_>>(), 3)).unwrap();
-    let c = claims::claims(&d, crate::common::roles()).unwrap();
+    let c = claims::claims(&crate::common::sealed(&d), crate::common::roles()).unwrap();
 
     let e = row(&c, "fb-error-rate");
     assert_eq!(e.verdict, Verdict::NotReproduced, "judged on eta_5 as written (rate 1.0): {}", e.measured);
@@ -284,10 +284,10 @@ fn fb_rows_on_synthetic_records() {
 
     // optimal as written: reproduced
     write_json(&dir.run_file("adaptive"), &record("adaptive", Refine::Adaptive, synthetic_levels(1.5, 0.2, 26))).unwrap();
-    let c = claims::claims(&d, crate::common::roles()).unwrap();
+    let c = claims::claims(&crate::common::sealed(&d), crate::common::roles()).unwrap();
     assert_eq!(row(&c, "fb-error-rate").verdict, Verdict::Reproduced);
     write_json(&dir.run_file("adaptive"), &record("adaptive", Refine::Adaptive, synthetic_levels(1.5, 0.0, 26))).unwrap();
-    let c = claims::claims(&d, crate::common::roles()).unwrap();
+    let c = claims::claims(&crate::common::sealed(&d), crate::common::roles()).unwrap();
     assert_eq!(row(&c, "fb-efficiency").verdict, Verdict::Holds);
 
     // a zone that stalls away from a fails
@@ -296,14 +296,14 @@ fn fb_rows_on_synthetic_records() {
         l.zone_min = Some(a + 0.01);
     }
     write_json(&dir.run_file("uniform"), &record("uniform", Refine::Uniform, stalled)).unwrap();
-    let c = claims::claims(&d, crate::common::roles()).unwrap();
+    let c = claims::claims(&crate::common::sealed(&d), crate::common::roles()).unwrap();
     assert_eq!(row(&c, "fb-contact-zone").verdict, Verdict::Fails);
     // unreliable C_0: error above 0.45 eta_h at one level
     let mut bad = synthetic_levels(1.5, 0.0, 26);
     bad[5].terms.estimate = 0.5 * bad[5].err_quadrature.unwrap();
     bad[5].terms.eta_h = bad[5].terms.estimate / 0.45;
     write_json(&dir.run_file("uniform"), &record("uniform", Refine::Uniform, bad)).unwrap();
-    let c = claims::claims(&d, crate::common::roles()).unwrap();
+    let c = claims::claims(&crate::common::sealed(&d), crate::common::roles()).unwrap();
     assert_eq!(row(&c, "fb-reliability").verdict, Verdict::Fails);
 
     // a deep study's runs, where stored, are the ones judged (and named)
@@ -312,7 +312,7 @@ fn fb_rows_on_synthetic_records() {
     let mut as_written = record("fb_as_written", Refine::Adaptive, synthetic_levels(1.5, 0.0, 26));
     as_written.study = "deep".into();
     write_json(&deep.run_file("fb_as_written"), &as_written).unwrap();
-    let c = claims::claims(&d, crate::common::roles()).unwrap();
+    let c = claims::claims(&crate::common::sealed(&d), crate::common::roles()).unwrap();
     let e = row(&c, "fb-error-rate");
     assert_eq!(e.verdict, Verdict::Reproduced, "{}", e.measured);
     assert!(e.measured.contains("eta_5 as written (deep/fb_as_written) 1.50 ± 0.00"), "{}", e.measured);

@@ -9,7 +9,7 @@ use super::{
 };
 use crate::analysis::roles::{self, Role};
 use crate::analysis::verdict::{self, Abscissa, RateReport, refinement};
-use crate::records::{RunRecord, StudyDir};
+use crate::records::RunRecord;
 
 /// A corner is a refinement centre when its smallest element within this distance of it ...
 const CORNER_NEAR: f64 = 0.02;
@@ -18,7 +18,7 @@ const CORNER_RING: f64 = 0.1;
 
 /// The claims of Example 7.2.
 pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let load = |s: &str| StudyDir::new(ctx.results, s).read_runs();
+    let load = |s: &str| ctx.shelf.runs(s);
     let (ex72, ct, large) = (load("ex72")?, load("contact_term_ablation")?, load("ex72_large")?);
     let a72 = ctx.pick(&ex72, roles::EX72_AS_WRITTEN);
     let u72 = ctx.find(&ex72, roles::EX72_UNIFORM);
@@ -35,7 +35,7 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     out.push(corners(ctx, a72, &errors));
     out.push(away(ctx, &errors));
     out.push(eta6_eta7(a72));
-    out.push(where_refined(ctx, a72, wfc));
+    out.push(where_refined(ctx, a72, wfc)?);
     Ok(())
 }
 
@@ -352,7 +352,7 @@ fn eta6_eta7(a72: Option<&RunRecord>) -> Claim {
 }
 
 /// Row of Example 7.2: where the adaptive mesh refines: local minima of h along Gamma_C, and the corners.
-fn where_refined(ctx: &Ctx, a72: Option<&RunRecord>, wfc: Option<&RunRecord>) -> Claim {
+fn where_refined(ctx: &Ctx, a72: Option<&RunRecord>, wfc: Option<&RunRecord>) -> std::io::Result<Claim> {
     // where the adaptive mesh refines: local minima of h along Gamma_C = {1} x (0, 1), corners
     let mut parts = Vec::new();
     // (free boundary, corners) of the run of role ex72 `as-written`, the run judged
@@ -361,7 +361,7 @@ fn where_refined(ctx: &Ctx, a72: Option<&RunRecord>, wfc: Option<&RunRecord>) ->
     let judged_role: Role = roles::EX72_AS_WRITTEN;
     for (role, record) in [(judged_role, a72), (roles::ABLATION_EX72_WFC, wfc)] {
         let (study, id) = (role.study, ctx.roles.id(role).unwrap_or(role.name));
-        let (Some(m), Some(r)) = (latest_mesh(ctx.results, study, id), record) else { continue };
+        let (Some(m), Some(r)) = (latest_mesh(ctx.shelf, study, id)?, record) else { continue };
         let Some((z0, z1)) = r.levels.get(m.level).and_then(|l| l.zone_min.zip(l.zone_max)) else { continue };
         if role == judged_role {
             judged = Some((true, true));
@@ -406,7 +406,7 @@ fn where_refined(ctx: &Ctx, a72: Option<&RunRecord>, wfc: Option<&RunRecord>) ->
             open_if_not: false,
         },
     ]);
-    Claim {
+    Ok(Claim {
         fragile: None,
         id: "7.2-refinement",
         summary: Summary {
@@ -422,5 +422,5 @@ fn where_refined(ctx: &Ctx, a72: Option<&RunRecord>, wfc: Option<&RunRecord>) ->
             .verdict(Kind::Paper, judged.map(|(f, c)| Evidence::All(vec![Some(Evidence::Bool(f)), Some(Evidence::Bool(c))])).as_ref()),
         criterion: test,
         kind: Kind::Paper,
-    }
+    })
 }

@@ -25,7 +25,7 @@ use super::{Claim, Criterion, Ctx, Evidence, Kind, OPTIMAL, Q, Summary, c0_text,
 use crate::analysis::roles::{self, Role, Roles};
 use crate::analysis::verdict::{self, Abscissa};
 use crate::base::stats::line_value_at;
-use crate::records::{RunRecord, StudyDir};
+use crate::records::RunRecord;
 
 /// (ln NDF, ln error) at the levels of `r`'s error-rate fit (every other level of its window).
 fn fit_points(ctx: &Ctx, r: &RunRecord) -> Option<Vec<(f64, f64)>> {
@@ -266,8 +266,8 @@ fn problem_roles(problem: &str) -> ProblemRoles {
 }
 
 impl Stored {
-    pub fn read(results: &std::path::Path, roles: &Roles) -> std::io::Result<Stored> {
-        let load = |s: &str| StudyDir::new(results, s).read_runs();
+    pub fn read(shelf: &crate::study::store::Shelf, roles: &Roles) -> std::io::Result<Stored> {
+        let load = |s: &str| shelf.runs(s);
         Ok(Stored {
             estimator_repair: load(roles::REPAIR_EX71.study)?,
             deep: load(roles::DEEP_EX71_REPAIRED.study)?,
@@ -310,7 +310,7 @@ impl Stored {
 }
 
 pub(super) fn estimator_repair_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let stored = Stored::read(ctx.results, ctx.roles)?;
+    let stored = Stored::read(ctx.shelf, ctx.roles)?;
     let names = ["error rate", "efficiency", "reliability", "unknowns"];
     let (mut parts, mut headline) = (Vec::new(), Vec::new());
     let (mut judged_problems, mut per_problem, mut separating) = (Vec::new(), Vec::new(), 0usize);

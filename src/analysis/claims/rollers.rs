@@ -11,7 +11,7 @@ use super::ex72::{Errors, Labels, error, rates};
 use super::{Claim, Criterion, Ctx, EX72_NU, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, growth_text, rate_headline, rate_text, source};
 use crate::analysis::roles::{self, Role};
 use crate::analysis::verdict::{self, Abscissa, RateReport};
-use crate::records::{RunRecord, StudyDir};
+use crate::records::RunRecord;
 
 /// The study.
 const STUDY: &str = roles::ROLLERS_AS_WRITTEN.study;
@@ -71,7 +71,7 @@ const TERMS: [Term; 3] = [
 /// The rows of Example 7.2 on rollers: the reference and the uniform rate first, then each
 /// contact term's four rows.
 pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let runs = StudyDir::new(ctx.results, STUDY).read_runs()?;
+    let runs = ctx.shelf.runs(STUDY)?;
     let errors = Errors {
         study: STUDY,
         adaptive: ctx.find(&runs, roles::ROLLERS_AS_WRITTEN),

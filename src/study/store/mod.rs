@@ -18,14 +18,18 @@
 //!   replace it; the runner repeats the check under the run's lock, and `--fresh` holds every run
 //!   lock of the study before it removes anything ([`Store::lock_every_run`]).
 //! - [`checkpoint`]: a run in progress kept after every level, to resume from.
+//! - [`shelf`]: the read side: a [`Shelf`] of study folders, made only after each passed
+//!   [`Store::read`], is all that figures, claims and the report pages read.
 
 pub mod check;
 pub mod checkpoint;
 mod lock;
+pub mod shelf;
 pub mod stale;
 pub mod write;
 
 pub use check::{Checked, Fault, first_difference};
+pub use shelf::{Shelf, ShelfError};
 pub use stale::Stale;
 pub use write::{RunWriter, Writer};
 

@@ -69,3 +69,52 @@ pub fn roles() -> &'static signorini::analysis::roles::Roles {
     static ROLES: std::sync::OnceLock<signorini::analysis::roles::Roles> = std::sync::OnceLock::new();
     ROLES.get_or_init(|| signorini::analysis::roles::read(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments")).unwrap())
 }
+
+/// The checked view of a results folder as `figures` and `report` open it: every declared study
+/// and every study the folder holds, each through the store's integrity check (a folder that
+/// does not exist holds none). A folder at fault panics with the check's message.
+pub fn shelf(results: &std::path::Path) -> signorini::study::store::Shelf {
+    use signorini::study::store::Shelf;
+    if !results.exists() {
+        return Shelf::open(results, std::iter::empty()).unwrap();
+    }
+    let experiments = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
+    let manifests = signorini::study::manifest::declared(&experiments, &[]).unwrap();
+    Shelf::open_folder(results, &manifests).unwrap_or_else(|e| panic!("{e:#}"))
+}
+
+/// Make a folder of hand-made records (written straight to `runs/` and `meshes/` by a test) a
+/// sound results folder, as the harness would have stored it: each record of its folder's
+/// study, saving the levels whose snapshot is there (each snapshot of its run and level, with
+/// the level's NDF, beside a VTU), and the summaries `levels.csv` and `provenance.json` rendered
+/// from the records (a provenance already there keeps its manifest). Then open it ([`shelf`]).
+pub fn sealed(results: &std::path::Path) -> signorini::study::store::Shelf {
+    use signorini::records::{MeshSnapshot, StudyDir, write_atomic, write_json};
+    for study in signorini::study::store::Shelf::in_folder(results).unwrap_or_default() {
+        let dir = StudyDir::new(results, &study);
+        let mut runs = dir.read_runs().unwrap();
+        for r in &mut runs {
+            r.study = study.clone();
+            let id = r.run.id.clone();
+            r.run.save_levels = (0..r.levels.len()).filter(|&l| dir.mesh_file(&id, l, "json").exists()).collect();
+            for &l in &r.run.save_levels {
+                let mut snap: MeshSnapshot =
+                    serde_json::from_str(&std::fs::read_to_string(dir.mesh_file(&id, l, "json")).unwrap()).unwrap();
+                (snap.study, snap.run, snap.level, snap.ndof) = (study.clone(), id.clone(), l, r.levels[l].ndof);
+                write_json(&dir.mesh_file(&id, l, "json"), &snap).unwrap();
+                write_atomic(&dir.mesh_file(&id, l, "vtu"), b"<?xml version=\"1.0\"?>\n<VTKFile></VTKFile>\n").unwrap();
+            }
+            write_json(&dir.run_file(&id), r).unwrap();
+        }
+        write_atomic(&dir.csv_file(), &dir.csv_bytes(&runs).unwrap()).unwrap();
+        let manifest = std::fs::read_to_string(dir.provenance_file())
+            .ok()
+            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+            .and_then(|v| v["manifest"].as_str().map(String::from))
+            .unwrap_or_else(|| format!("experiments/{study}.toml"));
+        let ids = runs.iter().map(|r| r.run.id.clone()).collect();
+        let p = signorini::study::provenance::collect(&study, std::path::Path::new(&manifest), b"", false, ids, &[]);
+        write_json(&dir.provenance_file(), &p).unwrap();
+    }
+    shelf(results)
+}
