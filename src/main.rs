@@ -852,6 +852,7 @@ fn run_figures(
         _ => std::path::PathBuf::from("results"),
     };
     let figures = figures.map(|f| f.to_path_buf()).unwrap_or_else(|| if tracked { "figures".into() } else { results.join("figures") });
+    output_folder("--figures", &figures, "figures writes its PNG and SVG files into a folder there")?;
     // what the figures and CLAIMS rows need, checked when the manifests are read
     let roles = signorini::analysis::roles::read(experiments)?;
     let (checked, drawn) = figure_studies(&results, tracked, experiments, only)?;
@@ -883,6 +884,7 @@ fn run_report(
     let under = |tracked_default: &str, scratch: &str| if tracked { tracked_default.into() } else { results.join(scratch) };
     let figures = figures.map_or_else(|| under("figures", "figures"), |f| f.to_path_buf());
     let out = out.map_or_else(|| under("target/report", "report"), |o| o.to_path_buf());
+    output_folder("--out", &out, "report writes its pages into a folder there")?;
     let drift = drift_report.map_or_else(|| under("target/drift/report.json", "drift-report.json"), |d| d.to_path_buf());
     let shelf = study::store::Shelf::open_folder(&results, &study::manifest::declared(experiments, &[])?)?;
     for page in signorini::page::write_pages(&shelf, &figures, &out, studies, &drift, &roles)? {
@@ -891,13 +893,19 @@ fn run_report(
     Ok(())
 }
 
+/// A folder a command writes into (`export --out`, `figures --figures`, `report --out`): a file
+/// there is an error naming the flag, now, not the operating system's "File exists" later.
+fn output_folder(flag: &str, path: &std::path::Path, writes: &str) -> Result<()> {
+    if path.exists() && !path.is_dir() {
+        bail!("{flag} {}: this is a file; {writes}: give a folder's path", path.display());
+    }
+    Ok(())
+}
+
 /// `export`: solve, write the case files, say where.
 fn run_export(args: &SolveArgs, out: &std::path::Path) -> Result<()> {
-    // before solving: export writes a folder (mesh.vtu, case.json), so a file there is an error
-    // now, not the operating system's "File exists" after the solve
-    if out.exists() && !out.is_dir() {
-        bail!("--out {}: this is a file; export writes a folder there (mesh.vtu, case.json): give a folder's path", out.display());
-    }
+    // before solving
+    output_folder("--out", out, "export writes a folder there (mesh.vtu, case.json)")?;
     let (mesh, sol, indicator, r) = run_solve(args)?;
     for f in report::export_case(out, &mesh, &sol, &indicator, &r)? {
         println!("wrote {}", f.display());

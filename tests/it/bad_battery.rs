@@ -317,6 +317,18 @@ fn bad_lengths_huge_numbers_export_files_and_unreached_minimums_are_named() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
     assert!(err.contains("--out taken: this is a file; export writes a folder there"), "{err}");
+    // figures and report say it the same way (battery 5, finding 11: "File exists (os error 17)")
+    let repo = env!("CARGO_MANIFEST_DIR");
+    let (experiments, results) = (format!("{repo}/experiments"), format!("{repo}/results"));
+    for (args, says) in [
+        (vec!["figures", "--results", &results, "--experiments", &experiments, "--figures", "taken"], "--figures taken: this is a file"),
+        (vec!["report", "--results", &results, "--experiments", &experiments, "--out", "taken"], "--out taken: this is a file"),
+    ] {
+        let o = Command::new(env!("CARGO_BIN_EXE_signorini")).current_dir(&dir).args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.contains(says) && err.contains("give a folder's path"), "{args:?}: {err}");
+    }
     let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
         .current_dir(&dir)
         .args(["solve", "--problem", "ex71", "--mesh", "structured:4", "--adapt-levels", "2", "--adapt-min-ndof", "100000"])
