@@ -430,7 +430,7 @@ fn parse_run(
         check_role(role, &id, roles).map_err(|(expected, got)| invalid.at(key("role"), &expected, got))?;
     }
     let problem = r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid.at(key("problem"), "a problem name", "nothing".into()))?;
-    let problem = if crate::problems::is_file(&problem) { spelled(&problem) } else { problem };
+    let problem = if crate::problems::is_file(&problem) { spelled_for(path, &problem) } else { problem };
     let mut constants = d.constants.clone().unwrap_or_default();
     constants.extend(r.constants.clone().unwrap_or_default());
     if let Err(e) = crate::problems::load(&resolve_problem(path, &problem), &constants) {
@@ -453,7 +453,7 @@ fn parse_run(
     let mesh = r.mesh.clone().or(d.mesh.clone()).unwrap_or_else(|| MeshSpec::DEFAULT.into());
     // one mesh, one spelling: `structured:04` and `structured: 4` are `structured:4`
     let mesh = match mesh.strip_prefix("gmsh:") {
-        Some(file) => format!("gmsh:{}", spelled(file.trim())),
+        Some(file) => format!("gmsh:{}", spelled_for(path, file.trim())),
         None => MeshSpec::parse(&mesh).map(|m| m.to_string()).unwrap_or(mesh),
     };
     MeshSpec::parse(&resolve_mesh(path, &mesh)).map_err(|e| invalid.at(key("mesh"), &e.expected(), format!("{mesh:?}")))?;
@@ -667,6 +667,19 @@ pub fn spelled(path: &str) -> String {
         ".".into()
     } else {
         joined
+    }
+}
+
+/// [`spelled`], and an absolute path inside the folder of the manifest at `manifest` made
+/// relative to it, as a relative one is written: `/home/me/study/p.toml` in
+/// `/home/me/study/s.toml` is `p.toml` (the same file, one spec; compared lexically, so a path
+/// through a symbolic link keeps its spelling).
+pub fn spelled_for(manifest: &Path, path: &str) -> String {
+    let path = spelled(path);
+    let folder = manifest.parent().and_then(|d| std::path::absolute(d).ok()).map(|d| spelled(&d.to_string_lossy()));
+    match folder.and_then(|d| path.strip_prefix(&format!("{}/", d.trim_end_matches('/'))).map(str::to_string)) {
+        Some(inside) if !inside.is_empty() => inside,
+        _ => path,
     }
 }
 

@@ -143,6 +143,9 @@ fn a_path_spelt_another_way_is_the_same_spec() {
     let a = Manifest::parse(&dir.join("s.toml"), &text("p.toml")).unwrap();
     let b = Manifest::parse(&dir.join("s.toml"), &text("./p.toml")).unwrap();
     assert_eq!(a.runs[0].spec, b.runs[0].spec);
+    // the same file by its absolute path (battery 5, finding 14: "changed ... none now")
+    let c = Manifest::parse(&dir.join("s.toml"), &text(&dir.join("p.toml").display().to_string())).unwrap();
+    assert_eq!(c.runs[0].spec, a.runs[0].spec);
     // one mesh, one spelling (battery 5, finding 15)
     for mesh in ["structured:02", "structured: 2", " structured:2 "] {
         let c = Manifest::parse(&dir.join("s.toml"), &text("p.toml").replace("structured:2", mesh)).unwrap();
