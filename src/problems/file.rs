@@ -296,6 +296,21 @@ fn chained_power(text: &str) -> Option<usize> {
     None
 }
 
+/// Why `text` is refused as a power exmex reads against the reader ([`negated_power`],
+/// [`chained_power`]), if it is.
+fn power_trap(text: &str) -> Option<String> {
+    if let Some(column) = negated_power(text) {
+        return Some(format!(
+            "the `-` at character {column} negates the base of a power, which exmex applies before `^` (-s^2 reads (-s)^2 = s^2, not -(s^2)): write -(s^2) or 0 - s^2 for minus the power, (-s)^2 for the power of the negation"
+        ));
+    }
+    chained_power(text).map(|column| {
+        format!(
+            "the `^` at character {column} follows another without parentheses; exmex reads a^b^c as (a^b)^c (2^3^2 = 64), the usual reading is a^(b^c) (512): write the parentheses you mean"
+        )
+    })
+}
+
 /// A parsed expression: exmex's default float operators, numbers with exponents.
 type Flat = FlatEx<f64, FloatOpsFactory<f64>, Number>;
 
@@ -515,23 +530,8 @@ impl Reader<'_> {
             Scalar::Number(v) => return Ok(Expr::Const(*v)),
             Scalar::Text(t) => t,
         };
-        if let Some(column) = negated_power(text) {
-            return Err(self.error(
-                key,
-                span,
-                format!(
-                    "{text:?}: the `-` at character {column} negates the base of a power, which exmex applies before `^` (-s^2 reads (-s)^2 = s^2, not -(s^2)): write -(s^2) or 0 - s^2 for minus the power, (-s)^2 for the power of the negation"
-                ),
-            ));
-        }
-        if let Some(column) = chained_power(text) {
-            return Err(self.error(
-                key,
-                span,
-                format!(
-                    "{text:?}: the `^` at character {column} follows another without parentheses; exmex reads a^b^c as (a^b)^c (2^3^2 = 64), the usual reading is a^(b^c) (512): write the parentheses you mean"
-                ),
-            ));
+        if let Some(why) = power_trap(text) {
+            return Err(self.error(key, span, format!("{text:?}: {why}")));
         }
         let flat = Flat::parse(text).map_err(|e| {
             // exmex's message for two operands side by side ("2x", "500 MPa")

@@ -401,10 +401,7 @@ fn theta_of(study: &Path) -> f64 {
 #[test]
 fn a_second_manifest_waiting_for_a_run_never_replaces_it_without_replace_in_either_order() {
     let dir = tmp("two-manifests");
-    for (sub, theta) in [("one", "0.5"), ("two", "0.6")] {
-        std::fs::create_dir_all(dir.join(sub)).unwrap();
-        std::fs::write(dir.join(sub).join("s.toml"), LONG.replace("theta = 0.5", &format!("theta = {theta}"))).unwrap();
-    }
+    long_manifests(&dir, "theta = 0.5", [("one", "theta = 0.5"), ("two", "theta = 0.6")]);
     for (first, second, theta) in [("one", "two", 0.5), ("two", "one", 0.6)] {
         let results = format!("results-{first}");
         let study = dir.join(&results).join("s");
@@ -553,10 +550,7 @@ fn a_record_with_an_unknown_field_or_another_format_is_a_fault_of_its_run() {
 #[test]
 fn a_run_being_replaced_is_not_kept_for_its_old_manifest() {
     let dir = tmp("being-replaced");
-    for (sub, theta) in [("one", "0.5"), ("two", "0.6")] {
-        std::fs::create_dir_all(dir.join(sub)).unwrap();
-        std::fs::write(dir.join(sub).join("s.toml"), LONG.replace("theta = 0.5", &format!("theta = {theta}"))).unwrap();
-    }
+    long_manifests(&dir, "theta = 0.5", [("one", "theta = 0.5"), ("two", "theta = 0.6")]);
     let study = dir.join("results/s");
     let (code, out) = signorini(&dir, &["run", "one/s.toml", "--results", "results"]);
     assert_eq!(code, 0, "{out}");
@@ -589,10 +583,7 @@ fn a_run_being_replaced_is_not_kept_for_its_old_manifest() {
 #[test]
 fn a_second_manifest_with_other_runs_is_refused_while_the_first_computes() {
     let dir = tmp("other-runs");
-    for (sub, id) in [("one", "a"), ("two", "b")] {
-        std::fs::create_dir_all(dir.join(sub)).unwrap();
-        std::fs::write(dir.join(sub).join("s.toml"), LONG.replace("id = \"a\"", &format!("id = \"{id}\""))).unwrap();
-    }
+    long_manifests(&dir, "id = \"a\"", [("one", "id = \"a\""), ("two", "id = \"b\"")]);
     let study = dir.join("results/s");
     let p1 = spawn(&dir, &["run", "one/s.toml", "--results", "results"]);
     computing(&study);
@@ -665,4 +656,12 @@ fn the_shelf_hands_out_only_what_the_check_read() {
     std::fs::remove_file(results.join("hertz/meshes/adaptive_level19.json")).unwrap();
     let e = Shelf::open(&results, [Store::new(&results, "hertz")]).unwrap_err();
     assert!(format!("{e:#}").contains("adaptive_level19.json"), "{e:#}");
+}
+
+/// `one/s.toml` and `two/s.toml` in `dir`: the manifest LONG with `from` replaced by each text.
+fn long_manifests(dir: &Path, from: &str, variants: [(&str, &str); 2]) {
+    for (sub, to) in variants {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+        std::fs::write(dir.join(sub).join("s.toml"), LONG.replace(from, to)).unwrap();
+    }
 }
