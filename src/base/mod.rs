@@ -1,10 +1,12 @@
 //! The `base/` floor (the lowest): what every floor above uses and that uses nothing of the crate:
-//! the reference triangle ([`element`]: P2 basis, affine maps, Gauss rules, sampling lattices) and
+//! the reference triangle ([`element`]: P2 basis, affine maps, Gauss rules, sampling lattices),
+//! content hashes ([`digest`]) and
 //! the memory a solve needs and may still allocate ([`memory`]), the one reader of a user's input
 //! file ([`input`]: a regular file of bounded size, never a pipe or a device), least-squares lines with
 //! confidence intervals ([`stats`]), and notes to standard error that a failed write cannot stop
 //! ([`note`]), and TOML errors in the files' words ([`toml_text`]).
 
+pub mod digest;
 pub mod element;
 pub mod input;
 pub mod memory;

@@ -21,6 +21,21 @@ pub enum RecordError {
     /// A float JSON cannot hold: the file is not written.
     #[error("not writing {}: {bad} (JSON cannot hold it, and the file could not be read back)", path.display())]
     NonFinite { path: PathBuf, bad: NonFinite },
+    /// A mesh snapshot whose bytes are not those its run's record holds the SHA-256 of (edited,
+    /// swapped with another run's, or from before records held the hashes).
+    #[error("{}: {}", path.display(), snapshot_mismatch(run, held.as_deref(), found))]
+    Snapshot { path: PathBuf, run: String, held: Option<String>, found: String },
+}
+
+fn snapshot_mismatch(run: &str, held: Option<&str>, found: &str) -> String {
+    match held {
+        Some(held) => format!(
+            "sha256 {} is not the {} that the record of run {run} holds for it: the snapshot was edited or is another run's",
+            &found[..12],
+            &held[..held.len().min(12)]
+        ),
+        None => format!("the record of run {run} holds no sha256 for it (sha256 {} found)", &found[..12]),
+    }
 }
 
 impl RecordError {
@@ -41,7 +56,7 @@ impl From<RecordError> for std::io::Error {
     fn from(e: RecordError) -> Self {
         let kind = match &e {
             RecordError::Io { error, .. } => error.kind(),
-            RecordError::NonFinite { .. } => std::io::ErrorKind::InvalidData,
+            RecordError::NonFinite { .. } | RecordError::Snapshot { .. } => std::io::ErrorKind::InvalidData,
             RecordError::Parse { .. } | RecordError::Serialise { .. } => std::io::ErrorKind::Other,
         };
         std::io::Error::new(kind, e)

@@ -58,8 +58,8 @@ fn temporary_for(path: &Path) -> std::path::PathBuf {
 /// interrupt), it removes its temporary files: nothing of it reaches the folder.
 #[derive(Debug, Default)]
 pub struct Batch {
-    /// (temporary file, destination), in order.
-    staged: Vec<(std::path::PathBuf, std::path::PathBuf)>,
+    /// (temporary file, destination, SHA-256 of the bytes), in order.
+    staged: Vec<(std::path::PathBuf, std::path::PathBuf, String)>,
 }
 
 impl Batch {
@@ -77,7 +77,7 @@ impl Batch {
             let _ = std::fs::remove_file(&tmp);
             return Err(step("writing", &tmp)(e));
         }
-        self.staged.push((tmp, path.to_path_buf()));
+        self.staged.push((tmp, path.to_path_buf(), crate::base::digest::sha256_hex(bytes)));
         Ok(())
     }
 
@@ -88,7 +88,12 @@ impl Batch {
 
     /// The destinations of the files added so far, in order.
     pub fn paths(&self) -> impl Iterator<Item = &Path> {
-        self.staged.iter().map(|(_, p)| p.as_path())
+        self.staged.iter().map(|(_, p, _)| p.as_path())
+    }
+
+    /// The SHA-256 of the bytes staged for `path` (the last ones, if it was added twice).
+    pub fn sha256_of(&self, path: &Path) -> Option<&str> {
+        self.staged.iter().rev().find(|(_, p, _)| p == path).map(|(_, _, h)| h.as_str())
     }
 
     /// Rename every file into place, in order. If a rename fails, the files not yet renamed are
@@ -96,10 +101,10 @@ impl Batch {
     pub fn commit(mut self) -> std::io::Result<()> {
         let staged = std::mem::take(&mut self.staged);
         let mut rest = staged.iter();
-        for (tmp, path) in rest.by_ref() {
+        for (tmp, path, _) in rest.by_ref() {
             if let Err(e) = std::fs::rename(tmp, path) {
                 let _ = std::fs::remove_file(tmp);
-                rest.for_each(|(t, _)| drop(std::fs::remove_file(t)));
+                rest.for_each(|(t, _, _)| drop(std::fs::remove_file(t)));
                 return Err(step("renaming the temporary file to", path)(e));
             }
         }
@@ -109,7 +114,7 @@ impl Batch {
 
 impl Drop for Batch {
     fn drop(&mut self) {
-        for (tmp, _) in &self.staged {
+        for (tmp, _, _) in &self.staged {
             let _ = std::fs::remove_file(tmp);
         }
     }
@@ -312,6 +317,23 @@ pub struct RunRecord {
     /// rebuilt and solved again (`adapt::replay`, the drift check's replay tier).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub history: Option<History>,
+    /// The SHA-256 of every mesh snapshot the run saved ([`RunRecord::saved_levels`]: the JSON
+    /// and the VTU of each, by file name in `meshes/`), taken from the bytes stored with the
+    /// record: what binds the snapshots to their run, so a swapped or edited snapshot is a fault
+    /// of the run ([`StudyDir::read_snapshot`]). Empty for a run that saves none.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub snapshots: std::collections::BTreeMap<String, String>,
+}
+
+impl RunRecord {
+    /// The levels whose mesh snapshot the run saves: those of `save_levels` it reached,
+    /// ascending.
+    pub fn saved_levels(&self) -> Vec<usize> {
+        let mut levels: Vec<usize> = self.run.save_levels.iter().copied().filter(|&l| l < self.levels.len()).collect();
+        levels.sort_unstable();
+        levels.dedup();
+        levels
+    }
 }
 
 /// A mesh snapshot for the mesh figure: vertices, triangles, and the contact nodes (active or not,
@@ -420,10 +442,25 @@ impl StudyDir {
         read_if_present(&self.run_file(run))
     }
 
-    pub fn read_mesh(&self, run: &str, level: usize) -> std::io::Result<MeshSnapshot> {
-        let f = self.mesh_file(run, level, "json");
-        let text = read_text(&f)?;
-        serde_json::from_str(&text).map_err(RecordError::parse(f))
+    /// The bytes of the snapshot `ext` (`json` or `vtu`) that `record` saves at `level`, checked
+    /// against the SHA-256 the record holds for it: a snapshot edited, swapped with another run's
+    /// or saved by no record is an error ([`RecordError::Snapshot`]), never read as this run's.
+    pub fn read_snapshot(&self, record: &RunRecord, level: usize, ext: &str) -> std::io::Result<Vec<u8>> {
+        let file = self.mesh_file(&record.run.id, level, ext);
+        let bytes = std::fs::read(&file).map_err(step("reading", &file))?;
+        let name = file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let found = crate::base::digest::sha256_hex(&bytes);
+        match record.snapshots.get(&name) {
+            Some(held) if *held == found => Ok(bytes),
+            held => Err(RecordError::Snapshot { path: file, run: record.run.id.clone(), held: held.cloned(), found }.into()),
+        }
+    }
+
+    /// The mesh snapshot (JSON) `record` saves at `level`, its bytes checked by
+    /// [`StudyDir::read_snapshot`].
+    pub fn read_mesh(&self, record: &RunRecord, level: usize) -> std::io::Result<MeshSnapshot> {
+        let bytes = self.read_snapshot(record, level, "json")?;
+        serde_json::from_slice(&bytes).map_err(RecordError::parse(self.mesh_file(&record.run.id, level, "json")))
     }
 
     /// The bytes of `levels.csv` for these runs (written by the study's store): columns `run`,
@@ -497,6 +534,7 @@ mod tests {
             levels: vec![level.clone(), LevelRecord { level: 1, ..level }],
             reference_ndof: None,
             history: None,
+            snapshots: Default::default(),
         };
         let text = String::from_utf8(study.csv_bytes(&[run]).unwrap()).unwrap();
         let lines: Vec<&str> = text.lines().collect();

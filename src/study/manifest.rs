@@ -691,7 +691,7 @@ pub fn input_hashes(manifest: &Path, problem: &str, mesh: &str) -> Result<BTreeM
     let mut add = |key: &'static str, written: &str, resolved: &Path| {
         let kind = if key == "mesh" { crate::mesh::gmsh::MESH_FILE } else { crate::problems::file::PROBLEM_FILE };
         let bytes = crate::base::input::read(resolved, kind).map_err(|e| (key, format!("{}: {e}", resolved.display())))?;
-        out.insert(written.to_string(), super::provenance::sha256_hex(&bytes));
+        out.insert(written.to_string(), crate::base::digest::sha256_hex(&bytes));
         Ok(())
     };
     if crate::problems::is_file(problem) {

@@ -256,7 +256,7 @@ fn run_planned(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &R
             drop(meshes);
             return Err(interruption(manifest, store, opts));
         };
-        store.lock(true)?.commit_run(&run, manifest, &record, meshes, opts.quick)?;
+        store.lock(true)?.commit_run(&run, manifest, record, meshes, opts.quick)?;
         executed.push(spec.id.clone());
     }
     Ok(executed)
@@ -519,7 +519,14 @@ fn run_one(
     if let Some(r) = &prepared.reference {
         run.stage_reference(&crate::records::ReferenceRecord::new(spec, &r.spec, r.rebuild.clone()), meshes)?;
     }
-    Ok(Some(RunRecord { study: study.to_string(), run: spec.clone(), levels, reference_ndof, history: Some(history) }))
+    Ok(Some(RunRecord {
+        study: study.to_string(),
+        run: spec.clone(),
+        levels,
+        reference_ndof,
+        history: Some(history),
+        snapshots: Default::default(),
+    }))
 }
 
 /// Where the run starts: level 0, or after the last level of its checkpoint (the mesh snapshots

@@ -1,8 +1,8 @@
 //! Provenance of a study's results (`results/STUDY/provenance.json`): git commit and dirty flag, Cargo.lock hash,
 //! rustc version, the manifest's hash, machine, threads, date.
 
+use crate::base::digest::sha256_hex;
 use serde::{Deserialize, Serialize};
-use sha2::{Digest, Sha256};
 use std::path::Path;
 use std::process::Command;
 
@@ -63,10 +63,6 @@ pub struct Machine {
 
 fn auto() -> String {
     "auto".into()
-}
-
-pub fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
 }
 
 fn command(cmd: &str, args: &[&str]) -> Option<String> {

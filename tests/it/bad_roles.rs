@@ -145,7 +145,7 @@ fn roles_are_not_hashed_into_the_provenance() {
         assert_eq!(m.bytes, kept.as_bytes(), "{}", m.study);
         assert_eq!(bare.bytes, m.bytes, "{}", m.study);
         assert_eq!(bare.runs, m.runs, "{}", m.study);
-        let hash = signorini::study::provenance::sha256_hex;
+        let hash = signorini::base::digest::sha256_hex;
         assert_eq!(hash(text.as_bytes()) == hash(&m.bytes), roles == 0, "{}: the hash covers the role lines", m.study);
     }
 }

@@ -275,7 +275,7 @@ fn a_missing_or_truncated_mesh_snapshot_fails_drift_and_figures_naming_it() {
     std::fs::write(&vtu, &vtu_bytes[..vtu_bytes.len() / 2]).unwrap();
     for (code, out) in drift_and_figures(&dir) {
         assert_ne!(code, 0, "{out}");
-        assert!(out.contains("meshes/b_level3.vtu") && out.contains("not a whole VTK file"), "{out}");
+        assert!(out.contains("meshes/b_level3.vtu") && out.contains("is not the") && out.contains("record of run b holds"), "{out}");
     }
     // run refuses too, and --replace computes run b again
     let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
@@ -283,6 +283,68 @@ fn a_missing_or_truncated_mesh_snapshot_fails_drift_and_figures_naming_it() {
     let (code, out) = signorini(&dir, &["run", m, "--results", "results", "--replace"]);
     assert!(code == 0 && out.contains("1 run(s) executed"), "{out}");
     assert_eq!(std::fs::read(&vtu).unwrap(), vtu_bytes, "run b computed again gives the same snapshot");
+}
+
+/// Battery 5, finding 6: a mesh snapshot is bound to its record by the SHA-256 the record holds
+/// of it (the bytes committed with it), so a snapshot swapped with another run's, edited by hand,
+/// or held by a record without the hashes is a fault of its run for `run`, `drift` and
+/// `figures` (before: all passed, and the Hertz row of CLAIMS read the edited contact forces).
+#[test]
+fn a_swapped_or_edited_mesh_snapshot_is_a_fault_of_its_run() {
+    let dir = tmp("snapshot-hash");
+    let text = STUDY
+        .replace("id = \"a\"\nlevels = 3\n", "id = \"a\"\nlevels = 3\ntheta = 0.7\nsave_levels = [2]\n")
+        .replace("save_levels = [3]", "save_levels = [2, 3]");
+    let m = manifest(&dir, &text);
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_eq!(code, 0, "{out}");
+    let study = results_of(&dir);
+    let record = |id: &str| -> signorini::records::RunRecord {
+        serde_json::from_slice(&std::fs::read(study.join(format!("runs/{id}.json"))).unwrap()).unwrap()
+    };
+    let held: Vec<String> = record("b").snapshots.into_keys().collect();
+    assert_eq!(held, ["b_level2.json", "b_level2.vtu", "b_level3.json", "b_level3.vtu"]);
+    for (name, hash) in &record("a").snapshots {
+        assert_eq!(*hash, signorini::base::digest::sha256_hex(&std::fs::read(study.join("meshes").join(name)).unwrap()), "{name}");
+    }
+    let pristine = contents(&study);
+    let restore = || pristine.iter().for_each(|(f, b)| std::fs::write(study.join(f), b).unwrap());
+    let refused = |what: &str, file: &str, why: &str| {
+        for (code, out) in drift_and_figures(&dir) {
+            assert!(code != 0 && out.contains(file) && out.contains(why), "{what}: {out}");
+        }
+        let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+        assert!(code != 0 && out.contains(file) && out.contains("Nothing was run or changed"), "{what}: {out}");
+    };
+    // the VTUs of runs a and b at level 2 swapped (both whole VTK files)
+    let (va, vb) = (study.join("meshes/a_level2.vtu"), study.join("meshes/b_level2.vtu"));
+    let (a_bytes, b_bytes) = (std::fs::read(&va).unwrap(), std::fs::read(&vb).unwrap());
+    assert_ne!(a_bytes, b_bytes);
+    std::fs::write(&va, &b_bytes).unwrap();
+    std::fs::write(&vb, &a_bytes).unwrap();
+    refused("swapped", "meshes/a_level2.vtu", "the snapshot was edited or is another run's");
+    restore();
+    // a contact force edited in the JSON the mesh figures (and the Hertz row) read
+    let json = study.join("meshes/b_level3.json");
+    let mut snap: signorini::records::MeshSnapshot = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    snap.contact_nodes[0].lambda += 1.0;
+    signorini::records::write_json(&json, &snap).unwrap();
+    refused("edited", "meshes/b_level3.json", "record of run b holds");
+    restore();
+    // a record whose hashes were taken out (as records were written before they were held)
+    let mut bare = record("a");
+    bare.snapshots.clear();
+    signorini::records::write_json(&study.join("runs/a.json"), &bare).unwrap();
+    refused("no hashes", "meshes/a_level2.json", "holds no sha256 for it");
+    // --replace computes run a again, with its hashes and the same snapshots
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results", "--replace"]);
+    assert!(code == 0 && out.contains("1 run(s) executed"), "{out}");
+    assert_eq!(std::fs::read(&va).unwrap(), a_bytes);
+    let stored = &pristine.iter().find(|(f, _)| f == "runs/a.json").unwrap().1;
+    assert_eq!(record("a").snapshots, serde_json::from_slice::<signorini::records::RunRecord>(stored).unwrap().snapshots);
+    for (code, out) in drift_and_figures(&dir) {
+        assert_eq!(code, 0, "{out}");
+    }
 }
 
 #[test]
@@ -652,6 +714,13 @@ fn the_shelf_hands_out_only_what_the_check_read() {
     std::fs::copy(results.join("hertz/meshes/adaptive_level19.json"), &stray).unwrap();
     assert!(matches!(shelf.mesh("hertz", "adaptive", 3), Err(ShelfError::NotSaved { level: 3, .. })));
     assert!(matches!(shelf.mesh("hertz", "nope", 19), Err(ShelfError::NoRun { .. })));
+    // a snapshot edited after the check is refused when it is read, not drawn
+    let json = results.join("hertz/meshes/adaptive_level19.json");
+    let bytes = std::fs::read(&json).unwrap();
+    std::fs::write(&json, [&bytes[..], b" "].concat()).unwrap();
+    let e = shelf.mesh("hertz", "adaptive", 19).unwrap_err();
+    assert!(matches!(e, ShelfError::Snapshot { .. }) && format!("{e}").contains("is not the"), "{e}");
+    std::fs::write(&json, &bytes).unwrap();
     // and the check itself stands in front: a folder at fault is no shelf
     std::fs::remove_file(results.join("hertz/meshes/adaptive_level19.json")).unwrap();
     let e = Shelf::open(&results, [Store::new(&results, "hertz")]).unwrap_err();

@@ -96,6 +96,7 @@ impl Run<'_> {
             levels: lv,
             reference_ndof: (self.problem == "ex72").then_some(2_000_000),
             history: None,
+            snapshots: Default::default(),
         }
     }
 }

@@ -383,7 +383,7 @@ fn manifests_resolve_problem_files_relative_to_themselves() {
     let files = prov["problem_files"].as_array().expect("problem_files in the provenance");
     assert_eq!(files.len(), 1);
     assert!(files[0]["path"].as_str().unwrap().ends_with("experiments/problems/wedge.toml"), "{files:?}");
-    assert_eq!(files[0]["sha256"].as_str().unwrap(), signorini::study::provenance::sha256_hex(&problem));
+    assert_eq!(files[0]["sha256"].as_str().unwrap(), signorini::base::digest::sha256_hex(&problem));
     // a missing file is an error naming the manifest's key
     let bad = Manifest::parse(&file, &text.replace("wedge.toml\"", "nothing.toml\"")).unwrap_err().to_string();
     assert!(bad.contains("key `run[0].problem`") && bad.contains("cannot read"), "{bad}");

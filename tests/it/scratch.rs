@@ -32,7 +32,7 @@ fn files_under(dir: &Path, out: &mut Vec<(PathBuf, String)>) {
         if e.path().is_dir() {
             files_under(&e.path(), out);
         } else {
-            out.push((e.path(), signorini::study::provenance::sha256_hex(&std::fs::read(e.path()).unwrap())));
+            out.push((e.path(), signorini::base::digest::sha256_hex(&std::fs::read(e.path()).unwrap())));
         }
     }
 }

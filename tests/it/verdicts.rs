@@ -197,7 +197,7 @@ fn record(id: &str, refine: Refine, levels: Vec<LevelRecord>) -> RunRecord {
         constants: Default::default(),
         inputs: Default::default(),
     };
-    RunRecord { study: "fb".into(), run, levels, reference_ndof: None, history: None }
+    RunRecord { study: "fb".into(), run, levels, reference_ndof: None, history: None, snapshots: Default::default() }
 }
 
 /// Levels with error C NDF^-rate, estimate 100x the error, l_h = 1, and a contact zone that

@@ -108,37 +108,44 @@ pub fn names(dir: &StudyDir, files: &[PathBuf]) -> String {
     files.iter().map(|f| f.strip_prefix(&dir.root).unwrap_or(f).display().to_string()).collect::<Vec<_>>().join(", ")
 }
 
-/// The mesh snapshots `record` saves that are missing or do not parse as its level, each with
-/// what is wrong: the JSON (what the mesh figures read) must be the run's level with the level's
-/// NDF, the VTU a whole VTK file.
+/// The mesh snapshots `record` saves that are missing, are not the bytes the record holds the
+/// SHA-256 of ([`StudyDir::read_snapshot`]: edited, another run's), or (the JSON the mesh
+/// figures read) are not the run's level with the level's NDF, each with what is wrong.
 pub(super) fn snapshot_faults(dir: &StudyDir, record: &RunRecord) -> Vec<(PathBuf, String)> {
     let id = &record.run.id;
     let mut out = Vec::new();
-    for &l in record.run.save_levels.iter().filter(|&&l| l < record.levels.len()) {
-        let json = dir.mesh_file(id, l, "json");
-        match dir.read_mesh(id, l) {
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => out.push((json, format!("missing: run {id} saves level {l}"))),
-            Err(e) => out.push((json, format!("does not parse as a mesh snapshot ({e})"))),
+    for l in record.saved_levels() {
+        for ext in ["json", "vtu"] {
+            let file = dir.mesh_file(id, l, ext);
+            match dir.read_snapshot(record, l, ext) {
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => out.push((file, format!("missing: run {id} saves level {l}"))),
+                Err(e) => {
+                    let what = without_path(&e.to_string(), &file);
+                    out.push((file, what))
+                }
+                Ok(_) => {}
+            }
+        }
+        match dir.read_mesh(record, l) {
             Ok(s) if s.run != *id || s.level != l || s.ndof != record.levels[l].ndof => out.push((
-                json,
+                dir.mesh_file(id, l, "json"),
                 format!(
                     "is run {} level {} with {} unknowns, not run {id} level {l} with {}",
                     s.run, s.level, s.ndof, record.levels[l].ndof
                 ),
             )),
-            Ok(_) => {}
-        }
-        let vtu = dir.mesh_file(id, l, "vtu");
-        match std::fs::read(&vtu) {
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => out.push((vtu, format!("missing: run {id} saves level {l}"))),
-            Err(e) => out.push((vtu, format!("cannot be read ({e})"))),
-            Ok(b) if !(b.starts_with(b"<?xml") && b.trim_ascii_end().ends_with(b"</VTKFile>")) => {
-                out.push((vtu, "is not a whole VTK file (no XML header or no closing </VTKFile>)".into()))
+            Err(e) if e.kind() == std::io::ErrorKind::Other => {
+                out.push((dir.mesh_file(id, l, "json"), format!("does not parse as a mesh snapshot ({e})")))
             }
-            Ok(_) => {}
+            _ => {}
         }
     }
     out
+}
+
+/// An error's text without the leading `PATH: ` it names (the fault names the file already).
+fn without_path(text: &str, file: &std::path::Path) -> String {
+    text.strip_prefix(&format!("{}: ", file.display())).unwrap_or(text).to_string()
 }
 
 /// The first line where two texts differ, shortened, as it reads in each.

@@ -131,23 +131,19 @@ impl Shelf {
     /// The levels whose mesh snapshot run `run` of `study` saves (the check found each one
     /// present and parsing), ascending; none for a run the study does not hold.
     pub fn saved_levels(&self, study: &str, run: &str) -> Result<Vec<usize>, ShelfError> {
-        let Some(r) = self.shelved(study)?.and_then(|s| s.runs.iter().find(|r| r.run.id == run)) else { return Ok(Vec::new()) };
-        let mut levels: Vec<usize> = r.run.save_levels.iter().copied().filter(|&l| l < r.levels.len()).collect();
-        levels.sort_unstable();
-        levels.dedup();
-        Ok(levels)
+        Ok(self.shelved(study)?.and_then(|s| s.runs.iter().find(|r| r.run.id == run)).map(RunRecord::saved_levels).unwrap_or_default())
     }
 
     /// The mesh snapshot of run `run` of `study` at `level`, one its record saves.
     pub fn mesh(&self, study: &str, run: &str, level: usize) -> Result<MeshSnapshot, ShelfError> {
-        let Some(shelved) = self.shelved(study)?.filter(|s| s.runs.iter().any(|r| r.run.id == run)) else {
+        let Some((shelved, record)) = self.shelved(study)?.and_then(|s| s.runs.iter().find(|r| r.run.id == run).map(|r| (s, r))) else {
             return Err(ShelfError::NoRun { study: study.to_string(), run: run.to_string() });
         };
-        if !self.saved_levels(study, run)?.contains(&level) {
+        if !record.saved_levels().contains(&level) {
             return Err(ShelfError::NotSaved { study: study.to_string(), run: run.to_string(), level });
         }
         let dir = shelved.store.dir();
-        dir.read_mesh(run, level).map_err(|source| ShelfError::Snapshot { file: dir.mesh_file(run, level, "json"), source })
+        dir.read_mesh(record, level).map_err(|source| ShelfError::Snapshot { file: dir.mesh_file(run, level, "json"), source })
     }
 
     /// The snapshot of the largest level run `run` of `study` saves, if any.

@@ -155,7 +155,7 @@ impl Writer<'_> {
     /// previous record and snapshots (a replaced run) are removed and everything is renamed into
     /// place; then its checkpoint goes. If a write fails, nothing of the run reaches the folder and
     /// no temporary file is left.
-    pub fn commit_run(&self, run: &RunWriter, manifest: &Manifest, record: &RunRecord, mut batch: Batch, quick: bool) -> Result<()> {
+    pub fn commit_run(&self, run: &RunWriter, manifest: &Manifest, record: RunRecord, mut batch: Batch, quick: bool) -> Result<()> {
         self.same_folder(run)?;
         if record.run.id != run.id {
             bail!("the record of run {} committed under the lock of run {}", record.run.id, run.id);
@@ -177,10 +177,11 @@ impl Writer<'_> {
                 run.id
             );
         }
+        let record = RunRecord { snapshots: staged_snapshots(dir, &record, &batch)?, ..record };
         runs.retain(|r| r.run.id != run.id);
         runs.push(record.clone());
         runs.sort_by_key(|r| dir.run_file(&r.run.id));
-        batch.add_json(&dir.run_file(&run.id), record)?;
+        batch.add_json(&dir.run_file(&run.id), &record)?;
         batch.add(&dir.csv_file(), &csv_bytes(dir, &runs)?)?;
         batch.add_json(&dir.provenance_file(), &provenance_of(manifest, &runs, quick))?;
         self.remove_stored(run)?;
@@ -270,6 +271,24 @@ fn stage_reference(dir: &StudyDir, reference: &ReferenceRecord, batch: &mut Batc
         batch.add_json(&file, reference)?;
     }
     Ok(())
+}
+
+/// The SHA-256 of each mesh snapshot `record` saves (JSON and VTU of every saved level), from
+/// the bytes `batch` stages for it: the record stores exactly what is committed beside it. A
+/// saved level the batch does not hold is an error (nothing is stored).
+fn staged_snapshots(dir: &StudyDir, record: &RunRecord, batch: &Batch) -> Result<std::collections::BTreeMap<String, String>> {
+    let mut out = std::collections::BTreeMap::new();
+    for level in record.saved_levels() {
+        for ext in ["json", "vtu"] {
+            let file = dir.mesh_file(&record.run.id, level, ext);
+            let Some(hash) = batch.sha256_of(&file) else {
+                bail!("run {} saves level {level}, but its snapshot {} was not written", record.run.id, file.display());
+            };
+            let name = file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            out.insert(name, hash.to_string());
+        }
+    }
+    Ok(out)
 }
 
 /// Whether `manifest` declares run `id`.

@@ -103,6 +103,11 @@ pub fn sealed(results: &std::path::Path) -> signorini::study::store::Shelf {
                 (snap.study, snap.run, snap.level, snap.ndof) = (study.clone(), id.clone(), l, r.levels[l].ndof);
                 write_json(&dir.mesh_file(&id, l, "json"), &snap).unwrap();
                 write_atomic(&dir.mesh_file(&id, l, "vtu"), b"<?xml version=\"1.0\"?>\n<VTKFile></VTKFile>\n").unwrap();
+                for ext in ["json", "vtu"] {
+                    let file = dir.mesh_file(&id, l, ext);
+                    let hash = signorini::base::digest::sha256_hex(&std::fs::read(&file).unwrap());
+                    r.snapshots.insert(file.file_name().unwrap().to_string_lossy().into_owned(), hash);
+                }
             }
             write_json(&dir.run_file(&id), r).unwrap();
         }
