@@ -19,7 +19,7 @@ use crate::analysis::roles::{self, DENSE_TWINS, Role, Roles};
 use crate::analysis::verdict::{self, Abscissa, RateReport, RateVerdict, refinement};
 // the paper's C_0 (Section 7, the estimator's default): a reliability row holds when the
 // smallest reliable C_0 of its runs is at most this
-use crate::estimator::estimate::C0_PAPER;
+use crate::estimator::estimate::{C0_PAPER, c0_paper};
 use crate::records::{MeshSnapshot, RunRecord};
 use crate::study::store::Shelf;
 pub use criterion::{Criterion, Evidence, Kind};
@@ -493,7 +493,7 @@ fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         id: "7.1-efficiency",
         summary: Summary { topic: "Ex. 7.1: efficiency index", paper: "bounded (Fig. 2b)", headline: growth_headline("log efficiency: ", g.as_ref(), a71) },
         claim: format!(
-            "Ex. 7.1: the efficiency index estimate/error stays bounded (Fig. 2b), C_0 = 0.45; bounded = the slope of log(efficiency) against log(NDF) has a 95% interval containing 0 no wider than {}",
+            "Ex. 7.1: the efficiency index estimate/error stays bounded (Fig. 2b), C_0 = {C0_PAPER}; bounded = the slope of log(efficiency) against log(NDF) has a 95% interval containing 0 no wider than {}",
             verdict::MAX_WIDTH,
         ),
         measured: format!(
@@ -551,20 +551,20 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         fragile: None,
         id: "c0",
         summary: Summary {
-            topic: "Reliability with C_0 = 0.45",
+            topic: concat!("Reliability with C_0 = ", c0_paper!()),
             paper: "C_0 eta_h >= error (6.1)",
             headline: if rows.is_empty() {
                 "n/a".into()
             } else {
-                format!("smallest reliable C_0 {worst:.1e} over {} runs: 0.45 is {:.1} decades above it", rows.len(), (C0_PAPER / worst).log10())
+                format!("smallest reliable C_0 {worst:.1e} over {} runs: {C0_PAPER} is {:.1} decades above it", rows.len(), (C0_PAPER / worst).log10())
             },
         },
-        claim: "Section 7: C_0 = 0.45 is consistent with the reliability bound (6.1): C_0 eta_h >= ||u - u_h||_Linf at every level, in all experiments".into(),
+        claim: concat!("Section 7: C_0 = ", c0_paper!(), " is consistent with the reliability bound (6.1): C_0 eta_h >= ||u - u_h||_Linf at every level, in all experiments").into(),
         measured: if rows.is_empty() {
             String::new()
         } else {
             format!(
-                "reliable with a large margin: C_0 = 0.45 overestimates the error by the factors below (the finding is the overestimation, not the reliability). {}",
+                "reliable with a large margin: C_0 = {C0_PAPER} overestimates the error by the factors below (the finding is the overestimation, not the reliability). {}",
                 rows.iter().map(|r| r.0.clone()).collect::<Vec<_>>().join("; ")
             )
         },
@@ -616,14 +616,14 @@ fn efficiency_size_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()>
         id: "efficiency-size",
         summary: Summary {
             topic: "Size of the efficiency index",
-            paper: "C_0 = 0.45 for both examples (Section 7)",
+            paper: concat!("C_0 = ", c0_paper!(), " for both examples (Section 7)"),
             headline: if per_problem.len() < 2 {
                 "n/a".into()
             } else {
                 format!("smallest reliable C_0 per problem {c0s}: one problem's C_0 is {:.0}x another's", hi / lo)
             },
         },
-        claim: "How large the efficiency index C_0 eta_h / error is, per problem and contact term, over the levels of each run's error-rate fit (the paper plots it in Fig. 2b and uses one C_0 = 0.45 for both examples; no claim on its size), and the smallest reliable C_0 per problem (the largest over its runs of max error / eta_h)".into(),
+        claim: concat!("How large the efficiency index C_0 eta_h / error is, per problem and contact term, over the levels of each run's error-rate fit (the paper plots it in Fig. 2b and uses one C_0 = ", c0_paper!(), " for both examples; no claim on its size), and the smallest reliable C_0 per problem (the largest over its runs of max error / eta_h)").into(),
         measured: if rows.is_empty() { "no data".into() } else { format!("estimate / error: {}. Smallest reliable C_0: {c0s}", rows.join("; ")) },
         verdict: reported.verdict(Kind::Beyond, (!rows.is_empty()).then_some(Evidence::Bool(true)).as_ref()),
         criterion: reported,
@@ -751,14 +751,15 @@ fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
         id: "fb-reliability",
         summary: Summary {
             topic: "fb: reliability",
-            paper: "C_0 = 0.45 reliable, carried over",
+            paper: concat!("C_0 = ", c0_paper!(), " reliable, carried over"),
             headline: rows
                 .iter()
                 .map(|r| r.1)
                 .reduce(f64::max)
                 .map_or("n/a".into(), |c| format!("smallest reliable C_0 {c:.1e} over {} runs", rows.len())),
         },
-        claim: "fb: C_0 = 0.45 is reliable, C_0 eta_h >= ||u - u_h||_Linf at every level; the smallest reliable C_0".into(),
+        claim: concat!("fb: C_0 = ", c0_paper!(), " is reliable, C_0 eta_h >= ||u - u_h||_Linf at every level; the smallest reliable C_0")
+            .into(),
         measured: if rows.is_empty() { "no data".into() } else { rows.iter().map(|r| r.0.clone()).collect::<Vec<_>>().join("; ") },
         verdict: test.verdict(Kind::Beyond, rows.iter().map(|r| r.1).reduce(f64::max).map(Evidence::Value).as_ref()),
         criterion: test,
@@ -1113,7 +1114,7 @@ pub fn markdown_for(claims: &[Claim], results: &Path) -> String {
          A trend is bounded when the slope of log(quantity) against log(NDF), over the same window, has an interval containing 0 and no wider than {w} (an interval containing 0 but wider is inconclusive, whatever its centre). \
          Example 7.1 and fb are judged on the runs of the study deep (to at least 1e7 NDF), Example 7.2's estimator and errors on ex72_large (to 1.1e6 NDF); every row names the runs it fits as study/run. \
          Intervals wider than ± {t} (in NDF) are marked. \
-         Errors and estimators are maxima over the quadrature points of each element (the `sampling` row repeats every verdict with a dense lattice); estimate = C_0 eta_h with C_0 = 0.45.\n\n",
+         Errors and estimators are maxima over the quadrature points of each element (the `sampling` row repeats every verdict with a dense lattice); estimate = C_0 eta_h with C_0 = {C0_PAPER}.\n\n",
         verdict::MIN_DECADES,
         verdict::MIN_POINTS,
         verdict::WINDOW_SHIFT,

@@ -111,7 +111,7 @@ pub enum StressFrame {
 pub struct EstimatorConfig {
     pub contact_term: ContactTerm,
     pub log_factor: LogFactor,
-    /// The constant replacing the hidden one of Theorem 6.1 (Section 7: 0.45).
+    /// The constant replacing the hidden one of Theorem 6.1 (Section 7: [`C0_PAPER`]).
     pub c0: f64,
     pub sampling: Sampling,
     /// Reading of sigma-hat_1, sigma-hat_2 in eta_4, eta_5 (absent in older records: normal).
@@ -119,8 +119,17 @@ pub struct EstimatorConfig {
     pub stress_frame: StressFrame,
 }
 
+/// The constant C_0 of Section 7 as a literal, for text that quotes it (`concat!`): its one
+/// definition, which [`C0_PAPER`] reads.
+macro_rules! c0_paper {
+    () => {
+        0.45
+    };
+}
+pub(crate) use c0_paper;
+
 /// The constant C_0 of Section 7, the estimator's default.
-pub const C0_PAPER: f64 = 0.45;
+pub const C0_PAPER: f64 = c0_paper!();
 
 impl Default for EstimatorConfig {
     fn default() -> Self {

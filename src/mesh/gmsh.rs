@@ -525,7 +525,7 @@ impl GmshFile {
     }
 
     /// Both vertices of line element `e` lie on the curve `c` its group is declared on (within
-    /// [`Curve::VERTEX_TOLERANCE`] of its size).
+    /// [`crate::problems::Curve::VERTEX_TOLERANCE`] of its size).
     fn check_on_curve(&self, c: &crate::problems::Curve, e: &GroupEdge, problem: &dyn Problem) -> Result<(), MeshError> {
         for v in e.v {
             let x = self.vertices[v];

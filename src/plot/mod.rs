@@ -22,7 +22,7 @@
 //! | `fig3b` | `ex72`, the run of role `as-written`, its mesh of level 20 (else the finest saved level, said in the title) | the triangles, thin; equal aspect; active contact nodes red, inactive blue; the obstacle's kink (`kinks`) as a black diamond; NDF, triangle and vertex counts |
 //! | `fig4a` | `ex71`, the run of role `as-written` | `eta1`..`eta5` vs NDF, log-log, NDF^-3/2 above the data; `eta6`, `eta7` are not plotted (as in the paper) but the legend says whether they are 0 at every level or gives their maximum |
 //! | `fig4b` | `ex72`, the run of role `as-written` | `eta1`..`eta7` vs NDF, same style |
-//! | `c0_sweep` | `c0_sweep`, a panel per problem | efficiency C0' eta_h / err_quadrature vs NDF for C0' = 0.45 (solid) and the smallest reliable C0' = max over levels of err_quadrature / eta_h (dashed), per run; line at 1; runs without errors are named in the legend |
+//! | `c0_sweep` | `c0_sweep`, a panel per problem | efficiency C0' eta_h / err_quadrature vs NDF for C0' = [`C0_PAPER`] (solid) and the smallest reliable C0' = max over levels of err_quadrature / eta_h (dashed), per run; line at 1; runs without errors are named in the legend |
 //! | `log_ablation` | `log_ablation`, a panel per problem | efficiency per level (vs NDF) for each `estimator.log_factor`; line at 1 |
 //! | `contact_term_ablation` | `contact_term_ablation`, a panel per problem | `estimate` (solid) and `eta5` (dashed) vs NDF for each `estimator.contact_term` |
 //! | `theta_ablation` | `theta_ablation`, a panel per problem | `err_quadrature` vs NDF for each theta and uniform, with NDF^-3/2; where some run of a problem has fewer than two errors, the estimate for all runs of that problem instead (the y label says which) |
@@ -68,7 +68,7 @@ mod repair;
 mod rich;
 
 use crate::analysis::roles::{self, Role, Roles};
-use crate::estimator::estimate::{C0_PAPER, ContactTerm, LogFactor};
+use crate::estimator::estimate::{C0_PAPER, ContactTerm, LogFactor, c0_paper};
 use crate::records::{LevelRecord, MeshSnapshot, Refine, RunRecord};
 use crate::study::store::Shelf;
 use anyhow::Context;
@@ -137,7 +137,7 @@ const ESTIMATE: &str = "estimate C_{0}η_{h}";
 /// /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf (Debian fonts-dejavu-core). Licence: the
 /// Bitstream Vera licence plus public-domain DejaVu changes, which allow copying, embedding and
 /// redistribution provided the copyright and licence notices go with every copy; the font file
-/// carries them in its name table (https://dejavu-fonts.github.io/License.html).
+/// carries them in its name table (<https://dejavu-fonts.github.io/License.html>).
 static FONT_BYTES: &[u8] = include_bytes!("DejaVuSans.ttf");
 
 /// What [`draw_figures`] did.
@@ -664,7 +664,7 @@ fn c0_sweep(shelf: &Shelf) -> anyhow::Result<Built> {
     if !out.iter().any(Panel::has_data) {
         return Ok(Err("study c0_sweep has no errors recorded".to_string()));
     }
-    Ok(Ok(panels("C_{0} sweep: efficiency for C_{0} = 0.45 and the smallest reliable C_{0}", out)))
+    Ok(Ok(panels(concat!("C_{0} sweep: efficiency for C_{0} = ", c0_paper!(), " and the smallest reliable C_{0}"), out)))
 }
 
 fn log_label(f: LogFactor) -> &'static str {

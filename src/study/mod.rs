@@ -490,7 +490,7 @@ pub fn preload_references(manifest: &Manifest, stored: &Store, progress: bool) -
 
 /// One run of the manifest at `manifest_file` (its problem and mesh files are relative to it): the
 /// adaptive loop with a progress bar, adding the declared levels' mesh snapshots to `meshes`, a
-/// checkpoint after every level that is not the last ([`checkpoint`]), resumed from the
+/// checkpoint after every level that is not the last ([`store::checkpoint`]), resumed from the
 /// checkpoint of an earlier, stopped process if there is one. `None` when interrupted.
 fn run_one(
     study: &str,

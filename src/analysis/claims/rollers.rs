@@ -11,6 +11,7 @@ use super::ex72::{Errors, Labels, error, rates};
 use super::{Claim, Criterion, Ctx, EX72_NU, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, growth_text, rate_headline, rate_text, source};
 use crate::analysis::roles::{self, Role};
 use crate::analysis::verdict::{self, Abscissa, RateReport};
+use crate::estimator::estimate::{C0_PAPER, c0_paper};
 use crate::records::RunRecord;
 
 /// The study.
@@ -214,14 +215,14 @@ fn efficiency(ctx: &Ctx, r: Option<&RunRecord>, term: &Term, labels: Labels) -> 
         id: labels.id,
         summary: Summary {
             topic: labels.topic,
-            paper: "efficient up to l_h (eq. 6.3), reliable with C_0 = 0.45",
+            paper: concat!("efficient up to l_h (eq. 6.3), reliable with C_0 = ", c0_paper!()),
             headline: over_lh
                 .as_ref()
                 .map(|g| format!("estimate/error/l_h slope {:.2} ± {:.2} ({})", g.rate.slope, g.rate.half_width, source(r)))
                 .unwrap_or("n/a".into()),
         },
         claim: format!(
-            "Ex. 7.2 on rollers, {}: the estimator is efficient up to the factor l_h of eq. 6.3: estimate / error / l_h does not grow with NDF (its trend bounded or falling); reliability with C_0 = 0.45 beside it",
+            "Ex. 7.2 on rollers, {}: the estimator is efficient up to the factor l_h of eq. 6.3: estimate / error / l_h does not grow with NDF (its trend bounded or falling); reliability with C_0 = {C0_PAPER} beside it",
             term.name
         ),
         measured: r

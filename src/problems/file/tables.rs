@@ -6,7 +6,7 @@ use super::*;
 /// What `[parts]` declares.
 pub(super) struct Parts {
     pub groups: BTreeMap<String, Part>,
-    /// where each group is named in [parts], for errors that belong there
+    /// where each group is named in `[parts]`, for errors that belong there
     pub group_keys: BTreeMap<String, (&'static str, std::ops::Range<usize>)>,
     pub contact_predicate: Option<Predicate>,
     pub dirichlet_predicate: Option<Predicate>,
