@@ -11,12 +11,14 @@
 //! lattice (`err_dense`); the `sampling` row lists the verdicts that differ.
 
 pub mod criterion;
+mod ex71;
 mod ex72;
+mod fb;
 pub mod repair;
 mod rollers;
 
 use crate::analysis::roles::{self, DENSE_TWINS, Role, Roles};
-use crate::analysis::verdict::{self, Abscissa, RateReport, RateVerdict, refinement};
+use crate::analysis::verdict::{self, RateReport, RateVerdict};
 // the paper's C_0 (Section 7, the estimator's default): a reliability row holds when the
 // smallest reliable C_0 of its runs is at most this
 use crate::estimator::estimate::{C0_PAPER, c0_paper};
@@ -386,151 +388,6 @@ fn latest_mesh(shelf: &Shelf, study: &str, run: &str) -> std::io::Result<Option<
     Ok(shelf.latest_mesh(study, run)?)
 }
 
-/// The claims of Example 7.1.
-fn ex71_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let load = |s: &str| ctx.shelf.runs(s);
-    let (ex71, ct, deep) = (load("ex71")?, load("contact_term_ablation")?, load("deep")?);
-    let a71 = ctx.deep_or(&deep, roles::DEEP_EX71_AS_WRITTEN, ctx.pick(&ex71, roles::EX71_AS_WRITTEN));
-    let u71 = ctx.deep_or(&deep, roles::DEEP_EX71_UNIFORM, ctx.find(&ex71, roles::EX71_UNIFORM));
-    let u71c = ctx.find(&ex71, roles::EX71_UNIFORM_CARTESIAN);
-    let wfc = ctx.deep_or(&deep, roles::DEEP_EX71_WFC, ctx.pick(&ct, roles::ABLATION_EX71_WFC));
-
-    let err = ctx.rate(a71, Q::Error);
-    let with_floor = |name: &str, r: Option<&RunRecord>| {
-        let text = rate_text(&format!("{name} ({})", source(r)), ctx.rate(r, Q::Error).as_ref(), Some(OPTIMAL));
-        r.map_or(text.clone(), |r| format!("{text}; {}", ctx.floor_text(r)))
-    };
-    let test = Criterion::rate(format!("the adaptive error ({})", source(a71)), OPTIMAL, Abscissa::Ndof);
-    out.push(Claim {
-        fragile: fragility(err.as_ref(), OPTIMAL),
-        id: "7.1-error-rate",
-        summary: Summary {
-            topic: "Ex. 7.1: error rate, adaptive",
-            paper: "NDF^-1.5 (Fig. 2a)",
-            headline: rate_headline("", err.as_ref(), a71),
-        },
-        claim: "Ex. 7.1: the error ||u - u_h||_Linf converges at the optimal rate NDF^(-3/2) under adaptive refinement (Fig. 2a)".into(),
-        measured: format!(
-            "{}. {}. {}",
-            with_floor("marking by eta_5 as written", a71),
-            with_floor("without full-contact nodes", wfc),
-            with_floor("uniform", u71)
-        ),
-        verdict: test.verdict(Kind::Paper, Evidence::rate(err.as_ref()).as_ref()),
-        criterion: test,
-        kind: Kind::Paper,
-    });
-
-    let est = ctx.rate(a71, Q::Field("eta_h"));
-    let test = Criterion::rate(format!("eta_h ({})", source(a71)), OPTIMAL, Abscissa::Ndof);
-    out.push(Claim {
-        fragile: fragility(est.as_ref(), OPTIMAL),
-        id: "7.1-estimator-rate",
-        summary: Summary {
-            topic: "Ex. 7.1: estimator rate",
-            paper: "eta_h at NDF^-1.5 (Fig. 2a)",
-            headline: rate_headline("eta_h ", est.as_ref(), a71),
-        },
-        claim: "Ex. 7.1: the estimator eta_h converges at NDF^(-3/2) (Fig. 2a)".into(),
-        measured: format!(
-            "as written ({}): {}. Without full-contact nodes ({}): {}",
-            source(a71),
-            estimator_text(ctx, a71),
-            source(wfc),
-            estimator_text(ctx, wfc)
-        ),
-        verdict: test.verdict(Kind::Paper, Evidence::rate(est.as_ref()).as_ref()),
-        criterion: test,
-        kind: Kind::Paper,
-    });
-
-    let terms: Vec<String> =
-        ["eta1", "eta2", "eta3", "eta4", "eta5"].iter().map(|n| rate_text(n, ctx.rate(a71, Q::Field(n)).as_ref(), Some(OPTIMAL))).collect();
-    let slower = |r: Option<&RunRecord>| -> String {
-        let rates: Option<Vec<f64>> = ["eta4", "eta5"].iter().map(|n| ctx.rate(r, Q::Field(n)).map(|x| x.main.rate.slope)).collect();
-        rates.map(|v| format!("NDF^(-{:.2})", v[0].min(v[1]))).unwrap_or("n/a".into())
-    };
-    let names = ["eta1", "eta2", "eta3", "eta4", "eta5"];
-    let test = Criterion::Each {
-        of: names.iter().map(|n| n.to_string()).collect(),
-        each: Box::new(Criterion::rate(format!("the term ({})", source(a71)), OPTIMAL, Abscissa::Ndof)),
-    };
-    let ev = a71.map(|_| Evidence::All(names.iter().map(|n| Evidence::rate(ctx.rate(a71, Q::Field(n)).as_ref())).collect()));
-    out.push(Claim {
-        fragile: None,
-        id: "7.1-eta5",
-        summary: Summary {
-            topic: "Ex. 7.1: eta_1..eta_5",
-            paper: "each at NDF^-1.5 (Fig. 4a)",
-            headline: slowest_headline(ctx, a71, &["eta1", "eta2", "eta3", "eta4", "eta5"]),
-        },
-        claim: "Ex. 7.1: the individual estimators eta_1..eta_5 decay optimally (Fig. 4a); in particular eta_5 = max_p h_p |sigma-hat_1(u_h)|".into(),
-        measured: format!(
-            "adaptive ({}): {}. Reading of sigma-hat (sigma n in a frame whose e_1 is the normal), the rows above: sigma-hat_1 = n . sigma n (normal stress, eta_5), sigma-hat_2 = t . sigma n (eta_4); \
-             |sigma_nn| is 3 to 6 on all of Gamma_C, so eta_5 ~ h. Uniform refinement ({}), this reading: {}; {}. \
-             Read literally as Cartesian components (estimator.stress_frame = \"cartesian\", run {}), sigma-hat_1 = -sigma_12 (zero for the exact solution) and sigma-hat_2 = -sigma_22: {}; {}. \
-             The slower of eta_4, eta_5 decays at {} (this reading) and {} (literal reading)",
-            source(a71),
-            terms.join("; "),
-            source(u71),
-            rate_text("eta4", ctx.rate(u71, Q::Field("eta4")).as_ref(), Some(OPTIMAL)),
-            rate_text("eta5", ctx.rate(u71, Q::Field("eta5")).as_ref(), Some(OPTIMAL)),
-            ctx.roles.source(roles::EX71_UNIFORM_CARTESIAN),
-            rate_text("eta4", ctx.rate(u71c, Q::Field("eta4")).as_ref(), Some(OPTIMAL)),
-            rate_text("eta5", ctx.rate(u71c, Q::Field("eta5")).as_ref(), Some(OPTIMAL)),
-            slower(u71),
-            slower(u71c),
-        ),
-        verdict: test.verdict(Kind::Paper, ev.as_ref()),
-        criterion: test,
-        kind: Kind::Paper,
-    });
-
-    let g = ctx.growth(a71, Q::Efficiency);
-    let test = Criterion::Bounded { what: format!("estimate / error ({})", source(a71)) };
-    out.push(Claim {
-        fragile: None,
-        id: "7.1-efficiency",
-        summary: Summary { topic: "Ex. 7.1: efficiency index", paper: "bounded (Fig. 2b)", headline: growth_headline("log efficiency: ", g.as_ref(), a71) },
-        claim: format!(
-            "Ex. 7.1: the efficiency index estimate/error stays bounded (Fig. 2b), C_0 = {C0_PAPER}; bounded = the slope of log(efficiency) against log(NDF) has a 95% interval containing 0 no wider than {}",
-            verdict::MAX_WIDTH,
-        ),
-        measured: format!(
-            "as written ({}): {}; {}; {}. Without full-contact nodes ({}): {}; {}",
-            source(a71),
-            growth_text("efficiency", g.as_ref()),
-            growth_text("efficiency / l_h", ctx.growth(a71, Q::EfficiencyOverLh).as_ref()),
-            growth_text("efficiency with l_h = 1, C_0 (Psi + eta_6 + eta_7) / error", ctx.growth(a71, Q::EfficiencyL1).as_ref()),
-            source(wfc),
-            growth_text("efficiency", ctx.growth(wfc, Q::Efficiency).as_ref()),
-            growth_text("efficiency / l_h", ctx.growth(wfc, Q::EfficiencyOverLh).as_ref()),
-        ),
-        verdict: test.verdict(Kind::Paper, Evidence::fit(g.as_ref()).as_ref()),
-        criterion: test,
-        kind: Kind::Paper,
-    });
-
-    let eta67 = a71.map(|r| r.levels.iter().map(|l| l.terms.eta6.max(l.terms.eta7)).fold(0.0, f64::max));
-    let test =
-        Criterion::AtMost { what: format!("the largest eta_6 or eta_7 at any level ({})", source(a71)), limit: VANISHING, interval: false };
-    out.push(Claim {
-        fragile: None,
-        id: "7.1-eta6-eta7",
-        summary: Summary {
-            topic: "Ex. 7.1: eta_6, eta_7",
-            paper: "vanish",
-            headline: eta67.map(|v| format!("largest {v:.1e} ({})", source(a71))).unwrap_or("n/a".into()),
-        },
-        claim: "Ex. 7.1: ||(chi + u_h2)^+||_Linf(Lambda) and ||(-u_h2 - chi)^+||_Linf(Gamma_C) vanish".into(),
-        measured: eta67.map(|v| format!("max over levels of eta6, eta7: {v:.3e}")).unwrap_or_default(),
-        verdict: test.verdict(Kind::Paper, eta67.map(Evidence::Value).as_ref()),
-        criterion: test,
-        kind: Kind::Paper,
-    });
-    Ok(())
-}
-
 /// The C_0 row: overestimation and the smallest reliable C_0, all runs with an error.
 fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let mut rows = Vec::new();
@@ -697,208 +554,6 @@ fn log_factor_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     Ok(())
 }
 
-/// The free-boundary example `fb` (beyond the paper): exact solution with contact on [a, 1].
-fn fb_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let fb = ctx.shelf.runs("fb")?;
-    let deep = ctx.shelf.runs("deep")?;
-    let ad = ctx.deep_or(&deep, roles::DEEP_FB_AS_WRITTEN, ctx.find(&fb, roles::FB_AS_WRITTEN));
-    let wfc = ctx.deep_or(&deep, roles::DEEP_FB_WFC, ctx.find(&fb, roles::FB_WFC));
-    let un = ctx.deep_or(&deep, roles::DEEP_FB_UNIFORM, ctx.find(&fb, roles::FB_UNIFORM));
-    let a = fb_free_boundary();
-    let none = ad.is_none();
-
-    let (e_ad, e_wfc, e_un) = (ctx.rate(ad, Q::Error), ctx.rate(wfc, Q::Error), ctx.rate(un, Q::Error));
-    // the paper's claim carried over, judged for its estimator as written (the variant beside it)
-    let test = Criterion::rate(format!("the adaptive error ({})", source(ad)), OPTIMAL, Abscissa::Ndof);
-    out.push(Claim {
-        fragile: fragility(e_ad.as_ref(), OPTIMAL),
-        id: "fb-error-rate",
-        summary: Summary { topic: "fb: error rate, adaptive", paper: "NDF^-1.5, carried over (beyond the paper)", headline: rate_headline("", e_ad.as_ref(), ad) },
-        claim: "fb (beyond the paper): with a free boundary at x = a = sqrt(2) - 1 and a known solution, adaptive refinement with the paper's estimator (eta_5 as written) converges at NDF^(-3/2); the variant without full-contact nodes and uniform refinement for comparison".into(),
-        measured: if none {
-            "no data".into()
-        } else {
-            let against_uniform = |r: Option<&RunRecord>| match (r, un) {
-                (Some(r), Some(u)) => format!("{}: {}", r.run.id, repair::unknowns(ctx, r, u).0),
-                _ => String::new(),
-            };
-            let floor = |r: Option<&RunRecord>| r.map(|r| format!("; {}", ctx.floor_text(r))).unwrap_or_default();
-            format!(
-                "{}{}. {}{}. {}{}. Unknowns for the same error: {}; {}",
-                rate_text(&format!("adaptive, eta_5 as written ({})", source(ad)), e_ad.as_ref(), Some(OPTIMAL)),
-                floor(ad),
-                rate_text(&format!("adaptive without full-contact nodes ({})", source(wfc)), e_wfc.as_ref(), Some(OPTIMAL)),
-                floor(wfc),
-                rate_text(&format!("uniform ({})", source(un)), e_un.as_ref(), None),
-                floor(un),
-                against_uniform(ad),
-                against_uniform(wfc)
-            )
-        },
-        verdict: test.verdict(Kind::Paper, Evidence::rate(e_ad.as_ref()).as_ref()),
-        criterion: test,
-        kind: Kind::Paper,
-    });
-
-    let rows: Vec<(String, f64)> = [ad, wfc, un].into_iter().filter_map(|r| c0_text(&source(r), r?, ctx.err_field())).collect();
-    let test = Criterion::AtMost {
-        what: format!("the smallest reliable C_0 (the largest error / eta_h at any level of {})", [ad, wfc, un].map(source).join(", ")),
-        limit: C0_PAPER,
-        interval: false,
-    };
-    out.push(Claim {
-        fragile: None,
-        id: "fb-reliability",
-        summary: Summary {
-            topic: "fb: reliability",
-            paper: concat!("C_0 = ", c0_paper!(), " reliable, carried over"),
-            headline: rows
-                .iter()
-                .map(|r| r.1)
-                .reduce(f64::max)
-                .map_or("n/a".into(), |c| format!("smallest reliable C_0 {c:.1e} over {} runs", rows.len())),
-        },
-        claim: concat!("fb: C_0 = ", c0_paper!(), " is reliable, C_0 eta_h >= ||u - u_h||_Linf at every level; the smallest reliable C_0")
-            .into(),
-        measured: if rows.is_empty() { "no data".into() } else { rows.iter().map(|r| r.0.clone()).collect::<Vec<_>>().join("; ") },
-        verdict: test.verdict(Kind::Beyond, rows.iter().map(|r| r.1).reduce(f64::max).map(Evidence::Value).as_ref()),
-        criterion: test,
-        kind: Kind::Beyond,
-    });
-
-    // judged for the paper's estimator as written, like 7.1-efficiency
-    let g = ctx.growth(ad, Q::Efficiency);
-    let test = Criterion::Bounded { what: format!("estimate / error ({})", source(ad)) };
-    out.push(Claim {
-        fragile: None,
-        id: "fb-efficiency",
-        summary: Summary {
-            topic: "fb: efficiency index",
-            paper: "bounded, carried over",
-            headline: growth_headline("log efficiency: ", g.as_ref(), ad),
-        },
-        claim: "fb: the efficiency index of the paper's estimator (eta_5 as written) stays bounded (same rule as 7.1-efficiency)".into(),
-        measured: if none {
-            "no data".into()
-        } else {
-            format!(
-                "adaptive ({}): {}; {}; adaptive without full-contact nodes ({}): {}; {}",
-                source(ad),
-                growth_text("efficiency", ctx.growth(ad, Q::Efficiency).as_ref()),
-                growth_text("efficiency / l_h", ctx.growth(ad, Q::EfficiencyOverLh).as_ref()),
-                source(wfc),
-                growth_text("efficiency", ctx.growth(wfc, Q::Efficiency).as_ref()),
-                growth_text("efficiency / l_h", ctx.growth(wfc, Q::EfficiencyOverLh).as_ref())
-            )
-        },
-        verdict: test.verdict(Kind::Beyond, Evidence::fit(g.as_ref()).as_ref()),
-        criterion: test,
-        kind: Kind::Beyond,
-    });
-
-    // refinement at x = a along Gamma_C = (0, 1) x {0}
-    let mut parts = Vec::new();
-    // the first mesh found decides
-    let mut decides: Option<(String, bool)> = None;
-    let meshes = [roles::FB_WFC, roles::FB_AS_WRITTEN];
-    for id in meshes.iter().filter_map(|&role| ctx.roles.id(role)) {
-        let Some(m) = latest_mesh(ctx.shelf, roles::FB_WFC.study, id)? else { continue };
-        let prof = refinement::profile(&m, [0.0, 0.0], [1.0, 0.0]);
-        match refinement::local_minimum(&prof, a, REFINE_REACH) {
-            Some(lm) => {
-                if decides.is_none() {
-                    decides = Some((format!("{}/{id} level {}", roles::FB_WFC.study, m.level), lm.holds));
-                }
-                parts.push(format!(
-                    "{id} level {} (NDF {}): at x = a {} → {}",
-                    m.level,
-                    m.ndof,
-                    lm.text(),
-                    if lm.holds { "local minimum" } else { "no local minimum" }
-                ));
-            }
-            None => parts.push(format!("{id} level {}: no mesh edge on Gamma_C contains x = a", m.level)),
-        }
-    }
-    let test = Criterion::Test {
-        passes_if: format!(
-            "the edge length along Gamma_C on the last saved mesh of {} has a local minimum (or a plateau of its own) at x = a: no edge within {REFINE_REACH} of a on either side is smaller than the edges at a, and one on each side is larger",
-            decides.as_ref().map_or(format!("{} (else {})", ctx.roles.source(meshes[0]), ctx.roles.source(meshes[1])), |d| d.0.clone())
-        ),
-        open_if_not: false,
-    };
-    out.push(Claim {
-        fragile: None,
-        id: "fb-refinement",
-        summary: Summary {
-            topic: "fb: refinement at the free boundary",
-            paper: "the mesh concentrates at free boundaries (beyond the paper)",
-            headline: parts.first().cloned().unwrap_or("n/a".into()),
-        },
-        claim: format!("fb: the adaptive mesh concentrates at the free boundary x = a: a local minimum (or plateau of its own) of the edge length along Gamma_C within {REFINE_REACH} of a"),
-        measured: if parts.is_empty() { "no data".into() } else { parts.join("; ") },
-        verdict: test.verdict(Kind::Beyond, decides.map(|d| Evidence::Bool(d.1)).as_ref()),
-        criterion: test,
-        kind: Kind::Beyond,
-    });
-
-    // the discrete contact zone [zone_min, zone_max] -> [a, 1]
-    let zone = |r: Option<&RunRecord>| -> Option<(String, String, Evidence)> {
-        let r = r?;
-        let ndof: Vec<usize> = r.levels.iter().map(|l| l.ndof).collect();
-        let d0: Vec<Option<f64>> = r.levels.iter().map(|l| l.zone_min.map(|z| (z - a).abs())).collect();
-        let last = r.levels.last()?;
-        let fit = verdict::rate_over(&ndof, &d0, ndof.len() - 1)?;
-        let end_ok = last.zone_max.is_some_and(|z| (z - 1.0).abs() <= 1e-12);
-        Some((
-            source(Some(r)),
-            format!(
-                "{}/{}: last level zone [{:.6}, {:.6}], |zone start - a| {:.1e} (h_min {:.1e}), decays at NDF^-({}) ({})",
-                r.study,
-                r.run.id,
-                last.zone_min.unwrap_or(f64::NAN),
-                last.zone_max.unwrap_or(f64::NAN),
-                d0.last().copied().flatten().unwrap_or(f64::NAN),
-                last.h_min,
-                fit.text(),
-                fit.range()
-            ),
-            Evidence::All(vec![Some(Evidence::Fit(fit)), Some(Evidence::Bool(end_ok))]),
-        ))
-    };
-    let zs: Vec<(String, String, Evidence)> = [ad, wfc, un].into_iter().filter_map(zone).collect();
-    let test = Criterion::Each {
-        of: zs.iter().map(|z| z.0.clone()).collect(),
-        each: Box::new(Criterion::All(vec![
-            Criterion::Decays { what: "|zone start - a| (the zone's first contact node against a, per level)".into() },
-            Criterion::Test { passes_if: "the last level's zone ends at x = 1 (within 1e-12)".into(), open_if_not: false },
-        ])),
-    };
-    let zone_decay = ad.and_then(|r| {
-        let ndof: Vec<usize> = r.levels.iter().map(|l| l.ndof).collect();
-        let d0: Vec<Option<f64>> = r.levels.iter().map(|l| l.zone_min.map(|z| (z - a).abs())).collect();
-        let fit = verdict::rate_over(&ndof, &d0, ndof.len() - 1)?;
-        Some(format!("|zone start - a| at NDF^-({}) ({}, {})", fit.text(), short_range(&fit), source(Some(r))))
-    });
-    out.push(Claim {
-        fragile: None,
-        id: "fb-contact-zone",
-        summary: Summary {
-            topic: "fb: the discrete contact zone",
-            paper: "tends to [a, 1] (beyond the paper)",
-            headline: zone_decay.unwrap_or("n/a".into()),
-        },
-        claim: "fb: the discrete contact zone tends to [a, 1]: |zone start - a| decays (rate interval above 0) and the zone ends at x = 1"
-            .into(),
-        measured: if zs.is_empty() { "no data".into() } else { zs.iter().map(|z| z.1.clone()).collect::<Vec<_>>().join("; ") },
-        verdict: test
-            .verdict(Kind::Beyond, (!zs.is_empty()).then(|| Evidence::All(zs.iter().map(|z| Some(z.2.clone())).collect())).as_ref()),
-        criterion: test,
-        kind: Kind::Beyond,
-    });
-    Ok(())
-}
-
 /// The tolerance of the Hertz check: a and p0 within 2% of Hertz's on the finest adaptive mesh.
 pub const HERTZ_TOLERANCE: f64 = 0.02;
 
@@ -987,14 +642,14 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> Result<(), ClaimsError> {
 pub fn claims_with(shelf: &Shelf, roles: &Roles, sampling: ErrorSampling) -> Result<Vec<Claim>, ClaimsError> {
     let ctx = Ctx { sampling, shelf, roles };
     let mut out = Vec::new();
-    ex71_claims(&ctx, &mut out)?;
+    ex71::claims(&ctx, &mut out)?;
     c0_claim(&ctx, &mut out)?;
     ex72::claims(&ctx, &mut out)?;
     rollers::claims(&ctx, &mut out)?;
     efficiency_size_claim(&ctx, &mut out)?;
     log_factor_claim(&ctx, &mut out)?;
     theta_claim(&ctx, &mut out)?;
-    fb_claims(&ctx, &mut out)?;
+    fb::claims(&ctx, &mut out)?;
     hertz_claims(&ctx, &mut out)?;
     repair::estimator_repair_claim(&ctx, &mut out)?;
     Ok(out)
