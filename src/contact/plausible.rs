@@ -70,7 +70,7 @@ pub enum ContactDataError {
 }
 
 /// The problem as errors name it: its file, or its built-in name.
-fn problem_name(problem: &dyn Problem) -> String {
+pub(super) fn problem_name(problem: &dyn Problem) -> String {
     match problem.source() {
         Some(file) => format!("problem file {}", file.display()),
         None => format!("problem {}", problem.name()),
