@@ -126,3 +126,42 @@ fn bad_traction_where_no_edge_is_neumann_is_refused_naming_traction() {
     let (code, out, err) = run("tr-neumann", SQUARE, &[(r#"traction = ["0", "0"]"#, r#"traction = ["0.01", "0"]"#)], SOLVE);
     assert!(code == 0 && out.contains("certified:"), "{err}");
 }
+
+/// `signorini ARGS` in `dir`: (exit code, stdout and stderr), never a panic.
+fn signorini_in(dir: &std::path::Path, args: &[&str]) -> (i32, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_signorini")).current_dir(dir).env("SIGNORINI_PROGRESS", "off").args(args).output().unwrap();
+    let all = String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert!(!all.contains("panicked"), "{all}");
+    (o.status.code().unwrap_or(-1), all)
+}
+
+#[test]
+fn bad_drift_against_a_folder_from_where_there_is_no_stored_results_folder_is_named() {
+    let dir = std::env::temp_dir().join(format!("signorini-bad-minor-noresults-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(dir.join("exp")).unwrap();
+    std::fs::create_dir_all(dir.join("empty")).unwrap();
+    let text =
+        "description = \"t\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:2\"\nlevels = 2\nquick_levels = 1\n[[run]]\nid = \"a\"\n";
+    std::fs::write(dir.join("exp/s.toml"), text).unwrap();
+    let (code, out) = signorini_in(&dir, &["run", "exp/s.toml", "--results", "s7"]);
+    assert_eq!(code, 0, "{out}");
+    // from a folder without ./results: an error naming it, not a drift with advice to rerun
+    let empty = dir.join("empty");
+    let (code, out) = signorini_in(&empty, &["drift", "--against", "../s7", "--experiments", "../exp"]);
+    assert_eq!(code, 1, "{out}");
+    assert!(
+        out.contains("no stored results folder `results` (relative to the current folder): it does not exist; pass --results DIR"),
+        "{out}"
+    );
+    assert!(!out.contains("field(s)") && !out.contains("rerun the study"), "{out}");
+    // a file where the folder should be, and without --against (nothing is rerun first)
+    std::fs::write(empty.join("results"), "").unwrap();
+    let (code, out) = signorini_in(&empty, &["drift", "--quick", "--experiments", "../exp"]);
+    assert!(code == 1 && out.contains("no stored results folder `results`") && out.contains("is not a folder"), "{out}");
+    assert!(!empty.join("target").exists(), "drift reran a study before refusing");
+    // named with --results, the same comparison is no drift
+    let (code, out) = signorini_in(&empty, &["drift", "--against", "../s7", "--experiments", "../exp", "--results", "../s7"]);
+    assert_eq!(code, 0, "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}
