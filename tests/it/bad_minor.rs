@@ -165,3 +165,67 @@ fn bad_drift_against_a_folder_from_where_there_is_no_stored_results_folder_is_na
     assert_eq!(code, 0, "{out}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `signorini solve` of the Gmsh square's problem (fixture `bad_data_gmsh.toml` with `edits`)
+/// on `tests/fixtures/square.msh` with `mesh_edits`: (exit code, stdout and stderr).
+fn solve_square(name: &str, edits: &[(&str, &str)], mesh_edits: &[(&str, &str)]) -> (i32, String) {
+    let dir = std::env::temp_dir().join(format!("signorini-bad-minor-{name}-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    for (file, fixture_name, edits) in [("v.toml", "bad_data_gmsh.toml", edits), ("sq.msh", "square.msh", mesh_edits)] {
+        let mut text = fixture(fixture_name);
+        for (from, to) in edits {
+            assert!(text.contains(from), "{from} not in {fixture_name}");
+            text = text.replacen(from, to, 1);
+        }
+        std::fs::write(dir.join(file), text).unwrap();
+    }
+    let out = signorini_in(&dir, &["solve", "--problem", "v.toml", "--mesh", "gmsh:sq.msh"]);
+    std::fs::remove_dir_all(&dir).ok();
+    out
+}
+
+const SQUARE_NODES: &str = "0 0 0\n1 0 0\n1 1 0\n0 1 0";
+
+#[test]
+fn bad_mesh_scaled_past_what_f64_squares_is_named_as_a_scale_not_a_zero_area() {
+    for (scale, says) in [
+        ("1e200", "has an area that is not a finite number at coordinates of size 1e200"),
+        ("1e-200", "has an area that underflows to 0 at coordinates of size 1e-200"),
+    ] {
+        let nodes = format!("0 0 0\n{scale} 0 0\n{scale} {scale} 0\n0 {scale} 0");
+        let (code, out) = solve_square(scale, &[], &[(SQUARE_NODES, &nodes)]);
+        assert_eq!(code, 1, "{out}");
+        assert!(out.contains("sq.msh, line 37: triangle 5 ") && out.contains(says) && out.contains("rescale the mesh"), "{out}");
+    }
+    // a triangle that is flat is still that (node 3 on the line through 1 and 2)
+    let (code, out) = solve_square("flat", &[], &[(SQUARE_NODES, "0 0 0\n1 0 0\n2 0 0\n0 1 0")]);
+    assert!(code == 1 && out.contains("triangle 5 has zero area"), "{out}");
+    // CAD round-off in z is read as the plane; a z of the mesh's size is not
+    let (code, out) = solve_square("z-roundoff", &[], &[(SQUARE_NODES, "0 0 0\n1 0 1e-17\n1 1 0\n0 1 -1e-15")]);
+    assert!(code == 0 && out.contains("certified:"), "{out}");
+    let (code, out) = solve_square("z-off", &[], &[(SQUARE_NODES, "0 0 0\n1 0 1e-9\n1 1 0\n0 1 0")]);
+    assert!(code == 1 && out.contains("node 2 has z = 1e-9: a planar mesh in z = 0 is expected"), "{out}");
+}
+
+#[test]
+fn bad_smaller_gaps_name_the_groups_the_empty_part_and_the_duplicate_key() {
+    // curve 1 (the bottom) in the groups "bottom" and "sides"
+    let (code, out) = solve_square("two-groups", &[], &[("1 0 0 0 1 0 0 1 1 0", "1 0 0 0 1 0 0 2 1 2 0")]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains(r#"curve 1 is in 2 physical groups ("bottom" (tag 1), "sides" (tag 2))"#), "{out}");
+    let (code, out) = solve_square("empty-contact", &[(r#"contact = ["bottom"]"#, "contact = []")], &[]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("v.toml:11:11: key `parts.contact`: at least one physical group: parts.contact is empty"), "{out}");
+    for (name, edit, says) in [
+        (
+            "dup-top",
+            ("traction = [\"0\", \"0\"]", "traction = [\"0\", \"0\"]\ntraction = [\"1\", \"0\"]"),
+            "v.toml:4:1: key `traction`: duplicate key",
+        ),
+        ("dup-table", ("lambda = 1", "lambda = 1\nmu = 2"), "v.toml:9:1: key `material.mu`: duplicate key"),
+    ] {
+        let (code, out) = solve_square(name, &[edit], &[]);
+        assert!(code == 1 && out.contains(says), "{name}: {out}");
+    }
+}
