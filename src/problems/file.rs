@@ -731,7 +731,7 @@ impl FileProblem {
         let mut raw: FileToml = toml::from_str(text).map_err(|e| {
             let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
             let (file, message) = (path.to_path_buf(), crate::base::toml_text::plain(e.message().trim_end()));
-            match crate::base::toml_text::key_of(&e) {
+            match crate::base::toml_text::key_of(&e).or_else(|| crate::base::toml_text::duplicate_key(&e, text)) {
                 Some(key) => ProblemFileError::Invalid { file, key, line, column, message },
                 None => ProblemFileError::Syntax { file, line, column, message },
             }

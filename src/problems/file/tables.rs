@@ -126,6 +126,13 @@ impl Reader<'_> {
                 ));
                 }
                 PartToml::Predicate(p) => predicates[(part == Part::Dirichlet) as usize] = Some(self.predicate(key, value.span(), p)?),
+                PartToml::Groups(list) if list.is_empty() && part == Part::Contact => {
+                    return Err(self.error(
+                        key,
+                        value.span(),
+                        "at least one physical group: parts.contact is empty, so nothing could be in contact (a mesh's groups would all be reported as named by no part)",
+                    ));
+                }
                 PartToml::Groups(list) => {
                     for g in list {
                         if let Some(other) = groups.insert(g.clone(), part) {
