@@ -9,6 +9,11 @@ pub fn shown(v: f64) -> String {
     if v == 0.0 || !v.is_finite() || (1e-4..1e9).contains(&v.abs()) { format!("{v}") } else { format!("{v:e}") }
 }
 
+/// A point `(x, y)`, each coordinate [`shown`].
+pub fn point(p: [f64; 2]) -> String {
+    format!("({}, {})", shown(p[0]), shown(p[1]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::shown;
@@ -28,6 +33,7 @@ mod tests {
         ] {
             assert_eq!(shown(v), s);
         }
+        assert_eq!(super::point([0.5, 1e308]), "(0.5, 1e308)");
         for v in [1e-300, 3.3e200, 7e-5, 2.5e12] {
             assert_eq!(shown(v).parse::<f64>().unwrap(), v, "reads back");
             assert!(shown(v).len() < 12, "{}", shown(v));

@@ -27,6 +27,7 @@
 //! errors carry the position in the file, turned into a line number here.
 
 use super::{BoundaryEdge, Mesh, MeshError, Part, key, msh_nodes};
+use crate::base::number::point;
 use crate::problems::Problem;
 use mshio::ElementType;
 use std::collections::{BTreeMap, HashMap};
@@ -169,7 +170,7 @@ fn check_folds(
                 return Err(error(
                     path,
                     line_of(tag),
-                    format!("triangles {other_tag} and {tag} overlap: their edge ({}, {})-({}, {}) {why}", pa[0], pa[1], pb[0], pb[1]),
+                    format!("triangles {other_tag} and {tag} overlap: their edge {}-{} {why}", point(pa), point(pb)),
                 ));
             }
         }
@@ -595,9 +596,8 @@ impl GmshFile {
                     &self.path,
                     e.line,
                     format!(
-                        "the vertex ({}, {}) of this line element of group \"{}\" is off the curve problem {} declares for the group ([curves]: {c:?}) by {off:.3e} of its size: the curve must be the one the mesh follows (refinement puts new boundary vertices on it)",
-                        x[0],
-                        x[1],
+                        "the vertex {} of this line element of group \"{}\" is off the curve problem {} declares for the group ([curves]: {c:?}) by {off:.3e} of its size: the curve must be the one the mesh follows (refinement puts new boundary vertices on it)",
+                        point(x),
                         self.groups[e.group].0,
                         problem.name()
                     ),
@@ -702,8 +702,9 @@ impl GmshFile {
                         file: path.clone(),
                         line: self.triangle_lines[t],
                         message: format!(
-                            "this triangle's edge from ({}, {}) to ({}, {}) is on the boundary but in no physical group of lines: every boundary edge needs a part",
-                            p[0], p[1], q[0], q[1]
+                            "this triangle's edge from {} to {} is on the boundary but in no physical group of lines: every boundary edge needs a part",
+                            point(p),
+                            point(q)
                         ),
                     });
                 };
