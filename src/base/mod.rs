@@ -4,12 +4,13 @@
 //! the memory a solve needs and may still allocate ([`memory`]), the one reader of a user's input
 //! file ([`input`]: a regular file of bounded size, never a pipe or a device), least-squares lines with
 //! confidence intervals ([`stats`]), and notes to standard error that a failed write cannot stop
-//! ([`note`]), and TOML errors in the files' words ([`toml_text`]).
+//! ([`note`]), numbers shown in messages at any magnitude ([`number`]), and TOML errors in the files' words ([`toml_text`]).
 
 pub mod digest;
 pub mod element;
 pub mod input;
 pub mod memory;
 pub mod note;
+pub mod number;
 pub mod stats;
 pub mod toml_text;

@@ -10,6 +10,28 @@ pub fn key_of(e: &toml::de::Error) -> Option<String> {
     bare.to_string().lines().find_map(|l| l.strip_prefix("in `")?.strip_suffix('`').map(str::to_string))
 }
 
+/// The key of a "duplicate key" error, read from `text` at the error's span (toml names it
+/// neither in its message nor in its key path): the line's text before `=` (a key, dotted or
+/// quoted) after the header of its table, if any (`material.mu`), or the whole line (a table
+/// header such as `[material]`).
+pub fn duplicate_key(e: &toml::de::Error, text: &str) -> Option<String> {
+    if !e.message().starts_with("duplicate key") {
+        return None;
+    }
+    let start = e.span()?.start;
+    let line = text.get(start..)?.lines().next()?;
+    let key = line.split_once('=').map_or(line, |(k, _)| k).trim();
+    if key.is_empty() {
+        return None;
+    }
+    // a key in a table is named with the table's header above it (`material.mu`)
+    let table = text[..start].lines().rev().map(str::trim).find(|l| l.starts_with('[')).map(|h| h.trim_matches(['[', ']']).trim());
+    Some(match table {
+        Some(t) if !key.starts_with('[') && !t.is_empty() => format!("{t}.{key}"),
+        _ => key.to_string(),
+    })
+}
+
 /// toml's (serde's) message with Rust's type names in TOML's words and every number of more
 /// than 17 digits (toml prints `levels = 1e300` as 301 digits) in scientific notation.
 pub fn plain(message: &str) -> String {

@@ -34,6 +34,7 @@
 //! it is evaluated; Young's modulus, Poisson's ratio and the Lamé constants are checked when a
 //! problem file is read (`problems::file`).
 
+use crate::base::number::{point, shown};
 use crate::fem::assembly::DofMap;
 use crate::mesh::{Mesh, P2Nodes};
 use crate::problems::{Part, Problem};
@@ -49,28 +50,28 @@ pub const PRESCRIBED_PENETRATION: f64 = 1e-9;
 #[derive(Debug, thiserror::Error)]
 pub enum ContactDataError {
     #[error(
-        "{problem}: the contact normal (`contact.normal`) at ({x}, {y}) on the contact part ({part}), edge ({ax}, {ay})-({bx}, {by}), is ({nx:.6}, {ny:.6}), {how} the edge's outward normal ({ox:.6}, {oy:.6}) (n . n_out = {dot:.6}, an angle of {angle:.1} degrees): a contact normal must point out of the body, within {max} degrees of the outward normal",
-        x = .at[0], y = .at[1], ax = .edge[0][0], ay = .edge[0][1], bx = .edge[1][0], by = .edge[1][1],
+        "{problem}: the contact normal (`contact.normal`) at {x} on the contact part ({part}), edge {a}-{b}, is ({nx:.6}, {ny:.6}), {how} the edge's outward normal ({ox:.6}, {oy:.6}) (n . n_out = {dot:.6}, an angle of {angle:.1} degrees): a contact normal must point out of the body, within {max} degrees of the outward normal",
+        x = point(*.at), a = point(.edge[0]), b = point(.edge[1]),
         nx = .normal[0], ny = .normal[1], ox = .outward[0], oy = .outward[1],
         how = if *.dot < 0.0 { "reversed against" } else { "nearly tangent to the boundary: far from" },
         angle = .dot.clamp(-1.0, 1.0).acos().to_degrees(), max = MAX_NORMAL_ANGLE_DEGREES
     )]
     Normal { problem: String, part: String, at: [f64; 2], edge: [[f64; 2]; 2], normal: [f64; 2], outward: [f64; 2], dot: f64 },
     #[error(
-        "{problem}: the gap `contact.chi` at ({x}, {y}) on the contact part ({part}) is {chi}: the obstacle would overlap the body by more than the body's size (the diameter of the mesh's bounding box, {diameter}); a gap below minus the body's size is a sign or unit mistake",
-        x = .at[0], y = .at[1]
+        "{problem}: the gap `contact.chi` at {x} on the contact part ({part}) is {chi}: the obstacle would overlap the body by more than the body's size (the diameter of the mesh's bounding box, {d}); a gap below minus the body's size is a sign or unit mistake",
+        x = point(*.at), chi = shown(*.chi), d = shown(*.diameter)
     )]
     Gap { problem: String, part: String, at: [f64; 2], chi: f64, diameter: f64 },
     #[error(
-        "{problem}: the displacement prescribed at ({x}, {y}) on the closure of the contact part ({part}) by {by} is ({ux}, {uy}); along the contact normal ({nx:.6}, {ny:.6}) that is u . n = {un}, past the gap chi = {chi} by {over:.3e}: the body would start inside the obstacle there. Prescribe a displacement with u . n <= chi at the contact part's ends (or end the contact part before them)",
-        x = .at[0], y = .at[1], ux = .u[0], uy = .u[1], nx = .normal[0], ny = .normal[1], over = .un - .chi
+        "{problem}: the displacement prescribed at {x} on the closure of the contact part ({part}) by {by} is ({ux}, {uy}); along the contact normal ({nx:.6}, {ny:.6}) that is u . n = {un}, past the gap chi = {chi} by {over:.3e}: the body would start inside the obstacle there. Prescribe a displacement with u . n <= chi at the contact part's ends (or end the contact part before them)",
+        x = point(*.at), ux = .u[0], uy = .u[1], nx = .normal[0], ny = .normal[1], over = .un - .chi
     )]
     /// `u`: the prescribed components, "free" for one that is not.
     Prescribed { problem: String, part: String, by: String, at: [f64; 2], u: [String; 2], normal: [f64; 2], un: f64, chi: f64 },
 }
 
 /// The problem as errors name it: its file, or its built-in name.
-fn problem_name(problem: &dyn Problem) -> String {
+pub(super) fn problem_name(problem: &dyn Problem) -> String {
     match problem.source() {
         Some(file) => format!("problem file {}", file.display()),
         None => format!("problem {}", problem.name()),

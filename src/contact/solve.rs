@@ -29,6 +29,31 @@ pub enum SolveError {
     /// No boundary edge of the mesh is in the contact part.
     #[error("the problem's contact part matches no boundary edge of the mesh: there is nothing to be in contact (the problem declares: {})", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") })]
     NoContact { declared: Vec<String> },
+    /// A non-zero traction where no boundary edge of the mesh is Neumann: it would be ignored.
+    #[error("{problem}: the traction (`traction`) is ({tx}, {ty}) at ({x}, {y}), but no boundary edge of the mesh is in the Neumann part (the problem declares: {}): a traction acts only on Gamma_N and would be ignored; remove `traction` or leave part of the boundary to Neumann", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") }, tx = crate::base::number::shown(.value[0]), ty = crate::base::number::shown(.value[1]), x = crate::base::number::shown(.at[0]), y = crate::base::number::shown(.at[1]))]
+    UnusedTraction { problem: String, at: [f64; 2], value: [f64; 2], declared: Vec<String> },
+}
+
+/// Refuse a traction that would be ignored: where no boundary edge is Neumann, the traction is
+/// evaluated at the three P2 nodes of every boundary edge with the edge's outward normal, and
+/// any non-zero value is an error naming `traction` (the default zero traction passes).
+fn unused_traction(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem) -> Result<(), SolveError> {
+    use crate::problems::Part;
+    if mesh.boundary.iter().any(|e| e.part == Part::Neumann) {
+        return Ok(());
+    }
+    let outward = super::plausible::outward_normals(mesh, nodes);
+    for (three, n) in nodes.boundary_nodes.iter().zip(outward) {
+        for &p in three {
+            let at = nodes.coords[p];
+            let value = problem.traction(at, n);
+            if value != [0.0, 0.0] {
+                let problem_name = super::plausible::problem_name(problem);
+                return Err(SolveError::UnusedTraction { problem: problem_name, at, value, declared: problem.declared_parts() });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A discrete solution and everything computed on the way.
@@ -127,6 +152,7 @@ pub fn solve(
     if dofs.contact.is_empty() {
         return Err(SolveError::NoContact { declared: problem.declared_parts() });
     }
+    unused_traction(mesh, &nodes, problem)?;
     let System { matrix, rhs, dirichlet } = assembly::assemble(mesh, &nodes, &dofs, problem);
     // the data were evaluated where they are used (gap and normal in the DofMap, load and
     // Dirichlet data in the assembly): any that was not a finite number stops here

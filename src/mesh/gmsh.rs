@@ -27,6 +27,7 @@
 //! errors carry the position in the file, turned into a line number here.
 
 use super::{BoundaryEdge, Mesh, MeshError, Part, key, msh_nodes};
+use crate::base::number::point;
 use crate::problems::Problem;
 use mshio::ElementType;
 use std::collections::{BTreeMap, HashMap};
@@ -169,7 +170,7 @@ fn check_folds(
                 return Err(error(
                     path,
                     line_of(tag),
-                    format!("triangles {other_tag} and {tag} overlap: their edge ({}, {})-({}, {}) {why}", pa[0], pa[1], pb[0], pb[1]),
+                    format!("triangles {other_tag} and {tag} overlap: their edge {}-{} {why}", point(pa), point(pb)),
                 ));
             }
         }
@@ -261,7 +262,7 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     let nodes = msh.data.nodes.as_ref().ok_or_else(|| error(path, None, "the file has no $Nodes section"))?;
     let elements = msh.data.elements.as_ref().ok_or_else(|| error(path, None, "the file has no $Elements section"))?;
     let node_at = nodes_by_tag(path, &bytes, binary, nodes)?;
-    let (tri_nodes, line_elems) = elements_by_kind(path, &msh, elements, &line_of)?;
+    let (tri_nodes, line_elems) = elements_by_kind(path, &msh, elements, &names, &line_of)?;
     let (vertices, used) = vertices_of(path, &tri_nodes, &node_at, &line_of)?;
     let (triangles, triangle_lines) = oriented_triangles(path, &vertices, &used, &tri_nodes, &line_of)?;
     check_folds(path, &vertices, &triangles, &tri_nodes, &line_of)?;
@@ -355,6 +356,7 @@ fn elements_by_kind(
     path: &Path,
     msh: &mshio::MshFile<u64, i32, f64>,
     elements: &mshio::Elements<u64, i32>,
+    names: &PhysicalNames,
     line_of: &LineOf,
 ) -> Result<(TriangleTags, GroupLineTags), MeshError> {
     let listed: usize = elements.element_blocks.iter().map(|b| b.elements.len()).sum();
@@ -386,7 +388,12 @@ fn elements_by_kind(
                     return Err(error(
                         path,
                         first.and_then(line_of),
-                        format!("curve {} is in {} physical groups: one boundary part per edge is needed", block.entity_tag, groups.len()),
+                        format!(
+                            "curve {} is in {} physical groups ({}): one boundary part per edge is needed (a group of all walls beside the parts cannot be read; remove it or split the curve)",
+                            block.entity_tag,
+                            groups.len(),
+                            groups.iter().map(|&g| group_name(names, g)).collect::<Vec<_>>().join(", ")
+                        ),
                     ));
                 }
                 if let Some(&g) = groups.first() {
@@ -411,6 +418,18 @@ fn elements_by_kind(
     Ok((tri_nodes, line_elems))
 }
 
+/// Physical curve group `g` as messages name it: `"name" (tag g)`, or `tag g` without a name.
+fn group_name(names: &PhysicalNames, g: i32) -> String {
+    match names.get(&(1, g)) {
+        Some((name, _)) => format!("\"{name}\" (tag {g})"),
+        None => format!("tag {g}"),
+    }
+}
+
+/// How far from z = 0, relative to the diagonal of the bounding box of the triangles' nodes, a
+/// node may lie (CAD round-off) and be read as in the plane.
+pub const PLANAR_TOLERANCE: f64 = 1e-12;
+
 /// The vertices: the nodes of the triangles (each must be in `$Nodes`, in the plane z = 0), in
 /// ascending tag order; with the vertex index of every node tag used.
 fn vertices_of(
@@ -428,14 +447,28 @@ fn vertices_of(
             used.insert(*n, usize::MAX);
         }
     }
+    // CAD round-off leaves z = 1e-17 and the like: a z within PLANAR_TOLERANCE of the size of
+    // the triangles' nodes (the diagonal of their bounding box) is taken as 0
+    let bounds = used.keys().map(|n| node_at[n]).fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |b, p| {
+        [b[0].min(p[0]), b[1].min(p[1]), b[2].max(p[0]), b[3].max(p[1])]
+    });
+    let planar = PLANAR_TOLERANCE * (bounds[2] - bounds[0]).hypot(bounds[3] - bounds[1]);
     let mut vertices = Vec::with_capacity(used.len());
     for tag in node_at.keys() {
         if let Some(index) = used.get_mut(tag)
             && *index == usize::MAX
         {
             let [x, y, z] = node_at[tag];
-            if z != 0.0 {
-                return Err(error(path, None, format!("node {tag} has z = {z}: a planar mesh in z = 0 is expected")));
+            if !(z.abs() <= planar) {
+                return Err(error(
+                    path,
+                    None,
+                    format!(
+                        "node {tag} has z = {}: a planar mesh in z = 0 is expected (|z| at most {PLANAR_TOLERANCE:e} times the mesh's size, {})",
+                        crate::base::number::shown(z),
+                        crate::base::number::shown(planar / PLANAR_TOLERANCE)
+                    ),
+                ));
             }
             *index = vertices.len();
             vertices.push([x, y]);
@@ -444,7 +477,8 @@ fn vertices_of(
     Ok((vertices, used))
 }
 
-/// The triangles in vertex indices, counter-clockwise (none of zero area) and with the longest
+/// The triangles in vertex indices, counter-clockwise (none of zero or no finite area: a
+/// [`scale_fault`] is named as such) and with the longest
 /// edge opposite the first vertex; with their lines in the file.
 fn oriented_triangles(
     path: &Path,
@@ -459,8 +493,9 @@ fn oriented_triangles(
         let [a, b, c] = tri.map(|n| used[&n]);
         let (pa, pb, pc) = (vertices[a], vertices[b], vertices[c]);
         let area = 0.5 * ((pb[0] - pa[0]) * (pc[1] - pa[1]) - (pb[1] - pa[1]) * (pc[0] - pa[0]));
-        if !(area.abs() > 0.0) {
-            return Err(error(path, line_of(*tag), format!("triangle {tag} has zero area")));
+        if !(area.abs() > 0.0 && area.is_finite()) {
+            let why = scale_fault([pa, pb, pc], area).unwrap_or_else(|| "has zero area".to_string());
+            return Err(error(path, line_of(*tag), format!("triangle {tag} {why}")));
         }
         let t = if area > 0.0 { [a, b, c] } else { [a, c, b] };
         // longest edge opposite the first vertex (first of equal lengths)
@@ -470,6 +505,32 @@ fn oriented_triangles(
         triangle_lines.push(line_of(*tag));
     }
     Ok((triangles, triangle_lines))
+}
+
+/// Why a triangle whose computed `area` is zero or not a number is not degenerate, if it is
+/// not: the scale of its coordinates. Lengths beyond about 1e154 square past f64's largest
+/// number (the area is infinite, or NaN as inf - inf), lengths below about 1e-154 square to 0;
+/// the same triangle with its coordinates divided by its longest edge has an area.
+fn scale_fault(p: [[f64; 2]; 3], area: f64) -> Option<String> {
+    use crate::base::number::shown;
+    // hypot, not the square root of the squares: the lengths themselves neither overflow nor
+    // underflow where their squares do
+    let length = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    let edges = [length(p[0], p[1]), length(p[1], p[2]), length(p[2], p[0])];
+    let longest = edges.iter().fold(0.0f64, |a, &l| a.max(l));
+    let size = p.iter().flatten().fold(0.0f64, |a, &v| a.max(v.abs()));
+    let what = if !area.is_finite() { "an area that is not a finite number" } else { "an area that underflows to 0" };
+    let advice = "f64 cannot hold the squares of lengths at that scale: rescale the mesh (other units)";
+    if longest == 0.0 {
+        return None;
+    }
+    if !longest.is_finite() {
+        return Some(format!("has {what}: its coordinates reach {}, {advice}", shown(size)));
+    }
+    let q = p.map(|v| [v[0] / longest, v[1] / longest]);
+    let scaled = 0.5 * ((q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[1][1] - q[0][1]) * (q[2][0] - q[0][0]));
+    (scaled.abs() > 0.0)
+        .then(|| format!("has {what} at coordinates of size {} (its longest edge {}): {advice}", shown(size), shown(longest)))
 }
 
 /// The line elements of the physical groups as edges between vertices (a node of no triangle is
@@ -535,9 +596,8 @@ impl GmshFile {
                     &self.path,
                     e.line,
                     format!(
-                        "the vertex ({}, {}) of this line element of group \"{}\" is off the curve problem {} declares for the group ([curves]: {c:?}) by {off:.3e} of its size: the curve must be the one the mesh follows (refinement puts new boundary vertices on it)",
-                        x[0],
-                        x[1],
+                        "the vertex {} of this line element of group \"{}\" is off the curve problem {} declares for the group ([curves]: {c:?}) by {off:.3e} of its size: the curve must be the one the mesh follows (refinement puts new boundary vertices on it)",
+                        point(x),
                         self.groups[e.group].0,
                         problem.name()
                     ),
@@ -642,8 +702,9 @@ impl GmshFile {
                         file: path.clone(),
                         line: self.triangle_lines[t],
                         message: format!(
-                            "this triangle's edge from ({}, {}) to ({}, {}) is on the boundary but in no physical group of lines: every boundary edge needs a part",
-                            p[0], p[1], q[0], q[1]
+                            "this triangle's edge from {} to {} is on the boundary but in no physical group of lines: every boundary edge needs a part",
+                            point(p),
+                            point(q)
                         ),
                     });
                 };

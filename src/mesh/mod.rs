@@ -61,7 +61,7 @@ pub enum MeshError {
     GroupsOnBuiltIn { mesh: String, groups: String },
     /// A point the problem requires to be a vertex (`origin`: where it declares it) is not one;
     /// `outside` says so with the mesh's extent when it lies outside the mesh's bounding box.
-    #[error("{origin}: ({x}, {y}) is not a vertex of the mesh{}", outside.as_ref().map(|o| format!(" (it lies outside the mesh, {o})")).unwrap_or_default())]
+    #[error("{origin}: {} is not a vertex of the mesh{}", crate::base::number::point([*.x, *.y]), outside.as_ref().map(|o| format!(" (it lies outside the mesh, {o})")).unwrap_or_default())]
     MissingVertex { origin: String, x: f64, y: f64, outside: Option<String> },
     /// A load break line x = c that no element crosses (`origin`: where the problem declares it).
     #[error("{origin}: the line x = {c} does not cross the mesh ({extent}): a load break is a line x = c inside the body")]

@@ -26,7 +26,10 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+mod names;
 mod tables;
+
+pub use names::{CONSTANTS as EXPRESSION_CONSTANTS, FUNCTIONS as EXPRESSION_FUNCTIONS};
 
 /// A problem file as [`crate::base::input::read`] reads it: a regular file of at most
 /// [`TEXT_LIMIT`](crate::base::input::TEXT_LIMIT) bytes.
@@ -533,9 +536,14 @@ impl Reader<'_> {
         if let Some(why) = power_trap(text) {
             return Err(self.error(key, span, format!("{text:?}: {why}")));
         }
+        let mut known: Vec<&str> = vars.to_vec();
+        known.extend(self.constants.keys().map(String::as_str));
+        if let Some(why) = names::refused_name(text, &known) {
+            return Err(self.error(key, span, why));
+        }
         let flat = Flat::parse(text).map_err(|e| {
-            // exmex's message for two operands side by side ("2x", "500 MPa")
-            let hint = if e.msg().contains("ops and") { " (a product needs `*`, as in 2*x; numbers carry no units)" } else { "" };
+            // exmex's message for two operands side by side ("x y", "(x)(y)")
+            let hint = if e.msg().contains("ops and") { format!(" ({})", names::PRODUCT) } else { String::new() };
             self.error(key, span.clone(), format!("cannot parse {text:?}: {}{hint}", e.msg()))
         })?;
         let names = flat.var_names();
@@ -723,7 +731,7 @@ impl FileProblem {
         let mut raw: FileToml = toml::from_str(text).map_err(|e| {
             let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
             let (file, message) = (path.to_path_buf(), crate::base::toml_text::plain(e.message().trim_end()));
-            match crate::base::toml_text::key_of(&e) {
+            match crate::base::toml_text::key_of(&e).or_else(|| crate::base::toml_text::duplicate_key(&e, text)) {
                 Some(key) => ProblemFileError::Invalid { file, key, line, column, message },
                 None => ProblemFileError::Syntax { file, line, column, message },
             }

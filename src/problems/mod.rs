@@ -159,7 +159,7 @@ pub struct PointConstraint {
 /// A datum of a problem that is not a finite number at a point where it is used (a body force
 /// `sqrt(x - 2)`, Dirichlet data `0.1 / x` at x = 0, a gap `ln(0)`, a contact normal of length 0).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("problem {problem}: `{key}` is {value} at ({}, {}): every datum must be a finite number (a normal, of positive length) at the quadrature and boundary points where it is used", .x[0], .x[1])]
+#[error("problem {problem}: `{key}` is {value} at {}: every datum must be a finite number (a normal, of positive length) at the quadrature and boundary points where it is used", crate::base::number::point(*.x))]
 pub struct BadDatum {
     pub problem: String,
     /// The key as the problem file spells it (`body_force[0]`, `contact.chi`, ...).

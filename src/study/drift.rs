@@ -697,6 +697,7 @@ pub fn check(
     claims: &dyn Fn(&Path) -> std::io::Result<String>,
 ) -> anyhow::Result<DriftReport> {
     use anyhow::Context;
+    stored_root(&opts.results)?;
     let (manifests, not_compared) = match &opts.against {
         Some(dir) => select_against(dir, manifests, !all_studies)?,
         None => {
@@ -790,6 +791,19 @@ pub fn check(
         }
     }
     Ok(report)
+}
+
+/// The stored results folder a drift run compares with must be a folder, checked before any
+/// study is compared or rerun: one that does not exist (drift run from another folder than the
+/// repository's) made every run "no stored results", a drift, with advice to rerun into the
+/// folder compared.
+fn stored_root(results: &Path) -> anyhow::Result<()> {
+    if results.is_dir() {
+        return Ok(());
+    }
+    let relative = if results.is_relative() { " (relative to the current folder)" } else { "" };
+    let what = if results.exists() { "is not a folder" } else { "does not exist" };
+    anyhow::bail!("no stored results folder `{}`{relative}: it {what}; pass --results DIR", results.display())
 }
 
 /// The largest change of every float field over the studies of a report, as a table.

@@ -36,8 +36,8 @@ pub const BEYOND: f64 = 100.0;
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ExactError {
     #[error(
-        "{problem}: the exact solution's gradient contradicts its displacement: at ({x}, {y}) `exact.grad[{i}][{j}]` (d u_{i1} / d {var}) is {declared:.6e}, while central differences of `exact.u[{i}]` give {differenced:.6e} (steps {step:.1e} and half that agree to {spread:.1e}), at {count} of {sampled} sampled points; write the derivative of u there, or leave `exact.grad` out and it is differentiated from u",
-        x = .at[0], y = .at[1], i1 = .i + 1, var = ["x", "y"][*.j]
+        "{problem}: the exact solution's gradient contradicts its displacement: at {x} `exact.grad[{i}][{j}]` (d u_{i1} / d {var}) is {declared:.6e}, while central differences of `exact.u[{i}]` give {differenced:.6e} (steps {step:.1e} and half that agree to {spread:.1e}), at {count} of {sampled} sampled points; write the derivative of u there, or leave `exact.grad` out and it is differentiated from u",
+        x = crate::base::number::point(*.at), i1 = .i + 1, var = ["x", "y"][*.j]
     )]
     Gradient {
         problem: String,
@@ -52,8 +52,8 @@ pub enum ExactError {
         sampled: usize,
     },
     #[error(
-        "{problem}: the body force is not -div sigma(u) of the exact solution: at ({x}, {y}) `body_force[{i}]` is {declared:.6e}, while -div sigma(u) is {differenced:.6e} by central differences of sigma(exact.grad) (steps {step:.1e} and half that agree to {spread:.1e}), at {count} of {sampled} sampled points; an exact solution must solve the equations, -div sigma(u) = f (paper eq. 1.1)",
-        x = .at[0], y = .at[1]
+        "{problem}: the body force is not -div sigma(u) of the exact solution: at {x} `body_force[{i}]` is {declared:.6e}, while -div sigma(u) is {differenced:.6e} by central differences of sigma(exact.grad) (steps {step:.1e} and half that agree to {spread:.1e}), at {count} of {sampled} sampled points; an exact solution must solve the equations, -div sigma(u) = f (paper eq. 1.1)",
+        x = crate::base::number::point(*.at)
     )]
     BodyForce {
         problem: String,
@@ -67,8 +67,8 @@ pub enum ExactError {
         sampled: usize,
     },
     #[error(
-        "{problem}: the exact solution does not satisfy {what}: at ({x}, {y}) {detail}, at {count} of {sampled} sampled boundary points; an exact solution must satisfy the problem's boundary and contact conditions (paper eq. 1.1-1.8), or the errors are measured against the solution of another problem",
-        x = .at[0], y = .at[1]
+        "{problem}: the exact solution does not satisfy {what}: at {x} {detail}, at {count} of {sampled} sampled boundary points; an exact solution must satisfy the problem's boundary and contact conditions (paper eq. 1.1-1.8), or the errors are measured against the solution of another problem",
+        x = crate::base::number::point(*.at)
     )]
     Boundary { problem: String, what: String, at: [f64; 2], detail: String, count: usize, sampled: usize },
 }

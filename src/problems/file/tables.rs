@@ -55,15 +55,13 @@ impl Reader<'_> {
                     ));
                 }
                 let nu_span = m.nu.as_ref().map_or(0..0, |v| v.span());
-                match model.get_ref().as_str() {
-                    "plane_strain" if nu > -1.0 && nu < 0.5 => Material::from_young(e, nu),
-                    "plane_stress" if nu > -1.0 && nu < 1.0 => Material::from_young_plane_stress(e, nu),
-                    "plane_strain" => {
-                        return Err(self.error("material.nu", nu_span, format!("a Poisson ratio in (-1, 0.5) in plane strain, got {nu}")));
-                    }
-                    "plane_stress" => {
-                        return Err(self.error("material.nu", nu_span, format!("a Poisson ratio in (-1, 1) in plane stress, got {nu}")));
-                    }
+                let model_name = model.get_ref().as_str();
+                if matches!(model_name, "plane_strain" | "plane_stress") && !(nu > -1.0 && nu < 0.5) {
+                    return Err(self.error("material.nu", nu_span, poisson_ratio_refused(model_name, nu)));
+                }
+                match model_name {
+                    "plane_strain" => Material::from_young(e, nu),
+                    "plane_stress" => Material::from_young_plane_stress(e, nu),
                     other => {
                         return Err(self.error(
                             "material.model",
@@ -128,6 +126,13 @@ impl Reader<'_> {
                 ));
                 }
                 PartToml::Predicate(p) => predicates[(part == Part::Dirichlet) as usize] = Some(self.predicate(key, value.span(), p)?),
+                PartToml::Groups(list) if list.is_empty() && part == Part::Contact => {
+                    return Err(self.error(
+                        key,
+                        value.span(),
+                        "at least one physical group: parts.contact is empty, so nothing could be in contact (a mesh's groups would all be reported as named by no part)",
+                    ));
+                }
                 PartToml::Groups(list) => {
                     for g in list {
                         if let Some(other) = groups.insert(g.clone(), part) {
@@ -358,4 +363,18 @@ impl Reader<'_> {
 /// Whether a component is written `"free"` (not prescribed).
 fn is_free(value: &Scalar) -> bool {
     matches!(value, Scalar::Text(t) if t.trim() == "free")
+}
+
+/// Why a Poisson ratio `nu` outside (-1, 0.5) is refused, whatever the `model`: E and nu
+/// describe a 3-D material (plane strain is a long body of it, plane stress a thin plate), whose
+/// bulk modulus E / (3 (1 - 2 nu)) is infinite at nu = 0.5 and negative beyond, and whose shear
+/// modulus E / (2 (1 + nu)) is not positive at nu <= -1. (The plane-stress operator alone would
+/// stay coercive up to nu < 1, but no material has such a ratio.)
+fn poisson_ratio_refused(model: &str, nu: f64) -> String {
+    let why = if nu >= 0.5 {
+        "at 0.5 and beyond, the bulk modulus E / (3 (1 - 2 nu)) of the 3-D material E and nu describe is infinite or negative"
+    } else {
+        "at -1 and below, the shear modulus E / (2 (1 + nu)) is not positive"
+    };
+    format!("a Poisson ratio in (-1, 0.5) in {}, got {nu}: {why}", model.replace('_', " "))
 }
