@@ -27,7 +27,7 @@ pub struct Probe {
 pub enum ProbeError {
     #[error("malformed --probe '{0}': expected X,Y with two finite numbers, e.g. 0.5,0.25")]
     Malformed(String),
-    #[error("--probe {x},{y}: the point is outside the domain (no triangle of the mesh contains it)")]
+    #[error("--probe {},{}: the point is outside the domain (no triangle of the mesh contains it)", crate::base::number::shown(*x), crate::base::number::shown(*y))]
     Outside { x: f64, y: f64 },
 }
 
@@ -199,10 +199,17 @@ impl SolveReport {
 }
 
 /// `v` to 6 significant digits without trailing zeros (0.1875, 0.254745): an arc length in the
-/// summary, not the 17 digits of a point on a curved Gmsh boundary (`--json` keeps those).
+/// summary, not the 17 digits of a point on a curved Gmsh boundary (`--json` keeps those). In
+/// scientific notation (1.25e150) where [`crate::base::number::shown`] would be.
 fn significant(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         return v.to_string();
+    }
+    if !(1e-4..1e9).contains(&v.abs()) {
+        let s = format!("{v:.5e}");
+        let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = if mantissa.contains('.') { mantissa.trim_end_matches('0').trim_end_matches('.') } else { mantissa };
+        return format!("{mantissa}e{exponent}");
     }
     let decimals = (5 - v.abs().log10().floor() as i32).max(0) as usize;
     let s = format!("{v:.decimals$}");
@@ -246,4 +253,14 @@ pub fn export_case(
     records::write_atomic(&vtu, solution_vtu(mesh, sol, indicator).as_bytes())?;
     records::write_json(&case, report)?;
     Ok(vec![vtu, case])
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn arc_lengths_of_any_size_print_in_a_few_characters() {
+        for (v, s) in [(0.1875, "0.1875"), (0.2547452048856056, "0.254745"), (1.0, "1"), (1.25e150, "1.25e150"), (-2.5e-150, "-2.5e-150")] {
+            assert_eq!(super::significant(v), s);
+        }
+    }
 }

@@ -349,8 +349,11 @@ pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<
     if !problems.is_empty() {
         // the advice writes into the folder being checked, never into results/ unless that is it
         let into = if results == std::path::Path::new("results") { String::new() } else { format!(" --results {}", results.display()) };
+        // runs stored with another spec or not declared are refused by a plain run: the advice
+        // that works replaces them
+        let replace = if runs.iter().any(|r| manifest.runs.iter().all(|p| p.spec != r.run)) { " --replace" } else { "" };
         bail!(
-            "{} does not match {}: {}. Complete it with `signorini run {}{into}` (or start over with --fresh) before drawing from it",
+            "{} does not match {}: {}. Complete it with `signorini run {}{into}{replace}` (or start over with --fresh) before drawing from it",
             dir.root.display(),
             manifest.file.display(),
             problems.join("; "),

@@ -240,3 +240,13 @@ fn bad_huge_point_in_a_message_is_shown_in_a_few_characters() {
     assert!(err.contains("key `required_vertices[0]`: (1e308, 0.5) is not a vertex of the mesh"), "{err}");
     assert!(!err.contains("0000000000"), "{err}");
 }
+
+/// Finding 12's probe: a point far outside the domain is named in a few characters.
+#[test]
+fn bad_probe_far_outside_is_shown_in_a_few_characters() {
+    let args = [SOLVE, &["--probe", "1e308,0.5"]].concat();
+    let (code, _, err) = run("probe-far", SQUARE, &[], &args);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("--probe 1e308,0.5: the point is outside the domain"), "{err}");
+    assert!(!err.contains("0000000000"), "{err}");
+}

@@ -657,6 +657,24 @@ fn a_second_manifest_with_other_runs_is_refused_while_the_first_computes() {
     assert_eq!(consistent(&study), ["a"]);
 }
 
+/// Battery 5, finding 17: where a stored run has another spec than the manifest declares, the
+/// advice `figures` gives is a command that completes the study when followed (a plain `run`
+/// refuses such a run: the advice carries --replace).
+#[test]
+fn the_advice_to_complete_a_study_works_when_followed() {
+    let (dir, _) = stored("advice");
+    manifest(&dir, &STUDY.replace("theta = 0.5", "theta = 0.7"));
+    let (code, out) = signorini(&dir, &["figures", "--results", "results", "--experiments", ".", "--figures", "figs"]);
+    assert_ne!(code, 0, "{out}");
+    let advice = out.split("Complete it with `").nth(1).and_then(|t| t.split('`').next()).unwrap_or_else(|| panic!("no advice: {out}"));
+    assert!(advice.ends_with("--replace"), "{advice}");
+    let args: Vec<&str> = advice.split_whitespace().skip(1).collect();
+    let (code, out) = signorini(&dir, &args);
+    assert_eq!(code, 0, "following `{advice}`: {out}");
+    let (code, out) = signorini(&dir, &["figures", "--results", "results", "--experiments", ".", "--figures", "figs"]);
+    assert_eq!(code, 0, "{out}");
+}
+
 // ---- the read side of the door: what figures, report and the CLAIMS rows read is checked
 
 /// Copy `from` into `to`, folders too.
