@@ -129,7 +129,9 @@ pub enum RoleError {
 }
 
 /// The roles `manifests` declare, checked against [`NEEDED`]: every needed role of a declared
-/// study must be declared (a study without a manifest has no data, and its rows say so). Called
+/// study must be declared (a study without a manifest has no data, and its rows say so: `run`
+/// checks the manifests it is given only, and a scratch experiments folder may hold one study;
+/// that the repository declares every study of [`studies::ALL`] is a test's). Called
 /// wherever the manifests are read for CLAIMS.md or the figures (`figures`, `drift`, `report`).
 pub fn check(manifests: &[Manifest]) -> Result<Roles, RoleError> {
     let roles = Roles { declared: manifests.iter().map(|m| (m.study.clone(), m.roles.clone())).collect() };
