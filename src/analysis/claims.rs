@@ -35,7 +35,7 @@ pub const OPTIMAL: f64 = 1.5;
 /// is marked in its row.
 pub const TARGET_HALF_WIDTH: f64 = 0.05;
 /// How far along Gamma_C either side of a claimed refinement location the edge lengths are
-/// compared ([`refinement::local_minimum`]).
+/// compared ([`verdict::refinement::local_minimum`]).
 pub const REFINE_REACH: f64 = 0.15;
 /// eta_6 and eta_7 of Example 7.1 vanish: none above this at any level (they are 0 up to
 /// round-off).
