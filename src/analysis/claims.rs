@@ -19,6 +19,7 @@ mod rollers;
 
 use crate::analysis::roles::{self, DENSE_TWINS, Role, Roles};
 use crate::analysis::verdict::{self, RateReport, RateVerdict};
+use crate::analysis::{problem_names, studies};
 // the paper's C_0 (Section 7, the estimator's default): a reliability row holds when the
 // smallest reliable C_0 of its runs is at most this
 use crate::estimator::estimate::{C0_PAPER, c0_paper};
@@ -34,7 +35,7 @@ pub const OPTIMAL: f64 = 1.5;
 /// is marked in its row.
 pub const TARGET_HALF_WIDTH: f64 = 0.05;
 /// How far along Gamma_C either side of a claimed refinement location the edge lengths are
-/// compared ([`refinement::local_minimum`]).
+/// compared ([`verdict::refinement::local_minimum`]).
 pub const REFINE_REACH: f64 = 0.15;
 /// eta_6 and eta_7 of Example 7.1 vanish: none above this at any level (they are 0 up to
 /// round-off).
@@ -391,7 +392,7 @@ fn latest_mesh(shelf: &Shelf, study: &str, run: &str) -> std::io::Result<Option<
 /// The C_0 row: overestimation and the smallest reliable C_0, all runs with an error.
 fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let mut rows = Vec::new();
-    for study in ["ex71", "ex72", "c0_sweep", "fb"] {
+    for study in [studies::EX71, studies::EX72, studies::C0_SWEEP, studies::FB] {
         for r in ctx.shelf.runs(study)? {
             if let Some(row) = c0_text(&format!("{study}/{}", r.run.id), &r, ctx.err_field()) {
                 rows.push(row);
@@ -437,15 +438,16 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 /// one problem is from another's.
 fn efficiency_size_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let load = |s: &str| ctx.shelf.runs(s);
-    let (deep, large, rollers, hertz) = (load("deep")?, load("ex72_large")?, load("ex72_rollers")?, load("hertz")?);
+    let (deep, large, rollers, hertz) =
+        (load(studies::DEEP)?, load(studies::EX72_LARGE)?, load(studies::EX72_ROLLERS)?, load(studies::HERTZ)?);
     let mut rows = Vec::new();
     let mut per_problem: Vec<(&str, f64)> = Vec::new();
     for (problem, runs, ids) in [
-        ("ex71", &deep, [roles::DEEP_EX71_AS_WRITTEN, roles::DEEP_EX71_WFC, roles::DEEP_EX71_REPAIRED]),
-        ("fb", &deep, [roles::DEEP_FB_AS_WRITTEN, roles::DEEP_FB_WFC, roles::DEEP_FB_REPAIRED]),
-        ("ex72", &large, [roles::LARGE_AS_WRITTEN, roles::LARGE_WFC, roles::LARGE_REPAIRED]),
-        ("ex72_rollers", &rollers, [roles::ROLLERS_AS_WRITTEN, roles::ROLLERS_WFC, roles::ROLLERS_REPAIRED]),
-        ("hertz", &hertz, [roles::HERTZ_AS_WRITTEN, roles::HERTZ_LIGHT, roles::HERTZ_REPAIRED]),
+        (problem_names::EX71, &deep, [roles::DEEP_EX71_AS_WRITTEN, roles::DEEP_EX71_WFC, roles::DEEP_EX71_REPAIRED]),
+        (problem_names::FB, &deep, [roles::DEEP_FB_AS_WRITTEN, roles::DEEP_FB_WFC, roles::DEEP_FB_REPAIRED]),
+        (problem_names::EX72, &large, [roles::LARGE_AS_WRITTEN, roles::LARGE_WFC, roles::LARGE_REPAIRED]),
+        (problem_names::EX72_ROLLERS, &rollers, [roles::ROLLERS_AS_WRITTEN, roles::ROLLERS_WFC, roles::ROLLERS_REPAIRED]),
+        (problem_names::HERTZ, &hertz, [roles::HERTZ_AS_WRITTEN, roles::HERTZ_LIGHT, roles::HERTZ_REPAIRED]),
     ] {
         for role in ids {
             let Some(r) = ctx.find(runs, role) else { continue };
@@ -491,7 +493,7 @@ fn efficiency_size_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()>
 
 /// The marking parameter theta (the paper does not give it): the error rate per theta.
 fn theta_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let runs = ctx.shelf.runs("theta_ablation")?;
+    let runs = ctx.shelf.runs(studies::THETA_ABLATION)?;
     let mut rows = Vec::new();
     let mut headline = Vec::new();
     for r in &runs {
@@ -504,7 +506,7 @@ fn theta_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             last.map_or(0, |l| l.ndof),
             ctx.values(r, Q::Error).last().copied().flatten().map_or("n/a".into(), |e| format!("{e:.2e}"))
         ));
-        if r.run.problem == "ex71" && r.run.refine == crate::records::Refine::Adaptive {
+        if r.run.problem == problem_names::EX71 && r.run.refine == crate::records::Refine::Adaptive {
             let short = |p: &RateReport| if p.main.spans_enough() { String::new() } else { " (under two decades: no verdict)".into() };
             headline.push(format!("θ = {}: {}", r.run.theta, rep.map_or("n/a".into(), |p| format!("{}{}", p.main.text(), short(&p)))));
         }
@@ -529,7 +531,7 @@ fn theta_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
 
 /// The log-factor ablation: the efficiency trend per l_h.
 fn log_factor_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
-    let la = ctx.shelf.runs("log_ablation")?;
+    let la = ctx.shelf.runs(studies::LOG_ABLATION)?;
     let rows: Vec<String> =
         la.iter().map(|r| growth_text(&format!("{} efficiency", r.run.id), ctx.growth(Some(r), Q::Efficiency).as_ref())).collect();
     let reported = Criterion::Reported { why: "an ablation of eq. 6.3's factor, no claim of the paper".into() };
@@ -624,7 +626,8 @@ fn hertz_claims(ctx: &Ctx, out: &mut Vec<Claim>) -> Result<(), ClaimsError> {
     ]);
     out.push(Claim {
         fragile: None,
-        id: "hertz",
+        // the row is named after the study it judges
+        id: studies::HERTZ,
         summary: Summary { topic: "Hertz: cylinder on a flat", paper: "Hertz's a and p0 within 2% (beyond the paper)", headline: headline.unwrap_or("n/a".into()) },
         claim: format!(
             "Hertz (beyond the paper): an elastic cylinder (plane strain) on a rigid flat, adaptive with the paper's estimator: on the finest mesh the contact half-width a (± half the node spacing at the zone's ends) and the peak pressure p0 within {:.0}% of Hertz's a = sqrt(4FR(1 - nu^2)/(pi E)), p0 = 2F/(pi a) at the computed force F; the run with the smaller load measures the finite-size deviation",

@@ -6,6 +6,7 @@
 //! role a study does not declare is an error naming the role, the study and what needs it, not a
 //! row without data.
 
+use crate::analysis::studies::{self, Study};
 use crate::records::RunRecord;
 use crate::study::manifest::Manifest;
 use std::collections::BTreeMap;
@@ -14,7 +15,7 @@ use std::path::{Path, PathBuf};
 /// A role a CLAIMS row or a figure needs: in study `study`, the run that declares `name`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Role {
-    pub study: &'static str,
+    pub study: Study,
     pub name: &'static str,
     /// What needs it (in the error when no run declares it).
     pub by: &'static str,
@@ -23,7 +24,7 @@ pub struct Role {
 /// The role constants and [`NEEDED`], the list of all of them (so no constant is left out of
 /// the check).
 macro_rules! roles {
-    ($($(#[$doc:meta])* $id:ident = ($study:literal, $name:literal, $by:literal);)*) => {
+    ($($(#[$doc:meta])* $id:ident = ($study:expr, $name:literal, $by:literal);)*) => {
         $($(#[$doc])* pub const $id: Role = Role { study: $study, name: $name, by: $by };)*
         /// Every role a CLAIMS row or a figure needs.
         pub const NEEDED: &[Role] = &[$($id),*];
@@ -32,53 +33,53 @@ macro_rules! roles {
 
 roles! {
     /// Example 7.1, adaptive with eta_5 as written (the paper's run).
-    EX71_AS_WRITTEN = ("ex71", "as-written", "the CLAIMS rows 7.1-* (where deep is not stored) and the figure fig4a");
+    EX71_AS_WRITTEN = (studies::EX71, "as-written", "the CLAIMS rows 7.1-* (where deep is not stored) and the figure fig4a");
     /// Its twin with the estimator's maxima on the dense lattice.
-    EX71_AS_WRITTEN_DENSE = ("ex71", "as-written-dense", "the dense pass of the CLAIMS rows 7.1-* (row sampling)");
-    EX71_UNIFORM = ("ex71", "uniform", "the CLAIMS rows 7.1-* (where deep is not stored)");
+    EX71_AS_WRITTEN_DENSE = (studies::EX71, "as-written-dense", "the dense pass of the CLAIMS rows 7.1-* (row sampling)");
+    EX71_UNIFORM = (studies::EX71, "uniform", "the CLAIMS rows 7.1-* (where deep is not stored)");
     /// Uniform refinement with sigma-hat read as Cartesian components.
-    EX71_UNIFORM_CARTESIAN = ("ex71", "uniform-cartesian", "the CLAIMS row 7.1-eta5");
-    EX72_AS_WRITTEN = ("ex72", "as-written", "the CLAIMS rows 7.2-* and the figures fig3b, fig4b");
-    EX72_AS_WRITTEN_DENSE = ("ex72", "as-written-dense", "the dense pass of the CLAIMS rows 7.2-* (row sampling)");
-    EX72_UNIFORM = ("ex72", "uniform", "the CLAIMS rows 7.2-* (where ex72_large holds no errors)");
-    ABLATION_EX71_WFC = ("contact_term_ablation", "ex71-without-full-contact", "the CLAIMS rows 7.1-* (where deep is not stored)");
+    EX71_UNIFORM_CARTESIAN = (studies::EX71, "uniform-cartesian", "the CLAIMS row 7.1-eta5");
+    EX72_AS_WRITTEN = (studies::EX72, "as-written", "the CLAIMS rows 7.2-* and the figures fig3b, fig4b");
+    EX72_AS_WRITTEN_DENSE = (studies::EX72, "as-written-dense", "the dense pass of the CLAIMS rows 7.2-* (row sampling)");
+    EX72_UNIFORM = (studies::EX72, "uniform", "the CLAIMS rows 7.2-* (where ex72_large holds no errors)");
+    ABLATION_EX71_WFC = (studies::CONTACT_TERM_ABLATION, "ex71-without-full-contact", "the CLAIMS rows 7.1-* (where deep is not stored)");
     ABLATION_EX71_WFC_DENSE =
-        ("contact_term_ablation", "ex71-without-full-contact-dense", "the dense pass of the CLAIMS rows 7.1-* (row sampling)");
+        (studies::CONTACT_TERM_ABLATION, "ex71-without-full-contact-dense", "the dense pass of the CLAIMS rows 7.1-* (row sampling)");
     ABLATION_EX72_WFC =
-        ("contact_term_ablation", "ex72-without-full-contact", "the CLAIMS rows 7.2-error, 7.2-refinement and the figure fig3b_variant");
-    ABLATION_EX72_AS_WRITTEN = ("contact_term_ablation", "ex72-as-written", "the CLAIMS row 7.2-error");
-    DEEP_EX71_AS_WRITTEN = ("deep", "ex71-as-written", "the CLAIMS rows 7.1-*, efficiency-size, estimator-repair and the figure deep_floor");
-    DEEP_EX71_WFC = ("deep", "ex71-without-full-contact", "the CLAIMS rows 7.1-*, efficiency-size and estimator-repair");
-    DEEP_EX71_REPAIRED = ("deep", "ex71-repaired", "the CLAIMS rows efficiency-size, estimator-repair and the figure estimator_repair");
-    DEEP_EX71_UNIFORM = ("deep", "ex71-uniform", "the CLAIMS rows 7.1-*, estimator-repair and the figure deep_floor");
-    DEEP_FB_AS_WRITTEN = ("deep", "fb-as-written", "the CLAIMS rows fb-*, efficiency-size, estimator-repair and the figure deep_floor");
-    DEEP_FB_WFC = ("deep", "fb-without-full-contact", "the CLAIMS rows fb-*, efficiency-size and estimator-repair");
-    DEEP_FB_REPAIRED = ("deep", "fb-repaired", "the CLAIMS rows efficiency-size, estimator-repair and the figure estimator_repair");
-    DEEP_FB_UNIFORM = ("deep", "fb-uniform", "the CLAIMS rows fb-*, estimator-repair and the figure deep_floor");
-    LARGE_AS_WRITTEN = ("ex72_large", "as-written", "the CLAIMS rows 7.2-*, efficiency-size and estimator-repair");
-    LARGE_WFC = ("ex72_large", "without-full-contact", "the CLAIMS rows 7.2-*, efficiency-size and estimator-repair");
-    LARGE_REPAIRED = ("ex72_large", "repaired", "the CLAIMS rows efficiency-size, estimator-repair and the figure estimator_repair");
-    LARGE_UNIFORM = ("ex72_large", "uniform", "the CLAIMS rows 7.2-* and estimator-repair");
-    ROLLERS_AS_WRITTEN = ("ex72_rollers", "as-written", "the CLAIMS rows 7.2r-* and efficiency-size");
-    ROLLERS_WFC = ("ex72_rollers", "without-full-contact", "the CLAIMS rows 7.2r-* and efficiency-size");
-    ROLLERS_REPAIRED = ("ex72_rollers", "repaired", "the CLAIMS rows 7.2r-* and efficiency-size");
-    ROLLERS_UNIFORM = ("ex72_rollers", "uniform", "the CLAIMS rows 7.2r-*");
+        (studies::CONTACT_TERM_ABLATION, "ex72-without-full-contact", "the CLAIMS rows 7.2-error, 7.2-refinement and the figure fig3b_variant");
+    ABLATION_EX72_AS_WRITTEN = (studies::CONTACT_TERM_ABLATION, "ex72-as-written", "the CLAIMS row 7.2-error");
+    DEEP_EX71_AS_WRITTEN = (studies::DEEP, "ex71-as-written", "the CLAIMS rows 7.1-*, efficiency-size, estimator-repair and the figure deep_floor");
+    DEEP_EX71_WFC = (studies::DEEP, "ex71-without-full-contact", "the CLAIMS rows 7.1-*, efficiency-size and estimator-repair");
+    DEEP_EX71_REPAIRED = (studies::DEEP, "ex71-repaired", "the CLAIMS rows efficiency-size, estimator-repair and the figure estimator_repair");
+    DEEP_EX71_UNIFORM = (studies::DEEP, "ex71-uniform", "the CLAIMS rows 7.1-*, estimator-repair and the figure deep_floor");
+    DEEP_FB_AS_WRITTEN = (studies::DEEP, "fb-as-written", "the CLAIMS rows fb-*, efficiency-size, estimator-repair and the figure deep_floor");
+    DEEP_FB_WFC = (studies::DEEP, "fb-without-full-contact", "the CLAIMS rows fb-*, efficiency-size and estimator-repair");
+    DEEP_FB_REPAIRED = (studies::DEEP, "fb-repaired", "the CLAIMS rows efficiency-size, estimator-repair and the figure estimator_repair");
+    DEEP_FB_UNIFORM = (studies::DEEP, "fb-uniform", "the CLAIMS rows fb-*, estimator-repair and the figure deep_floor");
+    LARGE_AS_WRITTEN = (studies::EX72_LARGE, "as-written", "the CLAIMS rows 7.2-*, efficiency-size and estimator-repair");
+    LARGE_WFC = (studies::EX72_LARGE, "without-full-contact", "the CLAIMS rows 7.2-*, efficiency-size and estimator-repair");
+    LARGE_REPAIRED = (studies::EX72_LARGE, "repaired", "the CLAIMS rows efficiency-size, estimator-repair and the figure estimator_repair");
+    LARGE_UNIFORM = (studies::EX72_LARGE, "uniform", "the CLAIMS rows 7.2-* and estimator-repair");
+    ROLLERS_AS_WRITTEN = (studies::EX72_ROLLERS, "as-written", "the CLAIMS rows 7.2r-* and efficiency-size");
+    ROLLERS_WFC = (studies::EX72_ROLLERS, "without-full-contact", "the CLAIMS rows 7.2r-* and efficiency-size");
+    ROLLERS_REPAIRED = (studies::EX72_ROLLERS, "repaired", "the CLAIMS rows 7.2r-* and efficiency-size");
+    ROLLERS_UNIFORM = (studies::EX72_ROLLERS, "uniform", "the CLAIMS rows 7.2r-*");
     /// Hertz, adaptive with the paper's estimator: the run the row `hertz` judges.
-    HERTZ_AS_WRITTEN = ("hertz", "as-written", "the CLAIMS rows hertz, efficiency-size, estimator-repair and the figure hertz_mesh");
+    HERTZ_AS_WRITTEN = (studies::HERTZ, "as-written", "the CLAIMS rows hertz, efficiency-size, estimator-repair and the figure hertz_mesh");
     /// Hertz with the smaller load.
-    HERTZ_LIGHT = ("hertz", "as-written-light", "the CLAIMS row efficiency-size");
-    HERTZ_REPAIRED = ("hertz", "repaired", "the CLAIMS rows efficiency-size, estimator-repair and the figure estimator_repair");
-    FB_AS_WRITTEN = ("fb", "as-written", "the CLAIMS rows fb-* (where deep is not stored) and the figure fb_mesh");
-    FB_WFC = ("fb", "without-full-contact", "the CLAIMS rows fb-* and the figure fb_mesh");
-    FB_UNIFORM = ("fb", "uniform", "the CLAIMS rows fb-* (where deep is not stored)");
-    REPAIR_EX71 = ("estimator_repair", "ex71-repaired", "the CLAIMS row estimator-repair (where deep is not stored)");
-    REPAIR_EX71_L1 = ("estimator_repair", "ex71-repaired-l1", "the CLAIMS row estimator-repair and the figure estimator_repair");
-    REPAIR_EX71_UNIFORM = ("estimator_repair", "ex71-uniform", "the CLAIMS row estimator-repair (where deep is not stored)");
-    REPAIR_FB = ("estimator_repair", "fb-repaired", "the CLAIMS row estimator-repair (where deep is not stored)");
-    REPAIR_FB_L1 = ("estimator_repair", "fb-repaired-l1", "the CLAIMS row estimator-repair and the figure estimator_repair");
-    REPAIR_FB_UNIFORM = ("estimator_repair", "fb-uniform", "the CLAIMS row estimator-repair (where deep is not stored)");
-    REPAIR_EX72 = ("estimator_repair", "ex72-repaired", "the CLAIMS row estimator-repair (where ex72_large is not stored)");
-    REPAIR_HERTZ = ("estimator_repair", "hertz-repaired", "the CLAIMS row estimator-repair (where hertz has no repaired run)");
+    HERTZ_LIGHT = (studies::HERTZ, "as-written-light", "the CLAIMS row efficiency-size");
+    HERTZ_REPAIRED = (studies::HERTZ, "repaired", "the CLAIMS rows efficiency-size, estimator-repair and the figure estimator_repair");
+    FB_AS_WRITTEN = (studies::FB, "as-written", "the CLAIMS rows fb-* (where deep is not stored) and the figure fb_mesh");
+    FB_WFC = (studies::FB, "without-full-contact", "the CLAIMS rows fb-* and the figure fb_mesh");
+    FB_UNIFORM = (studies::FB, "uniform", "the CLAIMS rows fb-* (where deep is not stored)");
+    REPAIR_EX71 = (studies::ESTIMATOR_REPAIR, "ex71-repaired", "the CLAIMS row estimator-repair (where deep is not stored)");
+    REPAIR_EX71_L1 = (studies::ESTIMATOR_REPAIR, "ex71-repaired-l1", "the CLAIMS row estimator-repair and the figure estimator_repair");
+    REPAIR_EX71_UNIFORM = (studies::ESTIMATOR_REPAIR, "ex71-uniform", "the CLAIMS row estimator-repair (where deep is not stored)");
+    REPAIR_FB = (studies::ESTIMATOR_REPAIR, "fb-repaired", "the CLAIMS row estimator-repair (where deep is not stored)");
+    REPAIR_FB_L1 = (studies::ESTIMATOR_REPAIR, "fb-repaired-l1", "the CLAIMS row estimator-repair and the figure estimator_repair");
+    REPAIR_FB_UNIFORM = (studies::ESTIMATOR_REPAIR, "fb-uniform", "the CLAIMS row estimator-repair (where deep is not stored)");
+    REPAIR_EX72 = (studies::ESTIMATOR_REPAIR, "ex72-repaired", "the CLAIMS row estimator-repair (where ex72_large is not stored)");
+    REPAIR_HERTZ = (studies::ESTIMATOR_REPAIR, "hertz-repaired", "the CLAIMS row estimator-repair (where hertz has no repaired run)");
 }
 
 /// Each run and its twin with the estimator's maxima on the dense lattice: the dense pass of
@@ -128,7 +129,9 @@ pub enum RoleError {
 }
 
 /// The roles `manifests` declare, checked against [`NEEDED`]: every needed role of a declared
-/// study must be declared (a study without a manifest has no data, and its rows say so). Called
+/// study must be declared (a study without a manifest has no data, and its rows say so: `run`
+/// checks the manifests it is given only, and a scratch experiments folder may hold one study;
+/// that the repository declares every study of [`studies::ALL`] is a test's). Called
 /// wherever the manifests are read for CLAIMS.md or the figures (`figures`, `drift`, `report`).
 pub fn check(manifests: &[Manifest]) -> Result<Roles, RoleError> {
     let roles = Roles { declared: manifests.iter().map(|m| (m.study.clone(), m.roles.clone())).collect() };

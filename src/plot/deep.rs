@@ -7,6 +7,7 @@
 
 use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, ESTIMATE, Figure, NDF_DESC, PALETTE, Style, runs, series, slope};
+use crate::analysis::problem_names;
 use crate::analysis::roles::{self, Roles};
 use crate::analysis::verdict::FLOOR_MARGIN;
 use crate::study::store::Shelf;
@@ -19,7 +20,7 @@ pub(super) fn deep_error(shelf: &Shelf) -> anyhow::Result<Built> {
         Err(why) => return Ok(Err(why)),
     };
     let mut panels = Vec::new();
-    for (problem, title) in [("ex71", "Example 7.1"), ("fb", "free boundary (fb)")] {
+    for (problem, title) in [(problem_names::EX71, "Example 7.1"), (problem_names::FB, "free boundary (fb)")] {
         let mut p = Panel::new(format!("{title}: error vs NDF to 1e7"), NDF_DESC, format!("error {ERR}"));
         for (k, r) in runs.iter().filter(|r| r.run.problem == problem).enumerate() {
             let style = Style {

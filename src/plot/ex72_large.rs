@@ -9,11 +9,12 @@
 
 use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, Figure, NDF_DESC, PALETTE, Style, runs, series, slope};
+use crate::analysis::studies::{self, Study};
 use crate::study::store::Shelf;
 
 /// One Example 7.2 study's error figure: its study, the problem's name in the panels and the title.
 struct Labels {
-    study: &'static str,
+    study: Study,
     problem: &'static str,
     /// The second panel's region: Gamma_C ("away from the corners" where there are corners).
     contact: &'static str,
@@ -24,7 +25,7 @@ pub(super) fn ex72_large_error(shelf: &Shelf) -> anyhow::Result<Built> {
     error_figure(
         shelf,
         Labels {
-            study: "ex72_large",
+            study: studies::EX72_LARGE,
             problem: "Example 7.2",
             contact: "Gamma_C, away from the corners",
             title: "Example 7.2 deep: the error against a reference of 4.5e6 unknowns",
@@ -36,7 +37,7 @@ pub(super) fn ex72_rollers_error(shelf: &Shelf) -> anyhow::Result<Built> {
     error_figure(
         shelf,
         Labels {
-            study: "ex72_rollers",
+            study: studies::EX72_ROLLERS,
             problem: "Example 7.2 on rollers",
             contact: "Gamma_C",
             title: "Example 7.2 on rollers: the error against a reference of 1.4e6 unknowns",

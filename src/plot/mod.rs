@@ -67,7 +67,9 @@ pub mod render;
 mod repair;
 mod rich;
 
+use crate::analysis::problem_names;
 use crate::analysis::roles::{self, Role, Roles};
+use crate::analysis::studies::{self, Study};
 use crate::estimator::estimate::{C0_PAPER, ContactTerm, LogFactor, c0_paper};
 use crate::records::{LevelRecord, MeshSnapshot, Refine, RunRecord};
 use crate::study::store::Shelf;
@@ -77,7 +79,8 @@ use render::{Figure, HLine, LineFigure, Marker, MeshFigure, PALETTE, Panel, Seri
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
-/// Every figure, in the order drawn.
+/// Every figure, in the order drawn. A figure that draws a whole ablation study (`c0_sweep`,
+/// `log_ablation`, ...) is named after it: its name is the study's ([`studies`]).
 pub const FIGURES: [&str; 20] = [
     "fig2a",
     "fig2b",
@@ -86,15 +89,15 @@ pub const FIGURES: [&str; 20] = [
     "fig3b_variant",
     "fig4a",
     "fig4b",
-    "c0_sweep",
-    "log_ablation",
-    "contact_term_ablation",
-    "theta_ablation",
+    studies::C0_SWEEP,
+    studies::LOG_ABLATION,
+    studies::CONTACT_TERM_ABLATION,
+    studies::THETA_ABLATION,
     "fb_error",
     "fb_mesh",
     "hertz_pressure",
     "hertz_mesh",
-    "estimator_repair",
+    studies::ESTIMATOR_REPAIR,
     "deep_error",
     "deep_floor",
     "ex72_large_error",
@@ -102,20 +105,20 @@ pub const FIGURES: [&str; 20] = [
 ];
 
 /// The study a figure is drawn from (the table above).
-pub fn study_of(figure: &str) -> Option<&'static str> {
+pub fn study_of(figure: &str) -> Option<Study> {
     Some(match figure {
-        "fig2a" | "fig2b" | "fig4a" => "ex71",
-        "fig3a" | "fig3b" | "fig4b" => "ex72",
-        "fig3b_variant" | "contact_term_ablation" => "contact_term_ablation",
-        "c0_sweep" => "c0_sweep",
-        "log_ablation" => "log_ablation",
-        "theta_ablation" => "theta_ablation",
-        "fb_error" | "fb_mesh" => "fb",
-        "hertz_pressure" | "hertz_mesh" => "hertz",
-        "estimator_repair" => "estimator_repair",
-        "deep_error" | "deep_floor" => "deep",
-        "ex72_large_error" => "ex72_large",
-        "ex72_rollers_error" => "ex72_rollers",
+        "fig2a" | "fig2b" | "fig4a" => studies::EX71,
+        "fig3a" | "fig3b" | "fig4b" => studies::EX72,
+        "fig3b_variant" | studies::CONTACT_TERM_ABLATION => studies::CONTACT_TERM_ABLATION,
+        studies::C0_SWEEP => studies::C0_SWEEP,
+        studies::LOG_ABLATION => studies::LOG_ABLATION,
+        studies::THETA_ABLATION => studies::THETA_ABLATION,
+        "fb_error" | "fb_mesh" => studies::FB,
+        "hertz_pressure" | "hertz_mesh" => studies::HERTZ,
+        studies::ESTIMATOR_REPAIR => studies::ESTIMATOR_REPAIR,
+        "deep_error" | "deep_floor" => studies::DEEP,
+        "ex72_large_error" => studies::EX72_LARGE,
+        "ex72_rollers_error" => studies::EX72_ROLLERS,
         _ => return None,
     })
 }
@@ -250,11 +253,11 @@ fn build(name: &str, shelf: &Shelf, roles: &Roles) -> anyhow::Result<Built> {
         "fig3b_variant" => mesh_at_level_20(shelf, roles, roles::ABLATION_EX72_WFC),
         "fig4a" => fig4(shelf, roles, roles::EX71_AS_WRITTEN, "4a", 5),
         "fig4b" => fig4(shelf, roles, roles::EX72_AS_WRITTEN, "4b", 7),
-        "c0_sweep" => c0_sweep(shelf),
-        "log_ablation" => log_ablation(shelf),
-        "contact_term_ablation" => contact_term_ablation(shelf),
-        "estimator_repair" => repair::estimator_repair(shelf, roles),
-        "theta_ablation" => theta_ablation(shelf),
+        studies::C0_SWEEP => c0_sweep(shelf),
+        studies::LOG_ABLATION => log_ablation(shelf),
+        studies::CONTACT_TERM_ABLATION => contact_term_ablation(shelf),
+        studies::ESTIMATOR_REPAIR => repair::estimator_repair(shelf, roles),
+        studies::THETA_ABLATION => theta_ablation(shelf),
         "fb_error" => fb::fb_error(shelf),
         "fb_mesh" => fb::fb_mesh(shelf, roles),
         "hertz_pressure" => hertz::hertz_pressure(shelf),
@@ -299,8 +302,8 @@ fn by_problem(runs: &[RunRecord]) -> BTreeMap<String, Vec<&RunRecord>> {
 
 fn problem_title(problem: &str) -> String {
     match problem {
-        "ex71" => "Example 7.1".to_string(),
-        "ex72" => "Example 7.2".to_string(),
+        problem_names::EX71 => "Example 7.1".to_string(),
+        problem_names::EX72 => "Example 7.2".to_string(),
         other => other.to_string(),
     }
 }
@@ -426,7 +429,7 @@ fn run_of_label(label: &str) -> String {
 }
 
 fn fig2a(shelf: &Shelf) -> anyhow::Result<Built> {
-    let runs = match runs(shelf, "ex71")? {
+    let runs = match runs(shelf, studies::EX71)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -438,7 +441,7 @@ fn fig2a(shelf: &Shelf) -> anyhow::Result<Built> {
 }
 
 fn fig2b(shelf: &Shelf) -> anyhow::Result<Built> {
-    let runs = match runs(shelf, "ex71")? {
+    let runs = match runs(shelf, studies::EX71)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -467,7 +470,7 @@ fn fig2b(shelf: &Shelf) -> anyhow::Result<Built> {
 }
 
 fn fig3a(shelf: &Shelf) -> anyhow::Result<Built> {
-    let runs = match runs(shelf, "ex72")? {
+    let runs = match runs(shelf, studies::EX72)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -567,13 +570,10 @@ fn mesh_figure(s: &MeshSnapshot, note: &str) -> MeshFigure {
 
 /// The snapshot does not store its problem; the study name says it for the paper's studies.
 fn problem_of(s: &MeshSnapshot) -> String {
-    if s.study.starts_with("ex71") || s.run.starts_with("ex71") {
-        "ex71".into()
-    } else if s.study.starts_with("ex72") || s.run.starts_with("ex72") {
-        "ex72".into()
-    } else {
-        s.study.clone()
-    }
+    [problem_names::EX71, problem_names::EX72]
+        .into_iter()
+        .find(|p| s.study.starts_with(p) || s.run.starts_with(p))
+        .map_or_else(|| s.study.clone(), str::to_string)
 }
 
 /// The mesh edges (each once) joined greedily into polylines.
@@ -637,7 +637,7 @@ fn panels(title: &str, panels: Vec<Panel>) -> Figure {
 }
 
 fn c0_sweep(shelf: &Shelf) -> anyhow::Result<Built> {
-    let runs = match runs(shelf, "c0_sweep")? {
+    let runs = match runs(shelf, studies::C0_SWEEP)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -676,7 +676,7 @@ fn log_label(f: LogFactor) -> &'static str {
 }
 
 fn log_ablation(shelf: &Shelf) -> anyhow::Result<Built> {
-    let runs = match runs(shelf, "log_ablation")? {
+    let runs = match runs(shelf, studies::LOG_ABLATION)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -707,7 +707,7 @@ fn contact_label(c: ContactTerm) -> &'static str {
 }
 
 fn contact_term_ablation(shelf: &Shelf) -> anyhow::Result<Built> {
-    let runs = match runs(shelf, "contact_term_ablation")? {
+    let runs = match runs(shelf, studies::CONTACT_TERM_ABLATION)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
@@ -728,7 +728,7 @@ fn contact_term_ablation(shelf: &Shelf) -> anyhow::Result<Built> {
 }
 
 fn theta_ablation(shelf: &Shelf) -> anyhow::Result<Built> {
-    let runs = match runs(shelf, "theta_ablation")? {
+    let runs = match runs(shelf, studies::THETA_ABLATION)? {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };

@@ -8,6 +8,7 @@
 //! (`target/drift/report.json` by default), whose date and scope the page states.
 
 use crate::analysis::claims::Claim;
+use crate::analysis::studies::{self, Study};
 use crate::records::RunRecord;
 use crate::study::store::Shelf;
 use base64::Engine;
@@ -21,19 +22,21 @@ pub fn figures_of(study: &str) -> Vec<&'static str> {
 }
 
 /// The studies a CLAIMS row rests on, from its id (a test checks that every row maps to one).
-pub fn claim_studies(id: &str) -> &'static [&'static str] {
+pub fn claim_studies(id: &str) -> &'static [Study] {
+    use studies::*;
     match id {
-        "c0" => &["c0_sweep"],
-        "sampling" => &["ex71", "ex72", "contact_term_ablation"],
-        "hertz" => &["hertz"],
-        "efficiency-size" => &["deep", "ex72_large", "ex72_rollers", "hertz"],
-        _ if id.starts_with("theta") => &["theta_ablation"],
-        _ if id.starts_with("7.1-") => &["deep", "ex71", "contact_term_ablation"],
-        _ if id.starts_with("7.2-") => &["ex72", "ex72_large"],
-        _ if id.starts_with("7.2r-") => &["ex72_rollers"],
-        _ if id.starts_with("log-factor") => &["log_ablation"],
-        _ if id.starts_with("fb-") => &["deep", "fb"],
-        _ if id.starts_with("estimator-repair") => &["deep", "estimator_repair", "hertz"],
+        "c0" => &[C0_SWEEP],
+        "sampling" => &[EX71, EX72, CONTACT_TERM_ABLATION],
+        // the row named after the study it judges
+        HERTZ => &[HERTZ],
+        "efficiency-size" => &[DEEP, EX72_LARGE, EX72_ROLLERS, HERTZ],
+        _ if id.starts_with("theta") => &[THETA_ABLATION],
+        _ if id.starts_with("7.1-") => &[DEEP, EX71, CONTACT_TERM_ABLATION],
+        _ if id.starts_with("7.2-") => &[EX72, EX72_LARGE],
+        _ if id.starts_with("7.2r-") => &[EX72_ROLLERS],
+        _ if id.starts_with("log-factor") => &[LOG_ABLATION],
+        _ if id.starts_with("fb-") => &[DEEP, FB],
+        _ if id.starts_with("estimator-repair") => &[DEEP, ESTIMATOR_REPAIR, HERTZ],
         _ => &[],
     }
 }

@@ -49,4 +49,5 @@ mod scratch;
 mod store;
 mod stress_frame;
 mod study;
+mod study_names;
 mod verdicts;

@@ -8,6 +8,7 @@ use super::{
     halving_exponents, latest_mesh, rate_headline, rate_text, slowest_headline, source,
 };
 use crate::analysis::roles::{self, Role};
+use crate::analysis::studies;
 use crate::analysis::verdict::{self, Abscissa, RateReport, refinement};
 use crate::records::RunRecord;
 
@@ -19,7 +20,7 @@ const CORNER_RING: f64 = 0.1;
 /// The claims of Example 7.2.
 pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let load = |s: &str| ctx.shelf.runs(s);
-    let (ex72, ct, large) = (load("ex72")?, load("contact_term_ablation")?, load("ex72_large")?);
+    let (ex72, ct, large) = (load(studies::EX72)?, load(studies::CONTACT_TERM_ABLATION)?, load(studies::EX72_LARGE)?);
     let a72 = ctx.pick(&ex72, roles::EX72_AS_WRITTEN);
     let u72 = ctx.find(&ex72, roles::EX72_UNIFORM);
     let wfc = ctx.pick(&ct, roles::ABLATION_EX72_WFC);

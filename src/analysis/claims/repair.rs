@@ -24,6 +24,7 @@ use super::criterion::Outcome;
 use super::{Claim, Criterion, Ctx, Evidence, Kind, OPTIMAL, Q, Summary, c0_text, growth_text, rate_text, short_range, source};
 use crate::analysis::roles::{self, Role, Roles};
 use crate::analysis::verdict::{self, Abscissa};
+use crate::analysis::{problem_names, studies};
 use crate::base::stats::line_value_at;
 use crate::estimator::estimate::{C0_PAPER, c0_paper};
 use crate::records::RunRecord;
@@ -183,7 +184,7 @@ fn coincidence(ctx: &Ctx, a: &RunRecord, b: &RunRecord) -> String {
 }
 
 /// The problems of the row, in its order.
-pub const PROBLEMS: [&str; 4] = ["ex71", "fb", "ex72", "hertz"];
+pub const PROBLEMS: [&str; 4] = [problem_names::EX71, problem_names::FB, problem_names::EX72, problem_names::HERTZ];
 
 /// The runs the row reads for one problem (the figure `estimator_repair` draws the same).
 #[derive(Clone, Copy, Debug)]
@@ -227,7 +228,7 @@ struct ProblemRoles {
 fn problem_roles(problem: &str) -> ProblemRoles {
     use roles::*;
     match problem {
-        "ex72" => ProblemRoles {
+        problem_names::EX72 => ProblemRoles {
             repaired: LARGE_REPAIRED,
             as_written: LARGE_AS_WRITTEN,
             without_full_contact: Some(LARGE_WFC),
@@ -236,7 +237,7 @@ fn problem_roles(problem: &str) -> ProblemRoles {
             small_l1: None,
             small_uniform: None,
         },
-        "hertz" => ProblemRoles {
+        problem_names::HERTZ => ProblemRoles {
             repaired: HERTZ_REPAIRED,
             as_written: HERTZ_AS_WRITTEN,
             without_full_contact: None,
@@ -245,7 +246,7 @@ fn problem_roles(problem: &str) -> ProblemRoles {
             small_l1: None,
             small_uniform: None,
         },
-        "fb" => ProblemRoles {
+        problem_names::FB => ProblemRoles {
             repaired: DEEP_FB_REPAIRED,
             as_written: DEEP_FB_AS_WRITTEN,
             without_full_contact: Some(DEEP_FB_WFC),
@@ -270,10 +271,10 @@ impl Stored {
     pub fn read(shelf: &crate::study::store::Shelf, roles: &Roles) -> std::io::Result<Stored> {
         let load = |s: &str| shelf.runs(s);
         Ok(Stored {
-            estimator_repair: load(roles::REPAIR_EX71.study)?,
-            deep: load(roles::DEEP_EX71_REPAIRED.study)?,
-            ex72_large: load(roles::LARGE_REPAIRED.study)?,
-            hertz: load(roles::HERTZ_REPAIRED.study)?,
+            estimator_repair: load(studies::ESTIMATOR_REPAIR)?,
+            deep: load(studies::DEEP)?,
+            ex72_large: load(studies::EX72_LARGE)?,
+            hertz: load(studies::HERTZ)?,
             roles: roles.clone(),
         })
     }
@@ -281,10 +282,10 @@ impl Stored {
     /// The stored runs of `role`'s study.
     fn runs_of(&self, role: Role) -> &[RunRecord] {
         match role.study {
-            s if s == roles::REPAIR_EX71.study => &self.estimator_repair,
-            s if s == roles::DEEP_EX71_REPAIRED.study => &self.deep,
-            s if s == roles::LARGE_REPAIRED.study => &self.ex72_large,
-            s if s == roles::HERTZ_REPAIRED.study => &self.hertz,
+            studies::ESTIMATOR_REPAIR => &self.estimator_repair,
+            studies::DEEP => &self.deep,
+            studies::EX72_LARGE => &self.ex72_large,
+            studies::HERTZ => &self.hertz,
             _ => &[],
         }
     }
