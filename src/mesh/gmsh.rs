@@ -560,7 +560,29 @@ fn group_edges(
         });
         edges.push(GroupEdge { v: [va, vb], group, line: line_of(tag) });
     }
+    distinct_group_names(path, &group_index, &groups)?;
     Ok((edges, groups))
+}
+
+/// A problem names a group by its name, an unnamed one by its tag: a group named "5" beside the
+/// unnamed group 5 would be one boundary part the file keeps apart (both read as "5"), so a name
+/// that is the tag of another group is refused.
+fn distinct_group_names(path: &Path, group_index: &BTreeMap<i32, usize>, groups: &[Group]) -> Result<(), MeshError> {
+    let mut seen: HashMap<&str, i32> = HashMap::new();
+    for (&tag, &g) in group_index {
+        let (name, line) = &groups[g];
+        if let Some(other) = seen.insert(name.as_str(), tag) {
+            let (named, unnamed) = if line.is_some() { (tag, other) } else { (other, tag) };
+            return Err(error(
+                path,
+                groups[group_index[&named]].1,
+                format!(
+                    "the physical group {named} is named \"{name}\", the tag of the unnamed group {unnamed}: a problem naming \"{name}\" could not tell them apart; rename the group or name group {unnamed}"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 impl GmshFile {

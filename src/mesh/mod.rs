@@ -37,6 +37,10 @@ pub struct Mesh {
     pub boundary: Vec<BoundaryEdge>,
 }
 
+/// Points inside each boundary edge of a built-in mesh, at which the parts are checked
+/// ([`Mesh::check_parts_whole`]): the edge is cut into this many equal pieces.
+pub const PART_SAMPLES: usize = 16;
+
 /// What is wrong with a mesh.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
@@ -59,6 +63,13 @@ pub enum MeshError {
         "the problem gives its boundary parts by Gmsh physical group ({groups}), but {mesh} is a built-in mesh without groups, and no Dirichlet edge is left: use a Gmsh mesh (gmsh:PATH.msh) or give the parts as predicates in x and y"
     )]
     GroupsOnBuiltIn { mesh: String, groups: String },
+    /// The problem's parts change inside a boundary edge of a built-in mesh
+    /// ([`Mesh::check_parts_whole`]).
+    #[error(
+        "the boundary parts change inside an edge of {mesh}: the edge from {} to {} is {edge:?} at its midpoint but {here:?} at {}; a part must end at a vertex of the mesh: choose a mesh whose grid lines meet the end of the part, or write the part's end where they do",
+        crate::base::number::point(*.a), crate::base::number::point(*.b), crate::base::number::point([*.x, *.y])
+    )]
+    PartInsideEdge { mesh: String, x: f64, y: f64, here: Part, edge: Part, a: [f64; 2], b: [f64; 2] },
     /// A point the problem requires to be a vertex (`origin`: where it declares it) is not one;
     /// `outside` says so with the mesh's extent when it lies outside the mesh's bounding box.
     #[error("{origin}: {} is not a vertex of the mesh{}", crate::base::number::point([*.x, *.y]), outside.as_ref().map(|o| format!(" (it lies outside the mesh, {o})")).unwrap_or_default())]
@@ -167,6 +178,9 @@ impl MeshSpec {
         if self.file().is_none() && !groups.is_empty() && !mesh.boundary.iter().any(|e| e.part == Part::Dirichlet) {
             return Err(MeshError::GroupsOnBuiltIn { mesh: self.to_string(), groups: groups.join(", ") });
         }
+        if self.file().is_none() {
+            mesh.check_parts_whole(self, &part_of)?;
+        }
         // what the problem declares of its mesh, named where it declares it (refinement keeps
         // the vertices: the initial mesh is where they are checked)
         mesh.check_declared_vertices(&problem.required_vertices_declared())?;
@@ -252,6 +266,26 @@ impl Mesh {
             })
             .collect();
         Mesh { vertices, triangles, boundary }
+    }
+
+    /// Every boundary edge of a built-in mesh lies in one part of the boundary: the predicates
+    /// give the same part at [`PART_SAMPLES`] points inside it as at its midpoint (the edge's
+    /// part, which refinement hands down). A part that ends inside an edge would be decided by
+    /// the midpoint, and the contact or Dirichlet part would silently grow or shrink to the
+    /// mesh's vertices (battery 6: contact for y < 0.6 read as y < 0.5 on structured:4).
+    fn check_parts_whole(&self, spec: &MeshSpec, part_of: &dyn Fn([f64; 2]) -> Part) -> Result<(), MeshError> {
+        for e in &self.boundary {
+            let [a, b] = e.v.map(|v| self.vertices[v]);
+            for k in 1..PART_SAMPLES {
+                let t = k as f64 / PART_SAMPLES as f64;
+                let x = [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+                let here = part_of(x);
+                if here != e.part {
+                    return Err(MeshError::PartInsideEdge { mesh: spec.to_string(), x: x[0], y: x[1], here, edge: e.part, a, b });
+                }
+            }
+        }
+        Ok(())
     }
 
     pub fn n_vertices(&self) -> usize {

@@ -250,3 +250,34 @@ fn bad_probe_far_outside_is_shown_in_a_few_characters() {
     assert!(err.contains("--probe 1e308,0.5: the point is outside the domain"), "{err}");
     assert!(!err.contains("0000000000"), "{err}");
 }
+
+/// Battery 6, finding 4: a physical group named as the tag of another, unnamed group ("1" beside
+/// the unnamed group 1) read as one boundary part, so a problem naming "1" held both sides:
+/// refused when the mesh is read, naming both groups.
+#[test]
+fn bad_group_named_as_another_groups_tag_is_refused() {
+    let (code, out) = solve_square("name-is-a-tag", &[], &[("3\n1 1 \"bottom\"\n1 2 \"sides\"", "2\n1 2 \"1\"")]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("the physical group 2 is named \"1\", the tag of the unnamed group 1"), "{out}");
+}
+
+/// Battery 6, finding 2: a part that ends inside a boundary edge of a built-in mesh was decided at
+/// the edge's midpoint (contact for x < 0.6 read as x < 0.5 on structured:4, certified): refused,
+/// naming the edge and the point where the part changes; where the grid meets the end (structured:5,
+/// structured:10) it solves.
+#[test]
+fn bad_part_ending_inside_an_edge_is_refused_where_the_grid_misses_it() {
+    let edit = (r#"contact = "y < 1e-12""#, r#"contact = "y < 1e-12 && x < 0.6""#);
+    for n in ["4", "8"] {
+        let args = ["solve", "--problem", "v.toml", "--mesh", &format!("structured:{n}")];
+        let (code, _, err) = run(&format!("part-in-edge-{n}"), SQUARE, &[edit], &args);
+        assert_eq!(code, 1, "{n}: {err}");
+        assert!(err.contains(&format!("the boundary parts change inside an edge of structured:{n}: the edge from (0.5, 0) to")), "{err}");
+        assert!(err.contains("a part must end at a vertex of the mesh"), "{err}");
+    }
+    for n in ["5", "10"] {
+        let args = ["solve", "--problem", "v.toml", "--mesh", &format!("structured:{n}")];
+        let (code, _, err) = run(&format!("part-at-vertex-{n}"), SQUARE, &[edit], &args);
+        assert_eq!(code, 0, "{n}: {err}");
+    }
+}
