@@ -657,6 +657,36 @@ fn a_second_manifest_with_other_runs_is_refused_while_the_first_computes() {
     assert_eq!(consistent(&study), ["a"]);
 }
 
+/// Battery 6, finding 5: the provenance lists the hash of every input a stored run read (its
+/// meshes' and problem files'); one zeroed by hand is a fault of `provenance.json` for `run`,
+/// `drift` and `figures`, not "kept".
+#[test]
+fn a_provenance_without_the_hash_of_an_input_a_run_read_is_refused() {
+    let dir = tmp("provenance-inputs");
+    let problems = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/problems/ex71.toml");
+    std::fs::create_dir_all(dir.join("problems")).unwrap();
+    std::fs::copy(problems, dir.join("problems/p.toml")).unwrap();
+    let m = manifest(&dir, &STUDY.replace("problem = \"ex71\"", "problem = \"problems/p.toml\""));
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_eq!(code, 0, "{out}");
+    let prov = results_of(&dir).join("provenance.json");
+    let text = std::fs::read_to_string(&prov).unwrap();
+    let mut p: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let hash = p["problem_files"][0]["sha256"].as_str().unwrap().to_string();
+    p["problem_files"][0]["sha256"] = serde_json::json!("0".repeat(64));
+    std::fs::write(&prov, serde_json::to_string_pretty(&p).unwrap() + "\n").unwrap();
+    let says = format!("does not hold the sha256 {} of the input problems/p.toml that run a read", &hash[..12]);
+    for (code, out) in drift_and_figures(&dir) {
+        assert!(code != 0 && out.contains("provenance.json") && out.contains(&says), "{out}");
+    }
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert!(code != 0 && out.contains("provenance.json") && out.contains(&says) && !out.contains("finished earlier, kept"), "{out}");
+    // --replace writes the provenance again from the manifest
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results", "--replace"]);
+    assert_eq!(code, 0, "{out}");
+    assert!(std::fs::read_to_string(&prov).unwrap().contains(&hash));
+}
+
 /// Battery 5, finding 17: where a stored run has another spec than the manifest declares, the
 /// advice `figures` gives is a command that completes the study when followed (a plain `run`
 /// refuses such a run: the advice carries --replace).

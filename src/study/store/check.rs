@@ -196,10 +196,25 @@ pub fn summary_faults(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<Fa
         Err(e) => fault(&prov, format!("cannot be read ({e})")),
         Ok(p) if p.runs != ids => fault(&prov, format!("lists the runs {}, the records are {}", p.runs.join(" "), ids.join(" "))),
         Ok(p) if p.study != study => fault(&prov, format!("is the provenance of study {}, not {study}", p.study)),
-        Ok(_) => {}
+        Ok(p) => {
+            if let Some((run, file, hash)) = input_not_in(&p, runs) {
+                fault(&prov, format!("does not hold the sha256 {} of the input {file} that run {run} read", &hash[..hash.len().min(12)]))
+            }
+        }
     }
     out.extend(by_run);
     out
+}
+
+/// The first input a record read (its `inputs`: problem or mesh file and hash) whose hash the
+/// provenance does not list among its meshes' and problem files' (an edited provenance; the
+/// provenance may list more, the inputs of declared runs not stored yet).
+pub(super) fn input_not_in<'r>(p: &Provenance, runs: &'r [RunRecord]) -> Option<(&'r str, &'r str, &'r str)> {
+    let listed: std::collections::BTreeSet<&str> =
+        p.mesh_sha256.values().map(String::as_str).chain(p.problem_files.iter().filter_map(|f| f.sha256.as_deref())).collect();
+    runs.iter()
+        .flat_map(|r| r.run.inputs.iter().map(move |(file, hash)| (r.run.id.as_str(), file.as_str(), hash.as_str())))
+        .find(|(_, _, hash)| !listed.contains(hash))
 }
 
 /// The runs whose rows in `levels.csv` (`on_disk`, which differs from what the records render)

@@ -134,7 +134,7 @@ impl Writer<'_> {
 
     /// Make `levels.csv` and `provenance.json` describe exactly `runs` (the runs present), writing
     /// only what would change: the CSV when its bytes differ, the provenance when it is missing,
-    /// unreadable or lists other runs. (A provenance records who computed the runs; a process that
+    /// unreadable, lists other runs or lacks the hash of an input they read. (A provenance records who computed the runs; a process that
     /// computed none of them has nothing to add to it.) Both are written together.
     pub fn sync_summaries(&self, manifest: &Manifest, runs: &[RunRecord], quick: bool) -> Result<()> {
         let dir = &self.store.dir;
@@ -144,7 +144,8 @@ impl Writer<'_> {
             batch.add(&dir.csv_file(), &csv)?;
         }
         let ids: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
-        if self.store.provenance().ok().map(|p| p.runs).as_ref() != Some(&ids) {
+        let stale = |p: Provenance| p.runs != ids || super::check::input_not_in(&p, runs).is_some();
+        if self.store.provenance().map_or(true, stale) {
             batch.add_json(&dir.provenance_file(), &provenance_of(manifest, runs, quick))?;
         }
         Ok(batch.commit()?)
