@@ -7,7 +7,9 @@
 //! same. Both are certified solutions of the wrong problem, and the error rates only look poor.
 //!
 //! The derivatives are taken by central differences at the centroids of up to [`SAMPLES`]
-//! triangles spread over the mesh, with the steps `s` and `s / 2`, `s` a thousandth of the
+//! triangles spread over the mesh, and the body force also at every point where the assembly
+//! evaluates it on this mesh (`fem::assembly::load_points`: whatever f the discrete problem
+//! sees is checked), with the steps `s` and `s / 2`, `s` a thousandth of the
 //! triangle's longest edge. A central difference is second-order, so the two steps differ by
 //! about 3/4 of the larger one's error; a mismatch is reported only where it exceeds
 //! [`CONSISTENT`] times the data's scale and [`BEYOND`] times that difference. Where a kink of
@@ -101,16 +103,31 @@ fn central(f: &dyn Fn([f64; 2]) -> f64, x: [f64; 2], j: usize, s: f64) -> f64 {
     (f(a) - f(b)) / (2.0 * s)
 }
 
-/// The centroid of every sampled triangle and its step (a thousandth of its longest edge).
-fn points(mesh: &Mesh) -> Vec<([f64; 2], f64)> {
-    let n = mesh.n_triangles();
+/// The difference step of every triangle: a thousandth of its longest edge, and at least 1e-6
+/// of the body's size (round-off in the differences stays far below the mismatches reported, on
+/// the smallest triangles of a graded mesh too).
+fn steps(mesh: &Mesh) -> Vec<f64> {
     let (lo, hi) = mesh.vertices.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), v| {
         ([lo[0].min(v[0]), lo[1].min(v[1])], [hi[0].max(v[0]), hi[1].max(v[1])])
     });
-    // a step of at least 1e-6 of the body's size: round-off in the differences stays far below
-    // the mismatches reported, on the smallest triangles of a graded mesh too
     let diameter = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+    (0..mesh.n_triangles())
+        .map(|k| {
+            let t = mesh.triangles[k].map(|v| mesh.vertices[v]);
+            let longest = (0..3).map(|e| (t[e][0] - t[(e + 1) % 3][0]).hypot(t[e][1] - t[(e + 1) % 3][1])).fold(0.0, f64::max);
+            1e-3 * longest.max(1e-3 * diameter)
+        })
+        .collect()
+}
+
+/// The centroid of every sampled triangle and its step ([`steps`]).
+fn points(mesh: &Mesh) -> Vec<([f64; 2], f64)> {
+    let n = mesh.n_triangles();
     let picks = SAMPLES.min(n);
+    let (lo, hi) = mesh.vertices.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), v| {
+        ([lo[0].min(v[0]), lo[1].min(v[1])], [hi[0].max(v[0]), hi[1].max(v[1])])
+    });
+    let diameter = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
     (0..picks)
         .map(|k| {
             let t = mesh.triangles[k * n / picks].map(|v| mesh.vertices[v]);
@@ -119,13 +136,6 @@ fn points(mesh: &Mesh) -> Vec<([f64; 2], f64)> {
             (c, 1e-3 * longest.max(1e-3 * diameter))
         })
         .collect()
-}
-
-/// The first contradicting sample of a list (by point), with how many contradict.
-fn first_contradiction(samples: &[Sample]) -> Option<(&Sample, usize)> {
-    let scale = samples.iter().flat_map(|s| [s.declared.abs(), s.fine.abs()]).filter(|v| v.is_finite()).fold(0.0, f64::max);
-    let bad: Vec<&Sample> = samples.iter().filter(|s| s.contradicts(scale)).collect();
-    bad.first().map(|s| (*s, bad.len()))
 }
 
 /// What a problem states (`declared`) against a difference quotient (`differenced` at a point
@@ -139,19 +149,43 @@ struct Mismatch {
     count: usize,
 }
 
-fn compare(pts: &[([f64; 2], f64)], declared: &dyn Fn([f64; 2]) -> f64, differenced: &dyn Fn([f64; 2], f64) -> f64) -> Option<Mismatch> {
-    let samples: Vec<Sample> = pts
+type Declared<'a> = &'a (dyn Fn([f64; 2]) -> f64 + Sync);
+type Differenced<'a> = &'a (dyn Fn([f64; 2], f64) -> f64 + Sync);
+
+/// The declared value and the finer step's quotient at every point (in parallel: the body force
+/// is compared at every quadrature point of the load), then the coarser step only where the
+/// finer one is off by more than [`CONSISTENT`] times the scale, the largest value over the
+/// points: a contradiction needs both steps, and elsewhere the answer is already no.
+fn compare(pts: &[([f64; 2], f64)], declared: Declared, differenced: Differenced) -> Option<Mismatch> {
+    use rayon::prelude::*;
+    let first: Vec<(f64, f64)> = pts.par_iter().map(|&(at, s)| (declared(at), differenced(at, s / 2.0))).collect();
+    let scale = first.iter().flat_map(|&(d, f)| [d.abs(), f.abs()]).filter(|v| v.is_finite()).fold(0.0, f64::max);
+    let bad: Vec<Sample> = pts
         .iter()
-        .map(|&(at, s)| Sample { at, declared: declared(at), coarse: differenced(at, s), fine: differenced(at, s / 2.0), step: s })
+        .zip(&first)
+        .filter(|(_, (d, f))| (f - d).abs() > CONSISTENT * scale)
+        .map(|(&(at, s), &(declared, fine))| Sample { at, declared, coarse: differenced(at, s), fine, step: s })
+        .filter(|sample| sample.contradicts(scale))
         .collect();
-    first_contradiction(&samples).map(|(s, count)| Mismatch {
+    bad.first().map(|s| Mismatch {
         at: s.at,
         declared: s.declared,
         differenced: s.fine,
         step: s.step,
         spread: (s.coarse - s.fine).abs(),
-        count,
+        count: bad.len(),
     })
+}
+
+/// The points where the body force is compared: the sampled centroids, and every point where
+/// the assembly evaluates f on this mesh ([`crate::fem::assembly::load_points`]), each with the
+/// step of its triangle. Whatever value of f the discrete problem sees is checked, so a file is
+/// not accepted on one mesh and refused on another for a mismatch between samples (battery 6).
+fn load_points(mesh: &Mesh, problem: &dyn Problem) -> Vec<([f64; 2], f64)> {
+    let steps = steps(mesh);
+    let mut pts = points(mesh);
+    pts.extend(crate::fem::assembly::load_points(mesh, &problem.load_breaks()).into_iter().map(|(t, x)| (x, steps[t])));
+    pts
 }
 
 /// Check `problem`'s exact solution, if it has one, on `mesh` (see the module docs).
@@ -184,6 +218,7 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Resul
         }
     }
     let material = problem.material();
+    let loads = load_points(mesh, problem);
     for i in 0..2 {
         // (sigma e_j)_i = sigma_ij: -div sigma(u)_i = -sum_j d/dx_j (sigma(grad) e_j)_i
         let minus_div = |x: [f64; 2], s: f64| -> f64 {
@@ -196,8 +231,9 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Resul
                 .sum();
             -div
         };
-        if let Some(m) = compare(&pts, &|at| problem.body_force(at)[i], &minus_div) {
+        if let Some(m) = compare(&loads, &|at| problem.body_force(at)[i], &minus_div) {
             let Mismatch { at, declared, differenced, step, spread, count } = m;
+            let sampled = loads.len();
             return Err(ExactError::BodyForce { problem: problem_name(), at, i, declared, differenced, step, spread, count, sampled });
         }
     }
