@@ -314,7 +314,7 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
         let corners = mesh.corners(t);
         let map = Affine::new(corners);
         e.k = element_stiffness(&map, material, &stiff_rule);
-        e.f = element_load(&map, corners, problem, &breaks, &load_rule, &load_basis);
+        e.f = element_load(&map, corners, &|x| problem.body_force(x), &breaks, &load_rule, &load_basis);
         let el = &nodes.elements[t];
         rotate(&mut e.k, Some(&mut e.f), el, dofs);
         e.locate(el, dofs, &dirichlet);
@@ -337,24 +337,60 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
     System { matrix, rhs, dirichlet }
 }
 
+/// Every point where [`assemble`] evaluates the body force, with its triangle: the load rule's
+/// points, or the piecewise rule's across a load break (`breaks`, the problem's
+/// `load_breaks`). Enumerated by [`element_load`] itself, so the exact solution's consistency
+/// check (`crate::contact::consistent`) sees every value of f the discrete problem sees.
+pub fn load_points(mesh: &Mesh, breaks: &[f64]) -> Vec<(usize, [f64; 2])> {
+    let load_rule = element::triangle_rule(LOAD_DEGREE);
+    let load_basis: Vec<[f64; N_NODES]> = load_rule.points.iter().map(|q| element::p2_values(q[0], q[1])).collect();
+    let mut out = Vec::new();
+    for t in 0..mesh.n_triangles() {
+        let corners = mesh.corners(t);
+        let seen = std::cell::RefCell::new(Vec::new());
+        let record = |x: [f64; 2]| {
+            seen.borrow_mut().push(x);
+            [0.0; 2]
+        };
+        element_load(&Affine::new(corners), corners, &record, breaks, &load_rule, &load_basis);
+        out.extend(seen.into_inner().into_iter().map(|x| (t, x)));
+    }
+    out
+}
+
+/// The points where [`assemble`] evaluates the Neumann traction on the boundary edge from `a`
+/// to `b`: (parameter s in [0, 1], Gauss weight, point).
+pub fn edge_points(a: [f64; 2], b: [f64; 2]) -> Vec<(f64, f64, [f64; 2])> {
+    let gauss = element::gauss_legendre(EDGE_POINTS);
+    gauss
+        .points
+        .iter()
+        .zip(&gauss.weights)
+        .map(|(s, &w)| {
+            let s = s[0];
+            (s, w, [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])])
+        })
+        .collect()
+}
+
 /// The body-force load int_T f phi_a of one triangle, local order `2 a + i` (Cartesian): the
 /// rule `load_rule` (with its P2 values `load_basis`), or piecewise across a load break.
 fn element_load(
     map: &Affine,
     corners: [[f64; 2]; 3],
-    problem: &dyn Problem,
+    body_force: &dyn Fn([f64; 2]) -> [f64; 2],
     breaks: &[f64],
     load_rule: &element::Rule<2>,
     load_basis: &[[f64; N_NODES]],
 ) -> [f64; 12] {
     let crossing = breaks.iter().find(|&&c| corners.iter().any(|v| v[0] < c) && corners.iter().any(|v| v[0] > c));
     if let Some(&c) = crossing {
-        return split_load(map, corners, c, &|x| problem.body_force(x));
+        return split_load(map, corners, c, body_force);
     }
     let mut f = [0.0; 12];
     let area = map.det.abs();
     for ((q, w), phi) in load_rule.points.iter().zip(&load_rule.weights).zip(load_basis) {
-        let fx = problem.body_force(map.map(*q));
+        let fx = body_force(map.map(*q));
         let (f0, f1) = (w * area * fx[0], w * area * fx[1]);
         for (a, &p) in phi.iter().enumerate() {
             f[2 * a] += f0 * p;
@@ -377,7 +413,6 @@ pub fn point_reactions(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dy
     let load_rule = element::triangle_rule(LOAD_DEGREE);
     let load_basis: Vec<[f64; N_NODES]> = load_rule.points.iter().map(|q| element::p2_values(q[0], q[1])).collect();
     let breaks = problem.load_breaks();
-    let gauss = element::gauss_legendre(EDGE_POINTS);
     dofs.points
         .iter()
         .map(|&(p, _)| {
@@ -387,7 +422,7 @@ pub fn point_reactions(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dy
                 let corners = mesh.corners(t);
                 let map = Affine::new(corners);
                 let k = element_stiffness(&map, problem.material(), &stiff_rule);
-                let f = element_load(&map, corners, problem, &breaks, &load_rule, &load_basis);
+                let f = element_load(&map, corners, &|x| problem.body_force(x), &breaks, &load_rule, &load_basis);
                 for (i, ri) in r.iter_mut().enumerate() {
                     let row = 2 * a + i;
                     *ri += (0..12).map(|l| k[row][l] * u[el[l / 2]][l % 2]).sum::<f64>() - f[row];
@@ -397,10 +432,9 @@ pub fn point_reactions(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dy
                 let Some(i) = bn.iter().position(|&q| q == p).filter(|_| be.part == Part::Neumann) else { continue };
                 let (a, b) = (mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
                 let (normal, len) = edge_normal(a, b);
-                for (s, w) in gauss.points.iter().zip(&gauss.weights) {
-                    let x = [a[0] + s[0] * (b[0] - a[0]), a[1] + s[0] * (b[1] - a[1])];
+                for (s, w, x) in edge_points(a, b) {
                     let g = problem.traction(x, normal);
-                    let phi = edge_basis(s[0])[i];
+                    let phi = edge_basis(s)[i];
                     r[0] -= w * len * g[0] * phi;
                     r[1] -= w * len * g[1] * phi;
                 }
@@ -684,7 +718,6 @@ pub fn edge_normal(a: [f64; 2], b: [f64; 2]) -> ([f64; 2], f64) {
 }
 
 fn neumann_load(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem, rhs: &mut [f64]) {
-    let gauss = element::gauss_legendre(EDGE_POINTS);
     for (be, bn) in mesh.boundary.iter().zip(&nodes.boundary_nodes) {
         if be.part != Part::Neumann {
             continue;
@@ -692,9 +725,7 @@ fn neumann_load(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
         let (a, b) = (mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
         let (normal, len) = edge_normal(a, b);
         let mut load = [[0.0; 2]; 3];
-        for (s, w) in gauss.points.iter().zip(&gauss.weights) {
-            let s = s[0];
-            let x = [a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1])];
+        for (s, w, x) in edge_points(a, b) {
             let g = problem.traction(x, normal);
             let phi = edge_basis(s);
             for i in 0..3 {

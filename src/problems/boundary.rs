@@ -40,6 +40,19 @@ impl Curve {
         }
     }
 
+    /// The unit normal of the curve at its point closest to `x`, pointing away from the circle's
+    /// centre (`None` at the centre, where it has no direction). Which side is the body's outside
+    /// the mesh decides: turn it to agree with the boundary edge's outward normal.
+    pub fn normal(&self, x: [f64; 2]) -> Option<[f64; 2]> {
+        match *self {
+            Curve::Circle { centre, .. } => {
+                let d = [x[0] - centre[0], x[1] - centre[1]];
+                let r = d[0].hypot(d[1]);
+                (r > 0.0).then(|| [d[0] / r, d[1] / r])
+            }
+        }
+    }
+
     /// The distance from `x` to the curve, relative to its size (the circle's radius).
     pub fn relative_distance(&self, x: [f64; 2]) -> f64 {
         match *self {

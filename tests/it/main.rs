@@ -20,6 +20,7 @@ mod bad_trust;
 mod cholesky;
 mod claims_criteria;
 mod cli_output;
+mod consistent_exact;
 mod convergence;
 mod doc_commands;
 mod drift;

@@ -6,34 +6,57 @@
 //! exact solution of another problem, and errors that never converge (battery: chi = -0.05 in
 //! Example 7.1 kept the error at 5e-2 on every mesh, certified).
 //!
-//! Sampled at the midpoints of up to [`super::SAMPLES`] straight boundary edges of each part,
-//! spread over the numbering (an edge on a curve is left out: its midpoint is off the curve and
-//! its normal is the chord's). A value off by more than [`super::CONSISTENT`] times the scale of
-//! what it is compared with (the largest |u| or |sigma n| over the samples) is a contradiction.
+//! Checked on every boundary edge of the mesh at every point where the discrete problem reads
+//! the data there: its end points and midpoint (the P2 nodes, where the Dirichlet data, the gap
+//! and the contact normal are taken) and the Gauss points of the traction
+//! ([`crate::fem::assembly::edge_points`]). An edge on a curve (`[curves]`) is checked at the
+//! curve's points closest to those, with the curve's own normal: its chord is off the curve, and
+//! the chord's normal is not the body's (battery 6: tension on a contact arc was certified when
+//! curved edges were left out). The points depend on the mesh, but every value of the data the
+//! discrete problem sees is checked (battery 6: a bump in the Dirichlet data between sampled
+//! midpoints passed on some meshes). A value off by more than [`super::CONSISTENT`] times the
+//! scale of what it is compared with (the largest |u| or |sigma n| over the points) is a
+//! contradiction.
 
-use super::{CONSISTENT, ExactError, SAMPLES};
+use super::{CONSISTENT, ExactError};
+use crate::fem::assembly::edge_points;
 use crate::mesh::{Mesh, P2Nodes};
-use crate::problems::{Exact, Part, Problem};
+use crate::problems::{Curve, Exact, Part, Problem};
 
-/// A sampled point of a straight boundary edge: the midpoint, the outward normal, the part.
+/// A checked point of a boundary edge: where, the body's outward normal there, the part.
 struct Point {
     at: [f64; 2],
     normal: [f64; 2],
     part: Part,
 }
 
+/// The point of `curve` closest to `x` and the curve's normal there, turned to agree with the
+/// chord's outward normal `chord` (the chord's own where the curve has no normal).
+fn on_curve(curve: &Curve, x: [f64; 2], chord: [f64; 2]) -> ([f64; 2], [f64; 2]) {
+    let at = curve.project(x);
+    let n = match curve.normal(at) {
+        Some(n) if n[0] * chord[0] + n[1] * chord[1] < 0.0 => [-n[0], -n[1]],
+        Some(n) => n,
+        None => chord,
+    };
+    (at, n)
+}
+
+/// Every checked point (see the module docs), edge by edge.
 fn sample(mesh: &Mesh, nodes: &P2Nodes) -> Vec<Point> {
     let normals = super::super::plausible::outward_normals(mesh, nodes);
     let mut out = Vec::new();
-    for part in [Part::Dirichlet, Part::Neumann, Part::Contact] {
-        let edges: Vec<usize> =
-            (0..mesh.boundary.len()).filter(|&b| mesh.boundary[b].part == part && mesh.boundary[b].curve.is_none()).collect();
-        let picks = SAMPLES.min(edges.len());
-        out.extend((0..picks).map(|k| {
-            let b = edges[k * edges.len() / picks];
-            let [p, q] = mesh.boundary[b].v.map(|v| mesh.vertices[v]);
-            Point { at: [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])], normal: normals[b], part }
-        }));
+    for (b, edge) in mesh.boundary.iter().enumerate() {
+        let [p, q] = edge.v.map(|v| mesh.vertices[v]);
+        let mid = [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])];
+        let chord = normals[b];
+        for x in [p, q, mid].into_iter().chain(edge_points(p, q).into_iter().map(|(_, _, x)| x)) {
+            let (at, normal) = match &edge.curve {
+                None => (x, chord),
+                Some(curve) => on_curve(curve, x, chord),
+            };
+            out.push(Point { at, normal, part: edge.part });
+        }
     }
     out
 }

@@ -7,7 +7,9 @@
 //! same. Both are certified solutions of the wrong problem, and the error rates only look poor.
 //!
 //! The derivatives are taken by central differences at the centroids of up to [`SAMPLES`]
-//! triangles spread over the mesh, with the steps `s` and `s / 2`, `s` a thousandth of the
+//! triangles spread over the mesh, and the body force also at every point where the assembly
+//! evaluates it on this mesh (`fem::assembly::load_points`: whatever f the discrete problem
+//! sees is checked), with the steps `s` and `s / 2`, `s` a thousandth of the
 //! triangle's longest edge. A central difference is second-order, so the two steps differ by
 //! about 3/4 of the larger one's error; a mismatch is reported only where it exceeds
 //! [`CONSISTENT`] times the data's scale and [`BEYOND`] times that difference. Where a kink of
@@ -21,7 +23,7 @@
 mod boundary;
 
 use crate::mesh::{Mesh, P2Nodes};
-use crate::problems::Problem;
+use crate::problems::{Exact, Material, Problem};
 
 /// Triangles sampled (spread evenly over the mesh's numbering).
 pub const SAMPLES: usize = 97;
@@ -101,31 +103,35 @@ fn central(f: &dyn Fn([f64; 2]) -> f64, x: [f64; 2], j: usize, s: f64) -> f64 {
     (f(a) - f(b)) / (2.0 * s)
 }
 
-/// The centroid of every sampled triangle and its step (a thousandth of its longest edge).
-fn points(mesh: &Mesh) -> Vec<([f64; 2], f64)> {
-    let n = mesh.n_triangles();
+/// The difference step of every triangle: a thousandth of its longest edge, and at least 1e-6
+/// of the body's size (round-off in the differences stays far below the mismatches reported, on
+/// the smallest triangles of a graded mesh too).
+fn steps(mesh: &Mesh) -> Vec<f64> {
     let (lo, hi) = mesh.vertices.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), v| {
         ([lo[0].min(v[0]), lo[1].min(v[1])], [hi[0].max(v[0]), hi[1].max(v[1])])
     });
-    // a step of at least 1e-6 of the body's size: round-off in the differences stays far below
-    // the mismatches reported, on the smallest triangles of a graded mesh too
     let diameter = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
-    let picks = SAMPLES.min(n);
-    (0..picks)
+    (0..mesh.n_triangles())
         .map(|k| {
-            let t = mesh.triangles[k * n / picks].map(|v| mesh.vertices[v]);
-            let c = [(t[0][0] + t[1][0] + t[2][0]) / 3.0, (t[0][1] + t[1][1] + t[2][1]) / 3.0];
+            let t = mesh.triangles[k].map(|v| mesh.vertices[v]);
             let longest = (0..3).map(|e| (t[e][0] - t[(e + 1) % 3][0]).hypot(t[e][1] - t[(e + 1) % 3][1])).fold(0.0, f64::max);
-            (c, 1e-3 * longest.max(1e-3 * diameter))
+            1e-3 * longest.max(1e-3 * diameter)
         })
         .collect()
 }
 
-/// The first contradicting sample of a list (by point), with how many contradict.
-fn first_contradiction(samples: &[Sample]) -> Option<(&Sample, usize)> {
-    let scale = samples.iter().flat_map(|s| [s.declared.abs(), s.fine.abs()]).filter(|v| v.is_finite()).fold(0.0, f64::max);
-    let bad: Vec<&Sample> = samples.iter().filter(|s| s.contradicts(scale)).collect();
-    bad.first().map(|s| (*s, bad.len()))
+/// The centroid of every sampled triangle and its step ([`steps`]).
+fn points(mesh: &Mesh) -> Vec<([f64; 2], f64)> {
+    let n = mesh.n_triangles();
+    let picks = SAMPLES.min(n);
+    let steps = steps(mesh);
+    (0..picks)
+        .map(|k| {
+            let t = mesh.triangles[k * n / picks].map(|v| mesh.vertices[v]);
+            let c = [(t[0][0] + t[1][0] + t[2][0]) / 3.0, (t[0][1] + t[1][1] + t[2][1]) / 3.0];
+            (c, steps[k * n / picks])
+        })
+        .collect()
 }
 
 /// What a problem states (`declared`) against a difference quotient (`differenced` at a point
@@ -139,19 +145,67 @@ struct Mismatch {
     count: usize,
 }
 
-fn compare(pts: &[([f64; 2], f64)], declared: &dyn Fn([f64; 2]) -> f64, differenced: &dyn Fn([f64; 2], f64) -> f64) -> Option<Mismatch> {
-    let samples: Vec<Sample> = pts
+type Declared<'a> = &'a (dyn Fn([f64; 2]) -> f64 + Sync);
+type Differenced<'a> = &'a (dyn Fn([f64; 2], f64) -> f64 + Sync);
+
+/// The declared value and the finer step's quotient at every point (in parallel: the body force
+/// is compared at every quadrature point of the load), then the coarser step only where the
+/// finer one is off by more than [`CONSISTENT`] times the scale, the largest value over the
+/// points: a contradiction needs both steps, and elsewhere the answer is already no.
+fn compare(pts: &[([f64; 2], f64)], declared: Declared, differenced: Differenced) -> Option<Mismatch> {
+    use rayon::prelude::*;
+    let first: Vec<(f64, f64)> = pts.par_iter().map(|&(at, s)| (declared(at), differenced(at, s / 2.0))).collect();
+    judge(pts, &first, differenced)
+}
+
+/// The first contradiction among `pts`, given the declared value and the finer step's quotient
+/// at each (`first`): the coarser step is taken only where the finer one is off (see [`compare`]).
+fn judge(pts: &[([f64; 2], f64)], first: &[(f64, f64)], differenced: Differenced) -> Option<Mismatch> {
+    let scale = first.iter().flat_map(|&(d, f)| [d.abs(), f.abs()]).filter(|v| v.is_finite()).fold(0.0, f64::max);
+    let bad: Vec<Sample> = pts
         .iter()
-        .map(|&(at, s)| Sample { at, declared: declared(at), coarse: differenced(at, s), fine: differenced(at, s / 2.0), step: s })
+        .zip(first)
+        .filter(|(_, (d, f))| (f - d).abs() > CONSISTENT * scale)
+        .map(|(&(at, s), &(declared, fine))| Sample { at, declared, coarse: differenced(at, s), fine, step: s })
+        .filter(|sample| sample.contradicts(scale))
         .collect();
-    first_contradiction(&samples).map(|(s, count)| Mismatch {
+    bad.first().map(|s| Mismatch {
         at: s.at,
         declared: s.declared,
         differenced: s.fine,
         step: s.step,
         spread: (s.coarse - s.fine).abs(),
-        count,
+        count: bad.len(),
     })
+}
+
+/// -div sigma(u) at `x` by central differences of sigma(exact.grad) with step `s`, both
+/// components from the same four gradients ((sigma e_j)_i = sigma_ij).
+fn minus_div(material: &Material, exact: &dyn Exact, x: [f64; 2], s: f64) -> [f64; 2] {
+    let mut div = [0.0; 2];
+    for j in 0..2 {
+        let mut e = [0.0; 2];
+        e[j] = 1.0;
+        let (mut a, mut b) = (x, x);
+        a[j] += s;
+        b[j] -= s;
+        let (ta, tb) = (material.traction(exact.grad(a), e), material.traction(exact.grad(b), e));
+        for i in 0..2 {
+            div[i] += (ta[i] - tb[i]) / (2.0 * s);
+        }
+    }
+    [-div[0], -div[1]]
+}
+
+/// The points where the body force is compared: the sampled centroids, and every point where
+/// the assembly evaluates f on this mesh ([`crate::fem::assembly::load_points`]), each with the
+/// step of its triangle. Whatever value of f the discrete problem sees is checked, so a file is
+/// not accepted on one mesh and refused on another for a mismatch between samples (battery 6).
+fn load_points(mesh: &Mesh, problem: &dyn Problem, centroids: &[([f64; 2], f64)]) -> Vec<([f64; 2], f64)> {
+    let steps = steps(mesh);
+    let mut pts = centroids.to_vec();
+    pts.extend(crate::fem::assembly::load_points(mesh, &problem.load_breaks()).into_iter().map(|(t, x)| (x, steps[t])));
+    pts
 }
 
 /// Check `problem`'s exact solution, if it has one, on `mesh` (see the module docs).
@@ -184,20 +238,16 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Resul
         }
     }
     let material = problem.material();
+    let loads = load_points(mesh, problem, &pts);
+    let first: Vec<([f64; 2], [f64; 2])> = {
+        use rayon::prelude::*;
+        loads.par_iter().map(|&(at, s)| (problem.body_force(at), minus_div(&material, exact, at, s / 2.0))).collect()
+    };
     for i in 0..2 {
-        // (sigma e_j)_i = sigma_ij: -div sigma(u)_i = -sum_j d/dx_j (sigma(grad) e_j)_i
-        let minus_div = |x: [f64; 2], s: f64| -> f64 {
-            let div: f64 = (0..2)
-                .map(|j| {
-                    let mut e = [0.0; 2];
-                    e[j] = 1.0;
-                    central(&|y| material.traction(exact.grad(y), e)[i], x, j, s)
-                })
-                .sum();
-            -div
-        };
-        if let Some(m) = compare(&pts, &|at| problem.body_force(at)[i], &minus_div) {
+        let first_i: Vec<(f64, f64)> = first.iter().map(|(f, d)| (f[i], d[i])).collect();
+        if let Some(m) = judge(&loads, &first_i, &|at, s| minus_div(&material, exact, at, s)[i]) {
             let Mismatch { at, declared, differenced, step, spread, count } = m;
+            let sampled = loads.len();
             return Err(ExactError::BodyForce { problem: problem_name(), at, i, declared, differenced, step, spread, count, sampled });
         }
     }
