@@ -69,7 +69,7 @@ pub enum ExactError {
         sampled: usize,
     },
     #[error(
-        "{problem}: the exact solution does not satisfy {what}: at {x} {detail}, at {count} of {sampled} sampled boundary points; an exact solution must satisfy the problem's boundary and contact conditions (paper eq. 1.1-1.8), or the errors are measured against the solution of another problem",
+        "{problem}: the exact solution does not satisfy {what}: at {x} {detail}, at {count} of {sampled} checked boundary points; an exact solution must satisfy the problem's boundary and contact conditions (paper eq. 1.1-1.8), or the errors are measured against the solution of another problem",
         x = crate::base::number::point(*.at)
     )]
     Boundary { problem: String, what: String, at: [f64; 2], detail: String, count: usize, sampled: usize },
