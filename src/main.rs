@@ -338,8 +338,13 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
     let estimator = args.estimator.config();
     let adaptive = args.adapt_levels.is_some() || args.adapt_min_ndof.is_some();
     let theta = args.theta;
-    let config =
-        AdaptConfig { levels: args.adapt_levels.map_or(200, |l| l + 1), theta, estimator, pdas: pdas.clone(), ..Default::default() };
+    let config = AdaptConfig {
+        levels: args.adapt_levels.map_or(200, |l| l.saturating_add(1)),
+        theta,
+        estimator,
+        pdas: pdas.clone(),
+        ..Default::default()
+    };
     validate("solve", &config, &spec)?;
     signorini::memory::check_memory(&spec.to_string(), spec.ndof()?)?;
     if let Some(n) = args.adapt_min_ndof {

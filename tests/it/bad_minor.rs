@@ -281,3 +281,14 @@ fn bad_part_ending_inside_an_edge_is_refused_where_the_grid_misses_it() {
         assert_eq!(code, 0, "{n}: {err}");
     }
 }
+
+/// Battery 6, finding 9: `--adapt-levels` at the largest integer wrapped to 0 levels ("expected a
+/// number of levels >= 1, got 0"); it is as many levels as --adapt-min-ndof needs.
+#[test]
+fn bad_adapt_levels_at_the_largest_integer_does_not_wrap() {
+    let args =
+        ["solve", "--problem", "ex71", "--mesh", "structured:2", "--adapt-levels", "18446744073709551615", "--adapt-min-ndof", "200"];
+    let (code, out, err) = run("levels-max", SQUARE, &[], &args);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(!err.contains("got 0"), "{err}");
+}
