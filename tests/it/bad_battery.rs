@@ -45,12 +45,9 @@ fn run(name: &str, base: &str, from: &str, to: &str, args: &[&str]) -> (i32, Str
     std::fs::write(dir.join("v.toml"), text.replace(from, to)).unwrap();
     std::fs::write(dir.join("qd.msh"), fixture("gmsh_renumbered/plain.msh")).unwrap();
     std::fs::write(dir.join("sq.msh"), fixture("square.msh")).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_signorini")).current_dir(&dir).args(args).output().unwrap();
-    let (out, err) = (String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned());
-    assert!(!err.contains("panicked"), "{name}: {err}");
-    let code = o.status.code().unwrap_or_else(|| panic!("{name}: killed by a signal\n{err}"));
+    let answer = crate::common::signorini_in(&dir, args);
     std::fs::remove_dir_all(&dir).ok();
-    (code, out, err)
+    answer
 }
 
 const QD: &str = "gmsh_renumbered/quarter_disc.toml";

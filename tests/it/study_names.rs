@@ -8,7 +8,7 @@
 use signorini::analysis::roles::NEEDED;
 use signorini::analysis::{problem_names, studies};
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 fn repo() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -16,17 +16,6 @@ fn repo() -> &'static Path {
 
 /// The files that define names: study-name literals are written there and nowhere else.
 const DEFINITIONS: [&str; 2] = ["src/analysis/studies.rs", "src/analysis/problem_names.rs"];
-
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for e in std::fs::read_dir(dir).unwrap().flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            rust_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
-}
 
 /// The string literals of Rust source `text` (their contents, unescaped only as far as `\"`),
 /// each with its line: comments, char literals and lifetimes are skipped; raw strings are read.
@@ -117,7 +106,7 @@ fn declared() -> BTreeSet<String> {
 fn literal_uses(names: &BTreeSet<String>) -> Vec<String> {
     let mut files = Vec::new();
     for dir in ["src/analysis", "src/plot"] {
-        rust_files(&repo().join(dir), &mut files);
+        crate::layers::rust_files(&repo().join(dir), &mut files);
     }
     files.sort();
     let mut found = Vec::new();

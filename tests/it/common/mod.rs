@@ -55,12 +55,13 @@ pub fn parse_err(text: &str) -> String {
     }
 }
 
-/// (exit code, stdout, stderr) of the binary run in `dir`; a panic is never an answer.
+/// (exit code, stdout, stderr) of the binary run in `dir`; a panic or a signal is never an answer.
 pub fn signorini_in(dir: &std::path::Path, args: &[&str]) -> (i32, String, String) {
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).current_dir(dir).output().unwrap();
     let (stdout, stderr) = (String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned());
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    (out.status.code().unwrap_or(-1), stdout, stderr)
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    let code = out.status.code().unwrap_or_else(|| panic!("{args:?}: killed by a signal\n{stderr}"));
+    (code, stdout, stderr)
 }
 
 /// The run roles the repository's manifests (`experiments/`) declare, checked against what the
