@@ -141,6 +141,20 @@ pub struct Level<'a> {
     pub next_active: Option<&'a [bool]>,
 }
 
+/// Below this fraction of (2 mu + |zeta|) max |u_h| (eta_h's size for an error as large as
+/// u_h itself: the estimator's terms are stresses times lengths) the estimate measures round-off,
+/// not an error. An exact discrete solution (a rigid translation, a linear field) gives about
+/// 1e-13 of it; the deepest stored levels, 1e-5 and more.
+pub const ROUNDOFF_ESTIMATE: f64 = 1e-10;
+
+/// Whether `est`'s eta_h is at round-off ([`ROUNDOFF_ESTIMATE`]): its indicators are noise, and
+/// the maximum strategy marks nothing (the loop stops, `AdaptTermination::NothingMarked`).
+pub fn estimate_at_roundoff(problem: &dyn Problem, sol: &DiscreteSolution, est: &Estimate) -> bool {
+    let m = problem.material();
+    let u_max = sol.u.iter().fold(0.0f64, |a, v| a.max(v[0].abs()).max(v[1].abs()));
+    est.terms.eta_h <= ROUNDOFF_ESTIMATE * (2.0 * m.mu + m.zeta.abs()) * u_max
+}
+
 /// Mark by the maximum strategy: eta_T >= theta max eta_T.
 pub fn mark_maximum(indicators: &[f64], theta: f64) -> Vec<bool> {
     let max = indicators.iter().cloned().fold(0.0, f64::max);
@@ -206,8 +220,9 @@ pub enum AdaptTermination {
     /// The observer returned `ControlFlow::Break` (checked before the other two: an observer that
     /// stops at the last level is reported here).
     StoppedByObserver,
-    /// The estimate of the last level solved is zero on every element: the maximum strategy
-    /// marks nothing, so the next level would be the same mesh again (not solved).
+    /// The estimate of the last level solved is zero on every element, or at round-off
+    /// ([`estimate_at_roundoff`]): the maximum strategy marks nothing, so the next level would
+    /// be the same mesh again (not solved).
     NothingMarked,
 }
 
@@ -223,9 +238,9 @@ impl AdaptTermination {
             AdaptTermination::StopNdofReached => {
                 Some(format!("stopped: the last level has at least stop_ndof = {} unknowns", config.stop_ndof.unwrap_or(0)))
             }
-            AdaptTermination::NothingMarked => Some(
-                "stopped: the estimate is zero on every element, so nothing is marked and the next level would be the same mesh".into(),
-            ),
+            AdaptTermination::NothingMarked => Some(format!(
+                "stopped: the estimate is zero, or at round-off (eta_h at most {ROUNDOFF_ESTIMATE:e} of (2 mu + lambda) max |u_h|: the discrete solution is exact to round-off), so nothing is marked and the next level would be the same mesh"
+            )),
         }
     }
 }
@@ -306,6 +321,7 @@ pub fn solve_level(
     let t_estimate = t0.elapsed().as_secs_f64();
     let error = reference.map(|r| norms::linf_error(mesh, &sol, r));
     let marks = match config.refine {
+        Refine::Adaptive if estimate_at_roundoff(problem, &sol, &est) => vec![false; mesh.n_triangles()],
         Refine::Adaptive => mark_maximum(&est.element, config.theta),
         Refine::Uniform => vec![true; mesh.n_triangles()],
     };

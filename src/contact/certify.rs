@@ -199,6 +199,26 @@ struct Held {
     range: [Option<[f64; 2]>; 2],
 }
 
+/// How wide a range of coordinates may be and still be one line: 1e-9 of the body's size (the
+/// diagonal of the nodes' bounding box, so a mesh far from the origin is judged by its own size,
+/// not by its distance from the origin), plus the round-off of coordinates of that magnitude.
+#[derive(Clone, Copy, Debug)]
+struct LineTolerance(f64);
+
+impl LineTolerance {
+    fn of(coords: &[[f64; 2]]) -> Self {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for x in coords {
+            for d in 0..2 {
+                (lo[d], hi[d]) = (lo[d].min(x[d]), hi[d].max(x[d]));
+            }
+        }
+        let size = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+        let magnitude = coords.iter().fold(0.0f64, |a, x| a.max(x[0].abs()).max(x[1].abs()));
+        LineTolerance((1e-9 * size + 8.0 * f64::EPSILON * magnitude).max(f64::MIN_POSITIVE))
+    }
+}
+
 impl Held {
     fn see(&mut self, p: usize, x: [f64; 2], fixed: [bool; 2]) {
         match self.first {
@@ -213,14 +233,14 @@ impl Held {
     }
 
     /// `None` if the rigid motions are stopped, else what is left free (for the error).
-    fn free_motion(&self, nodes: &P2Nodes, scale: f64) -> Option<String> {
+    fn free_motion(&self, nodes: &P2Nodes, scale: LineTolerance) -> Option<String> {
         let at = |p: usize| format!("({:.6}, {:.6})", nodes.coords[p][0], nodes.coords[p][1]);
         let p = match self.first {
             None => return Some("has no Dirichlet node".to_string()),
             Some(p) if !self.second => return Some(format!("is held at one point only, {}", at(p))),
             Some(p) => p,
         };
-        let on_one_line = |r: [f64; 2]| r[1] - r[0] <= 1e-9 * scale;
+        let on_one_line = |r: [f64; 2]| r[1] - r[0] <= scale.0;
         match self.range {
             [None, _] => Some(format!("has u_1 prescribed nowhere (a horizontal translation is free; first prescribed node {})", at(p))),
             [_, None] => Some(format!("has u_2 prescribed nowhere (a vertical translation is free; first prescribed node {})", at(p))),
@@ -251,7 +271,7 @@ pub fn check_held(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Pro
             }
         }
     }
-    let scale = nodes.coords.iter().fold(0.0f64, |a, x| a.max(x[0].abs()).max(x[1].abs())).max(f64::MIN_POSITIVE);
+    let scale = LineTolerance::of(&nodes.coords);
     let Some((b, triangles, held)) =
         held.iter().enumerate().find_map(|(b, h)| h.free_motion(nodes, scale).map(|why| (b, h.triangles, why)))
     else {

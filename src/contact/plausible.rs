@@ -50,13 +50,23 @@ pub const PRESCRIBED_PENETRATION: f64 = 1e-9;
 #[derive(Debug, thiserror::Error)]
 pub enum ContactDataError {
     #[error(
-        "{problem}: the contact normal (`contact.normal`) at {x} on the contact part ({part}), edge {a}-{b}, is ({nx:.6}, {ny:.6}), {how} the edge's outward normal ({ox:.6}, {oy:.6}) (n . n_out = {dot:.6}, an angle of {angle:.1} degrees): a contact normal must point out of the body, within {max} degrees of the outward normal",
+        "{problem}: the contact normal (`contact.normal`) at {x} on the contact part ({part}), edge {a}-{b}, is ({nx:.6}, {ny:.6}), {how} the edge's outward normal ({ox:.6}, {oy:.6}) (n . n_out = {dot:.6}, an angle of {angle:.1} degrees): a contact normal must point out of the body, within {max} degrees of the outward normal{note}",
         x = point(*.at), a = point(.edge[0]), b = point(.edge[1]),
         nx = .normal[0], ny = .normal[1], ox = .outward[0], oy = .outward[1],
         how = if *.dot < 0.0 { "reversed against" } else { "nearly tangent to the boundary: far from" },
-        angle = .dot.clamp(-1.0, 1.0).acos().to_degrees(), max = MAX_NORMAL_ANGLE_DEGREES
+        angle = .dot.clamp(-1.0, 1.0).acos().to_degrees(), max = MAX_NORMAL_ANGLE_DEGREES,
+        note = .note.as_ref().map_or(String::new(), |n| format!(". {n}"))
     )]
-    Normal { problem: String, part: String, at: [f64; 2], edge: [[f64; 2]; 2], normal: [f64; 2], outward: [f64; 2], dot: f64 },
+    Normal {
+        problem: String,
+        part: String,
+        at: [f64; 2],
+        edge: [[f64; 2]; 2],
+        normal: [f64; 2],
+        outward: [f64; 2],
+        dot: f64,
+        note: Option<String>,
+    },
     #[error(
         "{problem}: the gap `contact.chi` at {x} on the contact part ({part}) is {chi}: the obstacle would overlap the body by more than the body's size (the diameter of the mesh's bounding box, {d}); a gap below minus the body's size is a sign or unit mistake",
         x = point(*.at), chi = shown(*.chi), d = shown(*.diameter)
@@ -138,8 +148,9 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
         {
             let edge = mesh.boundary[b].v.map(|v| mesh.vertices[v]);
             let outward = outward[b].expect("a contact edge");
+            let note = problem.normal_note();
             let (problem, part) = (problem_name(problem), contact_part(problem));
-            return Err(Box::new(ContactDataError::Normal { problem, part, at, edge, normal: c.normal, outward, dot }));
+            return Err(Box::new(ContactDataError::Normal { problem, part, at, edge, normal: c.normal, outward, dot, note }));
         }
         if c.gap < -diameter {
             let (problem, part) = (problem_name(problem), contact_part(problem));

@@ -32,6 +32,26 @@ pub enum SolveError {
     /// A non-zero traction where no boundary edge of the mesh is Neumann: it would be ignored.
     #[error("{problem}: the traction (`traction`) is ({tx}, {ty}) at ({x}, {y}), but no boundary edge of the mesh is in the Neumann part (the problem declares: {}): a traction acts only on Gamma_N and would be ignored; remove `traction` or leave part of the boundary to Neumann", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") }, tx = crate::base::number::shown(.value[0]), ty = crate::base::number::shown(.value[1]), x = crate::base::number::shown(.at[0]), y = crate::base::number::shown(.at[1]))]
     UnusedTraction { problem: String, at: [f64; 2], value: [f64; 2], declared: Vec<String> },
+    /// An entry of the assembled stiffness matrix or load vector overflowed f64's range while
+    /// the data themselves are finite: the problem's scale, not its data, is at fault.
+    #[error("{problem}: the assembled {what} has an entry that is not a finite number (overflow beyond f64's range, about 1.8e308) although every datum is finite: the material (mu = {mu}, zeta = {zeta}) or the loads are too large for this mesh; give them in other units (for example E in GPa instead of Pa) so that the stiffness entries, about mu times a mesh-independent factor, stay well inside the range", mu = crate::base::number::shown(*.mu), zeta = crate::base::number::shown(*.zeta))]
+    Overflow { problem: String, what: &'static str, mu: f64, zeta: f64 },
+}
+
+/// Refuse an assembled system with an entry beyond f64's range ([`SolveError::Overflow`]): the
+/// one check between the data (each finite, `Problem::bad_datum`) and the factorisation, which
+/// would otherwise read the overflow as a matrix that is not positive definite.
+fn check_finite(system: &assembly::System, problem: &dyn Problem) -> Result<(), SolveError> {
+    use rayon::prelude::*;
+    let what = if !system.matrix.values().par_iter().all(|v| v.is_finite()) {
+        "stiffness matrix"
+    } else if !system.rhs.iter().all(|v| v.is_finite()) {
+        "load vector"
+    } else {
+        return Ok(());
+    };
+    let m = problem.material();
+    Err(SolveError::Overflow { problem: super::plausible::problem_name(problem), what, mu: m.mu, zeta: m.zeta })
 }
 
 /// Refuse a traction that would be ignored: where no boundary edge is Neumann, the traction is
@@ -153,12 +173,14 @@ pub fn solve(
         return Err(SolveError::NoContact { declared: problem.declared_parts() });
     }
     unused_traction(mesh, &nodes, problem)?;
-    let System { matrix, rhs, dirichlet } = assembly::assemble(mesh, &nodes, &dofs, problem);
+    let system = assembly::assemble(mesh, &nodes, &dofs, problem);
     // the data were evaluated where they are used (gap and normal in the DofMap, load and
     // Dirichlet data in the assembly): any that was not a finite number stops here
     if let Some(bad) = problem.bad_datum() {
         return Err(SolveError::Data(bad));
     }
+    check_finite(&system, problem)?;
+    let System { matrix, rhs, dirichlet } = system;
     let assembly_time = t0.elapsed().as_secs_f64();
     let strategy = options.strategy.unwrap_or(Strategy::auto(dofs.contact.len(), dofs.n_free));
     // the solver takes the matrix (and releases it before factorising, for the Schur strategy)

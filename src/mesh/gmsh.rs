@@ -197,15 +197,11 @@ fn nodes_by_tag(
         .map_err(fail)?
         .ok_or_else(|| fail("the $Nodes section is not where the file's sections lead".into()))?;
     section.check_against(nodes).map_err(fail)?;
-    // more nodes than tags between the smallest and the largest: some tag is listed twice
+    // The header's counts first, then each tag (our own reader's, which keeps every tag even where
+    // mshio drops a section's contiguous-looking tags): in its range, listed once. A header that
+    // declares more nodes than its range holds is then blamed on what is really wrong (a count the
+    // blocks do not hold, a tag outside the declared range, a tag listed twice), never guessed.
     let (min, max) = (nodes.min_node_tag, nodes.max_node_tag);
-    if nodes.num_nodes > max.saturating_sub(min) + 1 {
-        return Err(fail(format!(
-            "the $Nodes section has {} nodes but only {} tags between {min} and {max}: some node tag is listed twice",
-            nodes.num_nodes,
-            max.saturating_sub(min) + 1,
-        )));
-    }
     let listed: usize = nodes.node_blocks.iter().map(|b| b.nodes.len()).sum();
     if listed as u64 != nodes.num_nodes {
         return Err(fail(format!("the $Nodes header declares {} nodes, its blocks hold {listed}", nodes.num_nodes)));
@@ -339,7 +335,13 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<mshio::MshFile<u64, i32, f64>, Mes
             let within: Vec<String> = e.filter_msh_errors().skip(1).filter_map(|(_, k)| k.context().map(str::to_string)).collect();
             let end = if rest == 0 { " (the file ends here: truncated?)" } else { "" };
             let within = if within.is_empty() { String::new() } else { format!(" (in the {})", within.join(" of the ")) };
-            (offset, format!("not a valid MSH 4.1 file: {kind}{within}{end}"))
+            // what gmsh writes on request and mshio does not read: say which option to turn off
+            let advice = if kind.contains("parametric") || within.contains("parametric") {
+                " (write the file with gmsh's option Mesh.SaveParametric = 0, its default)"
+            } else {
+                ""
+            };
+            (offset, format!("not a valid MSH 4.1 file: {kind}{within}{end}{advice}"))
         })
     });
     match parsed {
@@ -648,6 +650,23 @@ impl GmshFile {
         for (name, line) in &self.groups {
             match problem.part_of_group(name) {
                 Some(p) => parts.push((p, problem.curve_of_group(name))),
+                None if problem.groups().is_empty() && self.groups.iter().all(|(g, _)| problem.part_of_group(g).is_none()) => {
+                    // a problem that names no group tags its parts by predicates or by its own rule
+                    let declared = problem.declared_parts();
+                    let how = if declared.is_empty() {
+                        "by its own rule on x and y".to_string()
+                    } else {
+                        format!("by predicates on x and y ({})", declared.join("; "))
+                    };
+                    return Err(MeshError::Gmsh {
+                        file: path.clone(),
+                        line: *line,
+                        message: format!(
+                            "problem {} declares its boundary parts {how}, which tag the built-in meshes (structured:N, symmetric:N) only; a Gmsh mesh's parts are its physical groups, named in a problem file (`[parts] contact = [\"{name}\"]`, ...; docs/problems-and-meshes.md)",
+                            problem.name(),
+                        ),
+                    });
+                }
                 None => {
                     let listed: Vec<String> = self
                         .groups

@@ -529,10 +529,14 @@ impl Reader<'_> {
 
     /// Parse `text` as an expression whose variables may be `vars` (and the constants).
     fn expr(&self, key: &str, span: std::ops::Range<usize>, value: &Scalar, vars: &[&str]) -> Result<Expr, ProblemFileError> {
-        let text = match value {
+        let written = match value {
             Scalar::Number(v) => return Ok(Expr::Const(*v)),
             Scalar::Text(t) => t,
         };
+        // a tab or a line break (a `"""` string over several lines) separates as a space does;
+        // exmex knows only the space
+        let spaced: String = written.chars().map(|c| if c.is_whitespace() { ' ' } else { c }).collect();
+        let text = spaced.as_str();
         if let Some(why) = power_trap(text) {
             return Err(self.error(key, span, format!("{text:?}: {why}")));
         }
@@ -639,6 +643,16 @@ impl Reader<'_> {
                     _ => Cmp::Gt,
                 };
                 let (lhs, rhs) = (&comparison[..at], &comparison[at + len..]);
+                if [lhs, rhs].iter().any(|side| side.matches('(').count() != side.matches(')').count()) {
+                    return Err(self.error(
+                        key,
+                        span.clone(),
+                        format!(
+                            "the parentheses of {:?} enclose a comparison: parentheses group terms of an expression, not comparisons (a predicate is comparisons joined by && and ||, && binding tighter, with no grouping around them): write `x > 1` rather than `(x > 1)`",
+                            comparison.trim()
+                        ),
+                    ));
+                }
                 if ["<", ">", "="].iter().any(|o| rhs.contains(o)) {
                     return Err(self.error(key, span.clone(), format!("one comparison in {comparison:?} (join several with && or ||)")));
                 }
@@ -867,6 +881,11 @@ impl Problem for FileProblem {
     }
     fn bad_datum(&self) -> Option<super::BadDatum> {
         self.watch.first()
+    }
+    fn normal_note(&self) -> Option<String> {
+        matches!(self.normal, Normal::Circles(_)).then(|| {
+            "`normal = \"outward\"` on a `[curves]` circle points away from the circle's centre, which is outward for a body inside the circle; for a body outside it (around a hole) give the normal toward the centre, `normal = [\"-(x - cx)\", \"-(y - cy)\"]` with the centre (cx, cy) (it is normalised)".to_string()
+        })
     }
     fn contact_normal(&self, x: [f64; 2]) -> [f64; 2] {
         match &self.normal {

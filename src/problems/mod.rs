@@ -139,6 +139,11 @@ pub trait Problem: Send + Sync {
     fn declared_parts(&self) -> Vec<String> {
         Vec::new()
     }
+    /// How the problem's source derives its contact normal, where a wrong normal needs it said
+    /// (a circle's outward direction assumes the body inside the circle), for error messages.
+    fn normal_note(&self) -> Option<String> {
+        None
+    }
     /// The first datum (in a fixed order: by key, then point) that was not a finite number
     /// where it was evaluated since the problem was made; `None` for problems whose data are
     /// finite by construction (the built-ins). The SOLVE step checks it after assembling and the

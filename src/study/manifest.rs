@@ -798,14 +798,32 @@ pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
     if files.is_empty() {
         anyhow::bail!("{} holds no study manifest (*.toml): nothing to do (the studies are declared in experiments/)", dir.display());
     }
-    let all = files.iter().map(|f| Manifest::load(f)).collect::<Result<Vec<_>, _>>()?;
+    // a study is named by its file's stem (`Manifest::parse`): the named ones are found, and
+    // only they are read, before any file is parsed
+    let stem = |f: &PathBuf| f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     for name in only {
-        if !all.iter().any(|m| &m.study == name) {
-            anyhow::bail!(
-                "unknown study '{name}'; declared studies: {}",
-                all.iter().map(|m| m.study.as_str()).collect::<Vec<_>>().join(", ")
-            );
+        if !files.iter().any(|f| &stem(f) == name) {
+            anyhow::bail!("unknown study '{name}'; declared studies: {}", files.iter().map(stem).collect::<Vec<_>>().join(", "));
         }
     }
-    Ok(all.into_iter().filter(|m| only.is_empty() || only.contains(&m.study)).collect())
+    files
+        .iter()
+        .filter(|f| only.is_empty() || only.contains(&stem(f)))
+        .map(|f| Manifest::load(f).map_err(|e| not_a_manifest(f, e)))
+        .collect()
+}
+
+/// A manifest's error, with a word where the file is a problem file put beside the manifests
+/// (its tables are a problem's, not a study's).
+fn not_a_manifest(file: &Path, error: ManifestError) -> anyhow::Error {
+    let tables = std::fs::read_to_string(file).ok().and_then(|t| t.parse::<toml::Table>().ok()).unwrap_or_default();
+    let problem_like = ["material", "contact", "parts", "body_force", "dirichlet"].iter().any(|k| tables.contains_key(*k));
+    if problem_like && !tables.contains_key("run") {
+        anyhow::anyhow!(
+            "{error}\n{} looks like a problem file (it has the tables of a problem: [material], [contact], [parts], ...), not a study manifest: every *.toml in the manifests' folder is read as a study; keep problem files in a subfolder (experiments/problems/ holds the declared ones)",
+            file.display()
+        )
+    } else {
+        anyhow::Error::new(error)
+    }
 }

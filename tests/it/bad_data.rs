@@ -101,15 +101,13 @@ fn malformed_gmsh_meshes_are_named() {
             "triangles 5 and 6 overlap: their edge (0, 0)-(1, 0) has both on the same side",
         ),
         ("count", "$Nodes\n1 4 1 4\n".into(), "$Nodes\n1 3 1 4\n".into(), "the $Nodes header declares 3 nodes, its blocks hold 4"),
+        // a header count or range that is wrong is named as such, not blamed on a tag listed twice
+        ("count-over", "$Nodes\n1 4 1 4\n".into(), "$Nodes\n1 5 1 4\n".into(), "the $Nodes header declares 5 nodes, its blocks hold 4"),
+        ("min-tag", "$Nodes\n1 4 1 4\n".into(), "$Nodes\n1 4 2 4\n".into(), "node tag 1 is outside the range 2 to 4"),
         ("inf", "0 1 0\n$EndNodes".into(), "1e999 1 0\n$EndNodes".into(), "node 4 has the coordinate inf"),
         ("nan", "0 1 0\n$EndNodes".into(), "nan 1 0\n$EndNodes".into(), "node 4 has the coordinate NaN"),
         // tags 1..4, then 4 again: mshio drops the tags of a section whose tags look contiguous
-        (
-            "dup-dense",
-            nodes.into(),
-            second_block("$Nodes\n2 5 1 4\n"),
-            "5 nodes but only 4 tags between 1 and 4: some node tag is listed twice",
-        ),
+        ("dup-dense", nodes.into(), second_block("$Nodes\n2 5 1 4\n"), "node tag 4 is listed twice, at (0, 1, 0) and at (0.5, 0.5, 0)"),
         // sparse tags (up to 9), 4 listed again in a second block with other coordinates
         ("dup-sparse", nodes.into(), second_block("$Nodes\n2 5 1 9\n"), "node tag 4 is listed twice, at (0, 1, 0) and at (0.5, 0.5, 0)"),
     ] {

@@ -109,11 +109,32 @@ fn nothing_to_mark_stops_the_loop_and_says_so() {
     assert_eq!(code, 0, "{err}");
     let rows: Vec<&str> = out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).collect();
     assert_eq!(rows.len(), 1, "{out}");
-    assert!(out.contains("# stopped: the estimate is zero on every element, so nothing is marked"), "{out}");
+    assert!(out.contains("# stopped: the estimate is zero, or at round-off (eta_h at most 1e-10 of (2 mu + lambda) max |u_h|: the discrete solution is exact to round-off), so nothing is marked"), "{out}");
     // uniform refinement marks everything: all levels are solved
     let (code, out, err) = signorini_in(&d, &["adapt", "--problem", "still.toml", "--levels", "3", "--uniform"]);
     assert_eq!(code, 0, "{err}");
     assert_eq!(out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).count(), 3, "{out}");
+}
+
+/// An exact discrete solution (a rigid translation: no load, the gap never reached) has an
+/// estimate of round-off only (about 1e-13 of (2 mu + lambda) max |u_h|): the loop does not
+/// refine on that noise, it stops after level 0 and says why; a real estimate still refines.
+#[test]
+fn an_estimate_at_round_off_marks_nothing_and_says_so() {
+    let d = tmp("roundoff-estimate");
+    let problem = "dirichlet = [0.1, 0]\n[material]\nE = 500\nnu = 0.3\nmodel = \"plane_strain\"\n[parts]\ncontact = \"x > 1 - 1e-12\"\ndirichlet = \"x < 1e-12\"\n[contact]\nnormal = \"outward\"\nchi = CHI\n";
+    std::fs::write(d.join("shift.toml"), problem.replace("CHI", "1")).unwrap();
+    let (code, out, err) = signorini_in(&d, &["adapt", "--problem", "shift.toml", "--mesh", "structured:4", "--levels", "4"]);
+    assert_eq!(code, 0, "{err}");
+    let rows: Vec<&str> = out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).collect();
+    assert_eq!(rows.len(), 1, "{out}");
+    assert!(out.contains("# stopped: the estimate is zero, or at round-off"), "{out}");
+    // the same body pressed 0.05 into contact: a real estimate, every level solved
+    std::fs::write(d.join("pressed.toml"), problem.replace("CHI", "0.05")).unwrap();
+    let (code, out, err) = signorini_in(&d, &["adapt", "--problem", "pressed.toml", "--mesh", "structured:4", "--levels", "4"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).count(), 4, "{out}");
+    assert!(!out.contains("# stopped"), "{out}");
 }
 
 /// The defaults are the library's, whichever way a run comes: the command line shows and uses

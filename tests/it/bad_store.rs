@@ -414,6 +414,13 @@ fn a_run_whose_problem_file_changed_is_a_changed_spec_naming_the_file() {
     assert!(code != 0 && out.contains("the input file problems/p.toml changed"), "{out}");
     let (code, out) = signorini(&dir, &["run", m, "--results", "results", "--replace"]);
     assert!(code == 0 && out.contains("2 run(s) executed"), "{out}");
+    // the same bytes under another name: said so, in one line, not "changed (none now)"
+    std::fs::copy(dir.join("problems/p.toml"), dir.join("problems/q.toml")).unwrap();
+    let m = manifest(&dir, &STUDY.replace("problem = \"ex71\"", "problem = \"problems/q.toml\""));
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(out.contains("the input file problems/p.toml is declared under another name now, problems/q.toml (the same content"), "{out}");
+    assert!(!out.contains("none now") && !out.contains("problems/q.toml is not in the stored spec"), "{out}");
 }
 
 // ---- issue 38, item 2: no concurrent process undoes a run (real processes, both orders)

@@ -10,6 +10,7 @@ mod bad_cli;
 mod bad_data;
 mod bad_edges;
 mod bad_input;
+mod bad_leftovers6;
 mod bad_minor;
 mod bad_physics;
 mod bad_roles;

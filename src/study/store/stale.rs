@@ -33,13 +33,27 @@ pub fn spec_differences(stored: &RunSpec, declared: &RunSpec) -> Vec<String> {
     keys.extend(b.iter().map(|(k, _)| k).filter(|k| !a.iter().any(|(ka, _)| ka == *k)));
     let show = |v: Option<Value>| v.map_or("(absent)".to_string(), |v| v.to_string());
     let hash = |v: Option<Value>| v.and_then(|v| v.as_str().map(|h| format!("sha256 {}", &h[..h.len().min(12)]))).unwrap_or("none".into());
-    keys.into_iter()
-        .filter(|k| get(&a, k) != get(&b, k))
+    let differing: Vec<&String> = keys.into_iter().filter(|k| get(&a, k) != get(&b, k)).collect();
+    // an input read under one name and declared under another with the same bytes: one line
+    let renamed = |k: &str| {
+        let h = get(&a, k).filter(|_| get(&b, k).is_none())?;
+        differing.iter().find(|o| o.starts_with("inputs.") && get(&a, o).is_none() && get(&b, o).as_ref() == Some(&h)).map(|o| (*o, h))
+    };
+    let renamed_to: Vec<&String> =
+        differing.iter().filter(|k| k.starts_with("inputs.")).filter_map(|k| renamed(k)).map(|(o, _)| o).collect();
+    differing
+        .iter()
+        .filter(|k| !renamed_to.contains(k))
         .map(|k| match k.strip_prefix("inputs.") {
             // an input file is named as such: the run read other bytes than the file holds now
-            Some(file) => match get(&a, k) {
-                None => format!("the input file {file} is not in the stored spec ({} now)", hash(get(&b, k))),
-                stored => format!("the input file {file} changed ({} stored, {} now)", hash(stored), hash(get(&b, k))),
+            Some(file) => match (renamed(k), get(&a, k)) {
+                (Some((other, h)), _) => format!(
+                    "the input file {file} is declared under another name now, {} (the same content, {}): the stored spec names the file the run read",
+                    other.trim_start_matches("inputs."),
+                    hash(Some(h))
+                ),
+                (None, None) => format!("the input file {file} is not in the stored spec ({} now)", hash(get(&b, k))),
+                (None, stored) => format!("the input file {file} changed ({} stored, {} now)", hash(stored), hash(get(&b, k))),
             },
             None => format!("{k}: {} stored, {} declared", show(get(&a, k)), show(get(&b, k))),
         })
