@@ -28,6 +28,13 @@
 //!   boundary lies in H^{1/2}, which holds no function with a jump, yet u . n would have to jump
 //!   from its prescribed value to at most chi at that end of Gamma_C; the discrete problems are
 //!   solvable only because the node is not constrained, and their solutions converge to nothing.
+//! * **No node of the closure of Gamma_C is left unconstrained along n.** Where one component
+//!   is prescribed (rollers meeting the contact part, a symmetry hold on it) and the normal has a
+//!   part along the free one, u . n depends on a free unknown that no constraint bounds (the node
+//!   is not a contact node): a certified answer could pass the obstacle there (a seventh battery
+//!   found a Hertz symmetry hold sinking by 6.7e-5). Refused, naming the node
+//!   ([`ContactDataError::HalfPrescribed`]); imposing the constraint on the free component alone is
+//!   not built.
 //!
 //! Not repeated here: a normal of length 0 or a gap that is not a finite number is refused by
 //! the data watch (`problems::BadDatum`, after assembly); a declared normal is normalised where
@@ -72,6 +79,12 @@ pub enum ContactDataError {
         x = point(*.at), chi = shown(*.chi), d = shown(*.diameter)
     )]
     Gap { problem: String, part: String, at: [f64; 2], chi: f64, diameter: f64 },
+    #[error(
+        "{problem}: the node at {x} on the closure of the contact part ({part}) has u_{fixed} prescribed by {by} and u_{free} free, and the contact normal there ({nx:.6}, {ny:.6}) acts on the free u_{free}: the contact condition u . n <= chi is imposed only at nodes with no prescribed component, so it would not hold there and the body could pass the obstacle at that node. Prescribe both components there, or let the contact part and the part or point that prescribes one component not meet",
+        x = point(*.at), nx = .normal[0], ny = .normal[1], fixed = .fixed + 1, free = 2 - .fixed
+    )]
+    /// `fixed`: the prescribed component (0 or 1).
+    HalfPrescribed { problem: String, part: String, by: String, at: [f64; 2], fixed: usize, normal: [f64; 2] },
     #[error(
         "{problem}: the displacement prescribed at {x} on the closure of the contact part ({part}) by {by} is ({ux}, {uy}); along the contact normal ({nx:.6}, {ny:.6}) that is u . n = {un}, past the gap chi = {chi} by {over:.3e}: the body would start inside the obstacle there. Prescribe a displacement with u . n <= chi at the contact part's ends (or end the contact part before them)",
         x = point(*.at), ux = .u[0], uy = .u[1], nx = .normal[0], ny = .normal[1], over = .un - .chi
@@ -190,19 +203,26 @@ fn check_prescribed(
             continue; // the data watch names it
         }
         let n = [n[0] / len, n[1] / len];
-        // u . n is known where both components are prescribed, or the one n lies along
+        let by = if nodes.part[p] == Some(Part::Dirichlet) {
+            "the Dirichlet data (`dirichlet`)"
+        } else {
+            "a point constraint (`point_constraints`)"
+        };
+        // u . n is known where both components are prescribed, or the one n lies along; where n
+        // has a part along a free component, u . n would be constrained by nothing (such a node
+        // is not a contact node): refused
         let un = match (fixed(p, 0), fixed(p, 1)) {
             (true, true) => u[0] * n[0] + u[1] * n[1],
             (true, false) if n[1].abs() < 1e-12 => u[0] * n[0],
             (false, true) if n[0].abs() < 1e-12 => u[1] * n[1],
-            _ => continue,
+            (true, false) | (false, true) => {
+                let fixed = if fixed(p, 0) { 0 } else { 1 };
+                let (problem, part) = (problem_name(problem), contact_part(problem));
+                return Err(Box::new(ContactDataError::HalfPrescribed { problem, part, by: by.into(), at: x, fixed, normal: n }));
+            }
+            (false, false) => continue,
         };
         if un - chi > PRESCRIBED_PENETRATION * diameter {
-            let by = if nodes.part[p] == Some(Part::Dirichlet) {
-                "the Dirichlet data (`dirichlet`)"
-            } else {
-                "a point constraint (`point_constraints`)"
-            };
             let (problem, part) = (problem_name(problem), contact_part(problem));
             let u = [0, 1].map(|i| if fixed(p, i) { u[i].to_string() } else { "free".to_string() });
             return Err(Box::new(ContactDataError::Prescribed { problem, part, by: by.into(), at: x, u, normal: n, un, chi }));
