@@ -389,6 +389,10 @@ pub struct Prepared {
     pub problem: Box<dyn problems::Problem>,
     pub mesh_spec: MeshSpec,
     pub reference: Option<Arc<ReferenceField>>,
+    /// The run's input files pinned to the bytes its spec holds the hashes of, for as long as
+    /// the run computes ([`manifest::pin_inputs`]): every later read (the initial mesh built
+    /// again on resuming, a replay) is of those bytes too.
+    pub pins: crate::base::pin::Pins,
 }
 
 impl Prepared {
@@ -413,6 +417,7 @@ impl Prepared {
 /// Load a run's problem and initial mesh (relative to `manifest_file`) and compute (or take from
 /// this process's cache) its reference solution. `None` when interrupted.
 pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, progress: bool) -> Result<Option<Prepared>> {
+    let pins = manifest::pin_inputs(manifest_file, spec);
     let problem_path = manifest::resolve_problem(manifest_file, &spec.problem);
     let mesh_path = manifest::resolve_mesh(manifest_file, &spec.mesh);
     let problem = problems::load(&problem_path, &spec.constants)?;
@@ -447,7 +452,7 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
         }
         _ => None,
     };
-    Ok(Some(Prepared { problem, mesh_spec, reference }))
+    Ok(Some(Prepared { problem, mesh_spec, reference, pins }))
 }
 
 /// Take the reference solutions of `manifest`'s runs from the study folder `stored` where it
@@ -476,11 +481,13 @@ pub fn preload_references(manifest: &Manifest, stored: &Store, progress: bool) -
                 record.rebuild.ndof
             );
             let spinner = Progress::new(progress, 0, &label);
+            let _pins = manifest::pin_inputs(&manifest.file, spec);
             let problem = problems::load(&problem_path, &spec.constants)?;
             let mesh_spec = MeshSpec::parse(&mesh_path)?;
-            let field = reference::replay(problem.as_ref(), &mesh_spec, &record.spec, &record.rebuild).with_context(|| {
-                format!("{study}/{}: replaying the stored reference {}", spec.id, stored.dir().reference_file(&file_key).display())
-            })?;
+            let field =
+                reference::replay(problem.as_ref(), &mesh_spec, &record.spec, &record.rebuild, &manifest.drift).with_context(|| {
+                    format!("{study}/{}: replaying the stored reference {}", spec.id, stored.dir().reference_file(&file_key).display())
+                })?;
             spinner.finish();
             if progress {
                 crate::base::note::line(format_args!("{label}: rebuilt in {:.1} s", started.elapsed().as_secs_f64()));
