@@ -262,10 +262,18 @@ fn run_planned(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &R
     Ok(executed)
 }
 
-/// Run `spec`, stored as declared: said so, and its reference stored if it is missing.
+/// Run `spec`, stored as declared: said so, and its reference stored if it is missing. With
+/// `--fresh` this process removed the run when it started over, so the record it finds now was
+/// stored by another process since (one that waited for the run's lock meanwhile): said so, and
+/// never the advice to start over, which is what this process did.
 fn keep(manifest: &Manifest, store: &Store, spec: &RunSpec, opts: &RunOptions) -> Result<()> {
     if opts.progress {
-        crate::base::note::line(format_args!("{}/{}: finished earlier, kept (use --fresh to start over)", manifest.study, spec.id));
+        let how = if opts.fresh {
+            "computed by another process after this one started over (--fresh), kept"
+        } else {
+            "finished earlier, kept (use --fresh to start over)"
+        };
+        crate::base::note::line(format_args!("{}/{}: {how}", manifest.study, spec.id));
     }
     store_missing_reference(manifest, store, spec, opts)
 }

@@ -891,3 +891,31 @@ fn an_edited_last_level_of_a_stored_reference_fails_drift_naming_the_field() {
     assert!(out.contains("is not what the replay gives") && out.contains("estimate stored 1000000000.0"), "{out}");
     assert!(!out.contains("drift: none"), "{out}");
 }
+
+/// Two concurrent `run --fresh --wait` and a `run --wait` on a stored study (the sequence of
+/// battery 7, finding 12): every process ends well, the folder holds both runs, and a `--fresh`
+/// process that finds a run another process stored after it started over says so; it never
+/// says "finished earlier, kept (use --fresh to start over)", advice it has followed. (Which
+/// process computes what depends on the timing; the messages must be true in every order.)
+#[test]
+fn a_fresh_process_that_keeps_a_run_another_stored_says_so_in_every_order() {
+    let dir = tmp("fresh-twice");
+    let m = manifest(&dir, &format!("{LONG}[[run]]\nid = \"b\"\nmesh = \"structured:2\"\nlevels = 3\n"));
+    let study = results_of(&dir);
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_eq!(code, 0, "{out}");
+    let fresh = ["run", m, "--results", "results", "--jobs", "1", "--fresh", "--wait"];
+    let p1 = spawn(&dir, &fresh);
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let p2 = spawn(&dir, &fresh);
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let p3 = spawn(&dir, &["run", m, "--results", "results", "--jobs", "1", "--wait"]);
+    for (name, child) in [("P1 --fresh", p1), ("P2 --fresh", p2), ("P3", p3)] {
+        let (code, out) = finish(child);
+        assert_eq!(code, 0, "{name}: {out}");
+        if name.contains("fresh") {
+            assert!(!out.contains("use --fresh to start over"), "{name}: {out}");
+        }
+    }
+    assert_eq!(consistent(&study), ["a", "b"]);
+}
