@@ -3,7 +3,7 @@
 //! a byte is read, so it can neither hang nor grow a buffer without end, and so is a file larger
 //! than its kind may be. The handle is opened without blocking (a named pipe with no writer
 //! would block `open` itself) and checked by `fstat` on that same handle, so what is checked is
-//! what is read.
+//! what is read. A file a running study pinned ([`super::pin`]) must read as the bytes it planned.
 
 use std::io::Read;
 use std::path::Path;
@@ -42,6 +42,9 @@ pub enum InputError {
     TooLarge { what: &'static str, size: String, limit: String },
     #[error("the file has {size}: reading it needs about {needed}, more than the {available} this process can allocate")]
     Memory { size: String, needed: String, available: String },
+    /// A file pinned to a run's planned bytes ([`super::pin`]) read with other bytes.
+    #[error(transparent)]
+    Changed(#[from] super::pin::Changed),
 }
 
 /// The bytes of the input file at `path` of kind `kind`, or why not (see the module's doc).
@@ -58,6 +61,8 @@ pub fn read(path: &Path, kind: Kind) -> Result<Vec<u8>, InputError> {
     let mut bytes = Vec::with_capacity(size as usize);
     // no more than was checked, should the file grow meanwhile
     file.take(size).read_to_end(&mut bytes).map_err(io)?;
+    // the bytes parsed are the bytes a pinned run planned, or nothing is parsed
+    super::pin::check(path, &bytes)?;
     Ok(bytes)
 }
 

@@ -12,5 +12,6 @@ pub mod input;
 pub mod memory;
 pub mod note;
 pub mod number;
+pub mod pin;
 pub mod stats;
 pub mod toml_text;

@@ -225,6 +225,25 @@ fn compare_level(
     }
 }
 
+/// The fields in which level record `fresh` (solved again) is not `stored`, compared as the
+/// drift check compares levels ([`compare_level`]: the tolerances of `spec`, measurements never,
+/// the scale of each field its stored value), leaving out the fields named in `skip`: what a
+/// replay of one stored level checks its record against.
+pub fn level_differences(stored: &LevelRecord, fresh: &LevelRecord, spec: &DriftSpec, skip: &[&str]) -> Vec<DriftRow> {
+    let as_value = |l: &LevelRecord| {
+        let mut v = serde_json::to_value(l).expect("records serialise");
+        if let Some(o) = v.as_object_mut() {
+            o.retain(|k, _| !skip.contains(&k.as_str()));
+        }
+        v
+    };
+    let (s, f) = (as_value(stored), as_value(fresh));
+    let scales = field_scales(std::slice::from_ref(&s));
+    let (mut rows, mut changes) = (Vec::new(), BTreeMap::new());
+    compare_level("", "", stored.level, &s, &f, &scales, spec, &mut rows, &mut changes);
+    rows
+}
+
 /// Observed rate of `field` in NDF: least-squares slope of -log(field) against log(ndof) over
 /// the last `last` levels (None if fewer levels or a non-positive value).
 pub fn observed_rate(run: &RunRecord, field: &str, last: usize) -> Option<f64> {

@@ -683,26 +683,46 @@ pub fn spelled_for(manifest: &Path, path: &str) -> String {
     }
 }
 
-/// The SHA-256 of every file a run with `problem` and `mesh` reads (a problem file, a Gmsh
-/// mesh), keyed by the path as the manifest writes it ([`RunSpec::inputs`]). A file that cannot
-/// be read is an error for the key naming it: (`problem` or `mesh`, the path and why).
-pub fn input_hashes(manifest: &Path, problem: &str, mesh: &str) -> Result<BTreeMap<String, String>, (&'static str, String)> {
-    let mut out = BTreeMap::new();
-    let mut add = |key: &'static str, written: &str, resolved: &Path| {
-        let kind = if key == "mesh" { crate::mesh::gmsh::MESH_FILE } else { crate::problems::file::PROBLEM_FILE };
-        let bytes = crate::base::input::read(resolved, kind).map_err(|e| (key, format!("{}: {e}", resolved.display())))?;
-        out.insert(written.to_string(), crate::base::digest::sha256_hex(&bytes));
-        Ok(())
-    };
+/// The files a run with `problem` and `mesh` reads (a problem file, a Gmsh mesh): for each,
+/// the key naming it in the manifest (`problem` or `mesh`), the path as the manifest writes it
+/// (the key of [`RunSpec::inputs`]) and the path resolved against the manifest's folder.
+pub fn input_files(manifest: &Path, problem: &str, mesh: &str) -> Vec<(&'static str, String, PathBuf)> {
+    let mut out = Vec::new();
     if crate::problems::is_file(problem) {
-        add("problem", problem, Path::new(&resolve_problem(manifest, problem)))?;
+        out.push(("problem", problem.to_string(), PathBuf::from(resolve_problem(manifest, problem))));
     }
     if let Ok(spec) = MeshSpec::parse(&resolve_mesh(manifest, mesh))
         && let Some(file) = spec.file()
     {
-        add("mesh", mesh.strip_prefix("gmsh:").unwrap_or(mesh).trim(), file)?;
+        out.push(("mesh", mesh.strip_prefix("gmsh:").unwrap_or(mesh).trim().to_string(), file.to_path_buf()));
+    }
+    out
+}
+
+/// The SHA-256 of every file a run with `problem` and `mesh` reads ([`input_files`]), keyed by
+/// the path as the manifest writes it ([`RunSpec::inputs`]). A file that cannot be read is an
+/// error for the key naming it: (`problem` or `mesh`, the path and why).
+pub fn input_hashes(manifest: &Path, problem: &str, mesh: &str) -> Result<BTreeMap<String, String>, (&'static str, String)> {
+    let mut out = BTreeMap::new();
+    for (key, written, resolved) in input_files(manifest, problem, mesh) {
+        let kind = if key == "mesh" { crate::mesh::gmsh::MESH_FILE } else { crate::problems::file::PROBLEM_FILE };
+        let bytes = crate::base::input::read(&resolved, kind).map_err(|e| (key, format!("{}: {e}", resolved.display())))?;
+        out.insert(written, crate::base::digest::sha256_hex(&bytes));
     }
     Ok(out)
+}
+
+/// Pin the input files of a run with `spec` (of the manifest at `manifest`) to the bytes its
+/// spec holds the hashes of ([`crate::base::pin`]): until the guard is dropped, a read of one
+/// of them with other bytes is an error naming it, so the record's `inputs` are the hashes of
+/// what the run parsed. (A file the spec holds no hash of, a record of an older format, is not
+/// pinned.)
+pub fn pin_inputs(manifest: &Path, spec: &RunSpec) -> crate::base::pin::Pins {
+    crate::base::pin::pin(
+        input_files(manifest, &spec.problem, &spec.mesh)
+            .into_iter()
+            .filter_map(|(_, written, resolved)| spec.inputs.get(&written).map(|h| (resolved, h.clone()))),
+    )
 }
 
 impl Manifest {
@@ -716,6 +736,21 @@ impl Manifest {
         files.sort();
         files.dedup();
         files
+    }
+
+    /// The SHA-256 each input file of the runs had when the manifest was read (their specs'
+    /// `inputs`), by resolved path: the bytes every run reads, since they are pinned to it
+    /// ([`pin_inputs`]). What the provenance records, without reading the files again.
+    pub fn planned_hashes(&self) -> BTreeMap<PathBuf, String> {
+        let mut out = BTreeMap::new();
+        for r in &self.runs {
+            for (_, written, resolved) in input_files(&self.file, &r.spec.problem, &r.spec.mesh) {
+                if let Some(h) = r.spec.inputs.get(&written) {
+                    out.insert(resolved, h.clone());
+                }
+            }
+        }
+        out
     }
 
     /// The problem files the runs name, resolved ([`resolve_problem`]), without repetition.

@@ -262,10 +262,18 @@ fn run_planned(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &R
     Ok(executed)
 }
 
-/// Run `spec`, stored as declared: said so, and its reference stored if it is missing.
+/// Run `spec`, stored as declared: said so, and its reference stored if it is missing. With
+/// `--fresh` this process removed the run when it started over, so the record it finds now was
+/// stored by another process since (one that waited for the run's lock meanwhile): said so, and
+/// never the advice to start over, which is what this process did.
 fn keep(manifest: &Manifest, store: &Store, spec: &RunSpec, opts: &RunOptions) -> Result<()> {
     if opts.progress {
-        crate::base::note::line(format_args!("{}/{}: finished earlier, kept (use --fresh to start over)", manifest.study, spec.id));
+        let how = if opts.fresh {
+            "computed by another process after this one started over (--fresh), kept"
+        } else {
+            "finished earlier, kept (use --fresh to start over)"
+        };
+        crate::base::note::line(format_args!("{}/{}: {how}", manifest.study, spec.id));
     }
     store_missing_reference(manifest, store, spec, opts)
 }
@@ -389,6 +397,10 @@ pub struct Prepared {
     pub problem: Box<dyn problems::Problem>,
     pub mesh_spec: MeshSpec,
     pub reference: Option<Arc<ReferenceField>>,
+    /// The run's input files pinned to the bytes its spec holds the hashes of, for as long as
+    /// the run computes ([`manifest::pin_inputs`]): every later read (the initial mesh built
+    /// again on resuming, a replay) is of those bytes too.
+    pub pins: crate::base::pin::Pins,
 }
 
 impl Prepared {
@@ -413,6 +425,7 @@ impl Prepared {
 /// Load a run's problem and initial mesh (relative to `manifest_file`) and compute (or take from
 /// this process's cache) its reference solution. `None` when interrupted.
 pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, progress: bool) -> Result<Option<Prepared>> {
+    let pins = manifest::pin_inputs(manifest_file, spec);
     let problem_path = manifest::resolve_problem(manifest_file, &spec.problem);
     let mesh_path = manifest::resolve_mesh(manifest_file, &spec.mesh);
     let problem = problems::load(&problem_path, &spec.constants)?;
@@ -447,7 +460,7 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
         }
         _ => None,
     };
-    Ok(Some(Prepared { problem, mesh_spec, reference }))
+    Ok(Some(Prepared { problem, mesh_spec, reference, pins }))
 }
 
 /// Take the reference solutions of `manifest`'s runs from the study folder `stored` where it
@@ -476,11 +489,13 @@ pub fn preload_references(manifest: &Manifest, stored: &Store, progress: bool) -
                 record.rebuild.ndof
             );
             let spinner = Progress::new(progress, 0, &label);
+            let _pins = manifest::pin_inputs(&manifest.file, spec);
             let problem = problems::load(&problem_path, &spec.constants)?;
             let mesh_spec = MeshSpec::parse(&mesh_path)?;
-            let field = reference::replay(problem.as_ref(), &mesh_spec, &record.spec, &record.rebuild).with_context(|| {
-                format!("{study}/{}: replaying the stored reference {}", spec.id, stored.dir().reference_file(&file_key).display())
-            })?;
+            let field =
+                reference::replay(problem.as_ref(), &mesh_spec, &record.spec, &record.rebuild, &manifest.drift).with_context(|| {
+                    format!("{study}/{}: replaying the stored reference {}", spec.id, stored.dir().reference_file(&file_key).display())
+                })?;
             spinner.finish();
             if progress {
                 crate::base::note::line(format_args!("{label}: rebuilt in {:.1} s", started.elapsed().as_secs_f64()));

@@ -59,7 +59,15 @@ pub enum ReferenceError {
     /// A stored reference that does not rebuild to what it records.
     #[error("the stored reference ({stored} unknowns) replays to {replayed} unknowns")]
     Replayed { stored: usize, replayed: usize },
+    /// A stored reference whose record of its last level is not what the replay gives (an
+    /// edited file: its estimate, its active nodes, its memory measurement...).
+    #[error("the stored record of its last level (level {level}) is not what the replay gives: {differences}")]
+    Record { level: usize, differences: String },
 }
+
+/// Fields of the last level a one-solve replay cannot give as the loop did: the active-set
+/// iteration starts from the set the loop ended with, so it takes fewer iterations.
+const NOT_REPLAYED: &[&str] = &["pdas_iterations"];
 
 /// The adaptive loop of a reference solution: the maximum strategy with `spec.theta`, the
 /// estimator with `spec.contact_term` (otherwise the defaults), as many levels as it takes.
@@ -110,12 +118,17 @@ pub fn compute(
 /// Rebuild a stored reference solution: the last mesh of its history from `mesh_spec`'s mesh
 /// (every level's fingerprint checked), solved once, as the loop solved it (the automatic
 /// ordering, as in [`compute`]), from the active set the loop's solve ended with (else from its
-/// warm start): the same solution in one solve, and in one numeric factorisation.
+/// warm start): the same solution in one solve, and in one numeric factorisation. The replayed
+/// level's record is compared with the stored record of the last level as the drift check
+/// compares levels (`tolerances`, the study's; `drift::level_differences`): a stored record
+/// that is not what its solve gives is an error naming the fields (measurements, `t_*` and
+/// `mem_*`, are not compared: no two solves share them).
 pub fn replay(
     problem: &dyn Problem,
     mesh_spec: &MeshSpec,
     spec: &ReferenceSpec,
     record: &Rebuild,
+    tolerances: &crate::study::manifest::DriftSpec,
 ) -> Result<ReferenceField, ReferenceError> {
     use adapt::replay::ReplayError;
     let mesh0 = mesh_spec.build(problem).map_err(|e| adapt::AdaptError::Solve(e.into()))?;
@@ -129,6 +142,12 @@ pub fn replay(
     let solved = crate::sparse::ordering::automatic(|| adapt::solve_level(problem, &mesh, last, &config, None, start, measured))?;
     if solved.record.ndof != record.ndof {
         return Err(ReferenceError::Replayed { stored: record.ndof, replayed: solved.record.ndof });
+    }
+    let rows = crate::study::drift::level_differences(&record.last, &solved.record, tolerances, NOT_REPLAYED);
+    if !rows.is_empty() {
+        let differences =
+            rows.iter().map(|r| format!("{} stored {}, replayed {} ({})", r.field, r.stored, r.fresh, r.tolerance)).collect::<Vec<_>>();
+        return Err(ReferenceError::Record { level: last, differences: differences.join("; ") });
     }
     Ok(ReferenceField::new(mesh, solved.solution.nodes.elements, solved.solution.u, spec.clone(), record.clone()))
 }

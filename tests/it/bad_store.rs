@@ -789,3 +789,133 @@ fn long_manifests(dir: &Path, from: &str, variants: [(&str, &str); 2]) {
         std::fs::write(dir.join(sub).join("s.toml"), LONG.replace(from, to)).unwrap();
     }
 }
+
+// ---- battery 7: what a record stores is what its run read, and what the summaries render is sound
+
+/// Wait until `file` exists (a run's checkpoint: its process computes it).
+fn appears(file: &Path) {
+    let start = std::time::Instant::now();
+    while !file.exists() {
+        assert!(start.elapsed().as_secs() < 120, "{} never appeared", file.display());
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
+/// `text` with the number after its first `"estimate": ` replaced by `value`, the rest of the
+/// bytes as they are (an edit the record's format check cannot see).
+fn first_estimate_set(text: &str, value: &str) -> String {
+    let at = text.find("\"estimate\": ").unwrap() + "\"estimate\": ".len();
+    let end = at + text[at..].find([',', '\n']).unwrap();
+    format!("{}{value}{}", &text[..at], &text[end..])
+}
+
+/// A problem file edited while an earlier run of the study computes (after the study was planned)
+/// is refused by name when the later run reads it, never computed and stored under the planned
+/// hash; the earlier run is kept, and with the file as planned the later run is computed with
+/// its hash (battery 7, finding 2: the record held the planned hash of bytes it never read).
+#[test]
+fn an_input_file_edited_while_the_study_runs_is_refused_by_name_not_stored_under_the_old_hash() {
+    let dir = tmp("input-edited");
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/problems/ex71.toml")).unwrap();
+    std::fs::write(dir.join("p.toml"), &text).unwrap();
+    let m = manifest(&dir, &format!("{LONG}[[run]]\nid = \"b\"\nproblem = \"p.toml\"\nmesh = \"structured:2\"\nlevels = 3\n"));
+    let study = results_of(&dir);
+    let child = spawn(&dir, &["run", m, "--results", "results", "--jobs", "1"]);
+    appears(&study.join(".partial/a.json"));
+    std::fs::write(dir.join("p.toml"), format!("{text}\n# edited while run a computes\n")).unwrap();
+    let (code, out) = finish(child);
+    assert_ne!(code, 0, "{out}");
+    assert!(out.contains("the input file") && out.contains("p.toml changed while the study ran: planned sha256"), "{out}");
+    assert!(study.join("runs/a.json").exists() && !study.join("runs/b.json").exists(), "{:?}", files(&study));
+    assert_eq!(consistent(&study), ["a"]);
+    // the file as planned again: b is computed from it and holds its hash
+    std::fs::write(dir.join("p.toml"), &text).unwrap();
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert!(code == 0 && out.contains("1 run(s) executed"), "{out}");
+    let b: serde_json::Value = serde_json::from_slice(&std::fs::read(study.join("runs/b.json")).unwrap()).unwrap();
+    assert_eq!(b["run"]["inputs"]["p.toml"].as_str(), Some(signorini::base::digest::sha256_hex(text.as_bytes()).as_str()));
+}
+
+/// A record edited while another process commits a run is not rendered into levels.csv: the
+/// commit checks the folder as `run` does at its start, refuses naming the record, and the next
+/// `run` refuses it too (battery 7, finding 3: the edit was laundered, and run, figures and
+/// report then passed the folder).
+#[test]
+fn a_record_edited_while_another_run_commits_is_refused_not_rendered_into_levels_csv() {
+    let (dir, _) = stored("laundered");
+    let study = results_of(&dir);
+    let m = manifest(&dir, &format!("{STUDY}\n[[run]]\nid = \"c\"\nmesh = \"structured:8\"\nlevels = 19\ntheta = 0.5\n"));
+    let child = spawn(&dir, &["run", m, "--results", "results", "--jobs", "1"]);
+    appears(&study.join(".partial/c.json"));
+    let a = std::fs::read_to_string(study.join("runs/a.json")).unwrap();
+    std::fs::write(study.join("runs/a.json"), first_estimate_set(&a, "123.5")).unwrap();
+    let (code, out) = finish(child);
+    assert_ne!(code, 0, "{out}");
+    assert!(out.contains("run c is not stored") && out.contains("runs/a.json"), "{out}");
+    let csv = std::fs::read_to_string(study.join("levels.csv")).unwrap();
+    assert!(!csv.contains(",123.5,"), "the edited record was rendered into levels.csv:\n{csv}");
+    assert!(!study.join("runs/c.json").exists());
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert!(code != 0 && out.contains("run a level 0"), "{out}");
+    let (code, out) = signorini(&dir, &["figures", "--results", "results", "--experiments", ".", "--figures", "figs"]);
+    assert_ne!(code, 0, "{out}");
+    // --replace computes a again and stores c: the folder is sound, and the edit is gone
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results", "--replace"]);
+    assert_eq!(code, 0, "{out}");
+    assert_eq!(consistent(&study), ["a", "b", "c"]);
+    assert!(!std::fs::read_to_string(study.join("levels.csv")).unwrap().contains(",123.5,"));
+}
+
+/// The stored record of a reference solution's last level is checked against its replay, as the
+/// drift check compares levels: an edited estimate or active-node count fails `drift` naming the
+/// field, where it passed (battery 7, finding 7); the unedited reference replays to no drift.
+#[test]
+fn an_edited_last_level_of_a_stored_reference_fails_drift_naming_the_field() {
+    let dir = tmp("reference-last");
+    let m = manifest(
+        &dir,
+        "description = \"ex72 with a small reference\"\n[defaults]\nproblem = \"ex72\"\nmesh = \"structured:4\"\nquick_levels = 2\n\
+         [defaults.reference]\ntheta = 0.5\nmin_ndof = 3000\n[[run]]\nid = \"a\"\nlevels = 3\n",
+    );
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_eq!(code, 0, "{out}");
+    let drift = |dir: &Path| signorini(dir, &["drift", "--study", "study", "--results", "results", "--experiments", "."]);
+    let (code, out) = drift(&dir);
+    assert!(code == 0 && out.contains("drift: none"), "{out}");
+    let refs = results_of(&dir).join("references");
+    let file = std::fs::read_dir(&refs).unwrap().flatten().map(|e| e.path()).find(|p| p.extension().is_some_and(|x| x == "json")).unwrap();
+    let text = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(&file, first_estimate_set(&text, "1000000000.0")).unwrap();
+    let (code, out) = drift(&dir);
+    assert_ne!(code, 0, "{out}");
+    assert!(out.contains("is not what the replay gives") && out.contains("estimate stored 1000000000.0"), "{out}");
+    assert!(!out.contains("drift: none"), "{out}");
+}
+
+/// Two concurrent `run --fresh --wait` and a `run --wait` on a stored study (the sequence of
+/// battery 7, finding 12): every process ends well, the folder holds both runs, and a `--fresh`
+/// process that finds a run another process stored after it started over says so; it never
+/// says "finished earlier, kept (use --fresh to start over)", advice it has followed. (Which
+/// process computes what depends on the timing; the messages must be true in every order.)
+#[test]
+fn a_fresh_process_that_keeps_a_run_another_stored_says_so_in_every_order() {
+    let dir = tmp("fresh-twice");
+    let m = manifest(&dir, &format!("{LONG}[[run]]\nid = \"b\"\nmesh = \"structured:2\"\nlevels = 3\n"));
+    let study = results_of(&dir);
+    let (code, out) = signorini(&dir, &["run", m, "--results", "results"]);
+    assert_eq!(code, 0, "{out}");
+    let fresh = ["run", m, "--results", "results", "--jobs", "1", "--fresh", "--wait"];
+    let p1 = spawn(&dir, &fresh);
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let p2 = spawn(&dir, &fresh);
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let p3 = spawn(&dir, &["run", m, "--results", "results", "--jobs", "1", "--wait"]);
+    for (name, child) in [("P1 --fresh", p1), ("P2 --fresh", p2), ("P3", p3)] {
+        let (code, out) = finish(child);
+        assert_eq!(code, 0, "{name}: {out}");
+        if name.contains("fresh") {
+            assert!(!out.contains("use --fresh to start over"), "{name}: {out}");
+        }
+    }
+    assert_eq!(consistent(&study), ["a", "b"]);
+}

@@ -145,7 +145,7 @@ fn stored_reference_replays_to_the_computed_one() {
     let computed =
         reference::compute(problem.as_ref(), &mesh_spec, reference_spec, &mut |_| std::ops::ControlFlow::Continue(())).unwrap().unwrap();
     assert!(computed.rebuild.history.levels.len() > 3, "the reference loop refines several levels");
-    let replayed = reference::replay(problem.as_ref(), &mesh_spec, reference_spec, &computed.rebuild).unwrap();
+    let replayed = reference::replay(problem.as_ref(), &mesh_spec, reference_spec, &computed.rebuild, &m.drift).unwrap();
     assert_eq!(replayed.ndof, computed.ndof);
     for i in 0..=20 {
         for j in 0..=20 {
@@ -159,7 +159,9 @@ fn stored_reference_replays_to_the_computed_one() {
     let first_unmarked = marks.iter().position(|m| !m).unwrap();
     marks[first_unmarked] = true;
     altered.history.levels[level].marks = signorini::records::Flags::encode(&marks);
-    let e =
-        reference::replay(problem.as_ref(), &mesh_spec, reference_spec, &altered).err().expect("altered marks do not replay").to_string();
+    let e = reference::replay(problem.as_ref(), &mesh_spec, reference_spec, &altered, &m.drift)
+        .err()
+        .expect("altered marks do not replay")
+        .to_string();
     assert!(e.contains(&format!("level {}", level + 1)) && e.contains("fingerprint"), "{e}");
 }

@@ -162,7 +162,7 @@ impl Writer<'_> {
             bail!("the record of run {} committed under the lock of run {}", record.run.id, run.id);
         }
         let dir = &self.store.dir;
-        let mut runs = self.store.records()?;
+        let mut runs = self.sound_records(&run.id)?;
         let foreign: Vec<&str> = runs.iter().map(|r| r.run.id.as_str()).filter(|id| !declares(manifest, id)).collect();
         if !foreign.is_empty() {
             bail!(
@@ -232,10 +232,37 @@ impl Writer<'_> {
 
     /// After a failure part-way through changing the folder (a removal or a rename that failed):
     /// remove the orphans and bring the summaries in line with the runs present.
+    /// A record at fault is left as it is, and so are the summaries (never rendered from it):
+    /// `run` refuses the folder naming it.
     pub fn repair(&self, manifest: &Manifest, quick: bool) -> Result<()> {
-        let runs = self.store.records()?;
-        self.remove_orphans(&runs)?;
-        self.sync_summaries(manifest, &runs, quick)
+        let checked = self.store.check()?;
+        self.remove_orphans(&checked.runs)?;
+        if checked.faults.iter().any(|f| f.record.is_some()) {
+            return Ok(());
+        }
+        self.sync_summaries(manifest, &checked.runs, quick)
+    }
+
+    /// The records, checked under the study lock as `run` checks them at its start
+    /// ([`Store::check`]), for a commit to render the summaries from: a record at fault (edited
+    /// while run `committing` computed; its own old record, which it replaces, aside) refuses
+    /// the commit naming it, so an edit is never rendered into `levels.csv` and then passed as
+    /// sound. Faults of the summaries alone are not the records': the commit renders them anew.
+    fn sound_records(&self, committing: &str) -> Result<Vec<RunRecord>> {
+        let checked = self.store.check()?;
+        let at_fault: Vec<String> =
+            checked.faults.iter().filter(|f| f.record.as_deref().is_some_and(|r| r != committing)).map(|f| format!("\n  {f}")).collect();
+        if !at_fault.is_empty() {
+            bail!(
+                "run {committing} is not stored: {} does not hold together (changed while the run computed?):{}\n\
+                 The summaries are rendered only from records that pass the check, so nothing was written (its checkpoint, if any, is kept). \
+                 Rerun the runs at fault with `{}` (or restore the files)",
+                self.store.dir.root.display(),
+                at_fault.concat(),
+                self.store.replace_command()
+            );
+        }
+        Ok(checked.runs)
     }
 
     /// A run's lock is of this folder (two stores of one process must not mix their guards).
@@ -247,13 +274,21 @@ impl Writer<'_> {
     }
 }
 
-/// The provenance of the study as it is now, for these runs.
+/// The provenance of the study as it is now, for these runs: the hashes of its input files are
+/// those the runs read (planned with the manifest and pinned while each run computed), not
+/// what the files hold now.
 fn provenance_of(manifest: &Manifest, runs: &[RunRecord], quick: bool) -> Provenance {
-    let meshes = manifest.mesh_files();
-    let meshes: Vec<&std::path::Path> = meshes.iter().map(|p| p.as_path()).collect();
     let ids = runs.iter().map(|r| r.run.id.clone()).collect();
-    let mut prov = provenance::collect(&manifest.study, &manifest.file, &manifest.bytes, quick, ids, &meshes);
-    prov.problem_files = manifest.problem_files().iter().map(|f| provenance::ProblemFile::of(f)).collect();
+    let mut prov = provenance::collect(&manifest.study, &manifest.file, &manifest.bytes, quick, ids, &[]);
+    let planned = manifest.planned_hashes();
+    let hash = |f: &std::path::Path| planned.get(f).cloned();
+    prov.mesh_sha256 = manifest
+        .mesh_files()
+        .iter()
+        .map(|m| (m.display().to_string(), hash(m).unwrap_or_else(|| "(not read by any run)".into())))
+        .collect();
+    prov.problem_files =
+        manifest.problem_files().iter().map(|f| provenance::ProblemFile { path: f.display().to_string(), sha256: hash(f) }).collect();
     prov
 }
 
