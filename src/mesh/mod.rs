@@ -54,13 +54,13 @@ fn switches(g: &dyn Fn(f64) -> Vec<f64>) -> Vec<f64> {
     let ts: Vec<f64> = (0..=PART_SAMPLES).map(|k| k as f64 / PART_SAMPLES as f64).collect();
     let values: Vec<Vec<f64>> = ts.iter().map(|&t| g(t)).collect();
     let mut out = Vec::new();
-    for c in 0..values[0].len() {
-        for k in 0..PART_SAMPLES {
-            let (s0, s1) = (sign(values[k][c]), sign(values[k + 1][c]));
+    for (v, t) in values.windows(2).zip(ts.windows(2)) {
+        for (c, (&v0, &v1)) in v[0].iter().zip(&v[1]).enumerate() {
+            let (s0, s1) = (sign(v0), sign(v1));
             if s0 == s1 {
                 continue;
             }
-            let (mut lo, mut hi) = (ts[k], ts[k + 1]);
+            let (mut lo, mut hi) = (t[0], t[1]);
             for _ in 0..80 {
                 let mid = 0.5 * (lo + hi);
                 if mid <= lo || mid >= hi {
