@@ -38,7 +38,7 @@ use rayon::prelude::*;
 /// Threshold, relative to the force scale, above which lambda_p counts as positive (Lambda_h^C).
 pub const LAMBDA_POSITIVE: f64 = 1e-10;
 /// Gauss points per edge for the "quadrature" sampling of edge terms.
-pub const EDGE_GAUSS: usize = 3;
+pub const EDGE_GAUSS: usize = crate::contact::norms::EDGE_GAUSS;
 
 /// Which contact nodes eta_5 is taken over. Manifests spell the values in snake_case
 /// (`as_written`), the command line in kebab-case (`--contact-term as-written`). The variants'

@@ -842,6 +842,10 @@ impl Problem for FileProblem {
             Part::Neumann
         }
     }
+    fn part_comparisons(&self, x: [f64; 2]) -> Vec<f64> {
+        let predicates = [&self.contact_predicate, &self.dirichlet_predicate];
+        predicates.into_iter().flatten().flat_map(|p| p.any.iter().flatten()).map(|c| c.lhs.at(x) - c.rhs.at(x)).collect()
+    }
     fn part_of_group(&self, group: &str) -> Option<Part> {
         self.groups.get(group).copied()
     }

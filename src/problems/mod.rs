@@ -69,6 +69,13 @@ pub trait Problem: Send + Sync {
     /// The boundary part containing boundary point `x` (an edge midpoint): how the built-in
     /// meshes (`structured:N`, `symmetric:N`) are tagged.
     fn part_of(&self, x: [f64; 2]) -> Part;
+    /// lhs - rhs of every comparison in the predicates behind [`Problem::part_of`], at `x`, in a
+    /// fixed order: along a line the part can change only where one of them changes sign (how
+    /// `Mesh::check_parts_whole` finds a part that ends inside an edge). Empty when the parts are
+    /// not written as comparisons (the built-ins).
+    fn part_comparisons(&self, _x: [f64; 2]) -> Vec<f64> {
+        Vec::new()
+    }
     /// The boundary part of the edges in the mesh file's physical group `group` (how Gmsh meshes
     /// are tagged); `None` if the problem does not name that group.
     fn part_of_group(&self, _group: &str) -> Option<Part> {

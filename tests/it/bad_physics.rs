@@ -262,3 +262,43 @@ fn an_exact_solution_that_breaks_a_boundary_or_contact_condition_is_refused() {
     let (code, err) = run_experiment("as-is", "ex71.toml", "chi = 0\n", "chi = 0\n", solve);
     assert_eq!(code, 0, "{err}");
 }
+
+/// Battery 7, finding 8: a contact part that is a narrow band inside one edge (y in (0.6113,
+/// 0.6133) on the right side of Example 7.2, between the 16 samples of structured:4 and 8) was
+/// silently dropped on those meshes and refused on 16 and 64. Every sign change of a comparison
+/// is now located by bisection and the parts tested on both sides of it: refused on every mesh,
+/// naming a point of the band; the file without the band passes.
+#[test]
+fn a_contact_band_inside_one_edge_is_refused_on_every_mesh() {
+    let whole = r#"contact = "x > 1 - 1e-12""#;
+    let side = r#"contact = "x > 1 - 1e-12 && y < 0.5""#;
+    let band = r#"contact = "x > 1 - 1e-12 && y < 0.5 || x > 1 - 1e-12 && y > 0.6113 && y < 0.6133""#;
+    for n in [4, 8, 16, 64] {
+        let mesh = format!("structured:{n}");
+        let args = ["solve", "--problem", "v.toml", "--mesh", &mesh];
+        let (code, err) = run_experiment(&format!("band-{n}"), "ex72.toml", whole, band, &args);
+        assert_eq!(code, 1, "{mesh}: {err}");
+        assert!(
+            err.contains("the boundary parts change inside an edge") && err.contains("Neumann at its midpoint but Contact at (1, 0.61"),
+            "{mesh}: {err}"
+        );
+        let (code, err) = run_experiment(&format!("side-{n}"), "ex72.toml", whole, side, &args);
+        assert_eq!(code, 0, "{mesh}: {err}");
+    }
+}
+
+/// Battery 7, finding 11: a `[curves]` circle with a centre that is not a number was blamed on
+/// its radius ("got radius 1"): the message names the centre.
+#[test]
+fn a_circle_with_a_centre_that_is_not_finite_names_the_centre() {
+    let mesh = format!("gmsh:{}", PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("experiments/meshes/hertz.msh").display());
+    for (name, centre) in [("centre-nan", "[nan, 1]"), ("centre-inf", "[0, inf]")] {
+        let to = format!("contact = {{ circle = {{ centre = {centre}, radius = 1 }} }}");
+        let from = "contact = { circle = { centre = [0, 1], radius = 1 } }";
+        let (code, err) = run_experiment(name, "hertz.toml", from, &to, &["solve", "--problem", "v.toml", "--mesh", &mesh]);
+        assert_eq!(code, 1, "{centre}: {err}");
+        assert!(err.contains("curves.contact.circle") && err.contains("got centre ["), "{centre}: {err}");
+        let shown = if centre.contains("nan") { "[NaN, 1]" } else { "[0, inf]" };
+        assert!(err.contains(shown), "{centre}: {err}");
+    }
+}

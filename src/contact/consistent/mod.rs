@@ -7,10 +7,14 @@
 //! same. Both are certified solutions of the wrong problem, and the error rates only look poor.
 //!
 //! The derivatives are taken by central differences at the centroids of up to [`SAMPLES`]
-//! triangles spread over the mesh, and the body force also at every point where the assembly
+//! triangles spread over the mesh; the gradient also at every point where it enters the discrete
+//! problem or the estimate, the points of the Neumann edges where the traction `"exact"` =
+//! sigma(grad) n is read (`boundary::gradient_points`: the P2 nodes, the traction's Gauss points,
+//! the estimator's edge points; battery 7: a band in a hand-written grad, divergence-free, between the centroids
+//! was certified on structured:4 to 32); the body force also at every point where the assembly
 //! evaluates it on this mesh (`fem::assembly::load_points`: whatever f the discrete problem
-//! sees is checked), with the steps `s` and `s / 2`, `s` a thousandth of the
-//! triangle's longest edge. A central difference is second-order, so the two steps differ by
+//! sees is checked). The steps are `s` and `s / 2`, `s` a thousandth of the
+//! triangle's (or boundary edge's) longest edge. A central difference is second-order, so the two steps differ by
 //! about 3/4 of the larger one's error; a mismatch is reported only where it exceeds
 //! [`CONSISTENT`] times the data's scale and [`BEYOND`] times that difference. Where a kink of
 //! the data falls inside the stencil (fb's (x - a)_+^(1/2) in f, at x = a) the two steps
@@ -107,10 +111,7 @@ fn central(f: &dyn Fn([f64; 2]) -> f64, x: [f64; 2], j: usize, s: f64) -> f64 {
 /// of the body's size (round-off in the differences stays far below the mismatches reported, on
 /// the smallest triangles of a graded mesh too).
 fn steps(mesh: &Mesh) -> Vec<f64> {
-    let (lo, hi) = mesh.vertices.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), v| {
-        ([lo[0].min(v[0]), lo[1].min(v[1])], [hi[0].max(v[0]), hi[1].max(v[1])])
-    });
-    let diameter = (hi[0] - lo[0]).hypot(hi[1] - lo[1]);
+    let diameter = diameter(mesh);
     (0..mesh.n_triangles())
         .map(|k| {
             let t = mesh.triangles[k].map(|v| mesh.vertices[v]);
@@ -118,6 +119,14 @@ fn steps(mesh: &Mesh) -> Vec<f64> {
             1e-3 * longest.max(1e-3 * diameter)
         })
         .collect()
+}
+
+/// The body's size: the diagonal of the mesh's bounding box.
+fn diameter(mesh: &Mesh) -> f64 {
+    let (lo, hi) = mesh.vertices.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), v| {
+        ([lo[0].min(v[0]), lo[1].min(v[1])], [hi[0].max(v[0]), hi[1].max(v[1])])
+    });
+    (hi[0] - lo[0]).hypot(hi[1] - lo[1])
 }
 
 /// The centroid of every sampled triangle and its step ([`steps`]).
@@ -216,11 +225,14 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Resul
         None => format!("problem {}", problem.name()),
     };
     let pts = points(mesh);
-    let sampled = pts.len();
+    // the gradient also where it enters: the traction "exact" = sigma(grad) n (battery 7)
+    let mut grad_pts = pts.clone();
+    grad_pts.extend(boundary::gradient_points(mesh, nodes));
+    let sampled = grad_pts.len();
     for i in 0..2 {
         for j in 0..2 {
             let u = |x: [f64; 2]| exact.u(x)[i];
-            if let Some(m) = compare(&pts, &|at| exact.grad(at)[i][j], &|at, s| central(&u, at, j, s)) {
+            if let Some(m) = compare(&grad_pts, &|at| exact.grad(at)[i][j], &|at, s| central(&u, at, j, s)) {
                 let Mismatch { at, declared, differenced, step, spread, count } = m;
                 return Err(ExactError::Gradient {
                     problem: problem_name(),

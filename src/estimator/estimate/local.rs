@@ -3,7 +3,7 @@
 //! residual f + div sigma(u_h) (eta_1), the boundary residuals on Neumann and contact edges
 //! (eta_3, eta_4, eta_5, eta_6, eta_7) and the interior traction jumps (eta_2).
 
-use super::{EDGE_GAUSS, EstimatorConfig, StressFrame};
+use super::{EstimatorConfig, StressFrame};
 use crate::base::element::{self, Affine, EDGE_VERTICES, N_NODES};
 use crate::contact::norms::Sampling;
 use crate::contact::solve::DiscreteSolution;
@@ -76,14 +76,9 @@ fn inf_norm(v: [f64; 2]) -> f64 {
     v[0].abs().max(v[1].abs())
 }
 
-/// Edge sampling parameters in [0, 1].
+/// Edge sampling parameters in [0, 1] ([`Sampling::edge_parameters`]).
 pub(super) fn edge_samples(sampling: Sampling) -> Vec<f64> {
-    match sampling {
-        Sampling::Quadrature => element::gauss_legendre(EDGE_GAUSS).points.iter().map(|p| p[0]).collect(),
-        Sampling::Dense => {
-            (0..=crate::contact::norms::LATTICE_ORDER).map(|k| k as f64 / crate::contact::norms::LATTICE_ORDER as f64).collect()
-        }
-    }
+    sampling.edge_parameters()
 }
 
 /// Stress (s11, s12, s22) of u_h at the three vertices of every element.

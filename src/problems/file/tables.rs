@@ -185,7 +185,10 @@ impl Reader<'_> {
                 return Err(self.error(
                     &format!("{key}.circle"),
                     curve.span(),
-                    format!("a finite centre and a positive radius, got radius {}", c.radius),
+                    format!(
+                        "a finite centre and a positive radius, got centre [{}, {}] and radius {}",
+                        c.centre.0[0], c.centre.0[1], c.radius
+                    ),
                 ));
             }
             curves.insert(group.clone(), Curve::Circle { centre: c.centre.0, radius: c.radius });
