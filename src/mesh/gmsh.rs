@@ -17,8 +17,16 @@
 //!   block (sparse tags too); a tag listed twice is an error. Nodes must lie in the plane z = 0.
 //!   Nodes not used by any triangle are dropped; the others become the mesh's vertices in
 //!   ascending tag order (for a file Gmsh wrote without renumbering, the file's order).
+//! * The triangles must form one mesh: no edge in three triangles or twice in one direction (one
+//!   folded over another, `check_folds`), and no two triangles overlapping geometrically (two
+//!   bodies in one place or crossing, [`overlap`](super::overlap)); the error names both
+//!   triangles, their lines and a point inside both.
 //! * A partitioned file (`$PartitionedEntities`) is refused by name: its elements sit on
 //!   partition entities, whose groups are their parents' (`refuse_partitioned`).
+//!
+//! Sections the harness does not read (`$Comments`, data sections, any other) are skipped
+//! wherever they appear, before `$MeshFormat` too, as gmsh skips them: `msh_sections` blanks
+//! them before any reader sees the bytes.
 //!
 //! `mshio` parses the `$MeshFormat`, `$Entities`, `$Nodes` and `$Elements` sections but not
 //! `$PhysicalNames`, so that small section (`dim tag "name"` per line, ASCII in binary files too)
@@ -26,7 +34,7 @@
 //! any order), so the tags are read by `mesh::msh_nodes` in every case. `mshio`'s
 //! errors carry the position in the file, turned into a line number here.
 
-use super::{BoundaryEdge, Mesh, MeshError, Part, key, msh_nodes};
+use super::{BoundaryEdge, Mesh, MeshError, Part, key, msh_nodes, msh_sections};
 use crate::base::number::point;
 use crate::problems::Problem;
 use mshio::ElementType;
@@ -178,6 +186,30 @@ fn check_folds(
     Ok(())
 }
 
+/// No two triangles overlap geometrically ([`super::overlap`]): the topology [`check_folds`]
+/// checks can be perfect for two bodies meshed in one place (each its own nodes) or crossing
+/// each other, whose solution would be either body's at a point (battery 7). Named by the
+/// triangles' tags and lines and a point inside both.
+fn check_overlaps(
+    path: &Path,
+    vertices: &[[f64; 2]],
+    triangles: &[[usize; 3]],
+    tags: &[([u64; 3], u64)],
+    line_of: &LineOf,
+) -> Result<(), MeshError> {
+    let Some(o) = super::overlap::find(vertices, triangles) else { return Ok(()) };
+    let (first, second) = (tags[o.a].1, tags[o.b].1);
+    let at = line_of(first).map(|l| format!(" (line {l})")).unwrap_or_default();
+    Err(error(
+        path,
+        line_of(second),
+        format!(
+            "triangles {first}{at} and {second} overlap: both hold the point {}; two bodies meshed in one place or crossing each other, or a body folded onto itself (the triangles of a mesh must meet only at shared edges and vertices)",
+            point(o.point)
+        ),
+    ))
+}
+
 /// Every node of the `$Nodes` section by its tag (ascending: the order the vertices take). The
 /// tags are the file's own, read by [`msh_nodes`] (`mshio` drops them when they look contiguous,
 /// whatever their order), after checking that it and `mshio` read the same section; the
@@ -249,6 +281,10 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
         other => error(path, None, other.to_string()),
     })?;
     let bytes = single_spaced(bytes);
+    // the sections gmsh skips are skipped by every reader below: blanked, lines kept
+    let bytes = msh_sections::blank_ignored(bytes).map_err(|(name, line)| {
+        error(path, Some(line), format!("the section ${name} has no line $End{name}: every section must be closed"))
+    })?;
     refuse_partitioned(path, &bytes)?;
     let names = physical_names(path, &bytes)?;
     let msh = parse(path, &bytes)?;
@@ -262,6 +298,7 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     let (vertices, used) = vertices_of(path, &tri_nodes, &node_at, &line_of)?;
     let (triangles, triangle_lines) = oriented_triangles(path, &vertices, &used, &tri_nodes, &line_of)?;
     check_folds(path, &vertices, &triangles, &tri_nodes, &line_of)?;
+    check_overlaps(path, &vertices, &triangles, &tri_nodes, &line_of)?;
     let (edges, groups) = group_edges(path, line_elems, &used, &node_at, &names, &line_of)?;
     Ok(GmshFile { path: path.to_path_buf(), vertices, triangles, triangle_lines, edges, groups })
 }
@@ -318,8 +355,11 @@ fn single_spaced(bytes: Vec<u8>) -> Vec<u8> {
 /// The file parsed by `mshio`; its error turned into one naming the line. `mshio` has a few
 /// `expect`s left on malformed input: a panic there is a malformed file too.
 fn parse(path: &Path, bytes: &[u8]) -> Result<mshio::MshFile<u64, i32, f64>, MeshError> {
+    // from the $MeshFormat line on: gmsh skips what comes before it (sections blanked by
+    // `msh_sections::blank_ignored`, stray lines); mshio wants the header first
+    let start = msh_sections::header(bytes);
     let parsed = std::panic::catch_unwind(|| {
-        mshio::parse_msh_bytes(bytes).map_err(|e| {
+        mshio::parse_msh_bytes(&bytes[start.unwrap_or(0)..]).map_err(|e| {
             let first = e.begin_msh_errors().next().or(e.backtrace.first());
             let (rest, kind) = first
                 .map(|(r, k)| (r.len(), k.context().map_or_else(|| k.to_string(), |c| format!("cannot read the {c}"))))
@@ -329,7 +369,7 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<mshio::MshFile<u64, i32, f64>, Mes
             });
             // mshio places header errors past the header: they are on the line after $MeshFormat
             let offset = match header {
-                true => bytes.windows(12).position(|w| w == b"$MeshFormat\n").map_or(0, |p| p + 12),
+                true => start.map_or(0, |p| p + 12),
                 false => bytes.len() - rest,
             };
             let within: Vec<String> = e.filter_msh_errors().skip(1).filter_map(|(_, k)| k.context().map(str::to_string)).collect();

@@ -28,13 +28,18 @@ pub struct Locator {
     tree: RTree<Boxed>,
 }
 
+/// The smallest and largest coordinates of a triangle's corners `c`.
+pub fn bounding_box(c: [[f64; 2]; 3]) -> ([f64; 2], [f64; 2]) {
+    let lo = [c[0][0].min(c[1][0]).min(c[2][0]), c[0][1].min(c[1][1]).min(c[2][1])];
+    let hi = [c[0][0].max(c[1][0]).max(c[2][0]), c[0][1].max(c[1][1]).max(c[2][1])];
+    (lo, hi)
+}
+
 impl Locator {
     pub fn new(mesh: &Mesh) -> Self {
         let boxes = (0..mesh.n_triangles())
             .map(|t| {
-                let c = mesh.corners(t);
-                let lo = [c[0][0].min(c[1][0]).min(c[2][0]), c[0][1].min(c[1][1]).min(c[2][1])];
-                let hi = [c[0][0].max(c[1][0]).max(c[2][0]), c[0][1].max(c[1][1]).max(c[2][1])];
+                let (lo, hi) = bounding_box(mesh.corners(t));
                 // a margin (relative to the box) so that a point on an edge is in the boxes of
                 // both triangles whatever the rounding
                 let pad = 1e-9 * (hi[0] - lo[0]).max(hi[1] - lo[1]) + 1e-300;

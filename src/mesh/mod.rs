@@ -5,12 +5,15 @@
 //! it approximates. [`P2Nodes`] numbers the P2 nodes: the mesh vertices first (node `v` is vertex
 //! `v`), then one midpoint per edge (on the straight edge: the elements are not isoparametric).
 //! [`MeshSpec`] describes a mesh: the unit square (`structured:N`, `symmetric:N`) or a Gmsh file
-//! (`gmsh:PATH.msh`, [`gmsh`]). [`locate`] finds the triangle holding a point.
+//! (`gmsh:PATH.msh`, [`gmsh`]). [`locate`] finds the triangle holding a point, [`overlap`] two
+//! triangles whose interiors overlap.
 
 pub mod gmsh;
 pub mod io;
 pub mod locate;
 mod msh_nodes;
+mod msh_sections;
+pub mod overlap;
 pub mod refine;
 
 use crate::problems::{Curve, Part, Problem};
@@ -94,6 +97,13 @@ pub enum MeshError {
     UntaggedBoundary { a: usize, b: usize },
     #[error("tagged edge ({a}, {b}) is not a boundary edge of the mesh")]
     TagNotOnBoundary { a: usize, b: usize },
+    /// Two triangles whose interiors overlap ([`overlap`]): two bodies in one place or crossing,
+    /// or a body folded onto itself; (x, y) is a point inside both.
+    #[error(
+        "triangles {a} and {b} overlap: both hold the point {} (two bodies meshed in one place or crossing each other, or a body folded onto itself: the triangles of a mesh must meet only at shared edges and vertices)",
+        crate::base::number::point([*.x, *.y])
+    )]
+    Overlap { a: usize, b: usize, x: f64, y: f64 },
     #[error("triangle {t} refers to vertex {v}, but the mesh has {n} vertices")]
     BadVertex { t: usize, v: usize, n: usize },
     #[error(
@@ -398,8 +408,8 @@ impl Mesh {
         min
     }
 
-    /// Check positive areas, conformity (every edge in one or two triangles), and that the tagged
-    /// edges are exactly the boundary edges.
+    /// Check positive areas, conformity (every edge in one or two triangles), that the tagged
+    /// edges are exactly the boundary edges, and that no two triangles overlap ([`overlap`]).
     pub fn check(&self) -> Result<(), MeshError> {
         let n = self.n_vertices();
         for (t, tri) in self.triangles.iter().enumerate() {
@@ -440,7 +450,11 @@ impl Mesh {
         // no hanging nodes: a vertex lying inside another triangle's edge would make that edge
         // appear once only, but on the interior; the tag check above catches it because such an
         // edge is not tagged.
-        Ok(())
+        // no overlap: a conforming topology can still be two bodies in one place, or crossing
+        match overlap::find(&self.vertices, &self.triangles) {
+            Some(o) => Err(MeshError::Overlap { a: o.a, b: o.b, x: o.point[0], y: o.point[1] }),
+            None => Ok(()),
+        }
     }
 
     /// Check that each given point is a mesh vertex (e.g. the kink of the obstacle).
@@ -720,6 +734,21 @@ pub(crate) mod tests {
         edge.v = interior;
         m.boundary.push(edge);
         assert!(matches!(m.check(), Err(MeshError::TagNotOnBoundary { .. })), "{:?}", m.check());
+        // two bodies crossing (the square and a copy shifted by (0.5, 0.25)), each conforming
+        // and tagged: the overlap is found, with a point in both
+        let m = Mesh::unit_square(2, false, &tag);
+        let n = m.n_vertices();
+        let mut two = m.clone();
+        two.vertices.extend(m.vertices.iter().map(|v| [v[0] + 0.5, v[1] + 0.25]));
+        two.triangles.extend(m.triangles.iter().map(|t| t.map(|v| v + n)));
+        two.boundary.extend(m.boundary.iter().map(|e| BoundaryEdge { v: e.v.map(|v| v + n), ..*e }));
+        match two.check() {
+            Err(MeshError::Overlap { a, b, x, y }) => {
+                assert!(a < m.n_triangles() && b >= m.n_triangles(), "{a} {b}");
+                assert!(x > 0.5 && x < 1.0 && y > 0.25 && y < 1.0, "({x}, {y})");
+            }
+            other => panic!("{other:?}"),
+        }
         assert!(MeshSpec::parse("structured:x").is_err());
         assert!(MeshSpec::parse("structured").is_err());
         assert!(MeshSpec::parse("cube:4").is_err());

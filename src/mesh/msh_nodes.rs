@@ -28,7 +28,7 @@ impl Encoding {
     /// The encoding the `$MeshFormat` header of `bytes` declares (`version fileType dataSize`,
     /// then in a binary file the `int` 1 in the file's byte order); None without that header.
     pub fn of(bytes: &[u8]) -> Option<Encoding> {
-        let start = bytes.windows(11).position(|w| w == b"$MeshFormat")? + 11;
+        let start = super::msh_sections::header(bytes)? + 11;
         let line_start = start + bytes[start..].iter().position(|&b| b == b'\n')? + 1;
         let line_end = line_start + bytes[line_start..].iter().position(|&b| b == b'\n')?;
         let line = std::str::from_utf8(&bytes[line_start..line_end]).ok()?;
@@ -131,24 +131,9 @@ impl Cursor<'_> {
 }
 
 /// The byte offset just after the line `$Nodes` (its end of line included), found by walking the
-/// file's sections from the start: each is a line `$Name`, skipped to its line `$EndName`.
+/// file's sections from the start ([`super::msh_sections::walk`]).
 fn nodes_start(bytes: &[u8]) -> Option<usize> {
-    let mut pos = 0;
-    loop {
-        while pos < bytes.len() && bytes[pos].is_ascii_whitespace() {
-            pos += 1;
-        }
-        if bytes.get(pos) != Some(&b'$') {
-            return None;
-        }
-        let eol = pos + bytes[pos..].iter().position(|&b| b == b'\n')?;
-        let name = std::str::from_utf8(&bytes[pos + 1..eol]).ok()?.trim_end_matches('\r');
-        if name == "Nodes" {
-            return Some(eol + 1);
-        }
-        let end = format!("$End{name}");
-        pos = eol + 1 + bytes[eol + 1..].windows(end.len()).position(|w| w == end.as_bytes())? + end.len();
-    }
+    super::msh_sections::walk(bytes).into_iter().find(|s| s.name == "Nodes").map(|s| s.body)
 }
 
 /// Read the `$Nodes` section of `bytes` (an MSH 4.1 file `mshio` has parsed); None when the file

@@ -69,17 +69,100 @@ fn a_contact_part_that_matches_no_edge_is_named() {
 
 /// A Gmsh variant of tests/fixtures/square.msh: (exit code, stderr).
 fn gmsh_variant(name: &str, from: &str, to: &str) -> (i32, String) {
-    let dir = tmp(name);
     let msh = fixture("square.msh");
     assert!(msh.contains(from), "{from}");
-    std::fs::write(dir.join("bad.msh"), msh.replace(from, to)).unwrap();
+    let (code, _, err) = solve_gmsh(name, &msh.replace(from, to));
+    (code, err)
+}
+
+/// `signorini solve` of bad_data_gmsh.toml on the mesh file `msh` (written as bad.msh), probed at
+/// (0.25, 0.5): (exit code, stdout without its timings, stderr).
+fn solve_gmsh(name: &str, msh: &str) -> (i32, String, String) {
+    let dir = tmp(name);
+    std::fs::write(dir.join("bad.msh"), msh).unwrap();
     std::fs::write(dir.join("v.toml"), fixture("bad_data_gmsh.toml")).unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
         .current_dir(&dir)
-        .args(["solve", "--problem", "v.toml", "--mesh", "gmsh:bad.msh"])
+        .args(["solve", "--problem", "v.toml", "--mesh", "gmsh:bad.msh", "--probe", "0.25,0.5"])
         .output()
         .unwrap();
-    (o.status.code().unwrap_or(-1), String::from_utf8_lossy(&o.stderr).into_owned())
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    let out: Vec<&str> = std::str::from_utf8(&o.stdout).unwrap().lines().filter(|l| !l.starts_with("time:")).collect();
+    (o.status.code().unwrap_or(-1), out.join("\n"), text(&o.stderr))
+}
+
+/// tests/fixtures/square.msh with a second square, its own nodes 5-8 shifted by `d`, its own
+/// boundary lines in the same groups and its triangles 11 and 12: two bodies, each a valid mesh.
+fn two_squares(d: [f64; 2]) -> String {
+    let msh = fixture("square.msh");
+    let copy: Vec<String> = ["0 0 0", "1 0 0", "1 1 0", "0 1 0"]
+        .iter()
+        .map(|p| {
+            let c: Vec<f64> = p.split(' ').map(|x| x.parse().unwrap()).collect();
+            format!("{} {} 0", c[0] + d[0], c[1] + d[1])
+        })
+        .collect();
+    let nodes = format!("0 1 0\n2 1 0 4\n5\n6\n7\n8\n{}\n$EndNodes", copy.join("\n"));
+    let elements = "6 1 4 3\n1 1 1 1\n7 5 6\n1 2 1 3\n8 6 7\n9 7 8\n10 8 5\n2 1 2 2\n11 5 6 7\n12 5 8 7\n$EndElements";
+    let out = msh
+        .replace("$Nodes\n1 4 1 4\n", "$Nodes\n2 8 1 8\n")
+        .replace("0 1 0\n$EndNodes", &nodes)
+        .replace("$Elements\n3 6 1 6\n", "$Elements\n6 12 1 12\n")
+        .replace("6 1 4 3\n$EndElements", elements);
+    assert_ne!(out, msh);
+    out
+}
+
+/// Battery 7, finding 6: two bodies in one place, or crossing each other, each a valid mesh of
+/// its own, were solved and certified (a probe gave one body's value). They are refused, naming
+/// a triangle of each (tag and line) and a point inside both; squares that only touch along an
+/// edge (each its own nodes) still solve.
+#[test]
+fn overlapping_bodies_in_a_gmsh_file_are_refused_naming_two_triangles_and_a_point() {
+    let (code, _, err) = solve_gmsh("touching", &two_squares([1.0, 0.0]));
+    assert_eq!(code, 0, "squares side by side: {err}");
+    for d in [[0.0, 0.0], [0.5, 0.0], [0.5, 0.25], [-0.3, 0.6]] {
+        let msh = two_squares(d);
+        let (code, out, err) = solve_gmsh(&format!("overlap{}-{}", d[0], d[1]), &msh);
+        assert_eq!(code, 1, "shift {d:?}: {out}{err}");
+        // the first triangle of the first square overlaps the first of the second in each shift
+        let line = |tag: u32| 1 + msh.lines().position(|l| l.starts_with(&format!("{tag} "))).unwrap();
+        let said = format!("bad.msh, line {}: triangles 5 (line {}) and 11 overlap: both hold the point (", line(11), line(5));
+        assert!(err.contains(&said), "shift {d:?}: {err}");
+        // the point named lies inside both squares
+        let at = err.split("both hold the point (").nth(1).and_then(|r| r.split(')').next()).unwrap();
+        let p: Vec<f64> = at.split(", ").map(|x| x.parse().unwrap()).collect();
+        let inside = |o: [f64; 2]| p[0] > o[0] && p[0] < o[0] + 1.0 && p[1] > o[1] && p[1] < o[1] + 1.0;
+        assert!(inside([0.0, 0.0]) && inside(d), "shift {d:?}: ({at}) is not in both");
+    }
+}
+
+/// Battery 7, finding 10: gmsh skips the sections it does not read (`$Comments`, any unknown
+/// one) wherever they are, before `$MeshFormat` too; a file opening with `$Comments` was
+/// refused as a bad header. Every placement now solves to the plain file's output, also when a
+/// comment holds a line a reader looks for (`$PhysicalNames`, `$MeshFormat`, `$Nodes`); a
+/// comment never closed is named at its line.
+#[test]
+fn sections_gmsh_skips_are_skipped_wherever_they_are() {
+    let plain = fixture("square.msh");
+    let (code, want, err) = solve_gmsh("plain", &plain);
+    assert_eq!(code, 0, "{err}");
+    let comment =
+        "$Comments\nwritten by hand\n$PhysicalNames\n1\n1 1 \"bottom\"\n$EndPhysicalNames\n$MeshFormat\n4.1 1 8\n$Nodes\n$EndComments";
+    for (name, from, to) in [
+        ("top", "$MeshFormat\n", format!("{comment}\n$MeshFormat\n")),
+        ("top-two", "$MeshFormat\n", format!("$Foo\n1 2 3\n$EndFoo\n\n{comment}\n$MeshFormat\n")),
+        ("between", "$Entities\n", format!("{comment}\n$Entities\n")),
+        ("before-nodes", "$Nodes\n", format!("{comment}\n$Nodes\n")),
+        ("end", "$EndElements\n", format!("$EndElements\n{comment}\n")),
+    ] {
+        assert!(plain.contains(from), "{from}");
+        let (code, out, err) = solve_gmsh(name, &plain.replacen(from, &to, 1));
+        assert_eq!((code, &out), (0, &want), "{name}: {err}");
+    }
+    let (code, _, err) = solve_gmsh("open", &plain.replace("$Entities\n", "$Comments\nno end\n$Entities\n"));
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("bad.msh, line 10: the section $Comments has no line $EndComments"), "{err}");
 }
 
 #[test]

@@ -1,0 +1,110 @@
+//! The sections of an MSH file, walked as gmsh walks them: a line `$Name` opens a section, the
+//! next line `$EndName` closes it, and lines between sections that do not start with `$` are
+//! skipped. Gmsh reads the sections it knows and skips every other one (`$Comments`, data
+//! sections) wherever it appears, before `$MeshFormat` too.
+//!
+//! Every reader of a Gmsh file's bytes (`mshio`, and the harness's own readers of
+//! `$PhysicalNames`, `$Nodes`, element lines and `$PartitionedEntities`) reads them after
+//! [`blank_ignored`] has blanked the sections the harness does not read, and from the
+//! `$MeshFormat` line [`header`] finds: so a `$Comments` section before the header, or one
+//! holding a line `$PhysicalNames`, is skipped by all of them alike.
+
+/// The sections the harness reads (with `mshio` or its own readers); every other is skipped.
+pub const READ: [&str; 6] = ["MeshFormat", "PhysicalNames", "Entities", "PartitionedEntities", "Nodes", "Elements"];
+
+/// A section: its name (after `$`), the byte offsets of its opening line and of its body (after
+/// that line), and the offset just past its closing line (None: the file has no `$EndName`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Section {
+    pub name: String,
+    pub start: usize,
+    pub body: usize,
+    pub end: Option<usize>,
+}
+
+/// The end of the line starting at `pos` (the offset of its `\n`, or the file's end).
+fn line_end(bytes: &[u8], pos: usize) -> usize {
+    bytes[pos..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |i| pos + i)
+}
+
+/// The offset just past the first line from `from` on that reads `$End{name}` (blanks around it
+/// allowed), if any.
+fn closing(bytes: &[u8], from: usize, name: &str) -> Option<usize> {
+    let end = format!("$End{name}");
+    let mut pos = from;
+    while pos < bytes.len() {
+        let eol = line_end(bytes, pos);
+        if bytes[pos..eol].trim_ascii() == end.as_bytes() {
+            return Some((eol + 1).min(bytes.len()));
+        }
+        pos = eol + 1;
+    }
+    None
+}
+
+/// The file's sections in order, up to the first one that is not closed (included, with `end`
+/// None). Inside a section nothing is read but its closing line (binary data included).
+pub fn walk(bytes: &[u8]) -> Vec<Section> {
+    let mut sections = Vec::new();
+    let mut pos = 0;
+    while pos < bytes.len() {
+        let eol = line_end(bytes, pos);
+        let line = bytes[pos..eol].trim_ascii();
+        let Some(name) = line.strip_prefix(b"$") else {
+            // not a section's opening line: skipped (gmsh skips it too; mshio names it if it
+            // lies after the header)
+            pos = eol + 1;
+            continue;
+        };
+        let name = String::from_utf8_lossy(name).into_owned();
+        let body = (eol + 1).min(bytes.len());
+        let end = closing(bytes, body, &name);
+        sections.push(Section { name, start: pos, body, end });
+        match end {
+            Some(e) => pos = e,
+            None => break,
+        }
+    }
+    sections
+}
+
+/// The offset of the `$MeshFormat` line, the first section of its own (not a line inside a
+/// section skipped before it).
+pub fn header(bytes: &[u8]) -> Option<usize> {
+    walk(bytes).into_iter().find(|s| s.name == "MeshFormat").map(|s| s.start)
+}
+
+/// `bytes` with every section the harness does not read ([`READ`]) blanked, each of its bytes
+/// but the line ends made a space (offsets and line numbers stay where they are). A skipped
+/// section that is never closed is an error: its name and 1-based line.
+pub fn blank_ignored(mut bytes: Vec<u8>) -> Result<Vec<u8>, (String, usize)> {
+    for s in walk(&bytes) {
+        if READ.contains(&s.name.as_str()) {
+            continue;
+        }
+        let Some(end) = s.end else {
+            let line = 1 + bytes[..s.start].iter().filter(|&&b| b == b'\n').count();
+            return Err((s.name, line));
+        };
+        bytes[s.start..end].iter_mut().filter(|b| **b != b'\n').for_each(|b| *b = b' ');
+    }
+    Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Comments before the header, between sections and holding a `$` line are blanked, line
+    /// by line; the sections read are kept byte for byte.
+    #[test]
+    fn comments_anywhere_are_blanked() {
+        let file = "$Comments\nhi\n$PhysicalNames\n$EndComments\n$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Foo\nx\n$EndFoo\n$Nodes\n0 0 0 0\n$EndNodes\n";
+        let out = String::from_utf8(blank_ignored(file.as_bytes().to_vec()).unwrap()).unwrap();
+        assert_eq!(out.lines().count(), file.lines().count());
+        assert!(!out.contains("PhysicalNames") && !out.contains("Comments") && !out.contains("Foo"), "{out}");
+        assert_eq!(header(out.as_bytes()), file.find("$MeshFormat"));
+        assert!(out.ends_with("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n    \n \n       \n$Nodes\n0 0 0 0\n$EndNodes\n"), "{out:?}");
+        assert_eq!(blank_ignored(b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Comments\nno end\n".to_vec()), Err(("Comments".into(), 4)));
+    }
+}
