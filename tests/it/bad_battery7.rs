@@ -9,10 +9,7 @@
 use crate::common::signorini_in;
 
 fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("signorini-battery7-{name}-{}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::common::scratch(&format!("battery7-{name}"))
 }
 
 const BLOCK: &str = "dirichlet = DIRICHLET\nPOINT\n[material]\nmu = 1\nlambda = 1\n[parts]\ncontact = \"y < 1e-12\"\ndirichlet = DPART\n[contact]\nnormal = \"outward\"\nchi = 0\n";

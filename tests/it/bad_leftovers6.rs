@@ -15,18 +15,10 @@
 //! * a parametric Gmsh file gave mshio's words only (wrong `$Nodes` header counts, and the same
 //!   input under another name: `bad_data` and `bad_store`).
 
-use crate::common::signorini_in;
-use std::path::{Path, PathBuf};
+use crate::common::{fixture, signorini_in};
 
-fn fixture(name: &str) -> String {
-    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(name)).unwrap()
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("signorini-leftovers6-{name}-{}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn tmp(name: &str) -> std::path::PathBuf {
+    crate::common::scratch(&format!("leftovers6-{name}"))
 }
 
 /// The `estimator:` line of a solve's output.

@@ -124,3 +124,16 @@ pub fn sealed(results: &std::path::Path) -> signorini::study::store::Shelf {
     }
     shelf(results)
 }
+
+/// The text of `tests/fixtures/NAME`.
+pub fn fixture(name: &str) -> String {
+    std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(name)).unwrap()
+}
+
+/// An empty scratch folder `signorini-NAME-PID` under the system's temporary folder.
+pub fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("signorini-{name}-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
