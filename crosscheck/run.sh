@@ -64,8 +64,18 @@ TOML
 (cd "$own" && "$py" "$root/experiments/meshes/generate.py" disc.geo) || exit 1
 "$bin" solve --problem "$own/disc.toml" --mesh "gmsh:$own/disc.msh" || exit 1
 
+# the self-test and the rates beside the comparison (two processes of its own): each prints its
+# table when it has ended, in this order
 status=0
-"$py" "$here/crosscheck.py" --out-dir "$out" selftest "$cases/ex71-structured-8" "$cases/ex72-structured-8" "$cases/fb-structured-8" || status=1
+mkdir -p "$cases/logs"
+"$py" "$here/crosscheck.py" --out-dir "$out" selftest "$cases/ex71-structured-8" "$cases/ex72-structured-8" "$cases/fb-structured-8" \
+    > "$cases/logs/selftest.txt" 2>&1 &
+selftest=$!
+"$py" "$here/crosscheck.py" --out-dir "$out" rates "${exact[@]}" > "$cases/logs/rates.txt" 2>&1 &
+rates=$!
 "$py" "$here/crosscheck.py" --out-dir "$out" compare "${all[@]}" || status=1
-"$py" "$here/crosscheck.py" --out-dir "$out" rates "${exact[@]}" || status=1
+wait "$selftest" || status=1
+cat "$cases/logs/selftest.txt"
+wait "$rates" || status=1
+cat "$cases/logs/rates.txt"
 exit $status

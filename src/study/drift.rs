@@ -735,41 +735,16 @@ pub fn check(
         changes: BTreeMap::new(),
         not_compared,
     };
-    for m in &manifests {
-        // a deep study in its tiers (unless --deep): quick forms, some runs to the end
-        let (m, quick) = if opts.against.is_some() { (m.clone(), opts.quick) } else { m.for_drift(opts.quick, opts.deep) };
-        let m = &m;
-        if opts.progress && quick && !opts.quick {
-            let (full, replay) = m.drift.deep.as_ref().map(|t| (t.full.join(", "), t.replay.join(", "))).unwrap_or_default();
-            let mut tiers = vec!["every run rerun in its quick form".to_string()];
-            if !full.is_empty() {
-                tiers.push(format!("{full} to the end"));
-            }
-            if !replay.is_empty() {
-                tiers.push(format!("the last level of {replay} replayed from its history"));
-            }
-            crate::base::note::line(format_args!("{}: a deep study: {} (all to the end: drift --deep)", m.study, tiers.join(", ")));
-        }
-        let fresh_root = match &opts.against {
-            Some(dir) => dir.clone(),
-            None => {
-                if !opts.deep {
-                    // a stored reference replayed in one solve; --deep computes it anew
-                    super::preload_references(m, &Store::new(&opts.results, &m.study), opts.progress)?;
-                }
-                let options = super::RunOptions {
-                    quick,
-                    shard: None,
-                    fresh: true,
-                    replace: false,
-                    results: opts.scratch.clone(),
-                    progress: opts.progress,
-                    wait_for_lock: true,
-                };
-                super::run_study(m, &options)?;
-                opts.scratch.clone()
-            }
-        };
+    // a deep study in its tiers (unless --deep): quick forms, some runs to the end
+    let planned: Vec<(Manifest, bool)> = manifests
+        .iter()
+        .map(|m| if opts.against.is_some() { (m.clone(), opts.quick) } else { m.for_drift(opts.quick, opts.deep) })
+        .collect();
+    if opts.against.is_none() {
+        rerun_all(&planned, opts)?;
+    }
+    for (m, quick) in &planned {
+        let fresh_root = opts.against.clone().unwrap_or_else(|| opts.scratch.clone());
         let stored_store = Store::of(&opts.results, m);
         let fresh_store = Store::of(&fresh_root, m);
         let checked = stored_store.check().with_context(|| format!("reading the stored runs of {}", m.study))?;
@@ -780,8 +755,8 @@ pub fn check(
             Some(_) => fresh_store.read().with_context(|| format!("--against {}: the study {}", fresh_root.display(), m.study))?,
             None => fresh_store.records().with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?,
         };
-        let mut c = compare(m, &stored, &fresh, quick);
-        if quick && !opts.quick && opts.against.is_none() {
+        let mut c = compare(m, &stored, &fresh, *quick);
+        if *quick && !opts.quick && opts.against.is_none() {
             replay_tier(m, &stored, opts.progress, &mut c)?;
         }
         c.rows.extend(checked.faults.iter().map(|f| fault_row(&stored_store, f)));
@@ -810,6 +785,80 @@ pub fn check(
         }
     }
     Ok(report)
+}
+
+/// Rerun every planned study (each with its quick flag) into the scratch folder: first the
+/// stored reference solutions replayed, one at a time (the largest solves of a drift run, each
+/// alone in memory; `--deep` computes them anew in their runs instead), then the studies' runs,
+/// [`RERUN_AT_ONCE`] studies at a time. Each study has its own folder and locks, and a run's
+/// numbers do not depend on the threads that compute it (the round-off measurement of one
+/// thread against all finds no change), so the records are the same as one study at a time;
+/// the comparisons and the replayed levels follow, one study at a time, in the manifests'
+/// order. The first error in that order is returned, after the studies under way have ended.
+fn rerun_all(planned: &[(Manifest, bool)], opts: &DriftOptions) -> anyhow::Result<()> {
+    if !opts.deep {
+        for (m, _) in planned {
+            super::preload_references(m, &Store::new(&opts.results, &m.study), opts.progress)?;
+        }
+    }
+    let workers = if rayon::current_num_threads() >= 2 { RERUN_AT_ONCE } else { 1 };
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let failed = std::sync::atomic::AtomicBool::new(false);
+    let outcomes: Vec<std::sync::Mutex<Option<anyhow::Result<()>>>> = planned.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| {
+                use std::sync::atomic::Ordering::SeqCst;
+                loop {
+                    let i = next.fetch_add(1, SeqCst);
+                    if i >= planned.len() || failed.load(SeqCst) {
+                        return;
+                    }
+                    let outcome = rerun(&planned[i].0, planned[i].1, opts);
+                    failed.fetch_or(outcome.is_err(), SeqCst);
+                    *outcomes[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(outcome);
+                }
+            });
+        }
+    });
+    for o in outcomes {
+        if let Some(Err(e)) = o.into_inner().unwrap_or_else(|e| e.into_inner()) {
+            return Err(e);
+        }
+    }
+    Ok(())
+}
+
+/// How many studies a drift run reruns at once on a machine with two threads or more: the
+/// adaptive loops of small meshes keep one core busy much of the time, so two of them at once
+/// keep two cores busy; more would add memory without adding cores on the machines the
+/// harness is tested on.
+pub const RERUN_AT_ONCE: usize = 2;
+
+/// One study's runs rerun into the scratch folder (started over), in its tiers.
+fn rerun(m: &Manifest, quick: bool, opts: &DriftOptions) -> anyhow::Result<()> {
+    if opts.progress && quick && !opts.quick {
+        let (full, replay) = m.drift.deep.as_ref().map(|t| (t.full.join(", "), t.replay.join(", "))).unwrap_or_default();
+        let mut tiers = vec!["every run rerun in its quick form".to_string()];
+        if !full.is_empty() {
+            tiers.push(format!("{full} to the end"));
+        }
+        if !replay.is_empty() {
+            tiers.push(format!("the last level of {replay} replayed from its history"));
+        }
+        crate::base::note::line(format_args!("{}: a deep study: {} (all to the end: drift --deep)", m.study, tiers.join(", ")));
+    }
+    let options = super::RunOptions {
+        quick,
+        shard: None,
+        fresh: true,
+        replace: false,
+        results: opts.scratch.clone(),
+        progress: opts.progress,
+        wait_for_lock: true,
+    };
+    super::run_study(m, &options)?;
+    Ok(())
 }
 
 /// The stored results folder a drift run compares with must be a folder, checked before any

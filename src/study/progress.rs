@@ -92,6 +92,8 @@ impl Progress {
         };
         bar.set_style(style);
         bar.set_prefix(prefix.to_string());
+        // drawn through the process's one display: a bar of another study's run takes its own line
+        let bar = crate::base::note::bars().add(bar);
         bar.enable_steady_tick(Duration::from_millis(200));
         Progress { bar, plain: None, heartbeat: Mutex::new(None) }
     }
@@ -118,8 +120,16 @@ impl Progress {
     }
 
     pub fn finish(&self) {
-        drop(self.heartbeat.lock().expect("progress").take());
+        drop(self.heartbeat.lock().unwrap_or_else(|e| e.into_inner()).take());
         self.bar.finish_and_clear();
+        crate::base::note::bars().remove(&self.bar);
+    }
+}
+
+/// A step that ends by an error or an interruption takes its bar off the display too.
+impl Drop for Progress {
+    fn drop(&mut self) {
+        self.finish();
     }
 }
 
