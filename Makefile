@@ -3,6 +3,7 @@
 CARGO ?= cargo
 # cargo builds into $(CARGO_TARGET_DIR) when it is set, target/ otherwise
 BIN := $(or $(CARGO_TARGET_DIR),target)/release/signorini
+SCRATCH := $(or $(CARGO_TARGET_DIR),target)/test-scratch
 
 .PHONY: all build test cluster-test figures reproduce drift crosscheck bench roundoff meshes mesh clean
 
@@ -31,7 +32,9 @@ test: build
 	$(CARGO) fmt --check
 	$(CARGO) clippy --release --locked --all-targets -- -D warnings
 	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || command -v google-chrome >/dev/null || [ -n "$$CHROMIUM" ] || echo "NOTE: no chromium on this machine: the browser check of the study pages (tests/it/report_page.rs) is SKIPPED (apt-get install chromium; CI installs it)"
-	$(CARGO) test --release --locked
+	@# the tests' scratch folders (std::env::temp_dir) under target/, emptied first, not left in /tmp
+	@rm -rf $(SCRATCH) && mkdir -p $(SCRATCH)
+	TMPDIR=$(abspath $(SCRATCH)) $(CARGO) test --release --locked
 	$(CARGO) run --release --locked --example own_problem
 	$(BIN) drift
 	$(BIN) report
