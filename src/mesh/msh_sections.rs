@@ -92,15 +92,38 @@ pub fn blank_ignored(mut bytes: Vec<u8>) -> Result<Vec<u8>, (usize, String)> {
         ));
     }
     let mut kept = 0;
-    for s in walk(&bytes) {
+    let sections = walk(&bytes);
+    for (k, s) in sections.iter().enumerate() {
         blank(&mut bytes[kept..s.start]);
         if READ.contains(&s.name.as_str()) {
             kept = s.end.unwrap_or(bytes.len());
             continue;
         }
         let Some(end) = s.end else {
-            let line = 1 + bytes[..s.start].iter().filter(|&&b| b == b'\n').count();
-            return Err((line, format!("the section ${} has no line $End{}: every section must be closed", s.name, s.name)));
+            let line_of = |offset: usize| 1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count();
+            let line = line_of(s.start);
+            // a `$EndName` line outside its section: the section ended before, at a line the
+            // walk took for its end (binary data can hold those bytes)
+            let closed = s.name.strip_prefix("End").and_then(|n| sections[..k].iter().rev().find(|o| o.name == n));
+            return Err(match closed {
+                Some(o) => (
+                    line,
+                    format!(
+                        "the line ${} closes no section: ${} (line {}) ended at line {}, the first line reading ${} after it{}",
+                        s.name,
+                        o.name,
+                        line_of(o.start),
+                        o.end.map_or(line, |e| line_of(e - 1)),
+                        s.name,
+                        if o.name == "Nodes" || o.name == "Elements" {
+                            " (in a binary file, its data may hold those bytes: write the file in ASCII)"
+                        } else {
+                            ""
+                        }
+                    ),
+                ),
+                None => (line, format!("the section ${} has no line $End{}: every section must be closed", s.name, s.name)),
+            });
         };
         blank(&mut bytes[s.start..end]);
         kept = end;
@@ -142,5 +165,16 @@ mod tests {
         let bom = blank_ignored(b"\xEF\xBB\xBF$MeshFormat\n4.1 0 8\n$EndMeshFormat\n".to_vec()).unwrap_err();
         assert_eq!(bom.0, 1);
         assert!(bom.1.contains("starts with a byte-order mark") && bom.1.contains("save it without one"), "{}", bom.1);
+    }
+
+    /// A `$EndNodes` line after the section's end (binary data holding those bytes) is named as
+    /// such, with where the walk ended the section.
+    #[test]
+    fn an_end_line_outside_its_section_is_named() {
+        let file = b"$MeshFormat\n4.1 1 8\n$EndMeshFormat\n$Nodes\nab\n$EndNodes\ncd\n$EndNodes\n$Elements\n$EndElements\n";
+        let (line, why) = blank_ignored(file.to_vec()).unwrap_err();
+        assert_eq!(line, 8);
+        assert!(why.starts_with("the line $EndNodes closes no section: $Nodes (line 4) ended at line 6,"), "{why}");
+        assert!(why.contains("binary"), "{why}");
     }
 }

@@ -321,7 +321,7 @@ type Flat = FlatEx<f64, FloatOpsFactory<f64>, Number>;
 /// `text` parsed by exmex, its calls checked and the two-argument ones written infix first
 /// ([`calls::infix`]): every expression of a problem file is parsed here. `Err`: why not.
 fn parse_flat(text: &str) -> Result<Flat, String> {
-    let infix = calls::infix(text).map_err(|why| format!("{text:?}: {why}"))?;
+    let infix = calls::infix(text).map_err(|why| format!("cannot parse {text:?}: {why}"))?;
     Flat::parse(&infix).map_err(|e| {
         // exmex's message for two operands side by side ("x y", "(x)(y)")
         let hint = if e.msg().contains("ops and") { format!(" ({})", names::PRODUCT) } else { String::new() };

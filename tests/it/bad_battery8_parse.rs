@@ -126,7 +126,7 @@ fn a_wrong_number_of_arguments_is_named() {
         ("max(0.1, min(0.2))", "min takes two arguments, got 1"),
         ("atan2()", "atan2 takes two arguments, got 0"),
         ("sqrt(0.1, 0.2)", "sqrt takes one argument, got 2"),
-        ("(0.1, 0.2)", "not in a call of min, max, atan2"),
+        ("(0.1, 0.2)", "not in a call of min, max or atan2"),
         ("0.1 max 0.2", "`max` at character 5 is a function of two arguments"),
     ] {
         let text = fixture(SQUARE).replace(CHI, &format!("chi = \"{expr}\""));

@@ -56,7 +56,7 @@ pub(super) fn infix(text: &str) -> Result<String, String> {
             '(' => open.push(Open { at: i, call: name.take(), commas: Vec::new() }),
             ',' => match open.last_mut() {
                 Some(o) => o.commas.push(i),
-                None => return Err(format!("the comma at character {} is outside every call ({})", i + 1, separates())),
+                None => return Err(format!("the comma at character {} is outside every call ({})", i + 1, SEPARATES)),
             },
             ')' => {
                 let o = open.pop().ok_or_else(|| format!("the `)` at character {} closes no `(`", i + 1))?;
@@ -76,9 +76,7 @@ pub(super) fn infix(text: &str) -> Result<String, String> {
 }
 
 /// What a comma separates, for messages.
-fn separates() -> String {
-    format!("a comma separates the two arguments of {}", TWO_ARGUMENTS.join(", "))
-}
+const SEPARATES: &str = "a comma separates the two arguments of min, max or atan2";
 
 /// Check the group `o` closed at `at` and, for a two-argument call, write it infix in `out`
 /// (what each character becomes): the name and the blanks after it dropped, `(` made `((`,
@@ -105,10 +103,8 @@ fn close(c: &[(usize, char)], o: &Open, at: usize, out: &mut [String]) -> Result
         }
         _ if !o.commas.is_empty() => {
             return Err(format!(
-                "the comma at character {} is not in a call of {} ({})",
-                o.commas[0] + 1,
-                TWO_ARGUMENTS.join(", "),
-                separates()
+                "the comma at character {} is not in a call of min, max or atan2 (nor is a tuple an expression)",
+                o.commas[0] + 1
             ));
         }
         _ => {}
@@ -139,7 +135,7 @@ mod tests {
             ("1, 2", "the comma at character 2 is outside every call"),
             ("2 min 3", "`min` at character 3 is a function of two arguments"),
             ("min(1, 2))", "the `)` at character 10 closes no `(`"),
-            ("min((1, 2)", "the `(` at character 4 is not closed"),
+            ("min(1, (2)", "the `(` at character 4 is not closed"),
         ] {
             let why = infix(bad).expect_err(bad);
             assert!(why.contains(says), "{bad}: {why}");
