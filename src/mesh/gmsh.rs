@@ -282,9 +282,7 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     })?;
     let bytes = single_spaced(bytes);
     // the sections gmsh skips are skipped by every reader below: blanked, lines kept
-    let bytes = msh_sections::blank_ignored(bytes).map_err(|(name, line)| {
-        error(path, Some(line), format!("the section ${name} has no line $End{name}: every section must be closed"))
-    })?;
+    let bytes = msh_sections::blank_ignored(bytes).map_err(|(line, why)| error(path, Some(line), why))?;
     refuse_partitioned(path, &bytes)?;
     let names = physical_names(path, &bytes)?;
     let msh = parse(path, &bytes)?;

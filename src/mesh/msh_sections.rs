@@ -74,21 +74,67 @@ pub fn header(bytes: &[u8]) -> Option<usize> {
     walk(bytes).into_iter().find(|s| s.name == "MeshFormat").map(|s| s.start)
 }
 
-/// `bytes` with every section the harness does not read ([`READ`]) blanked, each of its bytes
-/// but the line ends made a space (offsets and line numbers stay where they are). A skipped
-/// section that is never closed is an error: its name and 1-based line.
-pub fn blank_ignored(mut bytes: Vec<u8>) -> Result<Vec<u8>, (String, usize)> {
-    for s in walk(&bytes) {
+/// The UTF-8 byte-order mark some editors write at a text file's start.
+const BYTE_ORDER_MARK: &[u8] = b"\xEF\xBB\xBF";
+
+/// `bytes` with every section the harness does not read ([`READ`]) blanked, and every line
+/// between sections the walk skips (one that does not start with `$`), each of their bytes but
+/// the line ends made a space (offsets and line numbers stay where they are): every reader
+/// skips what gmsh skips. Refused, with the 1-based line and why: a skipped section that is
+/// never closed, a file that starts with a byte-order mark (gmsh refuses it too; its first
+/// line is then not `$MeshFormat`).
+pub fn blank_ignored(mut bytes: Vec<u8>) -> Result<Vec<u8>, (usize, String)> {
+    if bytes.starts_with(BYTE_ORDER_MARK) {
+        return Err((
+            1,
+            "the file starts with a byte-order mark (the bytes EF BB BF, before its first line): save it without one (gmsh refuses it too)"
+                .to_string(),
+        ));
+    }
+    let mut kept = 0;
+    let sections = walk(&bytes);
+    for (k, s) in sections.iter().enumerate() {
+        blank(&mut bytes[kept..s.start]);
         if READ.contains(&s.name.as_str()) {
+            kept = s.end.unwrap_or(bytes.len());
             continue;
         }
         let Some(end) = s.end else {
-            let line = 1 + bytes[..s.start].iter().filter(|&&b| b == b'\n').count();
-            return Err((s.name, line));
+            let line_of = |offset: usize| 1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count();
+            let line = line_of(s.start);
+            // a `$EndName` line outside its section: the section ended before, at a line the
+            // walk took for its end (binary data can hold those bytes)
+            let closed = s.name.strip_prefix("End").and_then(|n| sections[..k].iter().rev().find(|o| o.name == n));
+            return Err(match closed {
+                Some(o) => (
+                    line,
+                    format!(
+                        "the line ${} closes no section: ${} (line {}) ended at line {}, the first line reading ${} after it{}",
+                        s.name,
+                        o.name,
+                        line_of(o.start),
+                        o.end.map_or(line, |e| line_of(e - 1)),
+                        s.name,
+                        if o.name == "Nodes" || o.name == "Elements" {
+                            " (in a binary file, its data may hold those bytes: write the file in ASCII)"
+                        } else {
+                            ""
+                        }
+                    ),
+                ),
+                None => (line, format!("the section ${} has no line $End{}: every section must be closed", s.name, s.name)),
+            });
         };
-        bytes[s.start..end].iter_mut().filter(|b| **b != b'\n').for_each(|b| *b = b' ');
+        blank(&mut bytes[s.start..end]);
+        kept = end;
     }
+    blank(&mut bytes[kept..]);
     Ok(bytes)
+}
+
+/// Every byte but the line ends made a space.
+fn blank(bytes: &mut [u8]) {
+    bytes.iter_mut().filter(|b| **b != b'\n').for_each(|b| *b = b' ');
 }
 
 #[cfg(test)]
@@ -105,6 +151,30 @@ mod tests {
         assert!(!out.contains("PhysicalNames") && !out.contains("Comments") && !out.contains("Foo"), "{out}");
         assert_eq!(header(out.as_bytes()), file.find("$MeshFormat"));
         assert!(out.ends_with("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n    \n \n       \n$Nodes\n0 0 0 0\n$EndNodes\n"), "{out:?}");
-        assert_eq!(blank_ignored(b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Comments\nno end\n".to_vec()), Err(("Comments".into(), 4)));
+        let unclosed = blank_ignored(b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Comments\nno end\n".to_vec());
+        assert_eq!(unclosed, Err((4, "the section $Comments has no line $EndComments: every section must be closed".into())));
+    }
+
+    /// Lines between sections that do not start with `$` are blanked (gmsh skips them), before
+    /// the header, between sections and after the last; a byte-order mark is named.
+    #[test]
+    fn stray_lines_are_blanked_and_a_byte_order_mark_named() {
+        let file = "junk\n$MeshFormat\n4.1 0 8\n$EndMeshFormat\nstray 1\n$Nodes\n0 0 0 0\n$EndNodes\nafter\n  last";
+        let out = String::from_utf8(blank_ignored(file.as_bytes().to_vec()).unwrap()).unwrap();
+        assert_eq!(out, "    \n$MeshFormat\n4.1 0 8\n$EndMeshFormat\n       \n$Nodes\n0 0 0 0\n$EndNodes\n     \n      ");
+        let bom = blank_ignored(b"\xEF\xBB\xBF$MeshFormat\n4.1 0 8\n$EndMeshFormat\n".to_vec()).unwrap_err();
+        assert_eq!(bom.0, 1);
+        assert!(bom.1.contains("starts with a byte-order mark") && bom.1.contains("save it without one"), "{}", bom.1);
+    }
+
+    /// A `$EndNodes` line after the section's end (binary data holding those bytes) is named as
+    /// such, with where the walk ended the section.
+    #[test]
+    fn an_end_line_outside_its_section_is_named() {
+        let file = b"$MeshFormat\n4.1 1 8\n$EndMeshFormat\n$Nodes\nab\n$EndNodes\ncd\n$EndNodes\n$Elements\n$EndElements\n";
+        let (line, why) = blank_ignored(file.to_vec()).unwrap_err();
+        assert_eq!(line, 8);
+        assert!(why.starts_with("the line $EndNodes closes no section: $Nodes (line 4) ended at line 6,"), "{why}");
+        assert!(why.contains("binary"), "{why}");
     }
 }

@@ -26,6 +26,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+mod calls;
 mod names;
 mod tables;
 
@@ -60,7 +61,7 @@ enum Scalar {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(untagged, expecting = "an array of two numbers or expressions, or \"exact\"")]
 enum VectorToml {
-    Pair([Scalar; 2]),
+    Pair(Two<Scalar>),
     Word(String),
 }
 
@@ -68,7 +69,7 @@ enum VectorToml {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(untagged, expecting = "\"outward\" or an array of two numbers or expressions")]
 enum NormalToml {
-    Pair([Scalar; 2]),
+    Pair(Two<Scalar>),
     Word(String),
 }
 
@@ -169,8 +170,8 @@ struct ExactToml {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct PointToml {
-    at: Spanned<[Scalar; 2]>,
-    u: Spanned<[Scalar; 2]>,
+    at: Spanned<Two<Scalar>>,
+    u: Spanned<Two<Scalar>>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -316,6 +317,17 @@ fn power_trap(text: &str) -> Option<String> {
 
 /// A parsed expression: exmex's default float operators, numbers with exponents.
 type Flat = FlatEx<f64, FloatOpsFactory<f64>, Number>;
+
+/// `text` parsed by exmex, its calls checked and the two-argument ones written infix first
+/// ([`calls::infix`]): every expression of a problem file is parsed here. `Err`: why not.
+fn parse_flat(text: &str) -> Result<Flat, String> {
+    let infix = calls::infix(text).map_err(|why| format!("cannot parse {text:?}: {why}"))?;
+    Flat::parse(&infix).map_err(|e| {
+        // exmex's message for two operands side by side ("x y", "(x)(y)")
+        let hint = if e.msg().contains("ops and") { format!(" ({})", names::PRODUCT) } else { String::new() };
+        format!("cannot parse {text:?}: {}{hint}", e.msg())
+    })
+}
 
 /// What an expression's variable stands for.
 #[derive(Clone, Copy, Debug)]
@@ -545,11 +557,7 @@ impl Reader<'_> {
         if let Some(why) = names::refused_name(text, &known) {
             return Err(self.error(key, span, why));
         }
-        let flat = Flat::parse(text).map_err(|e| {
-            // exmex's message for two operands side by side ("x y", "(x)(y)")
-            let hint = if e.msg().contains("ops and") { format!(" ({})", names::PRODUCT) } else { String::new() };
-            self.error(key, span.clone(), format!("cannot parse {text:?}: {}{hint}", e.msg()))
-        })?;
+        let flat = parse_flat(text).map_err(|why| self.error(key, span.clone(), why))?;
         let names = flat.var_names();
         if names.len() > MAX_VARS {
             return Err(self.error(
@@ -670,7 +678,7 @@ impl Reader<'_> {
             if matches!(name.as_str(), "x" | "y" | "nx" | "ny") {
                 return Err(self.error(&format!("constants.{name}"), table[name].span(), "a name other than x, y, nx, ny (the variables)"));
             }
-            if Flat::parse(name).map(|f| f.var_names().len() != 1).unwrap_or(true) {
+            if parse_flat(name).map(|f| f.var_names().len() != 1).unwrap_or(true) {
                 return Err(self.error(
                     &format!("constants.{name}"),
                     table[name].span(),
@@ -686,7 +694,7 @@ impl Reader<'_> {
                 let value = &table[name];
                 let ready = match value.get_ref() {
                     Scalar::Number(_) => true,
-                    Scalar::Text(t) => Flat::parse(t).map(|f| f.var_names().iter().all(|v| self.constants.contains_key(v))).unwrap_or(true),
+                    Scalar::Text(t) => parse_flat(t).map(|f| f.var_names().iter().all(|v| self.constants.contains_key(v))).unwrap_or(true),
                 };
                 if ready {
                     let v = self.number(&format!("constants.{name}"), value)?;
@@ -704,7 +712,7 @@ impl Reader<'_> {
                     known.insert((*n).clone(), 0.0);
                 }
                 let Scalar::Text(t) = table[name].get_ref() else { unreachable!("numbers are always ready") };
-                let unknown = Flat::parse(t).map(|f| f.var_names().iter().find(|v| !known.contains_key(*v)).cloned()).unwrap_or_default();
+                let unknown = parse_flat(t).map(|f| f.var_names().iter().find(|v| !known.contains_key(*v)).cloned()).unwrap_or_default();
                 let message = match unknown {
                     Some(v) => format!("unknown variable `{v}` in {t:?} (a constant is a number or an expression of other constants)"),
                     None => format!(

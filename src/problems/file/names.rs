@@ -91,7 +91,7 @@ fn is_name_start(c: char) -> bool {
 }
 
 /// The index after the name that starts at `i`.
-fn name_end(chars: &[(usize, char)], mut i: usize) -> usize {
+pub(super) fn name_end(chars: &[(usize, char)], mut i: usize) -> usize {
     while i < chars.len() && (chars[i].1.is_alphanumeric() || chars[i].1 == '_') {
         i += 1;
     }
@@ -100,7 +100,7 @@ fn name_end(chars: &[(usize, char)], mut i: usize) -> usize {
 
 /// The index after the number that starts at `i`, as the expression's literal reads it
 /// (`12`, `1.5`, `.5`, `1e-12`; an `e` without exponent digits is not part of it).
-fn number_end(chars: &[(usize, char)], mut i: usize) -> usize {
+pub(super) fn number_end(chars: &[(usize, char)], mut i: usize) -> usize {
     let digits = |mut i: usize| {
         while i < chars.len() && chars[i].1.is_ascii_digit() {
             i += 1;

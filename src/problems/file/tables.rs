@@ -300,7 +300,7 @@ impl Reader<'_> {
         let mut out: Vec<super::super::PointConstraint> = Vec::new();
         for (i, c) in raw.iter().enumerate() {
             let key = format!("point_constraints[{i}]");
-            let number = |k: &str, v: &Spanned<[Scalar; 2]>, j: usize| {
+            let number = |k: &str, v: &Spanned<Two<Scalar>>, j: usize| {
                 self.number(&format!("{key}.{k}[{j}]"), &Spanned::new(v.span(), v.get_ref()[j].clone()))
             };
             let at = [number("at", &c.at, 0)?, number("at", &c.at, 1)?];
