@@ -6,7 +6,13 @@
 //!   stops the body moving through the obstacle along n; n must leave the body where it is
 //!   used. At every contact node the declared normal is compared with the outward unit normal
 //!   of the contact edges holding the node (at a vertex between two contact edges, the more
-//!   favourable of the two: a corner may take any direction of its normal cone). A normal with
+//!   favourable of the two: a corner may take any direction of its normal cone), and so it is
+//!   at every point of the contact part's sampling, the point set on which an exact solution's
+//!   contact conditions are checked (`consistent::boundary::sample`: the Gauss points and
+//!   pieces no longer than the body's size over 4096 along every contact edge, on a curve with
+//!   the curve's normal): a stretch of bad data between the nodes is refused on every mesh, not
+//!   only where refinement puts a node in it (battery 8: a reversed normal 0.005 long was
+//!   certified on structured:4 and 8). A normal with
 //!   n . n_out < 0 is reversed (the constraint would pull the body into the obstacle); one with
 //!   n . n_out < cos 80 degrees (within 10 degrees of the boundary) is nearly tangent: the
 //!   constraint would act mostly along the surface, limiting sliding, and the normal gap it
@@ -17,7 +23,9 @@
 //! * **The obstacle does not overlap the body by more than its size.** A gap chi(p) < -D, D the
 //!   diameter of the mesh's bounding box, asks the body to move by more than its own size at p:
 //!   outside linear (small-strain) elasticity everywhere it happens, and in practice a sign or
-//!   unit mistake.
+//!   unit mistake. Checked at the contact nodes and on the same sampling as the normal; a gap
+//!   or normal that is not a finite number at a sampled point is named as the data watch names
+//!   it ([`ContactDataError::Datum`]).
 //! * **Prescribed displacements do not push the body into the obstacle.** A node of the closure
 //!   of Gamma_C whose displacement is prescribed (a corner shared with Gamma_D, a point
 //!   constraint) is not a contact node, so the constraint is not imposed there; yet a prescribed
@@ -36,8 +44,8 @@
 //!   ([`ContactDataError::HalfPrescribed`]); imposing the constraint on the free component alone is
 //!   not built.
 //!
-//! Not repeated here: a normal of length 0 or a gap that is not a finite number is refused by
-//! the data watch (`problems::BadDatum`, after assembly); a declared normal is normalised where
+//! Not repeated here: a normal of length 0 or a gap that is not a finite number at a node is
+//! refused by the data watch (`problems::BadDatum`, after assembly); a declared normal is normalised where
 //! it is evaluated; Young's modulus, Poisson's ratio and the Lamé constants are checked when a
 //! problem file is read (`problems::file`).
 
@@ -91,6 +99,9 @@ pub enum ContactDataError {
     )]
     /// `u`: the prescribed components, "free" for one that is not.
     Prescribed { problem: String, part: String, by: String, at: [f64; 2], u: [String; 2], normal: [f64; 2], un: f64, chi: f64 },
+    /// The gap or the normal is not a finite number at a sampled point of the contact part.
+    #[error(transparent)]
+    Datum(crate::problems::BadDatum),
 }
 
 /// The problem as errors name it: its file, or its built-in name.
@@ -127,15 +138,34 @@ pub(super) fn outward_normals(mesh: &Mesh, nodes: &P2Nodes) -> Vec<[f64; 2]> {
     out
 }
 
-/// Check the problem's contact data at every contact node of the mesh (see the module docs).
-/// Data that are not finite numbers are left to the data watch, which names their key: when
-/// the gap or normal `dofs` holds already tripped it, nothing is checked here.
+/// Check the problem's contact data on the contact part and at the prescribed nodes of its
+/// closure (see the module docs). Data that are not finite numbers are named by the data watch:
+/// when the gap or normal `dofs` holds already tripped it, nothing is checked here (the SOLVE
+/// step names it after assembling); one that trips it at a sampled point between the nodes is
+/// returned at once ([`ContactDataError::Datum`]).
 pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem) -> Result<(), Box<ContactDataError>> {
     if problem.bad_datum().is_some() {
         return Ok(());
     }
     let outward: Vec<Option<[f64; 2]>> =
         outward_normals(mesh, nodes).into_iter().zip(&mesh.boundary).map(|(n, e)| (e.part == Part::Contact).then_some(n)).collect();
+    let diameter = super::consistent::diameter(mesh);
+    check_nodes(mesh, nodes, dofs, problem, &outward, diameter)?;
+    check_sampled(mesh, nodes, problem, diameter)?;
+    check_prescribed(nodes, dofs, problem, &outward, diameter)
+}
+
+/// The contact normal and the gap at every contact node, as the discrete problem reads them
+/// (on a curved edge the P2 midpoint is the chord's), against the chord's outward normal; at a
+/// vertex, the more favourable of its contact edges.
+fn check_nodes(
+    mesh: &Mesh,
+    nodes: &P2Nodes,
+    dofs: &DofMap,
+    problem: &dyn Problem,
+    outward: &[Option<[f64; 2]>],
+    diameter: f64,
+) -> Result<(), Box<ContactDataError>> {
     let cos_max = MAX_NORMAL_ANGLE_DEGREES.to_radians().cos();
     // per contact node, the most favourable of its contact edges: (n . n_out, edge)
     let mut best: Vec<Option<(f64, usize)>> = vec![None; dofs.contact.len()];
@@ -150,10 +180,6 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
             }
         }
     }
-    let bounds = mesh.vertices.iter().fold([f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY], |r, v| {
-        [r[0].min(v[0]), r[1].min(v[1]), r[2].max(v[0]), r[3].max(v[1])]
-    });
-    let diameter = (bounds[2] - bounds[0]).hypot(bounds[3] - bounds[1]);
     for (k, c) in dofs.contact.iter().enumerate() {
         let at = nodes.coords[c.node];
         if let Some((dot, b)) = best[k]
@@ -170,7 +196,65 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
             return Err(Box::new(ContactDataError::Gap { problem, part, at, chi: c.gap, diameter }));
         }
     }
-    check_prescribed(nodes, dofs, problem, &outward, diameter)
+    Ok(())
+}
+
+/// The contact normal and the gap at every point of the contact part's sampling
+/// ([`boundary::sample`](super::consistent::boundary::sample), the point set on which the exact
+/// solution's contact conditions are checked: the P2 nodes, the Gauss points and pieces no
+/// longer than the body's size over [`CONTACT_DENSITY`](super::consistent::boundary::CONTACT_DENSITY)
+/// along every contact edge), each against the body's outward normal there: a stretch of bad
+/// data longer than that spacing is refused on every mesh, not only on meshes that put a node
+/// in it. At a vertex, the more favourable of its contact edges' normals counts.
+fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, diameter: f64) -> Result<(), Box<ContactDataError>> {
+    use super::consistent::boundary::sample;
+    let cos_max = MAX_NORMAL_ANGLE_DEGREES.to_radians().cos();
+    let points = sample(mesh, nodes, Some(Part::Contact));
+    // per sampled point, n . n_out (NaN where the normal is not a number: the watch names it)
+    let mut dots = Vec::with_capacity(points.len());
+    let mut at_vertex: std::collections::HashMap<usize, f64> = std::collections::HashMap::new();
+    for (p, _) in &points {
+        let chi = problem.gap(p.at);
+        if chi < -diameter {
+            let (problem, part) = (problem_name(problem), contact_part(problem));
+            return Err(Box::new(ContactDataError::Gap { problem, part, at: p.at, chi, diameter }));
+        }
+        let n = problem.contact_normal(p.at);
+        let dot = n[0] * p.normal[0] + n[1] * p.normal[1];
+        dots.push((n, dot));
+        if let Some(v) = vertex(mesh, p.edge, p.t)
+            && dot.is_finite()
+        {
+            let best = at_vertex.entry(v).or_insert(dot);
+            *best = best.max(dot);
+        }
+    }
+    if let Some(bad) = problem.bad_datum() {
+        return Err(Box::new(ContactDataError::Datum(bad)));
+    }
+    for ((p, _), &(normal, dot)) in points.iter().zip(&dots) {
+        let dot = vertex(mesh, p.edge, p.t).and_then(|v| at_vertex.get(&v).copied()).unwrap_or(dot);
+        if dot < cos_max {
+            let edge = mesh.boundary[p.edge].v.map(|v| mesh.vertices[v]);
+            let note = problem.normal_note();
+            let (problem, part) = (problem_name(problem), contact_part(problem));
+            let outward = p.normal;
+            return Err(Box::new(ContactDataError::Normal { problem, part, at: p.at, edge, normal, outward, dot, note }));
+        }
+    }
+    Ok(())
+}
+
+/// The mesh vertex at parameter `t` of boundary edge `edge`, if `t` is one of its ends.
+fn vertex(mesh: &Mesh, edge: usize, t: f64) -> Option<usize> {
+    let v = mesh.boundary[edge].v;
+    if t == 0.0 {
+        Some(v[0])
+    } else if t == 1.0 {
+        Some(v[1])
+    } else {
+        None
+    }
 }
 
 /// The prescribed nodes of the closure of Gamma_C against the obstacle (see the module docs).

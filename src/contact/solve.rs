@@ -36,22 +36,62 @@ pub enum SolveError {
     /// the data themselves are finite: the problem's scale, not its data, is at fault.
     #[error("{problem}: the assembled {what} has an entry that is not a finite number (overflow beyond f64's range, about 1.8e308) although every datum is finite: the material (mu = {mu}, zeta = {zeta}) or the loads are too large for this mesh; give them in other units (for example E in GPa instead of Pa) so that the stiffness entries, about mu times a mesh-independent factor, stay well inside the range", mu = crate::base::number::shown(*.mu), zeta = crate::base::number::shown(*.zeta))]
     Overflow { problem: String, what: &'static str, mu: f64, zeta: f64 },
+    /// The assembled stiffness matrix is zero or has entries below f64's normal range
+    /// (subnormal: they keep fewer digits, and products of them vanish): the material is too
+    /// small in these units.
+    #[error("{problem}: the assembled stiffness matrix has entries below f64's normal range (about 2.2e-308: subnormal numbers, which keep fewer digits and whose products vanish; the largest entry is {largest}): the material (mu = {mu}, zeta = {zeta}) is too small in these units for the factorisation to be trusted; give them in other units (for example E in MPa instead of Pa, or lengths in mm instead of m) so that the stiffness entries, about mu times a mesh-independent factor, stay well inside the range", largest = crate::base::number::shown(*.largest), mu = crate::base::number::shown(*.mu), zeta = crate::base::number::shown(*.zeta))]
+    Underflow { problem: String, largest: f64, mu: f64, zeta: f64 },
+    /// The solve of a finite system gave a displacement, a product K u_h, or a product of forces
+    /// and displacements (the scale complementarity is measured on) beyond f64's range: the
+    /// loads are too large for the stiffness in these units.
+    #[error("{problem}: {what} is not a finite number (overflow beyond f64's range, about 1.8e308) although the assembled system is finite: the loads (largest load-vector entry {load}) and the displacements they cause (largest |u_h| {u}, with the stiffness mu = {mu}) are too large for f64; give the data in other units (for example loads in kN instead of N, or E in Pa instead of GPa) so that the loads, the displacements and their products stay well inside the range", load = crate::base::number::shown(*.load), u = crate::base::number::shown(*.u), mu = crate::base::number::shown(*.mu))]
+    SolutionOverflow { problem: String, what: &'static str, load: f64, u: f64, mu: f64 },
 }
 
 /// Refuse an assembled system with an entry beyond f64's range ([`SolveError::Overflow`]): the
 /// one check between the data (each finite, `Problem::bad_datum`) and the factorisation, which
 /// would otherwise read the overflow as a matrix that is not positive definite.
+/// It also refuses a stiffness matrix that is zero or holds a subnormal entry
+/// ([`SolveError::Underflow`]), which the factorisation would read as a singular matrix or a
+/// non-positive pivot. (A subnormal load entry is left alone: a load that decays to nothing far
+/// from where it acts is not a scale mistake.)
 fn check_finite(system: &assembly::System, problem: &dyn Problem) -> Result<(), SolveError> {
     use rayon::prelude::*;
+    let m = problem.material();
     let what = if !system.matrix.values().par_iter().all(|v| v.is_finite()) {
         "stiffness matrix"
     } else if !system.rhs.iter().all(|v| v.is_finite()) {
         "load vector"
     } else {
+        let largest = system.matrix.values().par_iter().fold(|| 0.0f64, |a, v| a.max(v.abs())).reduce(|| 0.0, f64::max);
+        let subnormal = system.matrix.values().par_iter().any(|v| *v != 0.0 && !v.is_normal());
+        if largest < f64::MIN_POSITIVE || subnormal {
+            return Err(SolveError::Underflow { problem: super::plausible::problem_name(problem), largest, mu: m.mu, zeta: m.zeta });
+        }
         return Ok(());
     };
-    let m = problem.material();
     Err(SolveError::Overflow { problem: super::plausible::problem_name(problem), what, mu: m.mu, zeta: m.zeta })
+}
+
+/// Refuse a solution of the (finite) system whose values, or whose products that the
+/// certificate ([`certify::certify`]) computes, are not finite ([`SolveError::SolutionOverflow`]):
+/// u_h itself, K u_h, and the scale of complementarity, (max |F| + max |K u_h|) times
+/// max(|u_h|, |chi_h|). The one check of the solve's result before it is certified, so that an
+/// overflow is named as one and not as a KKT condition violated by NaN.
+fn check_solution(u: &[f64], ku: &[f64], rhs: &[f64], gap: &[f64], problem: &dyn Problem) -> Result<(), SolveError> {
+    let largest = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let (u_max, ku_max, load) = (largest(u), largest(ku), largest(rhs));
+    let what = if !u.iter().all(|v| v.is_finite()) {
+        "the discrete solution u_h"
+    } else if !ku.iter().all(|v| v.is_finite()) {
+        "the product K u_h of the stiffness matrix and the discrete solution"
+    } else if !((load + ku_max) * u_max.max(largest(gap))).is_finite() {
+        "the product of the forces and the displacements (max |F| times max |u_h|, the scale of complementarity lambda_p (chi_h - u_h.n))"
+    } else {
+        return Ok(());
+    };
+    let problem_name = super::plausible::problem_name(problem);
+    Err(SolveError::SolutionOverflow { problem: problem_name, what, load, u: u_max, mu: problem.material().mu })
 }
 
 /// Refuse a traction that would be ignored: where no boundary edge is Neumann, the traction is
@@ -186,9 +226,13 @@ pub fn solve(
     // the solver takes the matrix (and releases it before factorising, for the Schur strategy)
     let mut solver = ContactSolver::with_strategy(matrix, dofs.n_interior, &dofs.unknown_coords(&nodes), strategy)?;
     let gap: Vec<f64> = dofs.contact.iter().map(|c| c.gap).collect();
-    let out = solver.solve_contact(&rhs, &gap, options, observe)?.converged()?;
+    let out = solver.solve_contact(&rhs, &gap, options, observe)?;
+    // an overflowing u_h may also stop the active-set method: named before its convergence is
+    check_solution(&out.u, &[], &rhs, &gap, problem)?;
+    let out = out.converged()?;
     // the residual F - K u, element by element: zero at free unknowns, lambda_p at contact normals
     let assembly::StiffnessProduct { ku, magnitude, row_norm } = assembly::stiffness_times(mesh, &nodes, &dofs, problem.material(), &out.u);
+    check_solution(&out.u, &ku, &rhs, &gap, problem)?;
     let normal_displacement = &out.u[dofs.n_interior..];
     let u_max = out.u.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let kkt = KktInput {

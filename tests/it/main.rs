@@ -8,6 +8,7 @@ mod adaptivity;
 mod bad_battery;
 mod bad_battery7;
 mod bad_battery8_parse;
+mod bad_battery8_contact;
 mod bad_cli;
 mod bad_data;
 mod bad_edges;

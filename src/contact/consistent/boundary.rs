@@ -33,11 +33,14 @@ use crate::fem::assembly::edge_points;
 use crate::mesh::{Mesh, P2Nodes};
 use crate::problems::{Curve, Exact, Part, Problem};
 
-/// A checked point of a boundary edge: where, the body's outward normal there, the part.
-struct Point {
-    at: [f64; 2],
-    normal: [f64; 2],
-    part: Part,
+/// A checked point of a boundary edge: where, the body's outward normal there, the part, and
+/// which edge (by index into `mesh.boundary`) at which parameter `t` (0 and 1: its vertices).
+pub(in crate::contact) struct Point {
+    pub at: [f64; 2],
+    pub normal: [f64; 2],
+    pub part: Part,
+    pub edge: usize,
+    pub t: f64,
 }
 
 /// The point of `curve` closest to `x` and the curve's normal there, turned to agree with the
@@ -79,12 +82,15 @@ fn parameters(p: [f64; 2], q: [f64; 2], part: Part, spacing: f64) -> Vec<f64> {
     s
 }
 
-/// Every checked point (see the module docs), edge by edge, with the length of its edge.
-fn sample(mesh: &Mesh, nodes: &P2Nodes) -> Vec<(Point, f64)> {
+/// Every checked point (see the module docs), edge by edge, with the length of its edge; with
+/// `only`, the edges of that part alone. The one point set of the contact part: the exact
+/// solution's contact conditions and the contact data ([`crate::contact::plausible`]) are
+/// checked on it.
+pub(in crate::contact) fn sample(mesh: &Mesh, nodes: &P2Nodes, only: Option<Part>) -> Vec<(Point, f64)> {
     let normals = super::super::plausible::outward_normals(mesh, nodes);
     let spacing = super::diameter(mesh) / CONTACT_DENSITY as f64;
     let mut out = Vec::new();
-    for (b, edge) in mesh.boundary.iter().enumerate() {
+    for (b, edge) in mesh.boundary.iter().enumerate().filter(|(_, e)| only.is_none_or(|p| e.part == p)) {
         let [p, q] = edge.v.map(|v| mesh.vertices[v]);
         let len = (p[0] - q[0]).hypot(p[1] - q[1]);
         let chord = normals[b];
@@ -94,7 +100,7 @@ fn sample(mesh: &Mesh, nodes: &P2Nodes) -> Vec<(Point, f64)> {
                 None => (x, chord),
                 Some(curve) => on_curve(curve, x, chord),
             };
-            out.push((Point { at, normal, part: edge.part }, len));
+            out.push((Point { at, normal, part: edge.part, edge: b, t }, len));
         }
     }
     out
@@ -108,7 +114,7 @@ fn sample(mesh: &Mesh, nodes: &P2Nodes) -> Vec<(Point, f64)> {
 pub(super) fn gradient_points(mesh: &Mesh, nodes: &P2Nodes) -> Vec<([f64; 2], f64)> {
     let floor = 1e-3 * super::diameter(mesh);
     let spacing = super::diameter(mesh) / CONTACT_DENSITY as f64;
-    let neumann = sample(mesh, nodes).into_iter().filter(|(p, _)| p.part == Part::Neumann);
+    let neumann = sample(mesh, nodes, Some(Part::Neumann)).into_iter();
     let mut out: Vec<([f64; 2], f64)> = neumann.map(|(p, len)| (p.at, 1e-3 * len.max(floor))).collect();
     for edge in mesh.boundary.iter().filter(|e| e.curve.is_some() && e.part == Part::Neumann) {
         let [p, q] = edge.v.map(|v| mesh.vertices[v]);
@@ -128,7 +134,7 @@ struct Violation {
 
 /// Check the exact solution against the boundary and contact conditions on `mesh`.
 pub fn check_boundary(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, nodes: &P2Nodes, name: &str) -> Result<(), ExactError> {
-    let points: Vec<Point> = sample(mesh, nodes).into_iter().map(|(p, _)| p).collect();
+    let points: Vec<Point> = sample(mesh, nodes, None).into_iter().map(|(p, _)| p).collect();
     let material = problem.material();
     let sigma_n = |x: [f64; 2], n: [f64; 2]| material.traction(exact.grad(x), n);
     let norm = |v: [f64; 2]| v[0].hypot(v[1]);

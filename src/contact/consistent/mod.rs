@@ -24,7 +24,7 @@
 //! The boundary and contact conditions are checked too (module `boundary`): an exact solution must
 //! satisfy them as well as the equations.
 
-mod boundary;
+pub(in crate::contact) mod boundary;
 
 use crate::mesh::{Mesh, P2Nodes};
 use crate::problems::{Exact, Material, Problem};
@@ -122,7 +122,7 @@ fn steps(mesh: &Mesh) -> Vec<f64> {
 }
 
 /// The body's size: the diagonal of the mesh's bounding box.
-fn diameter(mesh: &Mesh) -> f64 {
+pub(in crate::contact) fn diameter(mesh: &Mesh) -> f64 {
     let (lo, hi) = mesh.vertices.iter().fold(([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]), |(lo, hi), v| {
         ([lo[0].min(v[0]), lo[1].min(v[1])], [hi[0].max(v[0]), hi[1].max(v[1])])
     });
