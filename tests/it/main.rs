@@ -7,6 +7,7 @@ mod common;
 mod adaptivity;
 mod bad_battery;
 mod bad_battery7;
+mod bad_battery8_files;
 mod bad_cli;
 mod bad_data;
 mod bad_edges;
