@@ -9,7 +9,8 @@
 //!   as root replaced /dev/null): `base::input::check_target`, in `records::Batch` and in the
 //!   command line's early checks of `--save` and `--report`, refuses such a target;
 //! * a mesh snapshot no record names: named as a leftover by every reader and removed by `run`,
-//!   now also when it is a named pipe or a symlink (which the folder walk skipped).
+//!   now also when it is a named pipe or a symlink (which the folder walk skipped);
+//! * a lock file that is a named pipe or a symlink to a device: refused naming it.
 //!
 //! No test here touches a real device: device nodes are made in a scratch folder, and only as root.
 
@@ -201,4 +202,23 @@ fn a_mesh_snapshot_no_record_names_is_named_by_every_reader_and_removed_by_run()
         std::fs::read_dir(&meshes).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
     left.sort();
     assert_eq!(left, ["b_level3.json", "b_level3.vtu"]);
+}
+
+#[test]
+fn a_lock_file_that_is_a_pipe_or_a_link_to_a_device_is_refused_naming_it() {
+    let dir = stored("locks");
+    let study = dir.join("results/study");
+    fifo(&study.join(".lock"));
+    let (code, out) = within(&dir, READERS[0]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("study/.lock is a named pipe, not a file: remove it"), "{out}");
+    std::fs::remove_file(study.join(".lock")).unwrap();
+    let run_lock = study.join(".locks/a.lock");
+    std::fs::remove_file(&run_lock).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", &run_lock).unwrap();
+    let (code, out) = within(&dir, &["run", "study.toml", "--results", "results", "--fresh"]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains(".locks/a.lock is a character device, not a file: remove it"), "{out}");
+    // nothing was removed: the runs are still there
+    assert!(study.join("runs/a.json").is_file() && study.join("runs/b.json").is_file());
 }
