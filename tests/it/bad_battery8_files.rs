@@ -10,7 +10,9 @@
 //!   command line's early checks of `--save` and `--report`, refuses such a target;
 //! * a mesh snapshot no record names: named as a leftover by every reader and removed by `run`,
 //!   now also when it is a named pipe or a symlink (which the folder walk skipped);
-//! * a lock file that is a named pipe or a symlink to a device: refused naming it.
+//! * a lock file that is a named pipe or a symlink to a device: refused naming it;
+//! * a named pipe among the manifests of `--experiments`: refused by name (the word on a problem
+//!   file put beside the manifests read it again, past the reader, and hung).
 //!
 //! No test here touches a real device: device nodes are made in a scratch folder, and only as root.
 
@@ -221,4 +223,14 @@ fn a_lock_file_that_is_a_pipe_or_a_link_to_a_device_is_refused_naming_it() {
     assert!(out.contains(".locks/a.lock is a character device, not a file: remove it"), "{out}");
     // nothing was removed: the runs are still there
     assert!(study.join("runs/a.json").is_file() && study.join("runs/b.json").is_file());
+}
+
+#[test]
+fn a_named_pipe_among_the_manifests_is_refused_naming_it() {
+    let dir = crate::common::scratch("battery8-files-manifests");
+    std::fs::create_dir_all(dir.join("e")).unwrap();
+    fifo(&dir.join("e/x.toml"));
+    let (code, out) = within(&dir, &["figures", "--experiments", "e", "--results", "results"]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("x.toml") && out.contains("not a regular file (a named pipe)"), "{out}");
 }
