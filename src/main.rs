@@ -411,7 +411,7 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
     };
     validate("adapt", &config, &spec)?;
     if let Some(path) = &args.save {
-        check_writable(path)?;
+        check_writable("--save", path)?;
     }
     signorini::memory::check_memory(&spec.to_string(), spec.ndof()?)?;
     let mesh = spec.build(problem.as_ref())?;
@@ -487,20 +487,30 @@ impl std::fmt::Display for AdaptInterrupted {
 
 impl std::error::Error for AdaptInterrupted {}
 
-/// Refuse an output path whose folder does not exist before hours of work are spent, not after.
-fn check_writable(path: &std::path::Path) -> Result<()> {
+/// Refuse an output path whose folder does not exist, or that is not a file a write may replace
+/// (a named pipe, a device such as /dev/null: the write renames a new file over it), before
+/// hours of work are spent, not after.
+fn check_writable(flag: &str, path: &std::path::Path) -> Result<()> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
     if !dir.is_dir() {
-        bail!("--save {}: the folder {} does not exist", path.display(), dir.display());
+        bail!("{flag} {}: the folder {} does not exist", path.display(), dir.display());
     }
     if path.is_dir() {
-        bail!("--save {}: this is a folder; give the path of a file in it, e.g. {}", path.display(), path.join("solution.vtu").display());
+        bail!("{flag} {}: this is a folder; give the path of a file in it, e.g. {}", path.display(), path.join("solution.vtu").display());
     }
+    check_target(flag, path)?;
     // a file can be made there (the write goes through a temporary file in the same folder)
     let probe = dir.join(format!(".signorini-save-probe.{}", std::process::id()));
-    std::fs::File::create(&probe).with_context(|| format!("--save {}: cannot create a file in {}", path.display(), dir.display()))?;
+    std::fs::File::create(&probe).with_context(|| format!("{flag} {}: cannot create a file in {}", path.display(), dir.display()))?;
     std::fs::remove_file(&probe).ok();
     Ok(())
+}
+
+/// Refuse an output path a write may not replace (a named pipe, a device, a folder), naming the
+/// flag; the same check every atomic write makes ([`signorini::base::input::check_target`]), made
+/// here before any computation.
+fn check_target(flag: &str, path: &std::path::Path) -> Result<()> {
+    signorini::base::input::check_target(path).map_err(|e| anyhow::anyhow!("{flag} {}: {e}", path.display()))
 }
 
 /// The switches of `signorini run` that shape what a run does with the store.
@@ -740,7 +750,7 @@ fn report_to_merge_into(file: Option<ReportFile>) -> Result<Option<serde_json::V
     if !path.exists() {
         return Ok(None);
     }
-    let text = std::fs::read_to_string(path).with_context(|| format!("reading the drift report {} to merge into", path.display()))?;
+    let text = signorini::records::read_text(path).with_context(|| format!("reading the drift report {} to merge into", path.display()))?;
     let not_one = || {
         format!(
             "{}: not a drift report (expected the JSON `signorini drift --report` writes); nothing was rerun or written",
@@ -770,6 +780,9 @@ fn run_drift(
     let manifests = study::manifest::declared(experiments, only)?;
     // what the CLAIMS rows need, checked before any run is rerun
     let roles = signorini::analysis::roles::read(experiments)?;
+    if let Some(r) = report_file {
+        check_target("--report", r.path)?;
+    }
     let older = report_to_merge_into(report_file)?;
     let scratch = std::path::PathBuf::from("target/drift").join(if quick { "quick" } else { "full" });
     let options = study::drift::DriftOptions {
@@ -785,7 +798,7 @@ fn run_drift(
         // CLAIMS.md is compared only when every study is, so a folder at fault has each fault in
         // a row of the report already; rows drawn from records no one can trust are not compared
         let Ok(shelf) = study::store::Shelf::open_folder(r, &manifests) else {
-            return Ok(std::fs::read_to_string(r.join("CLAIMS.md")).unwrap_or_default());
+            return Ok(signorini::records::read_text(&r.join("CLAIMS.md")).unwrap_or_default());
         };
         signorini::claims::claims(&shelf, &roles).map(|c| signorini::claims::markdown_for(&c, r)).map_err(std::io::Error::other)
     })?;

@@ -1,9 +1,13 @@
-//! The one reader of a user's input file (a problem file, a study manifest, a Gmsh mesh): what is
-//! not a regular file (a named pipe, a device such as `/dev/zero`, a directory) is refused before
-//! a byte is read, so it can neither hang nor grow a buffer without end, and so is a file larger
-//! than its kind may be. The handle is opened without blocking (a named pipe with no writer
-//! would block `open` itself) and checked by `fstat` on that same handle, so what is checked is
-//! what is read. A file a running study pinned ([`super::pin`]) must read as the bytes it planned.
+//! The one reader of a file the harness reads (a user's problem file, study manifest or Gmsh
+//! mesh, and every file of a results folder: records, summaries, snapshots, references,
+//! checkpoints, reports): what is not a regular file after following symlinks (a named pipe, a
+//! device such as `/dev/zero`, a directory) is refused by its metadata before it is opened, so it
+//! can neither hang nor grow a buffer without end, and so is a file larger than its kind may be.
+//! The handle is then opened without blocking (a named pipe put in place meanwhile would block
+//! `open` itself) and checked again by `fstat` on that same handle, so what is checked is what is
+//! read. A file a running study pinned ([`super::pin`]) must read as the bytes it planned.
+//!
+//! Its counterpart for writes, [`check_target`], refuses to replace what is not a regular file.
 
 use std::io::Read;
 use std::path::Path;
@@ -31,6 +35,16 @@ pub enum Limit {
 /// a file beyond this is not a problem or a study written by a person).
 pub const TEXT_LIMIT: u64 = 16 * 1024 * 1024;
 
+/// A file of a results folder (`runs/*.json`, `levels.csv`, `provenance.json`,
+/// `references/*.json`, `meshes/*`, checkpoints, a drift report, a figure): at most 512 MiB. The
+/// largest file the harness has written under the tracked `results/` is 6.8 MB
+/// (`results/hertz/meshes/adaptive_level19.vtu`, 6,847,417 bytes; the largest record 5.0 MB), so
+/// the bound is about 78 times that: far above any study, far below what would exhaust memory.
+pub const RESULTS_LIMIT: u64 = 512 * 1024 * 1024;
+
+/// A file of a results folder ([`RESULTS_LIMIT`]).
+pub const RESULTS_FILE: Kind = Kind { what: "a file of a results folder", limit: Limit::Bytes(RESULTS_LIMIT) };
+
 /// Why an input file was not read. The caller's error names the path.
 #[derive(Debug, thiserror::Error)]
 pub enum InputError {
@@ -51,6 +65,11 @@ pub enum InputError {
 pub fn read(path: &Path, kind: Kind) -> Result<Vec<u8>, InputError> {
     use std::os::unix::fs::OpenOptionsExt;
     let io = |error| InputError::Io { what: kind.what, error };
+    // by name first, following symlinks: what is not a regular file is never opened
+    let named = std::fs::metadata(path).map_err(io)?;
+    if !named.is_file() {
+        return Err(InputError::NotRegular { what: kind.what, found: file_type(&named.file_type()) });
+    }
     let file = std::fs::OpenOptions::new().read(true).custom_flags(libc::O_NONBLOCK).open(path).map_err(io)?;
     let meta = file.metadata().map_err(io)?;
     if !meta.is_file() {
@@ -97,6 +116,29 @@ fn check_size(size: u64, kind: Kind) -> Result<(), InputError> {
             Ok(())
         }
         Limit::Bytes(_) => Ok(()),
+    }
+}
+
+/// Why a path is not replaced by a written file.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "not a regular file ({found}): give a file path (a file is written by renaming a new one over the path, which would replace {found})"
+)]
+pub struct NotFileTarget {
+    pub found: &'static str,
+}
+
+/// Whether `path` may be replaced by a file written there (a temporary file renamed over it): it
+/// does not exist, or is a regular file after following a symlink. A named pipe, a device (say
+/// `/dev/null`) or a folder is refused, by its metadata alone (never opened). Every atomic write
+/// checks its target here (`records::Batch::add`), and so do the command line's output flags
+/// before any computation. The caller's error names the path.
+pub fn check_target(path: &Path) -> Result<(), NotFileTarget> {
+    match std::fs::metadata(path) {
+        Ok(meta) if !meta.is_file() => Err(NotFileTarget { found: file_type(&meta.file_type()) }),
+        // none there (or a dangling symlink), or a regular file; what cannot be looked at fails
+        // at the write, naming the path
+        _ => Ok(()),
     }
 }
 
@@ -172,6 +214,18 @@ mod tests {
         assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
         let e = read(&fifo, TEXT).unwrap_err().to_string();
         assert!(e.starts_with("not a regular file (a named pipe)"), "{e}");
+        // a symlink is followed: to a regular file it reads, to a device it is refused
+        let link = dir.join("link");
+        std::os::unix::fs::symlink(&small, &link).unwrap();
+        assert_eq!(read(&link, TEXT).unwrap(), [b'a', 0xff]);
+        let zero = dir.join("zero");
+        std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
+        assert!(read(&zero, TEXT).unwrap_err().to_string().starts_with("not a regular file (a character device)"));
+        // a write may replace a regular file or nothing, never a pipe, a device or a folder
+        assert!(check_target(&small).is_ok() && check_target(&link).is_ok() && check_target(&dir.join("none")).is_ok());
+        assert_eq!(check_target(&fifo).unwrap_err().found, "a named pipe");
+        assert_eq!(check_target(&zero).unwrap_err().found, "a character device");
+        assert_eq!(check_target(&dir).unwrap_err().found, "a directory");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

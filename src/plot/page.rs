@@ -170,7 +170,7 @@ fn figures_html(figures: &Path, study: &str) -> std::io::Result<String> {
     let mut s = String::new();
     for name in figures_of(study) {
         let png = figures.join(format!("{name}.png"));
-        match std::fs::read(&png) {
+        match crate::records::read_bytes(&png) {
             Ok(bytes) if !bytes.starts_with(PNG_SIGNATURE) => {
                 return Err(std::io::Error::new(
                     std::io::ErrorKind::InvalidData,
@@ -194,7 +194,7 @@ fn figures_html(figures: &Path, study: &str) -> std::io::Result<String> {
                     escape(&png.display().to_string())
                 );
             }
-            Err(e) => return Err(std::io::Error::new(e.kind(), format!("reading {}: {e}", png.display()))),
+            Err(e) => return Err(e),
         }
     }
     Ok(s)
@@ -278,7 +278,7 @@ pub fn write_pages(
     // integrity check when the shelf was opened
     let claims =
         crate::analysis::claims::claims(shelf, roles).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
-    let drift = match std::fs::read_to_string(drift_report) {
+    let drift = match crate::records::read_text(drift_report) {
         Ok(t) => Some(serde_json::from_str(&t).with_context(|| format!("reading the drift report {}", drift_report.display()))?),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
         Err(e) => return Err(e).with_context(|| format!("reading the drift report {}", drift_report.display())),

@@ -53,6 +53,14 @@ fn temporary_for(path: &Path) -> std::path::PathBuf {
     path.with_file_name(format!(".{name}.tmp{}.{n}", std::process::id()))
 }
 
+/// `path` may be replaced by a renamed file ([`crate::base::input::check_target`]): the rename
+/// would replace whatever is there, so a named pipe, a device or a folder is refused, naming it.
+/// Checked when a file is staged and again just before its rename.
+fn replaceable(path: &Path) -> std::io::Result<()> {
+    crate::base::input::check_target(path)
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, format!("{}: {e}", path.display())))
+}
+
 /// Files written in full to temporary files, then renamed into place together by
 /// [`Batch::commit`], in the order they were added. Dropped without a commit (an error, an
 /// interrupt), it removes its temporary files: nothing of it reaches the folder.
@@ -66,6 +74,7 @@ impl Batch {
     /// Write `bytes` to a temporary file next to `path` (creating the directory). On an error
     /// the temporary file is removed and the error names the path and the step.
     pub fn add(&mut self, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+        replaceable(path)?;
         let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
         std::fs::create_dir_all(dir).map_err(step("creating the directory", dir))?;
         let tmp = temporary_for(path);
@@ -102,10 +111,11 @@ impl Batch {
         let staged = std::mem::take(&mut self.staged);
         let mut rest = staged.iter();
         for (tmp, path, _) in rest.by_ref() {
-            if let Err(e) = std::fs::rename(tmp, path) {
+            let renamed = replaceable(path).and_then(|()| std::fs::rename(tmp, path).map_err(step("renaming the temporary file to", path)));
+            if let Err(e) = renamed {
                 let _ = std::fs::remove_file(tmp);
                 rest.for_each(|(t, _, _)| drop(std::fs::remove_file(t)));
-                return Err(step("renaming the temporary file to", path)(e));
+                return Err(e);
             }
         }
         Ok(())
@@ -128,9 +138,28 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     batch.commit()
 }
 
-/// Read a text file; an error names the path.
+/// The bytes of a file of a results folder (a record, `levels.csv`, `provenance.json`, a
+/// reference, a mesh snapshot, a checkpoint, a drift report, a figure), through the one bounded
+/// reader [`crate::base::input::read`]: a path that is not a regular file after following
+/// symlinks (a named pipe, `/dev/zero`, a folder) or is larger than
+/// [`RESULTS_LIMIT`](crate::base::input::RESULTS_LIMIT) is refused before it is opened (kind
+/// `InvalidData`); a missing file keeps its kind (`NotFound`). An error names the path.
+pub fn read_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
+    crate::base::input::read(path, crate::base::input::RESULTS_FILE).map_err(|e| step("reading", path)(input_error(e)))
+}
+
+/// Read a text file of a results folder ([`read_bytes`], then UTF-8); an error names the path.
 pub fn read_text(path: &Path) -> std::io::Result<String> {
-    std::fs::read_to_string(path).map_err(step("reading", path))
+    crate::base::input::read_text(path, crate::base::input::RESULTS_FILE).map_err(|e| step("reading", path)(input_error(e)))
+}
+
+/// The reader's error as an `io::Error`: a failed file operation keeps its own (and kind),
+/// a file refused for its type or size is `InvalidData`.
+fn input_error(e: crate::base::input::InputError) -> std::io::Error {
+    match e {
+        crate::base::input::InputError::Io { error, .. } => error,
+        other => std::io::Error::new(std::io::ErrorKind::InvalidData, other.to_string()),
+    }
 }
 
 /// `value` as pretty JSON with a final newline, for the file `path`; an error (naming the path
@@ -355,10 +384,10 @@ pub struct MeshSnapshot {
 /// The JSON file at `path` read as a `T`; `None` if there is no such file; one that does not
 /// parse, or cannot be read, is an error naming it.
 fn read_if_present<T: serde::de::DeserializeOwned>(path: &Path) -> std::io::Result<Option<T>> {
-    match std::fs::read_to_string(path) {
+    match read_text(path) {
         Ok(text) => serde_json::from_str(&text).map(Some).map_err(RecordError::parse(path)),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(e) => Err(step("reading", path)(e)),
+        Err(e) => Err(e),
     }
 }
 
@@ -447,7 +476,7 @@ impl StudyDir {
     /// or saved by no record is an error ([`RecordError::Snapshot`]), never read as this run's.
     pub fn read_snapshot(&self, record: &RunRecord, level: usize, ext: &str) -> std::io::Result<Vec<u8>> {
         let file = self.mesh_file(&record.run.id, level, ext);
-        let bytes = std::fs::read(&file).map_err(step("reading", &file))?;
+        let bytes = read_bytes(&file)?;
         let name = file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let found = crate::base::digest::sha256_hex(&bytes);
         match record.snapshots.get(&name) {

@@ -851,7 +851,8 @@ pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
 /// A manifest's error, with a word where the file is a problem file put beside the manifests
 /// (its tables are a problem's, not a study's).
 fn not_a_manifest(file: &Path, error: ManifestError) -> anyhow::Error {
-    let tables = std::fs::read_to_string(file).ok().and_then(|t| t.parse::<toml::Table>().ok()).unwrap_or_default();
+    // through the one reader: a named pipe (refused by `load`) must not be read here either
+    let tables = crate::base::input::read_text(file, MANIFEST).ok().and_then(|t| t.parse::<toml::Table>().ok()).unwrap_or_default();
     let problem_like = ["material", "contact", "parts", "body_force", "dirichlet"].iter().any(|k| tables.contains_key(*k));
     if problem_like && !tables.contains_key("run") {
         anyhow::anyhow!(

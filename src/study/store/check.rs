@@ -48,7 +48,9 @@ fn saved(runs: &[RunRecord], run: &str, level: usize) -> bool {
     runs.iter().any(|r| r.run.id == run && r.run.save_levels.contains(&level) && level < r.levels.len())
 }
 
-/// The files of `dir` (one level, sorted by name); none if it does not exist.
+/// The entries of `dir` that are not folders (one level, sorted by name): files, and also
+/// symlinks, named pipes and devices, so that one the study never wrote under a snapshot's or a
+/// temporary file's name is named as a leftover like a file; none if `dir` does not exist.
 pub(super) fn files_in(dir: &std::path::Path) -> Result<Vec<(String, PathBuf)>> {
     let entries = match std::fs::read_dir(dir) {
         Ok(entries) => entries,
@@ -57,7 +59,7 @@ pub(super) fn files_in(dir: &std::path::Path) -> Result<Vec<(String, PathBuf)>> 
     };
     let mut out: Vec<(String, PathBuf)> = entries
         .flatten()
-        .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+        .filter(|e| e.file_type().is_ok_and(|t| !t.is_dir()))
         .map(|e| (e.file_name().to_string_lossy().into_owned(), e.path()))
         .collect();
     out.sort();
@@ -143,9 +145,11 @@ pub(super) fn snapshot_faults(dir: &StudyDir, record: &RunRecord) -> Vec<(PathBu
     out
 }
 
-/// An error's text without the leading `PATH: ` it names (the fault names the file already).
+/// An error's text without the leading `PATH: ` or `reading PATH: ` it names (the fault names
+/// the file already).
 fn without_path(text: &str, file: &std::path::Path) -> String {
-    text.strip_prefix(&format!("{}: ", file.display())).unwrap_or(text).to_string()
+    let text = text.strip_prefix(&format!("{}: ", file.display())).unwrap_or(text);
+    text.strip_prefix(&format!("reading {}: ", file.display())).unwrap_or(text).to_string()
 }
 
 /// The first line where two texts differ, shortened, as it reads in each.
@@ -178,7 +182,7 @@ pub fn summary_faults(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<Fa
     let mut out = Vec::new();
     let mut by_run = Vec::new();
     let mut fault = |file: &std::path::Path, what: String| out.push(Fault { file: file.to_path_buf(), what, record: None });
-    match (std::fs::read(&csv), dir.csv_bytes(runs)) {
+    match (records::read_bytes(&csv), dir.csv_bytes(runs)) {
         (Ok(on_disk), Ok(rendered)) if on_disk == rendered => {}
         (Ok(on_disk), Ok(rendered)) => {
             let (a, b) = first_difference(&String::from_utf8_lossy(&on_disk), &String::from_utf8_lossy(&rendered));
@@ -189,7 +193,7 @@ pub fn summary_faults(dir: &StudyDir, study: &str, runs: &[RunRecord]) -> Vec<Fa
         (_, Err(e)) => fault(&csv, format!("cannot be rendered from the records ({e})")),
     }
     let ids: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
-    match std::fs::read_to_string(&prov)
+    match records::read_text(&prov)
         .map_err(|e| e.to_string())
         .and_then(|t| serde_json::from_str::<Provenance>(&t).map_err(|e| e.to_string()))
     {

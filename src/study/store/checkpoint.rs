@@ -28,7 +28,7 @@ pub(super) fn file(dir: &StudyDir, run: &str) -> PathBuf {
 /// The checkpoint of `spec`'s run, if there is one for exactly this spec (one of another spec,
 /// or one that does not parse, is ignored: the run starts over and replaces it).
 pub(super) fn read(dir: &StudyDir, spec: &RunSpec) -> Option<Checkpoint> {
-    let text = std::fs::read_to_string(file(dir, &spec.id)).ok()?;
+    let text = crate::records::read_text(&file(dir, &spec.id)).ok()?;
     let c: Checkpoint = serde_json::from_str(&text).ok()?;
     let consistent = c.run == *spec && !c.levels.is_empty() && c.levels.len() == c.history.levels.len();
     consistent.then_some(c)

@@ -99,7 +99,12 @@ impl Lock {
     }
 }
 
+/// The lock file at `path`, made if missing; one that is not a regular file (a named pipe, a
+/// symlink to a device: its holder's text would be read without end) is refused, naming it.
 fn open(path: &Path) -> Result<std::fs::File> {
+    if let Err(e) = crate::base::input::check_target(path) {
+        bail!("the lock file {} is {}, not a file: remove it", path.display(), e.found);
+    }
     if let Some(parent) = path.parent() {
         std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
     }

@@ -161,7 +161,7 @@ impl Store {
     /// `provenance.json`.
     pub fn provenance(&self) -> Result<Provenance> {
         let file = self.dir.provenance_file();
-        let text = std::fs::read_to_string(&file).with_context(|| format!("reading {}", file.display()))?;
+        let text = crate::records::read_text(&file)?;
         serde_json::from_str(&text).with_context(|| format!("reading {}", file.display()))
     }
 

@@ -52,7 +52,7 @@ impl Shelf {
         let mut studies = BTreeMap::new();
         for store in stores {
             let runs = store.read()?;
-            let provenance = std::fs::read_to_string(store.dir().provenance_file()).ok();
+            let provenance = crate::records::read_text(&store.dir().provenance_file()).ok();
             let held = store.dir().root.join("runs").is_dir();
             studies.insert(store.study().to_string(), Shelved { store, runs, provenance, held });
         }

@@ -140,7 +140,7 @@ impl Writer<'_> {
         let dir = &self.store.dir;
         let mut batch = Batch::default();
         let csv = csv_bytes(dir, runs)?;
-        if std::fs::read(dir.csv_file()).ok().as_deref() != Some(csv.as_slice()) {
+        if crate::records::read_bytes(&dir.csv_file()).ok().as_deref() != Some(csv.as_slice()) {
             batch.add(&dir.csv_file(), &csv)?;
         }
         let ids: Vec<String> = runs.iter().map(|r| r.run.id.clone()).collect();
