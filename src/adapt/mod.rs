@@ -365,7 +365,8 @@ pub fn solve_level(
         err_nodal: error.map(|e| e.linf_nodal),
         efficiency: error.map(|e| t.estimate / e.linf_quadrature),
         err_contact: reference.and_then(|r| norms::linf_error_contact(mesh, &sol, r)),
-        err_right_half: reference.and_then(|r| norms::linf_error_where(mesh, &sol, r, norms::Sampling::Dense, &|x| x[0] >= 0.5)),
+        err_right_half: reference
+            .and_then(|r| norms::linf_error_where(mesh, &sol, r, crate::contact::sampling::Sampling::Dense, &|x| x[0] >= 0.5)),
         roundoff_floor: sol.roundoff,
         h_free_boundary: free_boundary_edge(mesh, &sol),
         max_indicator_x: peak[0],

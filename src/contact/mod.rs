@@ -10,6 +10,7 @@ pub mod certify;
 pub mod consistent;
 pub mod norms;
 pub mod plausible;
+pub mod sampling;
 pub mod solve;
 
 pub use active_set::{

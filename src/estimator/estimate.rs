@@ -29,7 +29,7 @@ mod local;
 pub mod repair;
 
 use crate::base::element::EDGE_VERTICES;
-use crate::contact::norms::Sampling;
+use crate::contact::sampling::Sampling;
 use crate::contact::solve::DiscreteSolution;
 use crate::mesh::{Mesh, dist};
 use crate::problems::{Part, Problem};
@@ -38,7 +38,7 @@ use rayon::prelude::*;
 /// Threshold, relative to the force scale, above which lambda_p counts as positive (Lambda_h^C).
 pub const LAMBDA_POSITIVE: f64 = 1e-10;
 /// Gauss points per edge for the "quadrature" sampling of edge terms.
-pub const EDGE_GAUSS: usize = crate::contact::norms::EDGE_GAUSS;
+pub const EDGE_GAUSS: usize = crate::contact::sampling::EDGE_GAUSS;
 
 /// Which contact nodes eta_5 is taken over. Manifests spell the values in snake_case
 /// (`as_written`), the command line in kebab-case (`--contact-term as-written`). The variants'

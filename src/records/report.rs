@@ -121,8 +121,8 @@ impl SolveReport {
             free_residual: sol.free_residual,
             error,
             error_sampling: NormPoints {
-                quadrature: crate::contact::norms::Sampling::Quadrature.describe(),
-                dense: crate::contact::norms::Sampling::Dense.describe(),
+                quadrature: crate::contact::sampling::Sampling::Quadrature.describe(),
+                dense: crate::contact::sampling::Sampling::Dense.describe(),
             },
             estimator: estimate.terms,
             estimator_config: estimate.config,

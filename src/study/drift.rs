@@ -777,7 +777,12 @@ pub fn check(
     }
     if all_studies && opts.against.is_none() {
         let file = opts.results.join("CLAIMS.md");
-        let stored = std::fs::read_to_string(&file).unwrap_or_default();
+        // through the results folder's one reader: a pipe or a device there is named, not read
+        let stored = match crate::records::read_text(&file) {
+            Ok(text) => text,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+            Err(e) => format!("(unreadable: {e})"),
+        };
         let rendered = claims(&opts.results).with_context(|| format!("rendering {}", file.display()))?;
         if stored != rendered {
             let (a, b) = first_difference(&stored, &rendered);

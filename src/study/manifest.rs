@@ -55,7 +55,7 @@
 //! every run before any is solved.
 
 use crate::adapt::AdaptConfig;
-use crate::contact::norms::Sampling;
+use crate::contact::sampling::Sampling;
 use crate::estimator::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
 use crate::mesh::MeshSpec;
 use crate::records::{ReferenceSpec, Refine, RunSpec};

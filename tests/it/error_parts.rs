@@ -6,7 +6,8 @@
 use crate::common;
 use common::*;
 use signorini::adapt;
-use signorini::norms::{self, Sampling};
+use signorini::contact::sampling::Sampling;
+use signorini::norms;
 use signorini::problems::{Ex71, Ex72, Exact, Patch, Problem};
 
 #[test]

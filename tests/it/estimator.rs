@@ -10,9 +10,9 @@
 
 use crate::common;
 use common::*;
+use signorini::contact::sampling::Sampling;
 use signorini::estimate::{self, ContactTerm, EstimatorConfig, LogFactor, Terms};
 use signorini::mesh::Mesh;
-use signorini::norms::Sampling;
 use signorini::problems::{Ex71, Ex72, Exact, Material, Part, Patch, Problem};
 
 /// The four estimator configurations that differ in what eta_1..eta_5 are (the log factor and

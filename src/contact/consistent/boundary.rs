@@ -15,7 +15,7 @@
 //! curved edges were left out). The points depend on the mesh, but every value of the data the
 //! discrete problem sees is checked (battery 6: a bump in the Dirichlet data between sampled
 //! midpoints passed on some meshes). On Neumann edges the estimator's edge points (both
-//! samplings, [`crate::contact::norms::Sampling::edge_parameters`]) are checked too: it reads
+//! samplings, [`crate::contact::sampling::Sampling::edge_parameters`]) are checked too: it reads
 //! the traction there.
 //!
 //! The contact conditions are not data the discrete problem reads between its nodes, yet an
@@ -65,7 +65,7 @@ pub const CONTACT_DENSITY: usize = 4096;
 /// edge points under both samplings), and on a contact edge also equal pieces no longer than
 /// `spacing`.
 fn parameters(p: [f64; 2], q: [f64; 2], part: Part, spacing: f64) -> Vec<f64> {
-    use crate::contact::norms::Sampling;
+    use crate::contact::sampling::Sampling;
     let mut s = vec![0.0, 1.0, 0.5];
     s.extend(edge_points(p, q).into_iter().map(|(t, _, _)| t));
     if part == Part::Neumann {

@@ -5,7 +5,7 @@
 
 use super::{EstimatorConfig, StressFrame};
 use crate::base::element::{self, Affine, EDGE_VERTICES, N_NODES};
-use crate::contact::norms::Sampling;
+use crate::contact::sampling::Sampling;
 use crate::contact::solve::DiscreteSolution;
 use crate::fem::assembly::edge_basis;
 use crate::mesh::Mesh;
