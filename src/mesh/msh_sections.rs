@@ -22,6 +22,20 @@ pub struct Section {
     pub end: Option<usize>,
 }
 
+/// A section name as a message shows it: control characters escaped (a file's bytes must not
+/// drive the terminal: battery 9 cleared it with an escape sequence), at most 60 characters.
+fn shown(name: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in name.chars().enumerate() {
+        if i == 60 {
+            out.push_str("...");
+            break;
+        }
+        if c.is_control() { out.extend(c.escape_default()) } else { out.push(c) }
+    }
+    out
+}
+
 /// The end of the line starting at `pos` (the offset of its `\n`, or the file's end).
 fn line_end(bytes: &[u8], pos: usize) -> usize {
     bytes[pos..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |i| pos + i)
@@ -110,11 +124,11 @@ pub fn blank_ignored(mut bytes: Vec<u8>) -> Result<Vec<u8>, (usize, String)> {
                     line,
                     format!(
                         "the line ${} closes no section: ${} (line {}) ended at line {}, the first line reading ${} after it{}",
-                        s.name,
-                        o.name,
+                        shown(&s.name),
+                        shown(&o.name),
                         line_of(o.start),
                         o.end.map_or(line, |e| line_of(e - 1)),
-                        s.name,
+                        shown(&s.name),
                         if o.name == "Nodes" || o.name == "Elements" {
                             " (in a binary file, its data may hold those bytes: write the file in ASCII)"
                         } else {
@@ -122,7 +136,10 @@ pub fn blank_ignored(mut bytes: Vec<u8>) -> Result<Vec<u8>, (usize, String)> {
                         }
                     ),
                 ),
-                None => (line, format!("the section ${} has no line $End{}: every section must be closed", s.name, s.name)),
+                None => {
+                    let name = shown(&s.name);
+                    (line, format!("the section ${name} has no line $End{name}: every section must be closed"))
+                }
             });
         };
         blank(&mut bytes[s.start..end]);
@@ -153,6 +170,18 @@ mod tests {
         assert!(out.ends_with("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n    \n \n       \n$Nodes\n0 0 0 0\n$EndNodes\n"), "{out:?}");
         let unclosed = blank_ignored(b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Comments\nno end\n".to_vec());
         assert_eq!(unclosed, Err((4, "the section $Comments has no line $EndComments: every section must be closed".into())));
+    }
+
+    /// A section name is shown with its control characters escaped and cut to 60 characters
+    /// (battery 9: an escape sequence in a name cleared the terminal of whoever read the error).
+    #[test]
+    fn a_section_name_in_a_message_cannot_drive_the_terminal() {
+        let long = "x".repeat(100);
+        let file = format!("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Bad\x1b[2J\x1b[31m\n1\n$X{long}\n");
+        let (_, message) = blank_ignored(file.into_bytes()).unwrap_err();
+        assert!(!message.contains('\x1b') && message.contains("\\u{1b}[2J"), "{message:?}");
+        let (_, message) = blank_ignored(format!("$X{long}\n").into_bytes()).unwrap_err();
+        assert!(message.contains(&format!("$X{}...", "x".repeat(59))) && !message.contains(&long), "{message:?}");
     }
 
     /// Lines between sections that do not start with `$` are blanked (gmsh skips them), before

@@ -740,6 +740,9 @@ pub fn check(
         .iter()
         .map(|m| if opts.against.is_some() { (m.clone(), opts.quick) } else { m.for_drift(opts.quick, opts.deep) })
         .collect();
+    // held until the comparisons end: another drift in this checkout waits rather than
+    // starting over the reruns this one compares
+    let _scratch = if opts.against.is_none() { Some(super::store::scratch_folder(&opts.scratch)?) } else { None };
     if opts.against.is_none() {
         rerun_all(&planned, opts)?;
     }

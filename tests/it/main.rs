@@ -10,6 +10,7 @@ mod bad_battery7;
 mod bad_battery8_contact;
 mod bad_battery8_files;
 mod bad_battery8_parse;
+mod bad_battery9;
 mod bad_cli;
 mod bad_data;
 mod bad_edges;

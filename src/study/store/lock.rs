@@ -99,6 +99,17 @@ impl Lock {
     }
 }
 
+/// The lock of a scratch folder a whole command reruns studies into (`drift`'s
+/// `target/drift/full`): the file `FOLDER.lock` beside it, held until the command ends. A second
+/// process waits for it, saying who holds it: two drifts in one checkout otherwise started over
+/// each other's reruns and compared what the other had removed (battery 9: a false drift).
+pub fn scratch_folder(folder: &Path) -> Result<Lock> {
+    let mut name = folder.file_name().map(|n| n.to_os_string()).unwrap_or_else(|| "scratch".into());
+    name.push(".lock");
+    let path = folder.with_file_name(name);
+    claim(open(&path)?, &path, &format!("the scratch folder {}", folder.display()), true)
+}
+
 /// The lock file at `path`, made if missing; one that is not a regular file (a named pipe, a
 /// symlink to a device: its holder's text would be read without end) is refused, naming it.
 fn open(path: &Path) -> Result<std::fs::File> {
