@@ -491,7 +491,10 @@ impl std::error::Error for AdaptInterrupted {}
 /// (a named pipe, a device such as /dev/null: the write renames a new file over it), before
 /// hours of work are spent, not after.
 fn check_writable(flag: &str, path: &std::path::Path) -> Result<()> {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    let dir = signorini::base::input::folder_of(path);
+    if let Some(blocking) = dir.ancestors().find(|a| a.exists() && !a.is_dir()) {
+        bail!("{flag} {}: {} is a file, not a folder", path.display(), blocking.display());
+    }
     if !dir.is_dir() {
         bail!("{flag} {}: the folder {} does not exist", path.display(), dir.display());
     }

@@ -142,6 +142,29 @@ pub fn check_target(path: &Path) -> Result<(), NotFileTarget> {
     }
 }
 
+/// Create the folder `dir` and its missing parents (`create_dir_all`). Where a path on the way
+/// exists and is not a folder (a file left where a results folder, `.locks` or an output folder
+/// must be), the error names that path and what it is, instead of the system's "File exists".
+/// Every folder the harness creates is created here.
+pub fn create_folder(dir: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        let blocking = dir.ancestors().find_map(|a| std::fs::metadata(a).ok().filter(|m| !m.is_dir()).map(|m| (a, m)));
+        let why = match blocking {
+            Some((a, meta)) => {
+                let what = if meta.is_file() { "a regular file" } else { file_type(&meta.file_type()) };
+                format!("{} is {what}, not a folder: move it away or choose another folder", a.display())
+            }
+            None => e.to_string(),
+        };
+        std::io::Error::new(e.kind(), format!("cannot create the folder {}: {why}", dir.display()))
+    })
+}
+
+/// The folder a file at `path` is written into: its parent, or `.` for a bare name.
+pub fn folder_of(path: &Path) -> &Path {
+    path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."))
+}
+
 /// A file type that is not a regular file, in words.
 fn file_type(t: &std::fs::FileType) -> &'static str {
     use std::os::unix::fs::FileTypeExt;

@@ -179,7 +179,7 @@ pub fn draw_figures(shelf: &Shelf, figures: &Path, roles: &Roles) -> anyhow::Res
 /// [`draw_figures`] for the figures `keep` accepts.
 pub fn draw_figures_where(shelf: &Shelf, figures: &Path, roles: &Roles, keep: &dyn Fn(&str) -> bool) -> anyhow::Result<Outcome> {
     register_font()?;
-    std::fs::create_dir_all(figures).with_context(|| format!("creating {}", figures.display()))?;
+    crate::base::input::create_folder(figures)?;
     let mut outcome = Outcome::default();
     let mut errors = Vec::new();
     for name in FIGURES.into_iter().filter(|f| keep(f)) {

@@ -283,7 +283,7 @@ pub fn write_pages(
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
         Err(e) => return Err(e).with_context(|| format!("reading the drift report {}", drift_report.display())),
     };
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    crate::base::input::create_folder(out)?;
     let mut written = Vec::new();
     for study in &chosen {
         let page = study_page(shelf, figures, study, &claims, drift.as_ref())?;

@@ -474,9 +474,14 @@ struct ExactExprs {
     u: [Expr; 2],
     /// `grad[i][j] = d u_i / d x_j`.
     grad: [[Expr; 2]; 2],
+    /// Whether the file writes `exact.grad` (otherwise exmex differentiated `exact.u`).
+    grad_written: bool,
 }
 
 impl Exact for ExactExprs {
+    fn grad_written(&self) -> bool {
+        self.grad_written
+    }
     fn u(&self, x: [f64; 2]) -> [f64; 2] {
         [self.u[0].at(x), self.u[1].at(x)]
     }

@@ -58,6 +58,11 @@ pub trait Exact: Send + Sync {
     fn u(&self, x: [f64; 2]) -> [f64; 2];
     /// `grad[i][j] = d u_i / d x_j`.
     fn grad(&self, x: [f64; 2]) -> [[f64; 2]; 2];
+    /// Whether the gradient is written by hand (code, or `exact.grad` in a problem file) rather
+    /// than differentiated from u symbolically: what a contradiction between the two blames.
+    fn grad_written(&self) -> bool {
+        true
+    }
 }
 
 /// A 2D frictionless unilateral contact problem (paper eq. 1.1–1.8).

@@ -75,8 +75,7 @@ impl Batch {
     /// the temporary file is removed and the error names the path and the step.
     pub fn add(&mut self, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         replaceable(path)?;
-        let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        std::fs::create_dir_all(dir).map_err(step("creating the directory", dir))?;
+        crate::base::input::create_folder(crate::base::input::folder_of(path))?;
         let tmp = temporary_for(path);
         let written = std::fs::File::create(&tmp).and_then(|mut f| {
             f.write_all(bytes)?;

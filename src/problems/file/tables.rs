@@ -357,7 +357,7 @@ impl Reader<'_> {
                         [[d(0, "x")?, d(0, "y")?], [d(1, "x")?, d(1, "y")?]]
                     }
                 };
-                Some(ExactExprs { u, grad })
+                Some(ExactExprs { u, grad, grad_written: e.grad.is_some() })
             }
         })
     }

@@ -117,7 +117,7 @@ fn open(path: &Path) -> Result<std::fs::File> {
         bail!("the lock file {} is {}, not a file: remove it", path.display(), e.found);
     }
     if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
+        crate::base::input::create_folder(parent)?;
     }
     std::fs::OpenOptions::new()
         .read(true)
