@@ -242,8 +242,8 @@ impl Problem for Scaled<'_> {
     fn dirichlet(&self, x: [f64; 2]) -> [f64; 2] {
         self.inner.dirichlet(x).map(|v| self.k * v)
     }
-    fn contact_normal(&self, x: [f64; 2]) -> [f64; 2] {
-        self.inner.contact_normal(x)
+    fn contact_normal(&self, x: [f64; 2], outward: [f64; 2]) -> [f64; 2] {
+        self.inner.contact_normal(x, outward)
     }
     fn gap(&self, x: [f64; 2]) -> f64 {
         self.k * self.inner.gap(x)

@@ -47,12 +47,7 @@ pub(in crate::contact) struct Point {
 /// chord's outward normal `chord` (the chord's own where the curve has no normal).
 fn on_curve(curve: &Curve, x: [f64; 2], chord: [f64; 2]) -> ([f64; 2], [f64; 2]) {
     let at = curve.project(x);
-    let n = match curve.normal(at) {
-        Some(n) if n[0] * chord[0] + n[1] * chord[1] < 0.0 => [-n[0], -n[1]],
-        Some(n) => n,
-        None => chord,
-    };
-    (at, n)
+    (at, curve.outward(at, chord))
 }
 
 /// The contact part is checked at points no farther apart than the body's size (the diagonal of
@@ -191,7 +186,7 @@ pub fn check_boundary(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, nod
                 }
             }
             Part::Contact => {
-                let cn = problem.contact_normal(p.at);
+                let cn = problem.contact_normal(p.at, p.normal);
                 let len = norm(cn);
                 let cn = [cn[0] / len, cn[1] / len];
                 let (un, chi) = (u[0] * cn[0] + u[1] * cn[1], problem.gap(p.at));

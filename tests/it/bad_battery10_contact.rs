@@ -1,0 +1,120 @@
+//! Battery 10, contact data:
+//! * F1: `normal = "outward"` with the contact predicate on two sides of the square gave the
+//!   corner node one side's normal (a tie of the nearest side): the corner passed the other wall
+//!   by 8% of the gap, certified. A contact node whose normal differs between its two contact
+//!   edges (a corner of the normal, also a declared normal that jumps there) is refused, naming
+//!   the node and both normals (`contact::plausible`, every problem).
+//! * F11: `outward` with a `[curves]` circle for one contact group gave a flat contact group the
+//!   circle's radial normal (21-40 degrees off): the body passed the wall by 7 times the gap,
+//!   certified. Each contact edge now gets its own outward normal, its circle's or the straight
+//!   edge's (`Mesh::outward_at`).
+//! * F9: `outward` with a predicate found the square's contact sides by sampling the predicate
+//!   at k/16: a contact stretch shorter than 1/16 of a side was "on none of the sides", or got
+//!   another side's normal and was refused as "nearly tangent". The normal is the contact edge's
+//!   own, on any mesh: no sampling.
+
+use super::common::{scratch, signorini_in};
+
+fn repo(path: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+/// u_h at the probe, from the `solve` output line `u_h(x, y) = (u1, u2)`.
+fn probe(out: &str, at: &str) -> [f64; 2] {
+    let line = out.lines().find(|l| l.starts_with(&format!("u_h({at})"))).unwrap_or_else(|| panic!("no probe {at}: {out}"));
+    let inner = line.split(" = (").nth(1).unwrap().trim_end_matches(')');
+    let v: Vec<f64> = inner.split(", ").map(|s| s.parse().unwrap()).collect();
+    [v[0], v[1]]
+}
+
+const SQUARE: &str = "dirichlet = [0.1, 0]\n[material]\nmu = 1\nlambda = 1\n[parts]\ncontact = \"CONTACT\"\ndirichlet = \"DIRICHLET\"\n[contact]\nnormal = NORMAL\nchi = 0.05\n";
+
+fn square(name: &str, contact: &str, dirichlet: &str, normal: &str, mesh: &str, probes: &[&str]) -> (i32, String, String) {
+    let dir = scratch(name);
+    let text = SQUARE.replace("CONTACT", contact).replace("DIRICHLET", dirichlet).replace("NORMAL", normal);
+    std::fs::write(dir.join("p.toml"), text).unwrap();
+    let mut args = vec!["solve", "--problem", "p.toml", "--mesh", mesh];
+    for p in probes {
+        args.extend(["--probe", p]);
+    }
+    signorini_in(&dir, &args)
+}
+
+#[test]
+fn a_corner_between_two_outward_contact_sides_is_refused_naming_the_node_and_both_normals() {
+    let (code, out, err) = square("b10-corner", "y < 1e-12 || x > 1 - 1e-12", "x < 1e-12", "\"outward\"", "structured:8", &["1,0"]);
+    assert_eq!(code, 1, "{out}{err}");
+    for part in [
+        "the contact node at (1, 0)",
+        "is a corner of the contact normal",
+        "(1.000000, 0.000000)",
+        "(0.000000, -1.000000)",
+        "90.0000 degrees",
+        "declare its direction",
+    ] {
+        assert!(err.contains(part), "{part}: {err}");
+    }
+    // the advice followed: the bottom's contact ends before the corner; the corner is held at the wall
+    let (code, out, err) = square(
+        "b10-corner-ended",
+        "y < 1e-12 && x < 0.875 || x > 1 - 1e-12",
+        "x < 1e-12",
+        "\"outward\"",
+        "structured:8",
+        &["1,0", "1,0.0625"],
+    );
+    assert_eq!(code, 0, "{err}");
+    for at in ["1, 0", "1, 0.0625"] {
+        let u = probe(&out, at);
+        assert!(u[0] <= 0.05 + 1e-12, "{at}: {u:?} passes the wall x = 1.05");
+    }
+}
+
+#[test]
+fn a_declared_normal_that_jumps_at_a_contact_vertex_is_a_corner_too() {
+    // (0, -1) on the bottom, (1, 0) on the right side and at the corner itself
+    let jump = "[\"max(0, signum(x - 1 + 1e-12))\", \"max(0, signum(x - 1 + 1e-12)) - 1\"]";
+    let (code, out, err) = square("b10-jump", "y < 1e-12 || x > 1 - 1e-12", "x < 1e-12", jump, "structured:8", &[]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(err.contains("the contact node at (1, 0)") && err.contains("is a corner of the contact normal"), "{err}");
+    // a declared constant direction has no corner: the bottom alone with it solves
+    let (code, _, err) = square("b10-flat", "y < 1e-12", "x < 1e-12", "[0, -1]", "structured:8", &[]);
+    assert_eq!(code, 0, "{err}");
+}
+
+#[test]
+fn outward_gives_a_flat_contact_group_its_own_normal_beside_a_circle_group() {
+    let dir = scratch("b10-circle-flat");
+    let mesh = format!("gmsh:{}", repo("experiments/meshes/quarter_disc.msh").display());
+    // the arc (a circle) and the flat bottom both in contact; the vertex (1, 0) where they meet
+    // at a right angle is held by a point constraint, so it carries no contact constraint
+    let problem = "dirichlet = [0, 0]\nbody_force = [0, \"-2\"]\n[[point_constraints]]\nat = [1, 0]\nu = [0, 0]\n[material]\nmu = 1\nlambda = 1\n[parts]\ncontact = [\"arc\", \"bottom\"]\ndirichlet = [\"left\"]\n[curves]\narc = { circle = { centre = [0, 0], radius = 1 } }\n[contact]\nnormal = \"outward\"\nchi = 0.02\n";
+    std::fs::write(dir.join("p.toml"), problem).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["solve", "--problem", "p.toml", "--mesh", &mesh, "--probe", "0.5,0", "--probe", "0.75,0"]);
+    assert_eq!(code, 0, "{err}");
+    // the bottom is held at the floor y = -0.02 along its own normal (0, -1), not along the
+    // circle's radial direction (1, 0) there
+    for at in ["0.5, 0", "0.75, 0"] {
+        let u = probe(&out, at);
+        assert!(u[1] >= -0.02 - 1e-12, "{at}: {u:?} passes the floor y = -0.02");
+    }
+    assert!((probe(&out, "0.75, 0")[1] + 0.02).abs() < 1e-9, "the bottom presses on the floor: {out}");
+    // without the point constraint the meeting vertex is a corner: refused, with both normals
+    std::fs::write(dir.join("p.toml"), problem.replace("[[point_constraints]]\nat = [1, 0]\nu = [0, 0]\n", "")).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["solve", "--problem", "p.toml", "--mesh", &mesh]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("the contact node at (1, 0)") && err.contains("corner") && err.contains("90.0000 degrees"), "{err}");
+}
+
+#[test]
+fn outward_finds_a_contact_stretch_shorter_than_a_sixteenth_of_a_side() {
+    // the top edge of the right side (1/32 long) alone
+    let (code, out, err) =
+        square("b10-tip", "x > 1 - 1e-12 && y > 0.96875", "x < 1e-12 && y > 0.5", "\"outward\"", "structured:32", &["1,0.984375"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(probe(&out, "1, 0.984375")[0] <= 0.05 + 1e-12, "{out}");
+    // beside the bottom, with its own normal (1, 0), not the bottom's (0, -1)
+    let (code, _, err) =
+        square("b10-tip-bottom", "y < 1e-12 || x > 1 - 1e-12 && y > 0.96875", "x < 1e-12 && y > 0.5", "\"outward\"", "structured:32", &[]);
+    assert_eq!(code, 0, "{err}");
+}
