@@ -118,3 +118,26 @@ fn outward_finds_a_contact_stretch_shorter_than_a_sixteenth_of_a_side() {
         square("b10-tip-bottom", "y < 1e-12 || x > 1 - 1e-12 && y > 0.96875", "x < 1e-12 && y > 0.5", "\"outward\"", "structured:32", &[]);
     assert_eq!(code, 0, "{err}");
 }
+
+/// F4: a stress-free exact solution (a rigid motion written with identities) was refused as
+/// "tangential traction 2e-19": the tractions were judged against the largest |sigma(u) n|, which
+/// was that round-off. The stress scale is now no less than the one the size of u and grad u
+/// implies; a real traction mismatch is still refused.
+#[test]
+fn a_stress_free_exact_solution_with_round_off_in_its_gradient_is_accepted() {
+    let dir = scratch("b10-rigid");
+    let text = "dirichlet = \"exact\"\ntraction = TRACTION\n[material]\nmu = 1\nlambda = 1\n[parts]\ncontact = \"y < 1e-12\"\ndirichlet = \"x < 1e-12\"\n[contact]\nnormal = \"outward\"\nchi = 1\n[exact]\nu = U\n";
+    for u in
+        ["[\"0.01 - 0.001*y*(sin(x)^2 + cos(x)^2)\", \"0.001*log10(10^x)\"]", "[\"0.01*(cosh(x)^2 - sinh(x)^2) - 0.001*y\", \"0.001*x\"]"]
+    {
+        std::fs::write(dir.join("p.toml"), text.replace("TRACTION", "\"exact\"").replace("U", u)).unwrap();
+        let (code, _, err) = signorini_in(&dir, &["solve", "--problem", "p.toml", "--mesh", "structured:4"]);
+        assert_eq!(code, 0, "{u}: {err}");
+    }
+    // a traction 1e-7 where sigma(u) n = 0: refused
+    let u = "[\"0.01 - 0.001*y\", \"0.001*x\"]";
+    std::fs::write(dir.join("p.toml"), text.replace("TRACTION", "[0, \"1e-7\"]").replace("U", u)).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["solve", "--problem", "p.toml", "--mesh", "structured:4"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("the traction on Gamma_N"), "{err}");
+}
