@@ -141,3 +141,86 @@ fn a_stress_free_exact_solution_with_round_off_in_its_gradient_is_accepted() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("the traction on Gamma_N"), "{err}");
 }
+
+/// An annulus 0.5 < r < 1 of `n` sectors and `layers` rings, the hole (a closed loop, on its
+/// circle) contact, the outer circle clamped; the gap closes on x > 0 only, the normal is the
+/// body's outward one (toward the centre).
+struct Hole;
+
+impl signorini::problems::Problem for Hole {
+    fn name(&self) -> &str {
+        "hole"
+    }
+    fn description(&self) -> &str {
+        "contact on a closed loop"
+    }
+    fn material(&self) -> signorini::problems::Material {
+        signorini::problems::Material { mu: 1.0, zeta: 1.0 }
+    }
+    fn part_of(&self, _x: [f64; 2]) -> signorini::problems::Part {
+        signorini::problems::Part::Neumann
+    }
+    fn body_force(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn traction(&self, _x: [f64; 2], _n: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn dirichlet(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn contact_normal(&self, _x: [f64; 2], outward: [f64; 2]) -> [f64; 2] {
+        outward
+    }
+    fn gap(&self, x: [f64; 2]) -> f64 {
+        0.002 - 0.01 * x[0].max(0.0) / 0.5
+    }
+}
+
+fn annulus(n: usize, layers: usize) -> signorini::mesh::Mesh {
+    use signorini::mesh::BoundaryEdge;
+    use signorini::problems::{Curve, Part};
+    let v = |k: usize, j: usize| k * n + j % n;
+    let mut vertices = Vec::new();
+    for k in 0..=layers {
+        let r = 0.5 + 0.5 * k as f64 / layers as f64;
+        for j in 0..n {
+            let t = std::f64::consts::TAU * j as f64 / n as f64;
+            vertices.push([r * t.cos(), r * t.sin()]);
+        }
+    }
+    let mut triangles = Vec::new();
+    for k in 0..layers {
+        for j in 0..n {
+            let (a, b, c, d) = (v(k, j), v(k + 1, j), v(k + 1, j + 1), v(k, j + 1));
+            triangles.extend([[a, b, c], [a, c, d]]);
+        }
+    }
+    let inner = Curve::Circle { centre: [0.0, 0.0], radius: 0.5 };
+    let mut boundary: Vec<BoundaryEdge> =
+        (0..n).map(|j| BoundaryEdge { v: [v(0, j + 1), v(0, j)], part: Part::Contact, curve: Some(inner) }).collect();
+    boundary.extend((0..n).map(|j| BoundaryEdge { v: [v(layers, j), v(layers, j + 1)], part: Part::Dirichlet, curve: None }));
+    let mesh = signorini::mesh::Mesh { vertices, triangles, boundary };
+    mesh.check().unwrap();
+    mesh
+}
+
+/// F7: on a closed contact loop, one active arc through the loop's start was reported as two
+/// zones, and zone_min/zone_max as the whole loop. It is one zone [s_first, s_last + L].
+#[test]
+fn an_active_arc_through_the_start_of_a_closed_contact_loop_is_one_zone() {
+    let mesh = annulus(32, 4);
+    let sol = super::common::solve_on(&Hole, &mesh);
+    let loop_length = 32.0 * 2.0 * 0.5 * (std::f64::consts::PI / 32.0).sin();
+    let zones = sol.contact_zones();
+    assert_eq!(zones.len(), 1, "{zones:?}");
+    let z = zones[0];
+    // pressed on x > 0 only: the arc crosses the x axis at (0.5, 0), the loop's start (the hole's
+    // boundary runs clockwise, the body on its left: from above the axis to below it)
+    assert!(z.s[0] < loop_length && z.s[1] > loop_length && z.s[1] - z.s[0] < 0.5 * loop_length, "{z:?} (L = {loop_length})");
+    assert!(z.from[1] > 0.0 && z.to[1] < 0.0 && z.from[0] > 0.0 && z.to[0] > 0.0, "{z:?}");
+    // its length is that of the active nodes: (active - 1) half-edges
+    let half = 0.5 * loop_length / 32.0;
+    assert!(((z.s[1] - z.s[0]) / half - (sol.active_count() - 1) as f64).abs() < 1e-9, "{z:?}: {} active", sol.active_count());
+    assert_eq!(sol.contact_zone(), Some(z.s));
+}
