@@ -91,6 +91,15 @@ pub enum MeshError {
     OddSymmetric { spec: String, suggest: String },
     #[error("triangle {t} has non-positive area {area:e} (vertices must be counter-clockwise and distinct)")]
     NonPositiveArea { t: usize, area: f64 },
+    /// Refinement put the new vertex of a curved boundary edge on its curve and turned a triangle
+    /// over ([`refine::refine`]).
+    #[error(
+        "refinement put the new vertex of the {part} boundary edge from {} to {} on its curve (the circle of centre {} and radius {radius}), at {}, and that turned triangle {t} over (area {area:.3e}): the mesh is thinner there than the curve's sagitta over the edge ({sagitta:.3e}); mesh the body finer near the curve (triangles along it deeper than the sagitta r - sqrt(r^2 - (h/2)^2) of their boundary edges h)",
+        crate::base::number::point(.edge[0]), crate::base::number::point(.edge[1]), crate::base::number::point(.curve.centre()), crate::base::number::point(*.at),
+        radius = .curve.radius(), part = format!("{:?}", .part).to_lowercase(),
+        sagitta = { let (r, h) = (.curve.radius(), dist(.edge[0], .edge[1])); r - (r * r - 0.25 * h * h).max(0.0).sqrt() }
+    )]
+    TurnedByCurve { t: usize, area: f64, edge: [[f64; 2]; 2], at: [f64; 2], curve: Curve, part: Part },
     #[error("mesh is not conforming: edge ({a}, {b}) is shared by {count} triangles")]
     NonConforming { a: usize, b: usize, count: usize },
     #[error("boundary edge ({a}, {b}) has no tag (every boundary edge must be Dirichlet, Neumann or contact)")]

@@ -64,6 +64,20 @@ impl Curve {
         }
     }
 
+    /// The circle's centre.
+    pub fn centre(&self) -> [f64; 2] {
+        match *self {
+            Curve::Circle { centre, .. } => centre,
+        }
+    }
+
+    /// The circle's radius.
+    pub fn radius(&self) -> f64 {
+        match *self {
+            Curve::Circle { radius, .. } => radius,
+        }
+    }
+
     /// The distance from `x` to the curve, relative to its size (the circle's radius).
     pub fn relative_distance(&self, x: [f64; 2]) -> f64 {
         match *self {

@@ -177,13 +177,14 @@ impl signorini::problems::Problem for Hole {
     }
 }
 
-fn annulus(n: usize, layers: usize) -> signorini::mesh::Mesh {
+/// Rings at the radii `radii` (0.5 first, 1 last), `n` sectors each.
+fn annulus(n: usize, radii: &[f64]) -> signorini::mesh::Mesh {
     use signorini::mesh::BoundaryEdge;
     use signorini::problems::{Curve, Part};
     let v = |k: usize, j: usize| k * n + j % n;
+    let layers = radii.len() - 1;
     let mut vertices = Vec::new();
-    for k in 0..=layers {
-        let r = 0.5 + 0.5 * k as f64 / layers as f64;
+    for &r in radii {
         for j in 0..n {
             let t = std::f64::consts::TAU * j as f64 / n as f64;
             vertices.push([r * t.cos(), r * t.sin()]);
@@ -209,7 +210,7 @@ fn annulus(n: usize, layers: usize) -> signorini::mesh::Mesh {
 /// zones, and zone_min/zone_max as the whole loop. It is one zone [s_first, s_last + L].
 #[test]
 fn an_active_arc_through_the_start_of_a_closed_contact_loop_is_one_zone() {
-    let mesh = annulus(32, 4);
+    let mesh = annulus(32, &[0.5, 0.625, 0.75, 0.875, 1.0]);
     let sol = super::common::solve_on(&Hole, &mesh);
     let loop_length = 32.0 * 2.0 * 0.5 * (std::f64::consts::PI / 32.0).sin();
     let zones = sol.contact_zones();
@@ -223,4 +224,33 @@ fn an_active_arc_through_the_start_of_a_closed_contact_loop_is_one_zone() {
     let half = 0.5 * loop_length / 32.0;
     assert!(((z.s[1] - z.s[0]) / half - (sol.active_count() - 1) as f64).abs() < 1e-9, "{z:?}: {} active", sol.active_count());
     assert_eq!(sol.contact_zone(), Some(z.s));
+}
+
+/// F10: refinement onto a concave curve (a hole's circle) turned a triangle over where the first
+/// layer is thinner than the chord's sagitta, and the error blamed the vertex order. It names the
+/// curve, the edge, the new vertex and the remedy.
+#[test]
+fn refinement_that_turns_a_triangle_over_on_a_curve_says_so() {
+    let mut mesh = annulus(16, &[0.5, 0.505, 0.6, 0.8, 1.0]);
+    let mut error = None;
+    for _ in 0..3 {
+        match signorini::mesh::refine::refine(&mesh, &vec![true; mesh.n_triangles()]) {
+            Ok(r) => mesh = r.mesh,
+            Err(e) => {
+                error = Some(e.to_string());
+                break;
+            }
+        }
+    }
+    let error = error.expect("refinement onto the hole turns a triangle over");
+    for part in [
+        "refinement put the new vertex of the contact boundary edge",
+        "the circle of centre (0, 0) and radius 0.5",
+        "turned triangle",
+        "thinner there than the curve's sagitta",
+        "mesh the body finer near the curve",
+    ] {
+        assert!(error.contains(part), "{part}: {error}");
+    }
+    assert!(!error.contains("counter-clockwise"), "{error}");
 }

@@ -240,7 +240,7 @@ fn quarter_disc_refined_onto_the_arc() {
     let mut m = MeshSpec::Gmsh(meshes_dir().join("quarter_disc.msh")).build(&p).unwrap();
     let mut errors = Vec::new();
     for _ in 0..8 {
-        m = signorini::mesh::refine::refine(&m, &vec![true; m.n_triangles()]).mesh;
+        m = signorini::mesh::refine::refine(&m, &vec![true; m.n_triangles()]).unwrap().mesh;
         m.check().unwrap();
         for e in m.boundary.iter().filter(|e| e.curve.is_some()) {
             for v in e.v {
