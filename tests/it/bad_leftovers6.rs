@@ -9,7 +9,8 @@
 //! * a tab or a line break in an expression gave exmex's "don't know how to parse"; a
 //!   parenthesised comparison "parentheses mismatch";
 //! * `normal = "outward"` on a circle around a hole was refused without saying why or what to
-//!   write (`Problem::normal_note`);
+//!   write (then a note; since battery 10 "outward" is the body's outward normal there, toward
+//!   the centre, and solves);
 //! * a predicate problem on a Gmsh mesh blamed every group; a problem file beside the manifests
 //!   was only an unknown manifest key;
 //! * a parametric Gmsh file gave mshio's words only (wrong `$Nodes` header counts, and the same
