@@ -34,7 +34,8 @@ impl Problem for Foundation {
     fn dirichlet(&self, _: [f64; 2]) -> [f64; 2] {
         [0.0, -0.02]
     }
-    fn contact_normal(&self, _: [f64; 2]) -> [f64; 2] {
+    /// The foundation's direction (the body's outward normal, the second argument, is not needed).
+    fn contact_normal(&self, _: [f64; 2], _: [f64; 2]) -> [f64; 2] {
         [0.0, -1.0]
     }
     /// The foundation lies chi(x) below the bottom: u . n = -u_y <= chi.

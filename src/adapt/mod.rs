@@ -56,6 +56,10 @@ pub enum AdaptError {
     NothingToSolve { start: usize, levels: usize },
     #[error(transparent)]
     Replay(#[from] replay::ReplayError),
+    /// Refining level `level` into the next failed (levels `0..=level` were solved and seen by
+    /// the observer).
+    #[error("refining level {level} (levels 0 to {level} were solved): {error}")]
+    Refine { level: usize, error: crate::mesh::MeshError },
 }
 
 impl AdaptConfig {
@@ -468,10 +472,12 @@ pub fn run_from(
             None
         } else {
             let t0 = Instant::now();
-            let refinement = refine::refine(&mesh, &marks);
-            let active = config.warm_start.then(|| transfer_active_set(&mesh, &sol, &refinement, problem));
+            let refined = refine::refine(&mesh, &marks).map(|refinement| {
+                let active = config.warm_start.then(|| transfer_active_set(&mesh, &sol, &refinement, problem));
+                (refinement.mesh, active)
+            });
             record.t_refine = t0.elapsed().as_secs_f64();
-            Some((refinement.mesh, active))
+            Some(refined)
         };
         record.t_level = t_level.elapsed().as_secs_f64();
         record.mem_peak_mib = crate::base::memory::peak_resident().filter(|_| measured).map(|b| b / (1024.0 * 1024.0));
@@ -482,7 +488,7 @@ pub fn run_from(
             estimate: &est,
             history: &entry,
             continues: next.is_some(),
-            next_active: next.as_ref().and_then(|(_, a)| a.as_deref()),
+            next_active: next.as_ref().and_then(|n| n.as_ref().ok()).and_then(|(_, a)| a.as_deref()),
         });
         records.push(record);
         history.levels.push(entry);
@@ -497,10 +503,11 @@ pub fn run_from(
             termination = AdaptTermination::NothingMarked;
         }
         match next {
-            Some((m, active)) => {
+            Some(Ok((m, active))) => {
                 mesh = m;
                 initial_active = active;
             }
+            Some(Err(error)) => return Err(AdaptError::Refine { level, error }),
             None => break,
         }
     }

@@ -23,6 +23,9 @@ pub enum ReplayError {
     Flags { level: usize, source: BadFlags },
     #[error("level {level}: {what} has {got} flags for {want} {of}")]
     Length { level: usize, what: &'static str, got: usize, want: usize, of: &'static str },
+    /// Refining level `level` into the next failed ([`refine::refine`]).
+    #[error("refining level {level}: {error}")]
+    Refine { level: usize, error: crate::mesh::MeshError },
 }
 
 /// The mesh of level `level`: `mesh0` refined by the marks of levels 0..level, every mesh on the
@@ -45,7 +48,7 @@ pub fn mesh_at(mesh0: Mesh, history: &History, level: usize) -> Result<Mesh, Rep
         if marks.len() != mesh.n_triangles() {
             return Err(ReplayError::Length { level: l, what: "the marks", got: marks.len(), want: mesh.n_triangles(), of: "elements" });
         }
-        mesh = refine::refine(&mesh, &marks).mesh;
+        mesh = refine::refine(&mesh, &marks).map_err(|error| ReplayError::Refine { level: l, error })?.mesh;
     }
     Ok(mesh)
 }
@@ -88,6 +91,6 @@ pub fn resume(mesh0: Mesh, records: Vec<LevelRecord>, history: History, next_act
     if marks.len() != mesh.n_triangles() {
         return Err(ReplayError::Length { level: last, what: "the marks", got: marks.len(), want: mesh.n_triangles(), of: "elements" });
     }
-    let mesh = refine::refine(&mesh, &marks).mesh;
+    let mesh = refine::refine(&mesh, &marks).map_err(|error| ReplayError::Refine { level: last, error })?.mesh;
     Ok(Start { mesh, level: last + 1, initial_active: next_active, records, history })
 }

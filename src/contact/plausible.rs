@@ -20,6 +20,12 @@
 //!   direction is often a flat foundation's, not the surface's normal (`hertz.toml`: the arc of
 //!   a cylinder against the direction (0, -1)), and such a part legitimately reaches well past
 //!   45 degrees on a curved body.
+//! * **A contact node carries one direction.** The node holds one constraint u . n <= chi; where
+//!   the normal differs between its two contact edges (two sides of the square with `normal =
+//!   "outward"`, two circles meeting at an angle, a declared normal that jumps there) the node is
+//!   held along one of them only and could pass the obstacle along the other (battery 10: the
+//!   corner of two contact sides took the bottom's normal and passed the side wall by 8% of the
+//!   gap, certified). Refused, naming the node and both normals ([`ContactDataError::Corner`]).
 //! * **The obstacle does not overlap the body by more than its size.** A gap chi(p) < -D, D the
 //!   diameter of the mesh's bounding box, asks the body to move by more than its own size at p:
 //!   outside linear (small-strain) elasticity everywhere it happens, and in practice a sign or
@@ -65,23 +71,20 @@ pub const PRESCRIBED_PENETRATION: f64 = 1e-9;
 #[derive(Debug, thiserror::Error)]
 pub enum ContactDataError {
     #[error(
-        "{problem}: the contact normal (`contact.normal`) at {x} on the contact part ({part}), edge {a}-{b}, is ({nx:.6}, {ny:.6}), {how} the edge's outward normal ({ox:.6}, {oy:.6}) (n . n_out = {dot:.6}, an angle of {angle:.1} degrees): a contact normal must point out of the body, within {max} degrees of the outward normal{note}",
+        "{problem}: the contact normal (`contact.normal`) at {x} on the contact part ({part}), edge {a}-{b}, is ({nx:.6}, {ny:.6}), {how} the edge's outward normal ({ox:.6}, {oy:.6}) (n . n_out = {dot:.6}, an angle of {angle:.1} degrees): a contact normal must point out of the body, within {max} degrees of the outward normal",
         x = point(*.at), a = point(.edge[0]), b = point(.edge[1]),
         nx = .normal[0], ny = .normal[1], ox = .outward[0], oy = .outward[1],
         how = if *.dot < 0.0 { "reversed against" } else { "nearly tangent to the boundary: far from" },
-        angle = .dot.clamp(-1.0, 1.0).acos().to_degrees(), max = MAX_NORMAL_ANGLE_DEGREES,
-        note = .note.as_ref().map_or(String::new(), |n| format!(". {n}"))
+        angle = .dot.clamp(-1.0, 1.0).acos().to_degrees(), max = MAX_NORMAL_ANGLE_DEGREES
     )]
-    Normal {
-        problem: String,
-        part: String,
-        at: [f64; 2],
-        edge: [[f64; 2]; 2],
-        normal: [f64; 2],
-        outward: [f64; 2],
-        dot: f64,
-        note: Option<String>,
-    },
+    Normal { problem: String, part: String, at: [f64; 2], edge: [[f64; 2]; 2], normal: [f64; 2], outward: [f64; 2], dot: f64 },
+    #[error(
+        "{problem}: the contact node at {x} on the contact part ({part}) is a corner of the contact normal: the node carries n = ({nx:.6}, {ny:.6}), but on the contact edge from {a} to {b} the normal next to it is ({sx:.6}, {sy:.6}), {angle:.4} degrees apart. One node carries one constraint u . n <= chi, so it could pass the obstacle along the other direction. Let one of the two contact stretches end before this node (the edge on one side of it not contact), or, where the obstacle is one flat surface, declare its direction (normal = [nx, ny])",
+        x = point(*.at), a = point(.edge[0]), b = point(.edge[1]), nx = .node[0], ny = .node[1], sx = .side[0], sy = .side[1],
+        angle = .angle.to_degrees()
+    )]
+    /// `node`: the node's normal; `side`: the normal on `edge` next to the node; `angle` in radians.
+    Corner { problem: String, part: String, at: [f64; 2], edge: [[f64; 2]; 2], node: [f64; 2], side: [f64; 2], angle: f64 },
     #[error(
         "{problem}: the gap `contact.chi` at {x} on the contact part ({part}) is {chi}: the obstacle would overlap the body by more than the body's size (the diameter of the mesh's bounding box, {d}); a gap below minus the body's size is a sign or unit mistake",
         x = point(*.at), chi = shown(*.chi), d = shown(*.diameter)
@@ -150,9 +153,46 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
     let outward: Vec<Option<[f64; 2]>> =
         outward_normals(mesh, nodes).into_iter().zip(&mesh.boundary).map(|(n, e)| (e.part == Part::Contact).then_some(n)).collect();
     let diameter = super::consistent::diameter(mesh);
+    check_corners(mesh, dofs, problem, diameter)?;
     check_nodes(mesh, nodes, dofs, problem, &outward, diameter)?;
     check_sampled(mesh, nodes, problem, diameter)?;
-    check_prescribed(nodes, dofs, problem, &outward, diameter)
+    check_prescribed(mesh, nodes, dofs, problem, diameter)
+}
+
+/// The largest angle (radians) between a contact vertex's normal and the normal on one of its
+/// contact edges next to it ([`check_corners`]): far below any corner of a body, far above what a
+/// smooth normal turns over [`PART_END`](crate::mesh::PART_END) of the body's size.
+pub const CORNER_ANGLE: f64 = 1e-6;
+
+/// Every contact vertex against the normal on each of its contact edges, at the vertex (with
+/// that edge's outward normal) and next to it ([`PART_END`](crate::mesh::PART_END) of the body's
+/// size inside the edge, as the part check takes a vertex): where they differ by more than
+/// [`CORNER_ANGLE`] the vertex is a corner of the normal (two contact sides of the square with
+/// `normal = "outward"`, two circles meeting at an angle, a declared normal that jumps there),
+/// and its one constraint u . n <= chi holds the body along one direction only (battery 10: the
+/// corner of two contact sides took the bottom's normal and passed the side wall, certified).
+/// Built-in problems and declared constant normals have no corner.
+fn check_corners(mesh: &Mesh, dofs: &DofMap, problem: &dyn Problem, diameter: f64) -> Result<(), Box<ContactDataError>> {
+    let angle = |a: [f64; 2], b: [f64; 2]| (a[0] * b[1] - a[1] * b[0]).abs().atan2(a[0] * b[0] + a[1] * b[1]);
+    for (b, e) in mesh.boundary.iter().enumerate().filter(|(_, e)| e.part == Part::Contact) {
+        let [p, q] = e.v.map(|v| mesh.vertices[v]);
+        let len = (q[0] - p[0]).hypot(q[1] - p[1]);
+        let t = (crate::mesh::PART_END * diameter / len).min(0.25);
+        for (v, at, far) in [(e.v[0], p, q), (e.v[1], q, p)] {
+            let Some(k) = dofs.contact_index[v] else { continue };
+            let node = dofs.contact[k].normal;
+            let next = [at[0] + t * (far[0] - at[0]), at[1] + t * (far[1] - at[1])];
+            for x in [at, next] {
+                let side = problem.contact_normal(x, mesh.outward_at(b, x));
+                let off = angle(node, side);
+                if off > CORNER_ANGLE {
+                    let (problem, part) = (problem_name(problem), contact_part(problem));
+                    return Err(Box::new(ContactDataError::Corner { problem, part, at, edge: [p, q], node, side, angle: off }));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The contact normal and the gap at every contact node, as the discrete problem reads them
@@ -187,9 +227,8 @@ fn check_nodes(
         {
             let edge = mesh.boundary[b].v.map(|v| mesh.vertices[v]);
             let outward = outward[b].expect("a contact edge");
-            let note = problem.normal_note();
             let (problem, part) = (problem_name(problem), contact_part(problem));
-            return Err(Box::new(ContactDataError::Normal { problem, part, at, edge, normal: c.normal, outward, dot, note }));
+            return Err(Box::new(ContactDataError::Normal { problem, part, at, edge, normal: c.normal, outward, dot }));
         }
         if c.gap < -diameter {
             let (problem, part) = (problem_name(problem), contact_part(problem));
@@ -219,7 +258,7 @@ fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, diameter: 
             let (problem, part) = (problem_name(problem), contact_part(problem));
             return Err(Box::new(ContactDataError::Gap { problem, part, at: p.at, chi, diameter }));
         }
-        let n = problem.contact_normal(p.at);
+        let n = problem.contact_normal(p.at, p.normal);
         let dot = n[0] * p.normal[0] + n[1] * p.normal[1];
         dots.push((n, dot));
         if let Some(v) = vertex(mesh, p.edge, p.t)
@@ -236,10 +275,9 @@ fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, diameter: 
         let dot = vertex(mesh, p.edge, p.t).and_then(|v| at_vertex.get(&v).copied()).unwrap_or(dot);
         if dot < cos_max {
             let edge = mesh.boundary[p.edge].v.map(|v| mesh.vertices[v]);
-            let note = problem.normal_note();
             let (problem, part) = (problem_name(problem), contact_part(problem));
             let outward = p.normal;
-            return Err(Box::new(ContactDataError::Normal { problem, part, at: p.at, edge, normal, outward, dot, note }));
+            return Err(Box::new(ContactDataError::Normal { problem, part, at: p.at, edge, normal, outward, dot }));
         }
     }
     Ok(())
@@ -259,28 +297,29 @@ fn vertex(mesh: &Mesh, edge: usize, t: f64) -> Option<usize> {
 
 /// The prescribed nodes of the closure of Gamma_C against the obstacle (see the module docs).
 fn check_prescribed(
+    mesh: &Mesh,
     nodes: &P2Nodes,
     dofs: &DofMap,
     problem: &dyn Problem,
-    outward: &[Option<[f64; 2]>],
     diameter: f64,
 ) -> Result<(), Box<ContactDataError>> {
-    let on_closure: std::collections::BTreeSet<usize> = nodes
+    // (node, contact edge holding it): the normal is the problem's on that edge
+    let on_closure: std::collections::BTreeSet<(usize, usize)> = nodes
         .boundary_nodes
         .iter()
-        .zip(outward)
-        .filter(|(_, o)| o.is_some())
-        .flat_map(|(three, _)| three.iter().copied())
-        .filter(|&p| dofs.contact_index[p].is_none())
+        .enumerate()
+        .filter(|(b, _)| mesh.boundary[*b].part == Part::Contact)
+        .flat_map(|(b, three)| three.iter().map(move |&p| (p, b)))
+        .filter(|&(p, _)| dofs.contact_index[p].is_none())
         .collect();
     if on_closure.is_empty() {
         return Ok(());
     }
     let values = dofs.prescribed(nodes, problem);
     let fixed = |p: usize, i: usize| dofs.dof[p][i] == crate::fem::assembly::FIXED;
-    for p in on_closure {
+    for (p, b) in on_closure {
         let x = nodes.coords[p];
-        let n = problem.contact_normal(x);
+        let n = problem.contact_normal(x, mesh.outward_at(b, x));
         let len = n[0].hypot(n[1]);
         let (chi, u) = (problem.gap(x), values[p]);
         if !(len > 0.0) || !chi.is_finite() {

@@ -362,7 +362,9 @@ impl DiscreteSolution {
     /// its edge of smallest first vertex); the arc length s of a P2 node is measured along the
     /// straight boundary edges from that start. A run of consecutive active contact nodes (vertices
     /// and edge midpoints, in that order) is one interval `[s_first, s_last]`; a node of Gamma_C
-    /// that is no contact node (on the closure of Gamma_D) ends a run. On the unit square s is x
+    /// that is no contact node (on the closure of Gamma_D) ends a run. On a closed component of
+    /// length L, a run through its start is one interval `[s_first, s_last + L]` (its end past
+    /// L: the arc is taken modulo L), listed first for that component. On the unit square s is x
     /// along the bottom from (0, 0) and y along the right side from (1, 0).
     pub fn contact_zones(&self) -> Vec<ContactInterval> {
         // contact edges: boundary edges whose midpoint is a contact node
@@ -405,6 +407,7 @@ impl DiscreteSolution {
                     zones.push(z);
                 }
             };
+            let first_zone = zones.len();
             let (mut e, mut s) = (start, 0.0);
             visit(edges[e][0], s, &mut zones);
             while !walked[e] {
@@ -419,14 +422,24 @@ impl DiscreteSolution {
                     _ => break,
                 }
             }
-            zones.extend(run);
+            // a closed loop walked back to its start: a run still open there and a first zone
+            // from s = 0 are one arc through the start (battery 10, F7: reported as two zones,
+            // and zone_min/zone_max as the whole loop); it is written [s_first, s_last + L]
+            let closed = edges[e][1] == edges[start][0];
+            match (run, zones.get(first_zone).copied()) {
+                (Some(last), Some(head)) if closed && head.s[0] == 0.0 => {
+                    zones[first_zone] = ContactInterval { component, s: [last.s[0], s + head.s[1]], from: last.from, to: head.to };
+                }
+                (run, _) => zones.extend(run),
+            }
             component += 1;
         }
         zones
     }
 
     /// [min, max] of the arc length over active contact nodes ([`Self::contact_zones`]): on the
-    /// unit square, x on the bottom and y on the right side.
+    /// unit square, x on the bottom and y on the right side; on a closed loop of length L, max
+    /// may exceed L where a zone wraps through the loop's start.
     pub fn contact_zone(&self) -> Option<[f64; 2]> {
         self.contact_zones().iter().fold(None, |z, c| Some(z.map_or(c.s, |[a, b]: [f64; 2]| [a.min(c.s[0]), b.max(c.s[1])])))
     }

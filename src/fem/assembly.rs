@@ -22,7 +22,8 @@ pub const LOAD_DEGREE: usize = 10;
 /// Gauss points per edge for Neumann loads.
 pub const EDGE_POINTS: usize = 8;
 
-/// A contact node: the P2 node, its outward unit normal and chi_h(p) = chi(p).
+/// A contact node: the P2 node, its constraint direction (`Problem::contact_normal`, a unit
+/// vector) and chi_h(p) = chi(p).
 #[derive(Clone, Copy, Debug)]
 pub struct ContactNode {
     pub node: usize,
@@ -54,7 +55,9 @@ const POINT_TOLERANCE: f64 = 1e-12;
 
 impl DofMap {
     /// Contact nodes are the nodes on Gamma_C with no prescribed component (the Dirichlet part
-    /// wins at shared corners, see `P2Nodes::part`). A node's component is prescribed on
+    /// wins at shared corners, see `P2Nodes::part`), each with the problem's normal at the
+    /// body's outward normal there (`P2Nodes::outward`: where two contact edges meet, one of
+    /// theirs; `contact::plausible` refuses a node where their normals differ). A node's component is prescribed on
     /// Gamma_D if the problem's Dirichlet data prescribe it (`Problem::dirichlet_components`),
     /// and at a point constraint's vertex if the constraint does.
     pub fn new(nodes: &P2Nodes, problem: &dyn Problem) -> Self {
@@ -83,7 +86,8 @@ impl DofMap {
             if nodes.part[p] == Some(Part::Contact) && fixed[p] == [false, false] {
                 let x = nodes.coords[p];
                 contact_index[p] = Some(contact.len());
-                contact.push(ContactNode { node: p, normal: problem.contact_normal(x), gap: problem.gap(x) });
+                let outward = nodes.outward[p].expect("a contact node is on a contact edge");
+                contact.push(ContactNode { node: p, normal: problem.contact_normal(x, outward), gap: problem.gap(x) });
                 dof[p][1] = next; // tangential unknown among the interior ones
                 next += 1;
                 continue;

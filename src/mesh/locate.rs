@@ -86,7 +86,7 @@ mod tests {
         for _ in 0..6 {
             // grade towards (1, 0): mark the triangles near it
             let marked: Vec<bool> = (0..mesh.n_triangles()).map(|t| crate::mesh::dist(mesh.corners(t)[0], [1.0, 0.0]) < 0.4).collect();
-            mesh = crate::mesh::refine::refine(&mesh, &marked).mesh;
+            mesh = crate::mesh::refine::refine(&mesh, &marked).unwrap().mesh;
         }
         let locator = Locator::new(&mesh);
         let brute = |x: [f64; 2]| {

@@ -91,6 +91,15 @@ pub enum MeshError {
     OddSymmetric { spec: String, suggest: String },
     #[error("triangle {t} has non-positive area {area:e} (vertices must be counter-clockwise and distinct)")]
     NonPositiveArea { t: usize, area: f64 },
+    /// Refinement put the new vertex of a curved boundary edge on its curve and turned a triangle
+    /// over ([`refine::refine`]).
+    #[error(
+        "refinement put the new vertex of the {part} boundary edge from {} to {} on its curve (the circle of centre {} and radius {radius}), at {}, and that turned triangle {t} over (area {area:.3e}): the mesh is thinner there than the curve's sagitta over the edge ({sagitta:.3e}); mesh the body finer near the curve (triangles along it deeper than the sagitta r - sqrt(r^2 - (h/2)^2) of their boundary edges h)",
+        crate::base::number::point(.edge[0]), crate::base::number::point(.edge[1]), crate::base::number::point(.curve.centre()), crate::base::number::point(*.at),
+        radius = .curve.radius(), part = format!("{:?}", .part).to_lowercase(),
+        sagitta = { let (r, h) = (.curve.radius(), dist(.edge[0], .edge[1])); r - (r * r - 0.25 * h * h).max(0.0).sqrt() }
+    )]
+    TurnedByCurve { t: usize, area: f64, edge: [[f64; 2]; 2], at: [f64; 2], curve: Curve, part: Part },
     #[error("mesh is not conforming: edge ({a}, {b}) is shared by {count} triangles")]
     NonConforming { a: usize, b: usize, count: usize },
     #[error("boundary edge ({a}, {b}) has no tag (every boundary edge must be Dirichlet, Neumann or contact)")]
@@ -369,6 +378,21 @@ impl Mesh {
         [self.vertices[a], self.vertices[b], self.vertices[c]]
     }
 
+    /// The body's outward unit normal at `x` on boundary edge `b`: its curve's
+    /// ([`Curve::outward`]) where the edge lies on one, else the straight edge's (to the right of
+    /// `v[0] -> v[1]`, which runs counter-clockwise along the boundary). What `normal =
+    /// "outward"` takes, edge by edge: at a vertex the two edges may disagree (a corner), which
+    /// `contact::plausible` refuses on the contact part. A zero component is +0.
+    pub fn outward_at(&self, b: usize, x: [f64; 2]) -> [f64; 2] {
+        let e = &self.boundary[b];
+        let [p, q] = e.v.map(|v| self.vertices[v]);
+        let (tx, ty) = (q[0] - p[0], q[1] - p[1]);
+        let l = tx.hypot(ty);
+        let chord = [ty / l, -tx / l];
+        let n = e.curve.map_or(chord, |c| c.outward(x, chord));
+        [n[0] + 0.0, n[1] + 0.0]
+    }
+
     /// Signed area of triangle `t` (positive for counter-clockwise).
     pub fn area(&self, t: usize) -> f64 {
         let [a, b, c] = self.corners(t);
@@ -582,6 +606,10 @@ pub struct P2Nodes {
     /// Gamma_D are Dirichlet nodes: the paper's spaces take the Dirichlet condition on the closed
     /// set Gamma_D, so a corner where Gamma_D meets Gamma_C carries no contact constraint).
     pub part: Vec<Option<Part>>,
+    /// Per boundary node, the body's outward unit normal there ([`Mesh::outward_at`]) on the
+    /// first boundary edge of the node's part (`None` inside): on a contact node, a contact
+    /// edge's, what `normal = "outward"` gives it.
+    pub outward: Vec<Option<[f64; 2]>>,
     /// Per boundary edge of the mesh (same order as `Mesh::boundary`), its three nodes
     /// `[a, b, midpoint]`.
     pub boundary_nodes: Vec<[usize; 3]>,
@@ -631,6 +659,7 @@ impl P2Nodes {
             Part::Neumann => 1,
         };
         let mut part: Vec<Option<Part>> = vec![None; coords.len()];
+        let mut outward: Vec<Option<[f64; 2]>> = vec![None; coords.len()];
         let mut boundary_nodes = Vec::with_capacity(mesh.boundary.len());
         let mut element_boundary = vec![[None; 3]; mesh.n_triangles()];
         for (bi, be) in mesh.boundary.iter().enumerate() {
@@ -640,6 +669,7 @@ impl P2Nodes {
             for node in [be.v[0], be.v[1], m] {
                 if part[node].is_none_or(|q| rank(be.part) > rank(q)) {
                     part[node] = Some(be.part);
+                    outward[node] = Some(mesh.outward_at(bi, coords[node]));
                 }
             }
             if let Some((t, le)) = edge_owner[e][0] {
@@ -647,7 +677,7 @@ impl P2Nodes {
             }
         }
         let edges = edges.edges;
-        P2Nodes { n_vertices: nv, edges, elements, coords, part, boundary_nodes, element_boundary, neighbours }
+        P2Nodes { n_vertices: nv, edges, elements, coords, part, outward, boundary_nodes, element_boundary, neighbours }
     }
 
     pub fn len(&self) -> usize {

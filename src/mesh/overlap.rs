@@ -161,7 +161,7 @@ mod tests {
         let disc = crate::problems::Curve::Circle { centre: [0.0, 0.0], radius: 1.0 };
         let mut mesh = crate::mesh::tests::disc(disc);
         for _ in 0..4 {
-            mesh = crate::mesh::refine::refine(&mesh, &vec![true; mesh.n_triangles()]).mesh;
+            mesh = crate::mesh::refine::refine(&mesh, &vec![true; mesh.n_triangles()]).unwrap().mesh;
         }
         assert_eq!(find(&mesh.vertices, &mesh.triangles), None);
         let n = mesh.n_vertices();

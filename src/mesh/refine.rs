@@ -54,7 +54,7 @@
 //! structures. The algorithm is short (the closure plus three bisection patterns), so it is
 //! written here against [`Mesh`] directly.
 
-use super::{BoundaryEdge, Mesh, P2Nodes};
+use super::{BoundaryEdge, Mesh, MeshError, P2Nodes};
 use crate::base::element::{Affine, p2_values};
 
 /// Marker for "no triangle" in the edge owner table.
@@ -144,10 +144,15 @@ impl Edges {
 /// has no hanging nodes. See the [module documentation](self) for the convention and the
 /// guarantees. With no marks the mesh is returned unchanged (and `parent[t] == t`).
 ///
+/// A new vertex put on a curve (the closest point to a curved boundary edge's midpoint) can
+/// turn a child triangle over where the mesh is thinner there than the curve's sagitta over the
+/// edge (a concave curve, a hole): that is refused by name ([`MeshError::TurnedByCurve`]), as the
+/// projection's doing, not the mesh's vertex order (battery 10, F10).
+///
 /// # Panics
 /// If `marked.len()` differs from the number of triangles, or the mesh is not conforming (an edge
 /// in three triangles, or a boundary edge that is no edge of a triangle).
-pub fn refine(mesh: &Mesh, marked: &[bool]) -> Refinement {
+pub fn refine(mesh: &Mesh, marked: &[bool]) -> Result<Refinement, MeshError> {
     let nt = mesh.n_triangles();
     assert_eq!(marked.len(), nt, "one mark per triangle is needed");
     let edges = Edges::new(mesh);
@@ -177,12 +182,12 @@ pub fn refine(mesh: &Mesh, marked: &[bool]) -> Refinement {
     // New vertices: the midpoints of the bisected edges, in edge order.
     let mut vertices = mesh.vertices.clone();
     let mut midpoint = vec![NONE; edges.len()];
-    // the curve of every curved boundary edge, by edge number
-    let mut curve_of = vec![None; edges.len()];
+    // every curved boundary edge, by edge number
+    let mut curved: Vec<Option<BoundaryEdge>> = vec![None; edges.len()];
     for be in mesh.boundary.iter().filter(|be| be.curve.is_some()) {
         let (lo, hi) = super::key(be.v[0], be.v[1]);
         if let Some(e) = edges.find(lo, hi) {
-            curve_of[e] = be.curve;
+            curved[e] = Some(*be);
         }
     }
     let n_split = split.iter().filter(|&&s| s).count();
@@ -195,7 +200,7 @@ pub fn refine(mesh: &Mesh, marked: &[bool]) -> Refinement {
                 let (p, q) = (mesh.vertices[tri[*i]], mesh.vertices[tri[*j]]);
                 midpoint[e] = vertices.len();
                 let m = [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])];
-                vertices.push(curve_of[e].map_or(m, |c: super::Curve| c.project(m)));
+                vertices.push(curved[e].and_then(|be| be.curve).map_or(m, |c: super::Curve| c.project(m)));
             }
         }
     }
@@ -249,7 +254,34 @@ pub fn refine(mesh: &Mesh, marked: &[bool]) -> Refinement {
         }
     }
 
-    Refinement { mesh: Mesh { vertices, triangles, boundary }, parent }
+    let mesh = Mesh { vertices, triangles, boundary };
+    check_projected(&mesh, &curved, &midpoint)?;
+    Ok(Refinement { mesh, parent })
+}
+
+/// Every triangle of the refined `mesh` with a vertex put on a curve has positive area (see
+/// [`refine`]); `curved` (the curved boundary edges) and `midpoint` are by edge of the parent
+/// mesh, whose vertices keep their numbers.
+fn check_projected(mesh: &Mesh, curved: &[Option<BoundaryEdge>], midpoint: &[usize]) -> Result<(), MeshError> {
+    let mut on_curve = std::collections::HashMap::new();
+    for (e, be) in curved.iter().enumerate() {
+        if let (Some(be), true) = (be, midpoint[e] != NONE) {
+            on_curve.insert(midpoint[e], (*be, e));
+        }
+    }
+    if on_curve.is_empty() {
+        return Ok(());
+    }
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let Some(&(be, e)) = tri.iter().find_map(|v| on_curve.get(v)) else { continue };
+        let area = mesh.area(t);
+        if !(area > 0.0) {
+            let edge = be.v.map(|v| mesh.vertices[v]);
+            let curve = be.curve.expect("a curved edge");
+            return Err(MeshError::TurnedByCurve { t, area, edge, at: mesh.vertices[midpoint[e]], curve, part: be.part });
+        }
+    }
+    Ok(())
 }
 
 /// Evaluate the P2 field with nodal values `values` (numbered by `old_nodes`) at every node of
@@ -429,7 +461,7 @@ mod tests {
                     }
                 }
             }
-            let r = refine(&mesh, &marked);
+            let r = refine(&mesh, &marked).unwrap();
             check_step(&mesh, &marked, &r);
             mesh = r.mesh;
         }
@@ -454,14 +486,14 @@ mod tests {
     fn single_bisection_of_the_diagonal() {
         // unit_square(1): vertices 0 (0,0), 1 (1,0), 2 (0,1), 3 (1,1); triangles [1,3,0], [2,0,3]
         let mesh = Mesh::unit_square(1, false, &tag);
-        let r = refine(&mesh, &[true, false]);
+        let r = refine(&mesh, &[true, false]).unwrap();
         assert_eq!(r.mesh.vertices[4], [0.5, 0.5]);
         assert_eq!(r.mesh.triangles, vec![[4, 1, 3], [4, 0, 1], [4, 2, 0], [4, 3, 2]]);
         assert_eq!(r.parent, vec![0, 0, 1, 1]);
         assert_eq!(r.mesh.boundary, mesh.boundary);
         // second step: bisecting [4, 1, 3] splits the right side (1, 3), so its neighbour
         // across that boundary edge is alone; the closure also bisects nothing else
-        let r2 = refine(&r.mesh, &[true, false, false, false]);
+        let r2 = refine(&r.mesh, &[true, false, false, false]).unwrap();
         r2.mesh.check().unwrap();
         assert_eq!(r2.mesh.vertices[5], [1.0, 0.5]);
         assert_eq!(&r2.mesh.triangles[..2], &[[5, 4, 1], [5, 3, 4]]);
@@ -478,7 +510,7 @@ mod tests {
         let mesh = Mesh::unit_square(4, false, &tag);
         let mut marked = vec![false; mesh.n_triangles()];
         marked[0] = true;
-        let r1 = refine(&mesh, &marked);
+        let r1 = refine(&mesh, &marked).unwrap();
         check_step(&mesh, &marked, &r1);
         assert_eq!(r1.mesh.n_triangles(), 34);
         let once = r1.mesh;
@@ -488,7 +520,7 @@ mod tests {
         // closure bisects that neighbour twice (3 children) and its diagonal partner once.
         let mut marked = vec![false; once.n_triangles()];
         marked[0] = true;
-        let r = refine(&once, &marked);
+        let r = refine(&once, &marked).unwrap();
         check_step(&once, &marked, &r);
         assert_eq!(r.mesh.n_triangles(), 34 + 1 + 2 + 1);
         assert_eq!(r.mesh.n_vertices(), once.n_vertices() + 2);
@@ -498,7 +530,7 @@ mod tests {
     fn no_marks_returns_the_same_mesh() {
         for mirror in [false, true] {
             let mesh = Mesh::unit_square(4, mirror, &tag);
-            let r = refine(&mesh, &vec![false; mesh.n_triangles()]);
+            let r = refine(&mesh, &vec![false; mesh.n_triangles()]).unwrap();
             assert_eq!(r.mesh.vertices, mesh.vertices);
             assert_eq!(r.mesh.triangles, mesh.triangles);
             assert_eq!(r.mesh.boundary, mesh.boundary);
@@ -511,7 +543,7 @@ mod tests {
         let mesh = Mesh::unit_square(6, true, &tag);
         let mut rng = Lcg(3);
         let marked: Vec<bool> = (0..mesh.n_triangles()).map(|_| rng.next_f64() < 0.3).collect();
-        let (a, b) = (refine(&mesh, &marked), refine(&mesh, &marked));
+        let (a, b) = (refine(&mesh, &marked).unwrap(), refine(&mesh, &marked).unwrap());
         assert_eq!(a.mesh.vertices, b.mesh.vertices);
         assert_eq!(a.mesh.triangles, b.mesh.triangles);
         assert_eq!(a.mesh.boundary, b.mesh.boundary);
@@ -539,7 +571,7 @@ mod tests {
         let mut mesh = super::super::tests::disc(circle);
         let mut rows = Vec::new();
         for _ in 0..14 {
-            mesh = refine(&mesh, &vec![true; mesh.n_triangles()]).mesh;
+            mesh = refine(&mesh, &vec![true; mesh.n_triangles()]).unwrap().mesh;
             mesh.check().unwrap();
             on_circle(&mesh);
             let n = mesh.boundary.len() as f64;
@@ -567,7 +599,7 @@ mod tests {
             let marked: Vec<bool> = (0..nt)
                 .map(|t| rng.next_f64() < p || (level % 2 == 1 && mesh.corners(t).iter().any(|&c| dist(c, focus) < 1.5 * mesh.diameter(t))))
                 .collect();
-            let r = refine(&mesh, &marked);
+            let r = refine(&mesh, &marked).unwrap();
             r.mesh.check().unwrap(); // positive areas, conforming, boundary tagged
             on_circle(&r.mesh);
             assert!(r.mesh.min_angle_degrees() > 10.0, "min angle {}", r.mesh.min_angle_degrees());
@@ -589,7 +621,7 @@ mod tests {
                 let nodes = P2Nodes::new(&mesh);
                 let values: Vec<[f64; 2]> = nodes.coords.iter().map(|&x| u(x)).collect();
                 let marked: Vec<bool> = (0..mesh.n_triangles()).map(|_| rng.next_f64() < 0.25).collect();
-                let r = refine(&mesh, &marked);
+                let r = refine(&mesh, &marked).unwrap();
                 let new_nodes = P2Nodes::new(&r.mesh);
                 let moved = transfer_p2(&mesh, &nodes, &values, &r, &new_nodes);
                 assert_eq!(moved.len(), new_nodes.len());

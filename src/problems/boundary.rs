@@ -53,6 +53,31 @@ impl Curve {
         }
     }
 
+    /// The body's outward unit normal at the curve's point closest to `x`: the curve's normal
+    /// turned to agree with `chord`, the outward normal of the straight boundary edge `x` lies on
+    /// (so it points into a hole for a body around one); `chord` itself at the centre.
+    pub fn outward(&self, x: [f64; 2], chord: [f64; 2]) -> [f64; 2] {
+        match self.normal(x) {
+            Some(n) if n[0] * chord[0] + n[1] * chord[1] < 0.0 => [-n[0], -n[1]],
+            Some(n) => n,
+            None => chord,
+        }
+    }
+
+    /// The circle's centre.
+    pub fn centre(&self) -> [f64; 2] {
+        match *self {
+            Curve::Circle { centre, .. } => centre,
+        }
+    }
+
+    /// The circle's radius.
+    pub fn radius(&self) -> f64 {
+        match *self {
+            Curve::Circle { radius, .. } => radius,
+        }
+    }
+
     /// The distance from `x` to the curve, relative to its size (the circle's radius).
     pub fn relative_distance(&self, x: [f64; 2]) -> f64 {
         match *self {

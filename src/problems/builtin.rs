@@ -76,7 +76,7 @@ impl Problem for Ex71 {
     fn dirichlet(&self, x: [f64; 2]) -> [f64; 2] {
         self.u(x)
     }
-    fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+    fn contact_normal(&self, _x: [f64; 2], _outward: [f64; 2]) -> [f64; 2] {
         [0.0, -1.0]
     }
     fn gap(&self, _x: [f64; 2]) -> f64 {
@@ -114,7 +114,7 @@ impl Problem for Ex72 {
     fn dirichlet(&self, _x: [f64; 2]) -> [f64; 2] {
         [0.1, 0.0]
     }
-    fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+    fn contact_normal(&self, _x: [f64; 2], _outward: [f64; 2]) -> [f64; 2] {
         [1.0, 0.0]
     }
     fn gap(&self, x: [f64; 2]) -> f64 {
@@ -228,7 +228,7 @@ impl Problem for Fb {
     fn dirichlet(&self, x: [f64; 2]) -> [f64; 2] {
         self.u(x)
     }
-    fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+    fn contact_normal(&self, _x: [f64; 2], _outward: [f64; 2]) -> [f64; 2] {
         [0.0, -1.0]
     }
     /// f has ((x - a)_+)^(1/2) and ^(3/2) terms.
@@ -324,7 +324,7 @@ impl Problem for Patch {
     fn dirichlet(&self, x: [f64; 2]) -> [f64; 2] {
         self.u(x)
     }
-    fn contact_normal(&self, _x: [f64; 2]) -> [f64; 2] {
+    fn contact_normal(&self, _x: [f64; 2], _outward: [f64; 2]) -> [f64; 2] {
         self.normal
     }
     fn gap(&self, _x: [f64; 2]) -> f64 {

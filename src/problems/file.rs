@@ -449,23 +449,9 @@ enum VectorData {
 enum Normal {
     /// A declared direction (normalised), possibly varying with x, y.
     Fixed([Expr; 2]),
-    /// The outward normal of the circles declared for the contact groups: away from the centre
-    /// of the circle `x` lies nearest (the body is inside the circle).
-    Circles(Vec<([f64; 2], f64)>),
-    /// The outward normal of the unit square's side that `x` lies nearest, among the sides on
-    /// which the contact predicate holds (the built-in meshes): outward normals in this order.
-    SquareSides(Vec<usize>),
-}
-
-/// The unit square's sides: bottom, right, top, left, with their outward normals.
-const SIDE_NORMALS: [[f64; 2]; 4] = [[0.0, -1.0], [1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]];
-
-fn side_point(side: usize, t: f64) -> [f64; 2] {
-    [[t, 0.0], [1.0, t], [t, 1.0], [0.0, t]][side]
-}
-
-fn side_distance(side: usize, x: [f64; 2]) -> f64 {
-    [x[1], 1.0 - x[0], 1.0 - x[1], x[0]][side].abs()
+    /// The body's outward normal on each contact edge: its `[curves]` circle's, or the straight
+    /// edge's (`Mesh::outward_at`).
+    Outward,
 }
 
 /// The exact solution of a problem file: u and its gradient (given or differentiated by exmex).
@@ -789,7 +775,7 @@ impl FileProblem {
         let point_constraints = r.point_constraints(&raw.point_constraints)?;
         let chi = r.expr("contact.chi", raw.contact.chi.span(), raw.contact.chi.get_ref(), &xy)?;
         let normal_value = &raw.contact.normal;
-        let normal = r.normal(normal_value, &parts, &curves)?;
+        let normal = r.normal(normal_value)?;
         let (required_vertices, load_breaks) = r.lists(&raw)?;
         let exact = r.exact(&raw.exact)?;
         let tables::Parts { groups, contact_predicate, dirichlet_predicate, declared_parts, .. } = parts;
@@ -899,12 +885,7 @@ impl Problem for FileProblem {
     fn bad_datum(&self) -> Option<super::BadDatum> {
         self.watch.first()
     }
-    fn normal_note(&self) -> Option<String> {
-        matches!(self.normal, Normal::Circles(_)).then(|| {
-            "`normal = \"outward\"` on a `[curves]` circle points away from the circle's centre, which is outward for a body inside the circle; for a body outside it (around a hole) give the normal toward the centre, `normal = [\"-(x - cx)\", \"-(y - cy)\"]` with the centre (cx, cy) (it is normalised)".to_string()
-        })
-    }
-    fn contact_normal(&self, x: [f64; 2]) -> [f64; 2] {
+    fn contact_normal(&self, x: [f64; 2], outward: [f64; 2]) -> [f64; 2] {
         match &self.normal {
             Normal::Fixed(n) => {
                 let (a, b) = (n[0].at(x), n[1].at(x));
@@ -915,18 +896,7 @@ impl Problem for FileProblem {
                 }
                 [a / l, b / l]
             }
-            Normal::Circles(circles) => {
-                let dist = |c: &([f64; 2], f64)| ((x[0] - c.0[0]).hypot(x[1] - c.0[1]) - c.1).abs();
-                let (c, _) = circles.iter().min_by(|a, b| dist(a).total_cmp(&dist(b))).expect("at least one circle");
-                let d = [x[0] - c[0], x[1] - c[1]];
-                let l = d[0].hypot(d[1]);
-                [d[0] / l, d[1] / l]
-            }
-            Normal::SquareSides(sides) => {
-                let s =
-                    sides.iter().copied().min_by(|&a, &b| side_distance(a, x).total_cmp(&side_distance(b, x))).expect("at least one side");
-                SIDE_NORMALS[s]
-            }
+            Normal::Outward => outward,
         }
     }
     fn gap(&self, x: [f64; 2]) -> f64 {

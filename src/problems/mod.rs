@@ -114,8 +114,12 @@ pub trait Problem: Send + Sync {
     fn point_constraints(&self) -> Vec<PointConstraint> {
         Vec::new()
     }
-    /// Outward unit normal of Gamma_C at `x`.
-    fn contact_normal(&self, x: [f64; 2]) -> [f64; 2];
+    /// The constraint direction n of u . n <= chi at `x` on Gamma_C, where the body's outward
+    /// unit normal is `outward` (on the contact edge in question: its curve's, or the straight
+    /// edge's, `Mesh::outward_at`). A declared direction ignores `outward`; `normal =
+    /// "outward"` returns it, so every edge gets its own (battery 10: a nearest circle or
+    /// square side gave a flat side another part's normal).
+    fn contact_normal(&self, x: [f64; 2], outward: [f64; 2]) -> [f64; 2];
     /// The gap chi: the constraint is u . n <= chi on Gamma_C.
     fn gap(&self, x: [f64; 2]) -> f64;
     /// Points that must be mesh vertices (kinks of chi), so that chi_h interpolates chi well.
@@ -150,11 +154,6 @@ pub trait Problem: Send + Sync {
     /// `parts.dirichlet = "x < 1e-12"`), for error messages; empty if it states none.
     fn declared_parts(&self) -> Vec<String> {
         Vec::new()
-    }
-    /// How the problem's source derives its contact normal, where a wrong normal needs it said
-    /// (a circle's outward direction assumes the body inside the circle), for error messages.
-    fn normal_note(&self) -> Option<String> {
-        None
     }
     /// The first datum (in a fixed order: by key, then point) that was not a finite number
     /// where it was evaluated since the problem was made; `None` for problems whose data are

@@ -208,6 +208,9 @@ pub struct LevelRecord {
     pub active_nodes: usize,
     pub full_contact_nodes: usize,
     pub pdas_iterations: usize,
+    /// The smallest and largest arc length of an active contact node along Gamma_C
+    /// (`DiscreteSolution::contact_zone`); on a closed contact loop of length L an active arc
+    /// through the loop's start is [s_first, s_last + L], so `zone_max` may exceed L.
     pub zone_min: Option<f64>,
     pub zone_max: Option<f64>,
     /// The estimator's terms (eta_1 .. eta_7, l_h, Psi, eta_h, C_0, the estimate), flattened:

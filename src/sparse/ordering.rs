@@ -548,7 +548,7 @@ mod tests {
         let mut mesh = MeshSpec::Structured(8).build(&p).expect("the unit square");
         for _ in 0..12 {
             let marked: Vec<bool> = (0..mesh.n_triangles()).map(|t| mesh.corners(t).iter().any(|c| c[1] == 0.0)).collect();
-            mesh = crate::mesh::refine::refine(&mesh, &marked).mesh;
+            mesh = crate::mesh::refine::refine(&mesh, &marked).unwrap().mesh;
         }
         let nodes = P2Nodes::new(&mesh);
         let dofs = DofMap::new(&nodes, &p);

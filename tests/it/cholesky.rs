@@ -42,7 +42,7 @@ fn graded() -> Mesh {
     let mut m = mesh(&problems::Ex72, "structured:8");
     for _ in 0..5 {
         let marked: Vec<bool> = (0..m.n_triangles()).map(|t| m.corners(t).iter().any(|c| c[1] < 1e-12)).collect();
-        m = refine(&m, &marked).mesh;
+        m = refine(&m, &marked).unwrap().mesh;
     }
     m
 }

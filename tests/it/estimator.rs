@@ -56,7 +56,7 @@ fn check_patch_exactness(p: &Patch, spec: &str) {
             for _ in 0..3 {
                 let marked: Vec<bool> =
                     (0..m.n_triangles()).map(|t| m.corners(t).iter().any(|x| signorini::mesh::dist(*x, [1.0, 0.5]) < 0.3)).collect();
-                m = signorini::mesh::refine::refine(&m, &marked).mesh;
+                m = signorini::mesh::refine::refine(&m, &marked).unwrap().mesh;
             }
             m
         }
@@ -242,8 +242,8 @@ impl Problem for Scaled<'_> {
     fn dirichlet(&self, x: [f64; 2]) -> [f64; 2] {
         self.inner.dirichlet(x).map(|v| self.k * v)
     }
-    fn contact_normal(&self, x: [f64; 2]) -> [f64; 2] {
-        self.inner.contact_normal(x)
+    fn contact_normal(&self, x: [f64; 2], outward: [f64; 2]) -> [f64; 2] {
+        self.inner.contact_normal(x, outward)
     }
     fn gap(&self, x: [f64; 2]) -> f64 {
         self.k * self.inner.gap(x)

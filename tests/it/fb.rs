@@ -84,7 +84,7 @@ fn fb_tractions_are_sigma_n_on_the_sides() {
 #[test]
 fn fb_satisfies_the_signorini_conditions_on_gamma_c() {
     let p = Fb;
-    let n = p.contact_normal([0.5, 0.0]);
+    let n = p.contact_normal([0.5, 0.0], [0.0, -1.0]);
     assert_eq!(n, [0.0, -1.0]);
     let mut in_contact = Vec::new();
     for i in 0..=1000 {

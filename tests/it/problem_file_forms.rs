@@ -154,7 +154,7 @@ fn difference(a: &dyn Problem, b: &dyn Problem) -> Option<String> {
                 ("body_force", same_vec(a.body_force(x), b.body_force(x))),
                 ("traction", same_vec(a.traction(x, n), b.traction(x, n))),
                 ("dirichlet", same_vec(a.dirichlet(x), b.dirichlet(x))),
-                ("normal", same_vec(a.contact_normal(x), b.contact_normal(x))),
+                ("normal", same_vec(a.contact_normal(x, n), b.contact_normal(x, n))),
                 ("gap", same(a.gap(x), b.gap(x))),
                 ("part", a.part_of(x) == b.part_of(x)),
             ];

@@ -40,6 +40,18 @@ fn points() -> Vec<[f64; 2]> {
     p
 }
 
+/// The unit square's outward normal at the boundary point `x`, of a side holding `x` whose
+/// midpoint is in `b`'s contact part: what the mesh gives `normal = "outward"` there.
+fn contact_side_outward(b: &dyn Problem, x: [f64; 2]) -> [f64; 2] {
+    let sides = [
+        ([0.5, 0.0], [0.0, -1.0], x[1] == 0.0),
+        ([1.0, 0.5], [1.0, 0.0], x[0] == 1.0),
+        ([0.5, 1.0], [0.0, 1.0], x[1] == 1.0),
+        ([0.0, 0.5], [-1.0, 0.0], x[0] == 0.0),
+    ];
+    sides.iter().find(|(m, _, on)| *on && b.part_of(*m) == Part::Contact).map(|s| s.1).expect("a contact side holds x")
+}
+
 /// The data of the file and of the built-in agree at every point: loads, Dirichlet data, gap,
 /// normal, parts, exact solution and its gradient (ex71's differentiated symbolically by exmex).
 #[test]
@@ -63,7 +75,8 @@ fn built_ins_as_files_state_the_same_data() {
                 assert_eq!(f.part_of(x), b.part_of(x), "{ctx}: part");
             }
             if b.part_of(x) == Part::Contact && on_boundary {
-                assert_eq!(f.contact_normal(x), b.contact_normal(x), "{ctx}: normal");
+                let o = contact_side_outward(b, x);
+                assert_eq!(f.contact_normal(x, o), b.contact_normal(x, o), "{ctx}: normal");
             }
             for (what, u, v) in [("body force", f.body_force(x), b.body_force(x)), ("dirichlet", f.dirichlet(x), b.dirichlet(x))] {
                 for i in 0..2 {
@@ -159,7 +172,8 @@ fn hertz_file_names_its_groups() {
     assert_eq!(p.body_force([0.1, 0.5]), [0.0, 0.0]);
     assert_eq!(p.traction([0.8, 0.4], [0.8, -0.6]), [0.0, 0.0]);
     let x = [0.2, 1.0 - (1.0f64 - 0.04).sqrt()];
-    assert_eq!(p.contact_normal(x), [0.0, -1.0]);
+    // declared: the arc's outward normal there does not change it
+    assert_eq!(p.contact_normal(x, [0.6, -0.8]), [0.0, -1.0]);
     assert_eq!(p.gap(x), x[1]);
     assert!(p.exact().is_none());
 }
@@ -208,7 +222,7 @@ fn a_good_file_reads_and_plane_stress_is_plane_stress() {
     assert_eq!(p.part_of([0.5, 0.0]), Part::Contact);
     assert_eq!(p.part_of([0.5, 1.0]), Part::Dirichlet);
     assert_eq!(p.part_of([0.0, 0.5]), Part::Neumann);
-    assert_eq!(p.contact_normal([0.25, 0.0]), [0.0, -1.0]);
+    assert_eq!(p.contact_normal([0.25, 0.0], [0.0, -1.0]), [0.0, -1.0]);
     assert_eq!(p.body_force([0.3, 0.3]), [0.0, -1.0]);
     assert_eq!(p.gap([0.5, 0.0]), 0.005);
     // predicates: && binds tighter than ||
@@ -219,9 +233,9 @@ fn a_good_file_reads_and_plane_stress_is_plane_stress() {
     assert_eq!(q.part_of([0.75, 0.0]), Part::Contact);
     assert_eq!(q.part_of([1.0, 0.5]), Part::Contact);
     assert_eq!(q.part_of([0.5, 1.0]), Part::Dirichlet);
-    // outward on two sides: the nearer one's normal
-    assert_eq!(q.contact_normal([1.0, 0.5]), [1.0, 0.0]);
-    assert_eq!(q.contact_normal([0.75, 0.0]), [0.0, -1.0]);
+    // outward on two sides: each edge's own outward normal (the mesh's), whatever side is nearer
+    assert_eq!(q.contact_normal([1.0, 0.02], [1.0, 0.0]), [1.0, 0.0]);
+    assert_eq!(q.contact_normal([0.98, 0.0], [0.0, -1.0]), [0.0, -1.0]);
 }
 
 #[test]
@@ -323,13 +337,15 @@ fn group_errors() {
     // a group in two parts
     let e = err(&groups.replace("neumann = [\"side\"]", "neumann = [\"top\"]"));
     assert!(e.contains("key `parts.neumann`") && e.contains("\"top\""), "{e}");
-    // outward needs a circle (or predicate parts on the unit square)
-    let e = err(&groups.replace("normal = [0, -1]", "normal = \"outward\""));
-    assert!(e.contains("key `contact.normal`") && e.contains("circle"), "{e}");
+    // outward without a circle: the straight edges' own outward normals (battery 10, F11)
+    let p = FileProblem::parse(Path::new("g.toml"), &groups.replace("normal = [0, -1]", "normal = \"outward\"")).unwrap();
+    assert_eq!(p.contact_normal([0.6, 0.2], [0.0, -1.0]), [0.0, -1.0]);
+    // with a circle, the mesh gives the circle's normal on the group's edges (Curve::outward)
     let with_circle =
         groups.replace("normal = [0, -1]", "normal = \"outward\"") + "\n[curves]\narc = { circle = { centre = [0, 1], radius = 1 } }\n";
     let p = FileProblem::parse(Path::new("g.toml"), &with_circle).unwrap();
-    let n = p.contact_normal([0.6, 0.2]);
+    let o = p.curve_of_group("arc").unwrap().outward([0.6, 0.2], [0.0, -1.0]);
+    let n = p.contact_normal([0.6, 0.2], o);
     assert!((n[0] - 0.6).abs() < 1e-15 && (n[1] + 0.8).abs() < 1e-15, "{n:?}");
 }
 
@@ -433,7 +449,7 @@ mod random_input {
             match FileProblem::parse(Path::new("problems/random.toml"), &text) {
                 Ok(p) => {
                     for x in [[0.5, 0.0], [0.0, 0.0], [1.0, 0.25]] {
-                        let _ = (p.gap(x), p.body_force(x), p.traction(x, [0.0, -1.0]), p.part_of(x), p.contact_normal(x));
+                        let _ = (p.gap(x), p.body_force(x), p.traction(x, [0.0, -1.0]), p.part_of(x), p.contact_normal(x, [0.0, -1.0]));
                     }
                 }
                 Err(e) => {

@@ -25,8 +25,9 @@
 //! mesh's bounding box) over [`CONTACT_DENSITY`], and all four contact conditions are checked at
 //! their ends. The rule: a violation longer than that spacing along Gamma_C is refused on every
 //! mesh, at the first level; a narrower one only where some mesh puts a point in it. A value off by more than [`super::CONSISTENT`] times the
-//! scale of what it is compared with (the largest |u| or |sigma n| over the points) is a
-//! contradiction.
+//! scale of what it is compared with (the largest |u| over the points, or for a traction
+//! [`stress_scale`]: the largest |sigma n|, no less than the stress the size of u and grad u
+//! implies) is a contradiction.
 
 use super::{CONSISTENT, ExactError};
 use crate::fem::assembly::edge_points;
@@ -47,12 +48,7 @@ pub(in crate::contact) struct Point {
 /// chord's outward normal `chord` (the chord's own where the curve has no normal).
 fn on_curve(curve: &Curve, x: [f64; 2], chord: [f64; 2]) -> ([f64; 2], [f64; 2]) {
     let at = curve.project(x);
-    let n = match curve.normal(at) {
-        Some(n) if n[0] * chord[0] + n[1] * chord[1] < 0.0 => [-n[0], -n[1]],
-        Some(n) => n,
-        None => chord,
-    };
-    (at, n)
+    (at, curve.outward(at, chord))
 }
 
 /// The contact part is checked at points no farther apart than the body's size (the diagonal of
@@ -124,6 +120,26 @@ pub(super) fn gradient_points(mesh: &Mesh, nodes: &P2Nodes) -> Vec<([f64; 2], f6
     out
 }
 
+/// The scale tractions are judged against: the largest |sigma(u) n| over the points, but no less
+/// than the stress the displacement's size implies, (2 mu + |lambda|) times the largest |grad u|
+/// over the points and the largest |u| over the body's size (the diagonal of the mesh's bounding
+/// box). For a stress-free exact solution (a rigid motion written with identities, sin^2 + cos^2)
+/// the largest |sigma(u) n| is the round-off of its gradient, and a tolerance relative to it
+/// refused that round-off as "tangential traction 2e-19" (battery 10, F4).
+fn stress_scale(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, points: &[Point], scale_u: f64) -> f64 {
+    let material = problem.material();
+    let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
+    let stiffness = 2.0 * material.mu + material.zeta.abs();
+    let (mut traction, mut gradient) = (0.0f64, 0.0f64);
+    for p in points {
+        let g = exact.grad(p.at);
+        let t = material.traction(g, p.normal);
+        traction = traction.max(finite(t[0].hypot(t[1])));
+        gradient = gradient.max(finite(g[0][0].abs().max(g[0][1].abs()).max(g[1][0].abs()).max(g[1][1].abs())));
+    }
+    traction.max(stiffness * gradient).max(stiffness * scale_u / super::diameter(mesh))
+}
+
 /// One condition at one point: how far it is violated (0 when it holds) and what the error says.
 struct Violation {
     at: [f64; 2],
@@ -140,7 +156,7 @@ pub fn check_boundary(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, nod
     let norm = |v: [f64; 2]| v[0].hypot(v[1]);
     let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
     let scale_u = points.iter().map(|p| finite(norm(exact.u(p.at)))).fold(0.0, f64::max);
-    let scale_s = points.iter().map(|p| finite(norm(sigma_n(p.at, p.normal)))).fold(0.0, f64::max);
+    let scale_s = stress_scale(problem, exact, mesh, &points, scale_u);
     let mut found: Vec<(Violation, f64)> = Vec::new();
     for p in &points {
         let (u, n) = (exact.u(p.at), p.normal);
@@ -191,7 +207,7 @@ pub fn check_boundary(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, nod
                 }
             }
             Part::Contact => {
-                let cn = problem.contact_normal(p.at);
+                let cn = problem.contact_normal(p.at, p.normal);
                 let len = norm(cn);
                 let cn = [cn[0] / len, cn[1] / len];
                 let (un, chi) = (u[0] * cn[0] + u[1] * cn[1], problem.gap(p.at));

@@ -211,13 +211,14 @@ type Differenced<'a> = &'a (dyn Fn([f64; 2], f64) -> Quotient + Sync);
 fn compare(pts: &[([f64; 2], f64)], declared: Declared, differenced: Differenced) -> Option<Mismatch> {
     use rayon::prelude::*;
     let first: Vec<(f64, Quotient)> = pts.par_iter().map(|&(at, s)| (declared(at), differenced(at, s / 2.0))).collect();
-    judge(pts, &first, differenced)
+    judge(pts, &first, differenced, 0.0)
 }
 
 /// The first contradiction among `pts`, given the declared value and the finer step's quotient
 /// at each (`first`): the coarser step is taken only where the finer one is off (see [`compare`]).
-fn judge(pts: &[([f64; 2], f64)], first: &[(f64, Quotient)], differenced: Differenced) -> Option<Mismatch> {
-    let scale = first.iter().flat_map(|&(d, f)| [d.abs(), f.value.abs()]).filter(|v| v.is_finite()).fold(0.0, f64::max);
+/// The scale is the largest value over the points, and no less than `floor`.
+fn judge(pts: &[([f64; 2], f64)], first: &[(f64, Quotient)], differenced: Differenced, floor: f64) -> Option<Mismatch> {
+    let scale = first.iter().flat_map(|&(d, f)| [d.abs(), f.value.abs()]).filter(|v| v.is_finite()).fold(floor, f64::max);
     let bad: Vec<Sample> = pts
         .iter()
         .zip(first)
@@ -304,9 +305,18 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Resul
         use rayon::prelude::*;
         loads.par_iter().map(|&(at, s)| (problem.body_force(at), minus_div(&material, exact, at, s / 2.0))).collect()
     };
+    // a body force's scale is no less than the stress the gradient implies over the body's size:
+    // for a stress-free exact solution (a rigid motion written as cosh(3 x)^2 - sinh(3 x)^2 - 0.001 y)
+    // the largest |f| and |div sigma| are the round-off of the symbolic gradient (battery 10, F4)
+    let gradient = grad_pts
+        .iter()
+        .flat_map(|&(at, _)| exact.grad(at).into_iter().flatten())
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |a, v| a.max(v.abs()));
+    let floor = (2.0 * material.mu + material.zeta.abs()) * gradient / diameter(mesh);
     for i in 0..2 {
         let first_i: Vec<(f64, Quotient)> = first.iter().map(|(f, d)| (f[i], d[i])).collect();
-        if let Some(m) = judge(&loads, &first_i, &|at, s| minus_div(&material, exact, at, s)[i]) {
+        if let Some(m) = judge(&loads, &first_i, &|at, s| minus_div(&material, exact, at, s)[i], floor) {
             let Mismatch { at, declared, differenced, step, spread, count } = m;
             let sampled = loads.len();
             return Err(ExactError::BodyForce { problem: problem_name(), at, i, declared, differenced, step, spread, count, sampled });

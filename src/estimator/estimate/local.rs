@@ -160,7 +160,7 @@ fn boundary_edge(
                 out.neumann[le] = out.neumann[le].max(inf_norm([g[0] - tr[0], g[1] - tr[1]]));
             }
             Part::Contact => {
-                let n = problem.contact_normal(x);
+                let n = problem.contact_normal(x, mesh.outward_at(bi, x));
                 let tng = [-n[1], n[0]];
                 // (sigma-hat_1, sigma-hat_2): eta_5 takes the first, eta_4 the second
                 let (s1, s2) = match config.stress_frame {

@@ -196,14 +196,10 @@ impl Reader<'_> {
         Ok(curves)
     }
 
-    /// `[contact] normal`: a direction, or "outward" from the contact groups' circles or the
-    /// unit square's sides the contact predicate takes.
-    pub(super) fn normal(
-        &self,
-        normal_value: &Spanned<NormalToml>,
-        parts: &Parts,
-        curves: &BTreeMap<String, Curve>,
-    ) -> Result<Normal, ProblemFileError> {
+    /// `[contact] normal`: a direction, or "outward": the body's outward normal on each contact
+    /// edge, its `[curves]` circle's or the straight edge's (found on the mesh, edge by edge: no
+    /// part of the file decides it for another).
+    pub(super) fn normal(&self, normal_value: &Spanned<NormalToml>) -> Result<Normal, ProblemFileError> {
         let xy = ["x", "y"];
         let normal = match normal_value.get_ref() {
             NormalToml::Pair(p) => {
@@ -215,34 +211,7 @@ impl Reader<'_> {
                 }
                 Normal::Fixed(n)
             }
-            NormalToml::Word(w) if w == "outward" => {
-                let circles: Vec<([f64; 2], f64)> = parts
-                    .groups
-                    .iter()
-                    .filter(|(_, p)| **p == Part::Contact)
-                    .filter_map(|(g, _)| curves.get(g))
-                    .map(|Curve::Circle { centre, radius }| (*centre, *radius))
-                    .collect();
-                if !circles.is_empty() {
-                    Normal::Circles(circles)
-                } else if let Some(p) = &parts.contact_predicate {
-                    let sides: Vec<usize> = (0..4).filter(|&s| (1..16).any(|k| p.holds(side_point(s, k as f64 / 16.0)))).collect();
-                    if sides.is_empty() {
-                        return Err(self.error(
-                        "contact.normal",
-                        normal_value.span(),
-                        "\"outward\" with a contact predicate takes the unit square's sides (the built-in meshes), but the predicate holds on none of them: give a direction [nx, ny]",
-                    ));
-                    }
-                    Normal::SquareSides(sides)
-                } else {
-                    return Err(self.error(
-                    "contact.normal",
-                    normal_value.span(),
-                    "\"outward\" needs a circle in [curves] for a contact group (or a contact predicate on the unit square): give a direction [nx, ny] otherwise",
-                ));
-                }
-            }
+            NormalToml::Word(w) if w == "outward" => Normal::Outward,
             NormalToml::Word(w) => {
                 return Err(self.error("contact.normal", normal_value.span(), format!("\"outward\" or [nx, ny], got {w:?}")));
             }
