@@ -513,7 +513,29 @@ fn check_writable(flag: &str, path: &std::path::Path) -> Result<()> {
 /// flag; the same check every atomic write makes ([`signorini::base::input::check_target`]), made
 /// here before any computation.
 fn check_target(flag: &str, path: &std::path::Path) -> Result<()> {
+    outside_study(flag, path)?;
     signorini::base::input::check_target(path).map_err(|e| anyhow::anyhow!("{flag} {}: {e}", path.display()))
+}
+
+/// Refuse an output path inside a results study folder (`STUDY/` holding `runs/`, `.lock` or
+/// `.locks`, at any depth: [`study::store::study_folder_above`]): only `run` writes there, under
+/// the study's lock, and a report, snapshot or page written past it replaced run records and
+/// snapshots (the run lost, or the folder refused). Every output flag comes through here
+/// ([`check_target`] for a file, [`output_folder`] for a folder), before any computation; the
+/// outputs' defaults (`figures/`, `RESULTS/figures`, `RESULTS/report`, `DIR/drift-report.json`)
+/// are beside the study folders, not in them.
+fn outside_study(flag: &str, path: &std::path::Path) -> Result<()> {
+    if let Some(dir) = study::store::study_folder_above(path) {
+        // named as the user wrote it where it is on the path given
+        let as_given = path.ancestors().find(|a| a.canonicalize().is_ok_and(|c| c == dir));
+        let dir = as_given.map_or(dir.clone(), |a| a.to_path_buf());
+        bail!(
+            "{flag} {}: this is inside the study folder {} (it holds runs/, .lock or .locks), where only `signorini run` writes, under the study's lock; a file written there could replace a run's record or snapshot. Nothing was computed or written; give a path outside the study folder",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(())
 }
 
 /// The switches of `signorini run` that shape what a run does with the store.
@@ -783,9 +805,9 @@ fn run_drift(
     let manifests = study::manifest::declared(experiments, only)?;
     // what the CLAIMS rows need, checked before any run is rerun
     let roles = signorini::analysis::roles::read(experiments)?;
-    if let Some(r) = report_file {
-        check_target("--report", r.path)?;
-    }
+    // the default too: `--against DIR` writes DIR/drift-report.json
+    let file = report_file.map(|r| r.path.to_path_buf()).unwrap_or_else(|| default_report(quick, against, only));
+    check_target("--report", &file)?;
     let older = report_to_merge_into(report_file)?;
     let scratch = std::path::PathBuf::from("target/drift").join(if quick { "quick" } else { "full" });
     let options = study::drift::DriftOptions {
@@ -810,7 +832,6 @@ fn run_drift(
         print!("{}", study::drift::table(&report.rows));
     }
     println!("\nlargest change of each float field (whether within tolerance or not):\n{}", study::drift::changes_table(&report));
-    let file = report_file.map(|r| r.path.to_path_buf()).unwrap_or_else(|| default_report(quick, against, only));
     let written = match older {
         Some(older) => report.merged_into(older).with_context(|| format!("merging into the drift report {}", file.display()))?,
         None => serde_json::to_value(&report)?,
@@ -917,6 +938,7 @@ fn run_report(
 /// A folder a command writes into (`export --out`, `figures --figures`, `report --out`): a file
 /// there is an error naming the flag, now, not the operating system's "File exists" later.
 fn output_folder(flag: &str, path: &std::path::Path, writes: &str) -> Result<()> {
+    outside_study(flag, path)?;
     if path.exists() && !path.is_dir() {
         bail!("{flag} {}: this is a file; {writes}: give a folder's path", path.display());
     }
