@@ -401,6 +401,8 @@ pub struct Prepared {
     /// the run computes ([`manifest::pin_inputs`]): every later read (the initial mesh built
     /// again on resuming, a replay) is of those bytes too.
     pub pins: crate::base::pin::Pins,
+    /// The code that computes the run: its checkpoint holds it, and only its own is resumed.
+    pub code: provenance::CodeVersion,
 }
 
 impl Prepared {
@@ -460,7 +462,7 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
         }
         _ => None,
     };
-    Ok(Some(Prepared { problem, mesh_spec, reference, pins }))
+    Ok(Some(Prepared { problem, mesh_spec, reference, pins, code: provenance::code_version(manifest_file) }))
 }
 
 /// Take the reference solutions of `manifest`'s runs from the study folder `stored` where it
@@ -559,7 +561,7 @@ fn start_of(
     progress: bool,
 ) -> Result<adapt::Start> {
     let mesh0 = prepared.initial_mesh()?;
-    let Some(c) = run.checkpoint(spec) else { return Ok(adapt::Start::new(mesh0)) };
+    let Some(c) = run.checkpoint(spec, &prepared.code) else { return Ok(adapt::Start::new(mesh0)) };
     let done = c.levels.len();
     crate::base::note::line(format_args!(
         "{study}/{}: resuming after level {} (from {})",
@@ -612,6 +614,8 @@ fn loop_of(
     let mut stopped = false;
     let mut kept = store::checkpoint::Checkpoint {
         run: spec.clone(),
+        code: prepared.code.clone(),
+        sha256: String::new(),
         levels: start.records.clone(),
         history: start.history.clone(),
         next_active: None,
