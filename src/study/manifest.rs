@@ -807,6 +807,20 @@ impl Manifest {
                     format!("a reference with min_ndof {}", rf.min_ndof),
                 ));
             }
+            // level 0 is always measured: a reference that may stop short of the margin above it
+            // measures nothing (the levels' own NDF is checked as each is solved)
+            if crate::study::reference::too_coarse_for(rf.min_ndof, ndof as usize) {
+                return Err(invalid(
+                    "reference.min_ndof",
+                    format!(
+                        "at least {} times the NDF of every level measured against it; level 0 ({}) has {ndof:.0}, so at least {:.0} (more: the reference must be finer than the run's last level)",
+                        crate::study::reference::REFERENCE_MARGIN,
+                        spec.mesh,
+                        (crate::study::reference::REFERENCE_MARGIN * ndof).ceil()
+                    ),
+                    rf.min_ndof.to_string(),
+                ));
+            }
             crate::base::memory::check_memory(&format!("the reference solution (min_ndof {})", rf.min_ndof), rf.min_ndof as f64).map_err(
                 |e| invalid("reference.min_ndof", "a reference solution that fits in this machine's memory".into(), e.to_string()),
             )?;

@@ -11,6 +11,12 @@
 //!   and the code version (provenance's commit and version, the executable's hash); one whose
 //!   content, code or format does not check is discarded with a line naming the file and why,
 //!   and the run starts over.
+//! * F3: a reference solution coarser than the run it measures (min_ndof 200, stopping at NDF
+//!   218, while the run reached 710) was accepted, and the stored errors measured the
+//!   reference's own error (1e-17 at its own mesh). A reference must now have at least
+//!   `REFERENCE_MARGIN` (1.5) times the NDF of every level measured against it: refused when
+//!   the manifest is checked if `min_ndof` is not that far above level 0, and when a level is
+//!   solved that comes closer (the run stops, nothing of it stored).
 
 use super::common::{scratch, signorini_in};
 
@@ -141,5 +147,44 @@ fn a_checkpoint_is_resumed_only_as_written_by_this_code() {
         eta1.push(record["levels"][0]["eta1"].as_f64().unwrap());
     }
     assert!(eta1.iter().all(|&e| e == eta1[0] && e != 0.1234), "{eta1:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+const COARSE_REFERENCE: &str = r#"description = "battery 10: a reference coarser than the run"
+[defaults]
+problem = "ex72"
+mesh = "structured:4"
+levels = 6
+[defaults.reference]
+theta = 0.5
+min_ndof = 200
+[[run]]
+id = "a"
+"#;
+
+#[test]
+fn a_reference_not_finer_than_every_level_is_refused() {
+    let dir = scratch("battery10-f3");
+    std::fs::write(dir.join("c.toml"), COARSE_REFERENCE).unwrap();
+    // min_ndof 200 against level 0's 162: refused before anything is solved
+    let (code, out, err) = signorini_in(&dir, &["run", "c.toml", "--results", "res"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(err.contains("run[0].reference.min_ndof") && err.contains("at least 1.5 times the NDF of every level"), "{err}");
+    assert!(err.contains("level 0 (structured:4) has 162, so at least 243") && err.contains("got 200"), "{err}");
+    assert!(!dir.join("res/c/runs").exists());
+    // min_ndof 300 passes the plan (the reference stops at 410); level 2 (NDF 290) stops the run
+    std::fs::write(dir.join("c.toml"), COARSE_REFERENCE.replace("min_ndof = 200", "min_ndof = 300")).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "c.toml", "--results", "res"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(err.contains("c/a: level 2 has NDF 290, and its errors would be measured against a reference solution of NDF 410"), "{err}");
+    assert!(err.contains("raise reference.min_ndof"), "{err}");
+    assert!(!dir.join("res/c/runs/a.json").exists());
+    // fine enough: stored
+    std::fs::write(dir.join("c.toml"), COARSE_REFERENCE.replace("min_ndof = 200", "min_ndof = 2000")).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["run", "c.toml", "--results", "res"]);
+    assert_eq!(code, 0, "{err}");
+    let record: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("res/c/runs/a.json")).unwrap()).unwrap();
+    let reference = record["reference_ndof"].as_f64().unwrap();
+    assert!(record["levels"].as_array().unwrap().iter().all(|l| reference >= 1.5 * l["ndof"].as_f64().unwrap()), "{record}");
     std::fs::remove_dir_all(&dir).ok();
 }
