@@ -17,6 +17,11 @@
 //!   `REFERENCE_MARGIN` (1.5) times the NDF of every level measured against it: refused when
 //!   the manifest is checked if `min_ndof` is not that far above level 0, and when a level is
 //!   solved that comes closer (the run stops, nothing of it stored).
+//! * F5: the study page quoted "no drift" from a drift report older than the records it
+//!   showed (`drift --against X`, then `run --replace` into X, then `report`). A drift report
+//!   now holds the SHA-256 of every record it compared (both sides with --against), and the
+//!   page says "not checked: the drift report ... predates these records" naming the runs
+//!   that changed.
 
 use super::common::{scratch, signorini_in};
 
@@ -186,5 +191,48 @@ fn a_reference_not_finer_than_every_level_is_refused() {
     let record: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("res/c/runs/a.json")).unwrap()).unwrap();
     let reference = record["reference_ndof"].as_f64().unwrap();
     assert!(record["levels"].as_array().unwrap().iter().all(|l| reference >= 1.5 * l["ndof"].as_f64().unwrap()), "{record}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The text of the Drift section of a study page.
+fn drift_section(page: &std::path::Path) -> String {
+    let html = std::fs::read_to_string(page).unwrap();
+    let start = html.find("<h2>Drift</h2>").unwrap_or_else(|| panic!("{html}"));
+    html[start..].split("<h2>Claims").next().unwrap().to_string()
+}
+
+#[test]
+fn the_page_quotes_a_drift_report_only_for_the_records_it_compared() {
+    let dir = scratch("battery10-f5");
+    std::fs::create_dir_all(dir.join("exp")).unwrap();
+    std::fs::write(dir.join("exp/st.toml"), STUDY).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "x"]);
+    assert_eq!(code, 0, "{err}");
+    let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "exp", "--against", "x", "--results", "x"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("x/drift-report.json")).unwrap()).unwrap();
+    let hashes = &report["studies"][0]["records"];
+    assert_eq!(hashes["a"].as_str().map(str::len), Some(64), "{report}");
+    assert_eq!(report["studies"][0]["against_records"], *hashes, "{report}");
+    let page = dir.join("x/report/st.html");
+    let (code, _, err) = signorini_in(&dir, &["report", "--experiments", "exp", "--results", "x"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(drift_section(&page).contains("<b>no drift</b>"), "{}", drift_section(&page));
+    // run b again with other levels: the report did not see the record now shown
+    std::fs::write(dir.join("exp/st.toml"), STUDY.replace("theta = 0.3", "theta = 0.3\nlevels = 4")).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "x", "--replace"]);
+    assert_eq!(code, 0, "{err}");
+    let (code, _, err) = signorini_in(&dir, &["report", "--experiments", "exp", "--results", "x"]);
+    assert_eq!(code, 0, "{err}");
+    let section = drift_section(&page);
+    assert!(!section.contains("no drift"), "{section}");
+    assert!(section.contains("not checked: the drift report of") && section.contains("run(s) b changed since"), "{section}");
+    // a report without hashes (an older harness) speaks for no records
+    let mut old = report.clone();
+    old["studies"][0].as_object_mut().unwrap().retain(|k, _| !k.ends_with("records"));
+    std::fs::write(dir.join("x/drift-report.json"), serde_json::to_string_pretty(&old).unwrap()).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["report", "--experiments", "exp", "--results", "x"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(drift_section(&page).contains("records no hashes"), "{}", drift_section(&page));
     std::fs::remove_dir_all(&dir).ok();
 }
