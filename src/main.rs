@@ -108,6 +108,10 @@ enum Command {
         /// If another process is running the same study, wait for it instead of refusing.
         #[arg(long)]
         wait: bool,
+        /// Check the manifests (and the shard) as a run does, print the runs it would compute,
+        /// one STUDY/RUN a line, and run nothing (scripts/slurm/submit.sh checks --tasks with it).
+        #[arg(long)]
+        plan: bool,
     },
     /// Rerun every declared study and compare with the stored results at every level, field by
     /// field, within the manifests' tolerances; check levels.csv, provenance.json and CLAIMS.md
@@ -544,6 +548,8 @@ struct RunFlags {
     fresh: bool,
     replace: bool,
     wait: bool,
+    /// Check and print the runs, run nothing.
+    plan: bool,
 }
 
 fn run_studies(
@@ -553,7 +559,7 @@ fn run_studies(
     results: Option<std::path::PathBuf>,
     flags: RunFlags,
 ) -> Result<()> {
-    let RunFlags { quick, fresh, replace, wait } = flags;
+    let RunFlags { quick, fresh, replace, wait, plan } = flags;
     if let Some(j) = jobs {
         rayon::ThreadPoolBuilder::new().num_threads(threads(j)?).build_global().context("setting the thread count")?;
     }
@@ -576,6 +582,14 @@ fn run_studies(
     }
     if let Some(shard) = shard {
         check_shard(&parsed, shard)?;
+    }
+    if plan {
+        for m in &parsed {
+            for (_, p) in m.runs.iter().enumerate().filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1)) {
+                println!("{}/{}", m.study, p.spec.id);
+            }
+        }
+        return Ok(());
     }
     for manifest in &parsed {
         let options = study::RunOptions { quick, shard, fresh, replace, results: results.clone(), progress: true, wait_for_lock: wait };
@@ -1007,8 +1021,8 @@ fn main() -> ExitCode {
             let report = report.as_deref().map(|f| ReportFile { path: f, merge: *merge });
             run_drift(*quick, *deep, against.as_deref(), report, accept, study, experiments, results)
         }
-        Command::Run { manifests, quick, jobs, shard, fresh, replace, results, wait } => {
-            let flags = RunFlags { quick: *quick, fresh: *fresh, replace: *replace, wait: *wait };
+        Command::Run { manifests, quick, jobs, shard, fresh, replace, results, wait, plan } => {
+            let flags = RunFlags { quick: *quick, fresh: *fresh, replace: *replace, wait: *wait, plan: *plan };
             run_studies(manifests, *jobs, shard.as_deref(), results.clone(), flags)
         }
         Command::Export { args, out } => run_export(args, out),
