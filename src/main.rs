@@ -611,7 +611,8 @@ fn check_one_declaration(manifests: &[study::manifest::Manifest], quick: bool) -
     for (i, a) in manifests.iter().enumerate() {
         if let Some(b) = manifests[..i].iter().find(|b| b.study == a.study && runs(b) != runs(a)) {
             bail!(
-                "{} and {} both declare study {} with different runs: given together, the second would find the first's runs stored with                  another spec; nothing was run. Run one of them (or give them different file names: the study is the file's name)",
+                "{} and {} both declare study {} with different runs: given together, the second would find the first's runs stored with \
+                 another spec; nothing was run. Run one of them (or give them different file names: the study is the file's name)",
                 b.file.display(),
                 a.file.display(),
                 a.study
@@ -633,7 +634,9 @@ fn check_quick_beside_full(manifest: &study::manifest::Manifest, results: &std::
     });
     if let Some(p) = full {
         bail!(
-            "{}: {} holds the full form of study {} (run {} with its {} levels); --quick computes only the first {} levels of each run,              another spec, and storing it there would replace the full runs. Nothing was run or changed. Give the quick runs another              folder: --results target/quick-results (the default of --quick) or any other",
+            "{}: {} holds the full form of study {} (run {} with its {} levels); --quick computes only the first {} levels of each run, \
+             another spec, and storing it there would replace the full runs. Nothing was run or changed. Give the quick runs another \
+             folder: --results target/quick-results (the default of --quick) or any other",
             manifest.file.display(),
             store.dir().root.display(),
             manifest.study,
@@ -703,7 +706,7 @@ fn accept_studies(accept: &[String], experiments: &std::path::Path, results: &st
             progress: true,
             wait_for_lock: false,
         };
-        study::run_study(m, &options)?;
+        study::run_study(m, &options).map_err(|e| accept_advice(e, &m.study))?;
         say!(
             "accepted: {} rewritten from a full rerun of {}; run `signorini figures`, review and commit the change",
             results.join(&m.study).display(),
@@ -712,6 +715,42 @@ fn accept_studies(accept: &[String], experiments: &std::path::Path, results: &st
     }
     Ok(())
 }
+
+/// `drift --accept STUDY` refused by a lock another process holds: the advice in drift's terms
+/// (the lock's own speaks of `--wait`, which drift has not; the run's of `--fresh`).
+fn accept_advice(e: anyhow::Error, study: &str) -> anyhow::Error {
+    match e.chain().find_map(|c| c.downcast_ref::<study::store::Held>()) {
+        Some(held) => anyhow::anyhow!(
+            "drift --accept {study}: {} is being written by {} (the lock is {}); --accept reruns the whole study and waits for no process: nothing was changed. Let that process finish (or stop it), then run `signorini drift --accept {study}` again",
+            held.what,
+            held.holder,
+            held.lock.display()
+        ),
+        None => e,
+    }
+}
+
+/// `drift` stopped by an interrupt while rerunning the studies into its scratch folder (exit
+/// status 130): nothing was compared and no report written; the advice is drift again (the
+/// scratch folder's runs are started over by it), not a `run` into the scratch folder.
+#[derive(Debug)]
+struct DriftInterrupted {
+    study: String,
+    scratch: std::path::PathBuf,
+}
+
+impl std::fmt::Display for DriftInterrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "drift: interrupted while rerunning {} into its scratch folder {}; nothing was compared and no report written, and the stored results are unchanged. Run the same `signorini drift` again to check",
+            self.study,
+            self.scratch.display()
+        )
+    }
+}
+
+impl std::error::Error for DriftInterrupted {}
 
 /// Where the drift report goes by default: `target/drift/report[_quick][-STUDY...].json`, or
 /// `DIR/drift-report.json` for a comparison against DIR (not the report `make test` leaves).
@@ -832,6 +871,7 @@ fn run_drift(
         results: results.to_path_buf(),
         progress: true,
     };
+    let scratch = options.scratch.clone();
     let report = study::drift::check(&manifests, only.is_empty(), &options, &|r| {
         // drift's interface takes an io::Result: the typed error's message travels in it
         // CLAIMS.md is compared only when every study is, so a folder at fault has each fault in
@@ -840,6 +880,10 @@ fn run_drift(
             return Ok(signorini::records::read_text(&r.join("CLAIMS.md")).unwrap_or_default());
         };
         signorini::claims::claims(&shelf, &roles).map(|c| signorini::claims::markdown_for(&c, r)).map_err(std::io::Error::other)
+    })
+    .map_err(|e| match e.downcast_ref::<study::Interrupted>() {
+        Some(i) => DriftInterrupted { study: i.study.clone(), scratch: scratch.clone() }.into(),
+        None => e,
     })?;
     // the table first: a report that cannot be written must not cost it
     if !report.rows.is_empty() {
@@ -963,6 +1007,9 @@ fn output_folder(flag: &str, path: &std::path::Path, writes: &str) -> Result<()>
 fn run_export(args: &SolveArgs, out: &std::path::Path) -> Result<()> {
     // before solving
     output_folder("--out", out, "export writes a folder there (mesh.vtu, case.json)")?;
+    for file in ["mesh.vtu", "case.json"] {
+        check_target("--out", &out.join(file))?;
+    }
     let (mesh, sol, indicator, r) = run_solve(args)?;
     for f in report::export_case(out, &mesh, &sol, &indicator, &r)? {
         println!("wrote {}", f.display());
@@ -1034,7 +1081,11 @@ fn main() -> ExitCode {
     let result = result.and_then(|()| stdout_result().map_err(|e| anyhow::anyhow!("writing standard output: {e}")));
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) if e.downcast_ref::<study::Interrupted>().is_some() || e.downcast_ref::<AdaptInterrupted>().is_some() => {
+        Err(e)
+            if e.downcast_ref::<study::Interrupted>().is_some()
+                || e.downcast_ref::<AdaptInterrupted>().is_some()
+                || e.downcast_ref::<DriftInterrupted>().is_some() =>
+        {
             say!("{e:#}");
             ExitCode::from(130)
         }

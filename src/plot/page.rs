@@ -280,6 +280,14 @@ pub fn study_page(
         escape(&shelf.root().display().to_string()),
         escape(&figures.display().to_string())
     );
+    let incomplete = shelf.not_as_declared(study);
+    if !incomplete.is_empty() {
+        let _ = writeln!(
+            s,
+            "<p class=\"bad\"><b>Incomplete</b>: the study's manifest declares runs this folder does not hold as declared: {}. The tables and figures below show only the runs it holds; complete it with <code>signorini run</code>.</p>",
+            escape(&incomplete.join(", "))
+        );
+    }
     let _ = writeln!(s, "<h2>Drift</h2><p>{}</p>", drift_status(drift, study, &runs));
     let _ = writeln!(s, "<h2>Claims</h2>\n{}", claims_table(&rows));
     let _ = writeln!(s, "<h2>Figures</h2>\n{}", figures_html(figures, study)?);
@@ -322,6 +330,14 @@ pub fn write_pages(
     crate::base::input::create_folder(out)?;
     let mut written = Vec::new();
     for study in &chosen {
+        let incomplete = shelf.not_as_declared(study);
+        if !incomplete.is_empty() {
+            crate::base::note::line(format_args!(
+                "report: {study} is incomplete in {} (its page says so): {}",
+                results.display(),
+                incomplete.join(", ")
+            ));
+        }
         let page = study_page(shelf, figures, study, &claims, drift.as_ref())?;
         let path = out.join(format!("{study}.html"));
         crate::records::write_atomic(&path, page.as_bytes()).with_context(|| format!("writing {}", path.display()))?;

@@ -22,6 +22,12 @@
 //!   now holds the SHA-256 of every record it compared (both sides with --against), and the
 //!   page says "not checked: the drift report ... predates these records" naming the runs
 //!   that changed.
+//! * Messages: M1 a run of spaces inside two messages of `run`; M2 `export --out DIR` wrote
+//!   mesh.vtu before refusing a named pipe at DIR/case.json (both targets are now checked before
+//!   the solve, and written as one batch); M3 an interrupted `drift` advised a `run` into its
+//!   scratch folder (now: run drift again); M4 `drift --accept` refused by a held lock advised
+//!   --fresh and --wait, which drift has not; M5 `report` on an incomplete study wrote its page
+//!   without a word (now the page and stderr name the missing runs).
 
 use super::common::{scratch, signorini_in};
 
@@ -234,5 +240,73 @@ fn the_page_quotes_a_drift_report_only_for_the_records_it_compared() {
     let (code, _, err) = signorini_in(&dir, &["report", "--experiments", "exp", "--results", "x"]);
     assert_eq!(code, 0, "{err}");
     assert!(drift_section(&page).contains("records no hashes"), "{}", drift_section(&page));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn messages_say_what_is_true_in_the_command_s_own_terms() {
+    let dir = stored("battery10-messages");
+    // M1: one space where the text continues
+    std::fs::create_dir_all(dir.join("exp2")).unwrap();
+    std::fs::write(dir.join("exp2/st.toml"), STUDY.replace("levels = 3", "levels = 4")).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "exp2/st.toml", "--results", "m1"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("stored with another spec") && !err.contains("  "), "{err}");
+    // M2: a named pipe where case.json goes: refused before anything is solved or written
+    std::fs::create_dir_all(dir.join("out")).unwrap();
+    assert!(std::process::Command::new("mkfifo").arg(dir.join("out/case.json")).status().unwrap().success());
+    let (code, out, err) = signorini_in(&dir, &["export", "--problem", "ex71", "--mesh", "structured:4", "--out", "out"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(err.contains("--out out/case.json: not a regular file (a named pipe)"), "{err}");
+    assert!(!dir.join("out/mesh.vtu").exists(), "a half-written export");
+    // M5: a study missing runs: the page and stderr say which
+    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "part", "--shard", "1/2"]);
+    assert_eq!(code, 0, "{err}");
+    let (code, _, err) = signorini_in(&dir, &["report", "--experiments", "exp", "--results", "part"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("report: st is incomplete in part (its page says so): b (missing)"), "{err}");
+    let page = std::fs::read_to_string(dir.join("part/report/st.html")).unwrap();
+    assert!(page.contains("<b>Incomplete</b>") && page.contains("b (missing)"), "{page}");
+    let page = |results: &str| std::fs::read_to_string(dir.join(results).join("report/st.html")).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["report", "--experiments", "exp", "--results", "res"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("incomplete") && !page("res").contains("Incomplete"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn drift_advises_drift_when_interrupted_or_refused_by_a_lock() {
+    let dir = scratch("battery10-drift-advice");
+    std::fs::create_dir_all(dir.join("exp")).unwrap();
+    std::fs::write(dir.join("exp/long.toml"), LONG).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["run", "exp/long.toml", "--results", "res"]);
+    assert_eq!(code, 0, "{err}");
+    // M4: a run of the study holds its lock (here: this test, through the library)
+    let store = signorini::study::store::Store::new(&dir.join("res"), "long");
+    let held = store.lock_run("long", false).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "exp", "--results", "res", "--accept", "long"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(err.contains("drift --accept long: run long of") && err.contains("then run `signorini drift --accept long` again"), "{err}");
+    assert!(!err.contains("--wait") && !err.contains("--fresh"), "{err}");
+    drop(held);
+    // M3: SIGINT while drift reruns the study into its scratch folder
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["drift", "--experiments", "exp", "--results", "res", "--report", "d.json"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while checkpoint_levels(&dir.join("target/drift/full/long/.partial/long.json")) < 2 {
+        assert!(started.elapsed().as_secs() < 120, "drift never started its rerun");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) }, 0);
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(err.contains("drift: interrupted while rerunning long into its scratch folder target/drift/full"), "{err}");
+    assert!(err.contains("Run the same `signorini drift` again") && !err.contains("Resume with"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }

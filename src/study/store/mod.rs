@@ -24,7 +24,7 @@
 pub mod check;
 pub mod checkpoint;
 mod lock;
-pub use lock::scratch_folder;
+pub use lock::{Held, scratch_folder};
 pub mod shelf;
 pub mod stale;
 pub mod write;
