@@ -860,7 +860,8 @@ fn run_drift(
     let roles = signorini::analysis::roles::read(experiments)?;
     // the default too: `--against DIR` writes DIR/drift-report.json
     let file = report_file.map(|r| r.path.to_path_buf()).unwrap_or_else(|| default_report(quick, against, only));
-    check_target("--report", &file)?;
+    let flag = if report_file.is_some() { "--report" } else { "the drift report (--report FILE writes it elsewhere)" };
+    check_target(flag, &file)?;
     let older = report_to_merge_into(report_file)?;
     let scratch = std::path::PathBuf::from("target/drift").join(if quick { "quick" } else { "full" });
     let options = study::drift::DriftOptions {

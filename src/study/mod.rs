@@ -677,7 +677,7 @@ pub fn replay_stored_level(manifest: &Manifest, stored: &RunRecord, level: usize
 
 /// A level just solved: its record must be one a file can hold (every float finite; otherwise
 /// the run stops here, naming the level, the field and the value), its errors measured against
-/// a reference finer than it by [`reference::REFERENCE_MARGIN`] (otherwise they measure the
+/// a reference finer than it by [`manifest::REFERENCE_MARGIN`] (otherwise they measure the
 /// reference's error: the run stops here), and its mesh snapshot is added to `meshes` if the
 /// run saves it. Every level a run computes comes through here.
 fn keep_level(study: &str, spec: &RunSpec, run: &RunWriter, meshes: &mut Batch, level: &Level, prepared: &Prepared) -> Result<()> {
@@ -686,7 +686,7 @@ fn keep_level(study: &str, spec: &RunSpec, run: &RunWriter, meshes: &mut Batch, 
         bail!("{study}/{}: level {}: {bad}; a record cannot hold it, so the run stops here and nothing of it is stored", spec.id, r.level);
     }
     if let (Some(reference), Some(rs)) = (&prepared.reference, &spec.reference)
-        && reference::too_coarse_for(reference.ndof, r.ndof)
+        && manifest::too_coarse_for(reference.ndof, r.ndof)
     {
         bail!(
             "{study}/{}: level {} has NDF {}, and its errors would be measured against a reference solution of NDF {} (reference.min_ndof = {}), \
@@ -697,8 +697,8 @@ fn keep_level(study: &str, spec: &RunSpec, run: &RunWriter, meshes: &mut Batch, 
             r.ndof,
             reference.ndof,
             rs.min_ndof,
-            reference::REFERENCE_MARGIN,
-            reference::REFERENCE_MARGIN
+            manifest::REFERENCE_MARGIN,
+            manifest::REFERENCE_MARGIN
         );
     }
     let problem = prepared.problem.as_ref();

@@ -45,20 +45,6 @@ impl ReferenceField {
     }
 }
 
-/// How many times a level's NDF a reference solution must have for the level's errors to be
-/// measured against it: a level at the reference's own NDF measures 1e-17 (its own mesh), and
-/// levels near it measure the reference's error, not theirs. 1.5 is below the smallest margin
-/// of the stored studies, 1.89 (`ex72`'s uniform run, NDF 132,098, against its adaptive
-/// reference of 250,070; hertz's manifest keeps 3.3 by convention), so that none is refused,
-/// and far above a reference coarser than the run (battery 10's F3: NDF 218 against 710).
-pub const REFERENCE_MARGIN: f64 = 1.5;
-
-/// Whether a reference of `reference_ndof` unknowns is too coarse to measure a level of
-/// `level_ndof` ([`REFERENCE_MARGIN`]).
-pub fn too_coarse_for(reference_ndof: usize, level_ndof: usize) -> bool {
-    (reference_ndof as f64) < REFERENCE_MARGIN * level_ndof as f64
-}
-
 /// Levels the reference loop may refine through before giving up on `min_ndof`.
 pub const REFERENCE_LEVELS: usize = 200;
 
