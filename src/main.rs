@@ -108,6 +108,10 @@ enum Command {
         /// If another process is running the same study, wait for it instead of refusing.
         #[arg(long)]
         wait: bool,
+        /// Check the manifests (and the shard) as a run does, print the runs it would compute,
+        /// one STUDY/RUN a line, and run nothing (scripts/slurm/submit.sh checks --tasks with it).
+        #[arg(long)]
+        plan: bool,
     },
     /// Rerun every declared study and compare with the stored results at every level, field by
     /// field, within the manifests' tolerances; check levels.csv, provenance.json and CLAIMS.md
@@ -513,7 +517,29 @@ fn check_writable(flag: &str, path: &std::path::Path) -> Result<()> {
 /// flag; the same check every atomic write makes ([`signorini::base::input::check_target`]), made
 /// here before any computation.
 fn check_target(flag: &str, path: &std::path::Path) -> Result<()> {
+    outside_study(flag, path)?;
     signorini::base::input::check_target(path).map_err(|e| anyhow::anyhow!("{flag} {}: {e}", path.display()))
+}
+
+/// Refuse an output path inside a results study folder (`STUDY/` holding `runs/`, `.lock` or
+/// `.locks`, at any depth: [`study::store::study_folder_above`]): only `run` writes there, under
+/// the study's lock, and a report, snapshot or page written past it replaced run records and
+/// snapshots (the run lost, or the folder refused). Every output flag comes through here
+/// ([`check_target`] for a file, [`output_folder`] for a folder), before any computation; the
+/// outputs' defaults (`figures/`, `RESULTS/figures`, `RESULTS/report`, `DIR/drift-report.json`)
+/// are beside the study folders, not in them.
+fn outside_study(flag: &str, path: &std::path::Path) -> Result<()> {
+    if let Some(dir) = study::store::study_folder_above(path) {
+        // named as the user wrote it where it is on the path given
+        let as_given = path.ancestors().find(|a| a.canonicalize().is_ok_and(|c| c == dir));
+        let dir = as_given.map_or(dir.clone(), |a| a.to_path_buf());
+        bail!(
+            "{flag} {}: this is inside the study folder {} (it holds runs/, .lock or .locks), where only `signorini run` writes, under the study's lock; a file written there could replace a run's record or snapshot. Nothing was computed or written; give a path outside the study folder",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(())
 }
 
 /// The switches of `signorini run` that shape what a run does with the store.
@@ -522,6 +548,8 @@ struct RunFlags {
     fresh: bool,
     replace: bool,
     wait: bool,
+    /// Check and print the runs, run nothing.
+    plan: bool,
 }
 
 fn run_studies(
@@ -531,7 +559,7 @@ fn run_studies(
     results: Option<std::path::PathBuf>,
     flags: RunFlags,
 ) -> Result<()> {
-    let RunFlags { quick, fresh, replace, wait } = flags;
+    let RunFlags { quick, fresh, replace, wait, plan } = flags;
     if let Some(j) = jobs {
         rayon::ThreadPoolBuilder::new().num_threads(threads(j)?).build_global().context("setting the thread count")?;
     }
@@ -555,6 +583,14 @@ fn run_studies(
     if let Some(shard) = shard {
         check_shard(&parsed, shard)?;
     }
+    if plan {
+        for m in &parsed {
+            for (_, p) in m.runs.iter().enumerate().filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1)) {
+                println!("{}/{}", m.study, p.spec.id);
+            }
+        }
+        return Ok(());
+    }
     for manifest in &parsed {
         let options = study::RunOptions { quick, shard, fresh, replace, results: results.clone(), progress: true, wait_for_lock: wait };
         let executed = study::run_study(manifest, &options)?;
@@ -575,7 +611,8 @@ fn check_one_declaration(manifests: &[study::manifest::Manifest], quick: bool) -
     for (i, a) in manifests.iter().enumerate() {
         if let Some(b) = manifests[..i].iter().find(|b| b.study == a.study && runs(b) != runs(a)) {
             bail!(
-                "{} and {} both declare study {} with different runs: given together, the second would find the first's runs stored with                  another spec; nothing was run. Run one of them (or give them different file names: the study is the file's name)",
+                "{} and {} both declare study {} with different runs: given together, the second would find the first's runs stored with \
+                 another spec; nothing was run. Run one of them (or give them different file names: the study is the file's name)",
                 b.file.display(),
                 a.file.display(),
                 a.study
@@ -597,7 +634,9 @@ fn check_quick_beside_full(manifest: &study::manifest::Manifest, results: &std::
     });
     if let Some(p) = full {
         bail!(
-            "{}: {} holds the full form of study {} (run {} with its {} levels); --quick computes only the first {} levels of each run,              another spec, and storing it there would replace the full runs. Nothing was run or changed. Give the quick runs another              folder: --results target/quick-results (the default of --quick) or any other",
+            "{}: {} holds the full form of study {} (run {} with its {} levels); --quick computes only the first {} levels of each run, \
+             another spec, and storing it there would replace the full runs. Nothing was run or changed. Give the quick runs another \
+             folder: --results target/quick-results (the default of --quick) or any other",
             manifest.file.display(),
             store.dir().root.display(),
             manifest.study,
@@ -667,7 +706,7 @@ fn accept_studies(accept: &[String], experiments: &std::path::Path, results: &st
             progress: true,
             wait_for_lock: false,
         };
-        study::run_study(m, &options)?;
+        study::run_study(m, &options).map_err(|e| accept_advice(e, &m.study))?;
         say!(
             "accepted: {} rewritten from a full rerun of {}; run `signorini figures`, review and commit the change",
             results.join(&m.study).display(),
@@ -676,6 +715,42 @@ fn accept_studies(accept: &[String], experiments: &std::path::Path, results: &st
     }
     Ok(())
 }
+
+/// `drift --accept STUDY` refused by a lock another process holds: the advice in drift's terms
+/// (the lock's own speaks of `--wait`, which drift has not; the run's of `--fresh`).
+fn accept_advice(e: anyhow::Error, study: &str) -> anyhow::Error {
+    match e.chain().find_map(|c| c.downcast_ref::<study::store::Held>()) {
+        Some(held) => anyhow::anyhow!(
+            "drift --accept {study}: {} is being written by {} (the lock is {}); --accept reruns the whole study and waits for no process: nothing was changed. Let that process finish (or stop it), then run `signorini drift --accept {study}` again",
+            held.what,
+            held.holder,
+            held.lock.display()
+        ),
+        None => e,
+    }
+}
+
+/// `drift` stopped by an interrupt while rerunning the studies into its scratch folder (exit
+/// status 130): nothing was compared and no report written; the advice is drift again (the
+/// scratch folder's runs are started over by it), not a `run` into the scratch folder.
+#[derive(Debug)]
+struct DriftInterrupted {
+    study: String,
+    scratch: std::path::PathBuf,
+}
+
+impl std::fmt::Display for DriftInterrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "drift: interrupted while rerunning {} into its scratch folder {}; nothing was compared and no report written, and the stored results are unchanged. Run the same `signorini drift` again to check",
+            self.study,
+            self.scratch.display()
+        )
+    }
+}
+
+impl std::error::Error for DriftInterrupted {}
 
 /// Where the drift report goes by default: `target/drift/report[_quick][-STUDY...].json`, or
 /// `DIR/drift-report.json` for a comparison against DIR (not the report `make test` leaves).
@@ -783,9 +858,10 @@ fn run_drift(
     let manifests = study::manifest::declared(experiments, only)?;
     // what the CLAIMS rows need, checked before any run is rerun
     let roles = signorini::analysis::roles::read(experiments)?;
-    if let Some(r) = report_file {
-        check_target("--report", r.path)?;
-    }
+    // the default too: `--against DIR` writes DIR/drift-report.json
+    let file = report_file.map(|r| r.path.to_path_buf()).unwrap_or_else(|| default_report(quick, against, only));
+    let flag = if report_file.is_some() { "--report" } else { "the drift report (--report FILE writes it elsewhere)" };
+    check_target(flag, &file)?;
     let older = report_to_merge_into(report_file)?;
     let scratch = std::path::PathBuf::from("target/drift").join(if quick { "quick" } else { "full" });
     let options = study::drift::DriftOptions {
@@ -796,6 +872,7 @@ fn run_drift(
         results: results.to_path_buf(),
         progress: true,
     };
+    let scratch = options.scratch.clone();
     let report = study::drift::check(&manifests, only.is_empty(), &options, &|r| {
         // drift's interface takes an io::Result: the typed error's message travels in it
         // CLAIMS.md is compared only when every study is, so a folder at fault has each fault in
@@ -804,13 +881,16 @@ fn run_drift(
             return Ok(signorini::records::read_text(&r.join("CLAIMS.md")).unwrap_or_default());
         };
         signorini::claims::claims(&shelf, &roles).map(|c| signorini::claims::markdown_for(&c, r)).map_err(std::io::Error::other)
+    })
+    .map_err(|e| match e.downcast_ref::<study::Interrupted>() {
+        Some(i) => DriftInterrupted { study: i.study.clone(), scratch: scratch.clone() }.into(),
+        None => e,
     })?;
     // the table first: a report that cannot be written must not cost it
     if !report.rows.is_empty() {
         print!("{}", study::drift::table(&report.rows));
     }
     println!("\nlargest change of each float field (whether within tolerance or not):\n{}", study::drift::changes_table(&report));
-    let file = report_file.map(|r| r.path.to_path_buf()).unwrap_or_else(|| default_report(quick, against, only));
     let written = match older {
         Some(older) => report.merged_into(older).with_context(|| format!("merging into the drift report {}", file.display()))?,
         None => serde_json::to_value(&report)?,
@@ -917,6 +997,7 @@ fn run_report(
 /// A folder a command writes into (`export --out`, `figures --figures`, `report --out`): a file
 /// there is an error naming the flag, now, not the operating system's "File exists" later.
 fn output_folder(flag: &str, path: &std::path::Path, writes: &str) -> Result<()> {
+    outside_study(flag, path)?;
     if path.exists() && !path.is_dir() {
         bail!("{flag} {}: this is a file; {writes}: give a folder's path", path.display());
     }
@@ -927,6 +1008,9 @@ fn output_folder(flag: &str, path: &std::path::Path, writes: &str) -> Result<()>
 fn run_export(args: &SolveArgs, out: &std::path::Path) -> Result<()> {
     // before solving
     output_folder("--out", out, "export writes a folder there (mesh.vtu, case.json)")?;
+    for file in ["mesh.vtu", "case.json"] {
+        check_target("--out", &out.join(file))?;
+    }
     let (mesh, sol, indicator, r) = run_solve(args)?;
     for f in report::export_case(out, &mesh, &sol, &indicator, &r)? {
         println!("wrote {}", f.display());
@@ -985,8 +1069,8 @@ fn main() -> ExitCode {
             let report = report.as_deref().map(|f| ReportFile { path: f, merge: *merge });
             run_drift(*quick, *deep, against.as_deref(), report, accept, study, experiments, results)
         }
-        Command::Run { manifests, quick, jobs, shard, fresh, replace, results, wait } => {
-            let flags = RunFlags { quick: *quick, fresh: *fresh, replace: *replace, wait: *wait };
+        Command::Run { manifests, quick, jobs, shard, fresh, replace, results, wait, plan } => {
+            let flags = RunFlags { quick: *quick, fresh: *fresh, replace: *replace, wait: *wait, plan: *plan };
             run_studies(manifests, *jobs, shard.as_deref(), results.clone(), flags)
         }
         Command::Export { args, out } => run_export(args, out),
@@ -998,7 +1082,11 @@ fn main() -> ExitCode {
     let result = result.and_then(|()| stdout_result().map_err(|e| anyhow::anyhow!("writing standard output: {e}")));
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) if e.downcast_ref::<study::Interrupted>().is_some() || e.downcast_ref::<AdaptInterrupted>().is_some() => {
+        Err(e)
+            if e.downcast_ref::<study::Interrupted>().is_some()
+                || e.downcast_ref::<AdaptInterrupted>().is_some()
+                || e.downcast_ref::<DriftInterrupted>().is_some() =>
+        {
             say!("{e:#}");
             ExitCode::from(130)
         }

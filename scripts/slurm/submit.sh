@@ -43,6 +43,12 @@ for n in tasks cpus; do
 done
 [ -f "$manifest" ] || fail "no manifest $manifest"
 [ -x "$bin" ] || fail "no binary $bin (make build)"
+# a bare name is the file here (as -x found it), not a command looked up on PATH
+case $bin in */*) ;; *) bin=./$bin ;; esac
+# the manifest as a run checks it, and the last task's shard must hold a run: a task beyond the
+# study's runs would fail, and the finish job (afterok) would then never start
+plan=$("$bin" run --plan --shard "$tasks/$tasks" "$manifest" 2>&1 >/dev/null) ||
+    fail "--tasks $tasks: $bin run --plan --shard $tasks/$tasks $manifest refused it: ${plan#error: }"
 logs=${logs:-$results/slurm-logs}
 mkdir -p "$logs"
 here=$(cd "$(dirname "$0")" && pwd)

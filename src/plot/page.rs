@@ -42,8 +42,9 @@ pub fn claim_studies(id: &str) -> &'static [Study] {
 }
 
 /// What the page says about drift: the report's date, whether it compared this study and what
-/// it found.
-fn drift_status(report: Option<&serde_json::Value>, study: &str) -> String {
+/// it found, for the records `runs` the page shows: a report that did not compare exactly these
+/// (by their hashes, `records` and `against_records` of its entry) says nothing about them.
+fn drift_status(report: Option<&serde_json::Value>, study: &str, runs: &[RunRecord]) -> String {
     let Some(r) = report else {
         return "not checked: no drift report found (run <code>signorini drift --study STUDY</code>)".replace("STUDY", &escape(study));
     };
@@ -58,14 +59,49 @@ fn drift_status(report: Option<&serde_json::Value>, study: &str) -> String {
     } else {
         "every level"
     };
+    let stale = entry.and_then(|e| records_not_compared(e, runs));
     match entry {
         None => format!("not checked in the drift report of {date}{against} (it did not include this study)"),
+        Some(_) if let Some(why) = stale => format!("not checked: the drift report of {date}{against} {why}"),
         Some(e) => match e["drift"].as_u64() {
             Some(0) => format!("<b>no drift</b>: rerun and compared at {scope}{against} on {date}, {} run(s)", e["runs"]),
             Some(n) => format!("<b class=\"bad\">drift</b>: {n} field(s) moved ({scope}{against}, {date}); see the drift report"),
             None => format!("unreadable entry in the drift report of {date}"),
         },
     }
+}
+
+/// Why a drift report's study entry does not speak for the records `runs`, if it does not: it
+/// names no hashes (a report of an older harness), or a run shown is not one it compared (run
+/// again since, or a report of another folder), or it compared a run the page does not show.
+fn records_not_compared(entry: &serde_json::Value, runs: &[RunRecord]) -> Option<String> {
+    let sides: Vec<&serde_json::Map<String, serde_json::Value>> =
+        ["records", "against_records"].iter().filter_map(|k| entry[*k].as_object()).collect();
+    if sides.is_empty() {
+        return Some("records no hashes of the records it compared, so it may predate these records".into());
+    }
+    // each side of the comparison (the stored folder, and with --against the other one) that
+    // holds exactly these records speaks for them
+    let differences = |side: &serde_json::Map<String, serde_json::Value>| {
+        let changed: Vec<&str> = runs
+            .iter()
+            .filter(|r| side.get(&r.run.id).and_then(|v| v.as_str()) != Some(crate::records::record_sha256(r).as_str()))
+            .map(|r| r.run.id.as_str())
+            .collect();
+        let gone: Vec<String> = side.keys().filter(|id| !runs.iter().any(|r| r.run.id == **id)).cloned().collect();
+        (changed, gone)
+    };
+    let (changed, gone) = sides.into_iter().map(differences).min_by_key(|(c, g)| c.len() + g.len())?;
+    if !changed.is_empty() {
+        return Some(format!(
+            "predates these records or compared others (run(s) {} changed since); rerun <code>signorini drift</code>",
+            escape(&changed.join(", "))
+        ));
+    }
+    if !gone.is_empty() {
+        return Some(format!("compared run(s) {} that these records no longer hold", escape(&gone.join(", "))));
+    }
+    None
 }
 
 /// HTML-escape text.
@@ -244,7 +280,15 @@ pub fn study_page(
         escape(&shelf.root().display().to_string()),
         escape(&figures.display().to_string())
     );
-    let _ = writeln!(s, "<h2>Drift</h2><p>{}</p>", drift_status(drift, study));
+    let incomplete = shelf.not_as_declared(study);
+    if !incomplete.is_empty() {
+        let _ = writeln!(
+            s,
+            "<p class=\"bad\"><b>Incomplete</b>: the study's manifest declares runs this folder does not hold as declared: {}. The tables and figures below show only the runs it holds; complete it with <code>signorini run</code>.</p>",
+            escape(&incomplete.join(", "))
+        );
+    }
+    let _ = writeln!(s, "<h2>Drift</h2><p>{}</p>", drift_status(drift, study, &runs));
     let _ = writeln!(s, "<h2>Claims</h2>\n{}", claims_table(&rows));
     let _ = writeln!(s, "<h2>Figures</h2>\n{}", figures_html(figures, study)?);
     let _ = writeln!(s, "<h2>Runs</h2>\n{}", run_table(&runs));
@@ -286,6 +330,14 @@ pub fn write_pages(
     crate::base::input::create_folder(out)?;
     let mut written = Vec::new();
     for study in &chosen {
+        let incomplete = shelf.not_as_declared(study);
+        if !incomplete.is_empty() {
+            crate::base::note::line(format_args!(
+                "report: {study} is incomplete in {} (its page says so): {}",
+                results.display(),
+                incomplete.join(", ")
+            ));
+        }
         let page = study_page(shelf, figures, study, &claims, drift.as_ref())?;
         let path = out.join(format!("{study}.html"));
         crate::records::write_atomic(&path, page.as_bytes()).with_context(|| format!("writing {}", path.display()))?;

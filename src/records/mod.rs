@@ -172,6 +172,13 @@ pub fn json_bytes<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Resul
     Ok(s.into_bytes())
 }
 
+/// The SHA-256 of a run record's file as the harness writes it ([`json_bytes`]; a stored
+/// record is checked to be exactly that): what a drift report keeps of each record it compared,
+/// and what the study page compares with the records it shows.
+pub fn record_sha256(record: &RunRecord) -> String {
+    json_bytes(Path::new("runs"), record).map(|b| crate::base::digest::sha256_hex(&b)).unwrap_or_else(|e| format!("(not written: {e})"))
+}
+
 /// Serialise as pretty JSON (checked by [`json_bytes`]) and write atomically.
 pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Result<()> {
     write_atomic(path, &json_bytes(path, value)?)

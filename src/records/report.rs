@@ -250,8 +250,12 @@ pub fn export_case(
     report: &SolveReport,
 ) -> Result<Vec<std::path::PathBuf>> {
     let (vtu, case) = (dir.join("mesh.vtu"), dir.join("case.json"));
-    records::write_atomic(&vtu, solution_vtu(mesh, sol, indicator).as_bytes())?;
-    records::write_json(&case, report)?;
+    // one batch: both files are checked and written before either lands, so a target that
+    // cannot be replaced (a named pipe where case.json goes) leaves no half-written export
+    let mut batch = records::Batch::default();
+    batch.add(&vtu, solution_vtu(mesh, sol, indicator).as_bytes())?;
+    batch.add_json(&case, report)?;
+    batch.commit()?;
     Ok(vec![vtu, case])
 }
 

@@ -774,7 +774,16 @@ pub fn check(
                 if c.rows.is_empty() { "no drift".to_string() } else { format!("{} field(s) moved", c.rows.len()) }
             ));
         }
-        report.studies.push(serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": c.rows.len(), "quick": quick }));
+        // the records compared, by hash: a page quoting this report checks that it shows them
+        let hashes = |runs: &[RunRecord]| -> BTreeMap<String, String> {
+            runs.iter().map(|r| (r.run.id.clone(), crate::records::record_sha256(r))).collect()
+        };
+        let mut entry =
+            serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": c.rows.len(), "quick": quick, "records": hashes(&stored) });
+        if opts.against.is_some() {
+            entry["against_records"] = serde_json::to_value(hashes(&fresh))?;
+        }
+        report.studies.push(entry);
         report.rows.extend(c.rows);
         report.changes.insert(m.study.clone(), c.changes);
     }

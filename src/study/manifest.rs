@@ -766,6 +766,20 @@ impl Manifest {
     }
 }
 
+/// How many times a level's NDF a reference solution must have for the level's errors to be
+/// measured against it: a level at the reference's own NDF measures 1e-17 (its own mesh), and
+/// levels near it measure the reference's error, not theirs. 1.5 is below the smallest margin
+/// of the stored studies, 1.89 (`ex72`'s uniform run, NDF 132,098, against its adaptive
+/// reference of 250,070; hertz's manifest keeps 3.3 by convention), so that none is refused,
+/// and far above a reference coarser than the run (battery 10's F3: NDF 218 against 710).
+pub const REFERENCE_MARGIN: f64 = 1.5;
+
+/// Whether a reference of `reference_ndof` unknowns is too coarse to measure a level of
+/// `level_ndof` ([`REFERENCE_MARGIN`]).
+pub fn too_coarse_for(reference_ndof: usize, level_ndof: usize) -> bool {
+    (reference_ndof as f64) < REFERENCE_MARGIN * level_ndof as f64
+}
+
 impl Manifest {
     /// What a run needs of its files and of this machine, checked for every run before any is
     /// solved (a mistake in the last run must not cost the first one's): the mesh is read and
@@ -805,6 +819,20 @@ impl Manifest {
                     "reference",
                     format!("no reference: problem {} has an exact solution, which the errors are measured against", spec.problem),
                     format!("a reference with min_ndof {}", rf.min_ndof),
+                ));
+            }
+            // level 0 is always measured: a reference that may stop short of the margin above it
+            // measures nothing (the levels' own NDF is checked as each is solved)
+            if too_coarse_for(rf.min_ndof, ndof as usize) {
+                return Err(invalid(
+                    "reference.min_ndof",
+                    format!(
+                        "at least {} times the NDF of every level measured against it; level 0 ({}) has {ndof:.0}, so at least {:.0} (more: the reference must be finer than the run's last level)",
+                        REFERENCE_MARGIN,
+                        spec.mesh,
+                        (REFERENCE_MARGIN * ndof).ceil()
+                    ),
+                    rf.min_ndof.to_string(),
                 ));
             }
             crate::base::memory::check_memory(&format!("the reference solution (min_ndof {})", rf.min_ndof), rf.min_ndof as f64).map_err(

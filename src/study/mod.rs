@@ -401,6 +401,8 @@ pub struct Prepared {
     /// the run computes ([`manifest::pin_inputs`]): every later read (the initial mesh built
     /// again on resuming, a replay) is of those bytes too.
     pub pins: crate::base::pin::Pins,
+    /// The code that computes the run: its checkpoint holds it, and only its own is resumed.
+    pub code: provenance::CodeVersion,
 }
 
 impl Prepared {
@@ -460,7 +462,7 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
         }
         _ => None,
     };
-    Ok(Some(Prepared { problem, mesh_spec, reference, pins }))
+    Ok(Some(Prepared { problem, mesh_spec, reference, pins, code: provenance::code_version(manifest_file) }))
 }
 
 /// Take the reference solutions of `manifest`'s runs from the study folder `stored` where it
@@ -559,7 +561,7 @@ fn start_of(
     progress: bool,
 ) -> Result<adapt::Start> {
     let mesh0 = prepared.initial_mesh()?;
-    let Some(c) = run.checkpoint(spec) else { return Ok(adapt::Start::new(mesh0)) };
+    let Some(c) = run.checkpoint(spec, &prepared.code) else { return Ok(adapt::Start::new(mesh0)) };
     let done = c.levels.len();
     crate::base::note::line(format_args!(
         "{study}/{}: resuming after level {} (from {})",
@@ -612,6 +614,8 @@ fn loop_of(
     let mut stopped = false;
     let mut kept = store::checkpoint::Checkpoint {
         run: spec.clone(),
+        code: prepared.code.clone(),
+        sha256: String::new(),
         levels: start.records.clone(),
         history: start.history.clone(),
         next_active: None,
@@ -627,7 +631,7 @@ fn loop_of(
                 r.err_quadrature.map(|e| format!(" error {e:.3e}")).unwrap_or_default()
             ));
             pb.inc(1);
-            let kept_level = keep_level(study, spec, run, meshes, &level, problem).and_then(|()| {
+            let kept_level = keep_level(study, spec, run, meshes, &level, prepared).and_then(|()| {
                 kept.levels.push(r.clone());
                 kept.history.levels.push(level.history.clone());
                 kept.next_active = level.next_active.map(crate::records::Flags::encode);
@@ -672,20 +676,32 @@ pub fn replay_stored_level(manifest: &Manifest, stored: &RunRecord, level: usize
 }
 
 /// A level just solved: its record must be one a file can hold (every float finite; otherwise
-/// the run stops here, naming the level, the field and the value), and its mesh snapshot is
-/// added to `meshes` if the run saves it.
-fn keep_level(
-    study: &str,
-    spec: &RunSpec,
-    run: &RunWriter,
-    meshes: &mut Batch,
-    level: &Level,
-    problem: &dyn problems::Problem,
-) -> Result<()> {
+/// the run stops here, naming the level, the field and the value), its errors measured against
+/// a reference finer than it by [`manifest::REFERENCE_MARGIN`] (otherwise they measure the
+/// reference's error: the run stops here), and its mesh snapshot is added to `meshes` if the
+/// run saves it. Every level a run computes comes through here.
+fn keep_level(study: &str, spec: &RunSpec, run: &RunWriter, meshes: &mut Batch, level: &Level, prepared: &Prepared) -> Result<()> {
     let r = level.record;
     if let Some(bad) = crate::records::first_non_finite(r) {
         bail!("{study}/{}: level {}: {bad}; a record cannot hold it, so the run stops here and nothing of it is stored", spec.id, r.level);
     }
+    if let (Some(reference), Some(rs)) = (&prepared.reference, &spec.reference)
+        && manifest::too_coarse_for(reference.ndof, r.ndof)
+    {
+        bail!(
+            "{study}/{}: level {} has NDF {}, and its errors would be measured against a reference solution of NDF {} (reference.min_ndof = {}), \
+             less than {} times finer: they would measure the reference's error, not the level's. Nothing of the run is stored; \
+             raise reference.min_ndof to at least {} times the NDF of the run's last level (or give the run fewer levels, max_ndof or stop_ndof)",
+            spec.id,
+            r.level,
+            r.ndof,
+            reference.ndof,
+            rs.min_ndof,
+            manifest::REFERENCE_MARGIN,
+            manifest::REFERENCE_MARGIN
+        );
+    }
+    let problem = prepared.problem.as_ref();
     if spec.save_levels.contains(&r.level) {
         save_level(study, spec, run, meshes, level, problem)?;
     }

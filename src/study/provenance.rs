@@ -101,13 +101,68 @@ pub fn utc_now() -> String {
     format!("{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z", rem / 3600, rem / 60 % 60, rem % 60)
 }
 
-pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: bool, runs: Vec<String>, meshes: &[&Path]) -> Provenance {
-    let root = manifest_path.parent().and_then(|p| p.parent()).filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+/// The checkout a manifest belongs to: the folder above its `experiments/`.
+fn root_of(manifest_path: &Path) -> &Path {
+    manifest_path.parent().and_then(|p| p.parent()).filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."))
+}
+
+/// A checkout's git commit and dirty flag.
+type GitState = (Option<String>, Option<bool>);
+
+/// The git commit of the checkout at `root` and whether tracked files outside results/ differ
+/// from it (the study's own outputs are not the code).
+fn git_state(root: &Path) -> GitState {
     let git_commit = command("git", &["-C", &root.to_string_lossy(), "rev-parse", "HEAD"]);
-    // dirty = tracked files changed outside results/ (the study's own outputs are not the code)
     let git_dirty =
         command("git", &["-C", &root.to_string_lossy(), "status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)results"])
             .map(|s| !s.is_empty());
+    (git_commit, git_dirty)
+}
+
+/// The code that computes a run: what `provenance.json` names it by (the package version, the
+/// git commit and whether the checkout was dirty) and the SHA-256 of the running executable,
+/// which tells two builds of one dirty checkout apart. A run's checkpoint holds it, and a
+/// resume takes over only the levels of this same code: levels of two builds under one
+/// record's provenance would be no one build's run.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CodeVersion {
+    pub signorini_version: String,
+    pub git_commit: Option<String>,
+    pub git_dirty: Option<bool>,
+    pub executable_sha256: Option<String>,
+}
+
+impl std::fmt::Display for CodeVersion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let commit = self.git_commit.as_deref().map_or("no git commit".to_string(), |c| format!("commit {}", &c[..c.len().min(12)]));
+        let dirty = if self.git_dirty == Some(true) { " (dirty)" } else { "" };
+        let exe = self.executable_sha256.as_deref().map_or("unknown".to_string(), |h| h[..h.len().min(12)].to_string());
+        write!(f, "signorini {}, {commit}{dirty}, executable sha256 {exe}", self.signorini_version)
+    }
+}
+
+/// This process's [`CodeVersion`] for the manifest at `manifest_path` (found once per checkout
+/// and process: the code of a running process does not change).
+pub fn code_version(manifest_path: &Path) -> CodeVersion {
+    use std::collections::HashMap;
+    use std::sync::{Mutex, OnceLock};
+    static EXE: OnceLock<Option<String>> = OnceLock::new();
+    static BY_ROOT: OnceLock<Mutex<HashMap<std::path::PathBuf, GitState>>> = OnceLock::new();
+    let executable_sha256 = EXE.get_or_init(|| std::env::current_exe().and_then(std::fs::read).ok().map(|b| sha256_hex(&b))).clone();
+    let root = root_of(manifest_path).to_path_buf();
+    let (git_commit, git_dirty) = BY_ROOT
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .entry(root)
+        .or_insert_with_key(|r| git_state(r))
+        .clone();
+    CodeVersion { signorini_version: env!("CARGO_PKG_VERSION").to_string(), git_commit, git_dirty, executable_sha256 }
+}
+
+pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: bool, runs: Vec<String>, meshes: &[&Path]) -> Provenance {
+    let root = root_of(manifest_path);
+    let (git_commit, git_dirty) = git_state(root);
     Provenance {
         study: study.to_string(),
         manifest: manifest_path.display().to_string(),

@@ -101,3 +101,32 @@ fn good_submit_calls_sbatch_for_the_array_and_the_finish_job() {
     assert!(calls.contains("--array=1-3") && calls.contains("--dependency=afterok:42"), "{calls}");
     assert!(s.work.join("res/slurm-logs").is_dir());
 }
+
+/// Battery 10, F2: `--tasks 5` for a study of 3 runs was submitted; tasks 4 and 5 failed ("this
+/// shard holds no run") and the finish job (afterok) never ran. The script now asks the binary
+/// (`run --plan --shard N/N`, which runs nothing) before it creates or submits anything.
+#[test]
+fn more_tasks_than_runs_are_refused_before_anything_is_submitted() {
+    let s = Setup::new("tasks");
+    std::fs::write(
+        s.work.join("m.toml"),
+        "[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\nlevels = 3\n[[run]]\nid = \"r1\"\n[[run]]\nid = \"r2\"\ntheta = 0.3\n[[run]]\nid = \"r3\"\nrefine = \"uniform\"\n",
+    )
+    .unwrap();
+    let bin = env!("CARGO_BIN_EXE_signorini");
+    let before = listing(&s.work);
+    let (code, err) = s.submit(&["--tasks", "5", "--results", "res", "--bin", bin, "m.toml"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.starts_with("submit.sh: --tasks 5: ") && err.contains("this shard holds no run (m has 3 run(s))"), "{err}");
+    assert_eq!(listing(&s.work), before, "created something");
+    assert_eq!(s.sbatch_calls(), 0);
+    // as many tasks as runs: submitted
+    let (code, err) = s.submit(&["--tasks", "3", "--results", "res", "--bin", bin, "m.toml"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(s.sbatch_calls(), 2, "{err}");
+    // what --plan prints: the shard's runs, and nothing run
+    let out = Command::new(bin).args(["run", "--plan", "--shard", "2/2", "m.toml"]).current_dir(&s.work).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(String::from_utf8_lossy(&out.stdout), "m/r2\n");
+    assert!(!s.work.join("results").exists());
+}

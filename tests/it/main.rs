@@ -7,6 +7,7 @@ mod common;
 mod adaptivity;
 mod bad_battery;
 mod bad_battery10_contact;
+mod bad_battery10_store;
 mod bad_battery7;
 mod bad_battery8_contact;
 mod bad_battery8_files;

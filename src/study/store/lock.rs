@@ -128,6 +128,17 @@ fn open(path: &Path) -> Result<std::fs::File> {
         .with_context(|| format!("opening the lock file {}", path.display()))
 }
 
+/// A lock another process holds, refused without waiting: what it covers, who holds it, the
+/// lock file. A command whose own advice differs (`drift --accept` has no `--wait`) finds it
+/// in the error's chain.
+#[derive(Debug, thiserror::Error)]
+#[error("{what} is being written by {holder}; wait for it to finish, or pass --wait to wait for it (the lock is {})", lock.display())]
+pub struct Held {
+    pub what: String,
+    pub holder: String,
+    pub lock: std::path::PathBuf,
+}
+
 /// Take the lock on `file`: at once if free; if held, refused naming the holder, or with `wait`
 /// after waiting for it.
 fn claim(mut file: std::fs::File, path: &Path, what: &str, wait: bool) -> Result<Lock> {
@@ -136,10 +147,7 @@ fn claim(mut file: std::fs::File, path: &Path, what: &str, wait: bool) -> Result
         Err(std::fs::TryLockError::WouldBlock) => {
             let holder = holder(&mut file);
             if !wait {
-                bail!(
-                    "{what} is being written by {holder}; wait for it to finish, or pass --wait to wait for it (the lock is {})",
-                    path.display()
-                );
+                return Err(Held { what: what.to_string(), holder, lock: path.to_path_buf() }.into());
             }
             crate::base::note::line(format_args!("{what} is being written by {holder}; waiting for it to finish"));
             file.lock().with_context(|| format!("waiting for the lock {}", path.display()))?;

@@ -24,7 +24,7 @@
 pub mod check;
 pub mod checkpoint;
 mod lock;
-pub use lock::scratch_folder;
+pub use lock::{Held, scratch_folder};
 pub mod shelf;
 pub mod stale;
 pub mod write;
@@ -38,6 +38,23 @@ use crate::records::{ReferenceRecord, RunRecord, RunSpec, StudyDir};
 use crate::study::provenance::Provenance;
 use anyhow::{Context, Result, bail};
 use std::path::PathBuf;
+
+/// The study folder that holds `path` (the path itself or a folder above it), if any: a folder
+/// holding `runs/`, `.lock` or `.locks` (what a study folder has once a run was stored or
+/// locked in it). Symlinks are followed (the deepest existing folder on the way is resolved),
+/// so a link into a study folder is found too. An output flag of the command line refuses a
+/// target there: every write into a study folder goes through the guard of a lock
+/// ([`mod@write`]), and an output written past it replaced run records and snapshots.
+pub fn study_folder_above(path: &std::path::Path) -> Option<PathBuf> {
+    let absolute = std::path::absolute(path).ok()?;
+    // resolve what exists (symlinks), keep the rest as written
+    let existing = absolute.ancestors().find(|a| a.exists())?;
+    let resolved = existing.canonicalize().ok()?;
+    let rest = absolute.strip_prefix(existing).ok()?;
+    let full = resolved.join(rest);
+    let is_study = |d: &std::path::Path| d.join("runs").is_dir() || d.join(".locks").is_dir() || d.join(".lock").is_file();
+    full.ancestors().find(|d| is_study(d)).map(|d| d.to_path_buf())
+}
 
 /// The one door to a study's results folder (`results/STUDY/`): readers check it as a whole
 /// ([`Store::check`], [`Store::read`]); writers hold its locks ([`Store::lock`],

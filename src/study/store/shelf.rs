@@ -35,6 +35,9 @@ struct Shelved {
     provenance: Option<String>,
     /// Whether its folder holds a `runs/` folder ([`Shelf::held`]).
     held: bool,
+    /// What its manifest declares that the folder does not hold as declared, where the shelf
+    /// was opened with its manifest ([`Shelf::not_as_declared`]).
+    not_as_declared: Vec<String>,
 }
 
 /// A read-only view of the checked study folders of one results folder.
@@ -54,7 +57,7 @@ impl Shelf {
             let runs = store.read()?;
             let provenance = crate::records::read_text(&store.dir().provenance_file()).ok();
             let held = store.dir().root.join("runs").is_dir();
-            studies.insert(store.study().to_string(), Shelved { store, runs, provenance, held });
+            studies.insert(store.study().to_string(), Shelved { store, runs, provenance, held, not_as_declared: Vec::new() });
         }
         Ok(Shelf { root: results.to_path_buf(), studies })
     }
@@ -64,7 +67,29 @@ impl Shelf {
     pub fn open_folder(results: &Path, manifests: &[crate::study::manifest::Manifest]) -> anyhow::Result<Shelf> {
         let declared = manifests.iter().map(|m| Store::of(results, m));
         let others = Shelf::in_folder(results)?.into_iter().filter(|s| !manifests.iter().any(|m| &m.study == s));
-        Shelf::open(results, declared.chain(others.map(|s| Store::new(results, &s)).collect::<Vec<_>>()))
+        let mut shelf = Shelf::open(results, declared.chain(others.map(|s| Store::new(results, &s)).collect::<Vec<_>>()))?;
+        for m in manifests {
+            if let Some(s) = shelf.studies.get_mut(&m.study) {
+                s.not_as_declared = m
+                    .runs
+                    .iter()
+                    .filter_map(|p| match s.runs.iter().find(|r| r.run.id == p.spec.id) {
+                        None => Some(format!("{} (missing)", p.spec.id)),
+                        Some(r) if r.run != p.spec => Some(format!("{} (computed with another spec)", p.spec.id)),
+                        Some(_) => None,
+                    })
+                    .collect();
+            }
+        }
+        Ok(shelf)
+    }
+
+    /// The runs `study`'s manifest declares that its folder does not hold as declared, each
+    /// with why ("r2 (missing)"): empty for a complete study, or one the shelf was opened
+    /// without the manifest of. What `report` says on the page and on stderr (`figures`
+    /// refuses such a folder).
+    pub fn not_as_declared(&self, study: &str) -> &[String] {
+        self.studies.get(study).map_or(&[], |s| &s.not_as_declared)
     }
 
     /// The studies under `results` (folders holding a `runs/` folder), by name: what

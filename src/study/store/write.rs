@@ -39,9 +39,10 @@ impl RunWriter<'_> {
         self.store.dir.mesh_file(&self.id, level, ext)
     }
 
-    /// The run's checkpoint, if there is one for exactly `spec` (`checkpoint::read`).
-    pub fn checkpoint(&self, spec: &records::RunSpec) -> Option<checkpoint::Checkpoint> {
-        checkpoint::read(&self.store.dir, spec)
+    /// The run's checkpoint, if there is one for exactly `spec` written by `code`, as written
+    /// (`checkpoint::read`; any other is discarded, saying why).
+    pub fn checkpoint(&self, spec: &records::RunSpec, code: &provenance::CodeVersion) -> Option<checkpoint::Checkpoint> {
+        checkpoint::read(&self.store.dir, spec, code)
     }
 
     /// `STUDY/.partial/RUN.json`, for messages.
