@@ -633,8 +633,7 @@ fn listed(names: &[String]) -> String {
 /// The studies a comparison `against` a folder covers: those of `manifests` the folder holds
 /// (with `named`, the studies were named one by one and each must be there), and the names of
 /// those it does not. A folder holding none of them is an error: there is nothing to compare.
-pub fn select_against(dir: &Path, results: &Path, manifests: &[Manifest], named: bool) -> anyhow::Result<(Vec<Manifest>, Vec<String>)> {
-    not_the_stored_folder(dir, results)?;
+pub fn select_against(dir: &Path, manifests: &[Manifest], named: bool) -> anyhow::Result<(Vec<Manifest>, Vec<String>)> {
     let held = held_by(dir, manifests).map_err(|e| anyhow::anyhow!("--against {}: {e}", dir.display()))?;
     if named && !held.absent.is_empty() {
         anyhow::bail!(
@@ -655,23 +654,6 @@ pub fn select_against(dir: &Path, results: &Path, manifests: &[Manifest], named:
         );
     }
     Ok((held.present, held.absent))
-}
-
-/// `--against DIR` where DIR is the stored folder itself (the same path, `./DIR/`, a symlink)
-/// would compare every record with itself and report no drift with nothing rerun: refused,
-/// naming both paths as resolved. Paths that cannot be resolved are left to the reads that
-/// follow, which name them.
-fn not_the_stored_folder(dir: &Path, results: &Path) -> anyhow::Result<()> {
-    let (Ok(a), Ok(r)) = (dir.canonicalize(), results.canonicalize()) else { return Ok(()) };
-    if a == r {
-        anyhow::bail!(
-            "--against {}: that is the stored results folder itself (--results {}; both resolve to {}): its records would be compared with themselves and no drift reported with nothing rerun. Rerun the study into another folder (`signorini run experiments/STUDY.toml --results DIR`) and compare that",
-            dir.display(),
-            results.display(),
-            a.display()
-        );
-    }
-    Ok(())
 }
 
 /// The provenance of a study in `fresh` against the stored one: the manifest, problem files and
@@ -736,7 +718,7 @@ pub fn check(
     use anyhow::Context;
     stored_root(&opts.results)?;
     let (manifests, not_compared) = match &opts.against {
-        Some(dir) => select_against(dir, &opts.results, manifests, !all_studies)?,
+        Some(dir) => select_against(dir, manifests, !all_studies)?,
         None => {
             for m in manifests {
                 m.check_runs()?;
