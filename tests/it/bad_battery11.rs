@@ -1,7 +1,4 @@
 //! Battery 11:
-//! * N1: `drift --against DIR` with DIR the stored results folder itself (the same path, `./DIR/`,
-//!   a symlink to it) compared every record with itself and said "drift: none"; refused now,
-//!   naming both paths as resolved (`study::drift::select_against`), before anything is written.
 //! * N6: a nearly tangent declared normal (`["x - 0.5", "-1e-3"]`) was refused as a "corner ...
 //!   0.0001 degrees apart": the per-node normal checks now run first, and a corner needs 1e-3
 //!   radians between the two sides' normals (`contact::plausible::CORNER_ANGLE`).
@@ -14,32 +11,6 @@
 //!   (as every level of `adapt` does) where the round-off exceeds 1e-2 of the deformation above it.
 
 use super::common::{scratch, signorini_in};
-
-fn study(dir: &std::path::Path) {
-    std::fs::create_dir_all(dir.join("experiments")).unwrap();
-    let manifest = "[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\nlevels = 2\n[[run]]\nid = \"a\"\n";
-    std::fs::write(dir.join("experiments/st.toml"), manifest).unwrap();
-    let (code, _, err) = signorini_in(dir, &["run", "experiments/st.toml", "--results", "res"]);
-    assert_eq!(code, 0, "{err}");
-}
-
-#[test]
-fn drift_against_the_stored_folder_itself_is_refused_naming_both_paths() {
-    let dir = scratch("b11-against-itself");
-    study(&dir);
-    #[cfg(unix)]
-    std::os::unix::fs::symlink("res", dir.join("same")).unwrap();
-    let resolved = dir.join("res").canonicalize().unwrap();
-    for against in ["res", "./res/", "same"] {
-        let (code, out, err) = signorini_in(&dir, &["drift", "--study", "st", "--results", "res", "--against", against]);
-        assert_eq!(code, 1, "{against}: {out}{err}");
-        assert!(!out.contains("drift: none") && !err.contains("drift: none"), "{against}: {out}{err}");
-        assert!(err.contains(&format!("--against {against}")), "{against}: {err}");
-        assert!(err.contains("the stored results folder itself") && err.contains("--results res"), "{against}: {err}");
-        assert!(err.contains(&resolved.display().to_string()), "{against}: {err}");
-        assert!(!dir.join("res/drift-report.json").exists(), "{against}: a report was written into the stored folder");
-    }
-}
 
 const TANGENT: &str = "dirichlet = [0, -0.01]\n[material]\nE = 100\nnu = 0.3\nmodel = \"plane_strain\"\n[parts]\ncontact = \"y < 1e-12\"\ndirichlet = \"y > 1 - 1e-12\"\n[contact]\nnormal = [\"x - 0.5\", \"-1e-3\"]\nchi = 0\n";
 
