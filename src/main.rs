@@ -397,6 +397,13 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
         return Err(solve::SolveError::Data(bad)).with_context(|| format!("estimating on {mesh_name}"));
     }
     est.terms.check_finite().with_context(|| format!("estimating on {mesh_name}"))?;
+    match adapt::resolution(problem.as_ref(), &sol, &est) {
+        adapt::Resolution::Unresolved(e) => return Err(e).with_context(|| format!("solving {} on {mesh_name}", problem.name())),
+        adapt::Resolution::AtRoundoff => say!(
+            "warning: the estimate is at the round-off of u_h: u_h is exact to round-off (a rigid motion), or a displacement far larger than its variation (a rigid translation in the data) left it no digits of the deformation; its terms measure round-off, not the discretisation error"
+        ),
+        adapt::Resolution::Resolved => {}
+    }
     let report = report::SolveReport::new(problem.name(), &mesh_name, &mesh, &sol, error, &est, &probes)?;
     Ok((mesh, sol, est.element, report))
 }

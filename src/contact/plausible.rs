@@ -27,7 +27,8 @@
 //!   corner of two contact sides took the bottom's normal and passed the side wall by 8% of the
 //!   gap, certified). Refused, naming the node and both normals ([`ContactDataError::Corner`]).
 //! * **The obstacle does not overlap the body by more than its size.** A gap chi(p) < -D, D the
-//!   diameter of the mesh's bounding box, asks the body to move by more than its own size at p:
+//!   body's extent along the contact normal n at p (max - min of x . n over the mesh's
+//!   vertices, [`Extent`]), asks the body to move through its whole thickness along n at p:
 //!   outside linear (small-strain) elasticity everywhere it happens, and in practice a sign or
 //!   unit mistake. Checked at the contact nodes and on the same sampling as the normal; a gap
 //!   or normal that is not a finite number at a sampled point is named as the data watch names
@@ -86,10 +87,11 @@ pub enum ContactDataError {
     /// `node`: the node's normal; `side`: the normal on `edge` next to the node; `angle` in radians.
     Corner { problem: String, part: String, at: [f64; 2], edge: [[f64; 2]; 2], node: [f64; 2], side: [f64; 2], angle: f64 },
     #[error(
-        "{problem}: the gap `contact.chi` at {x} on the contact part ({part}) is {chi}: the obstacle would overlap the body by more than the body's size (the diameter of the mesh's bounding box, {d}); a gap below minus the body's size is a sign or unit mistake",
-        x = point(*.at), chi = shown(*.chi), d = shown(*.diameter)
+        "{problem}: the gap `contact.chi` at {x} on the contact part ({part}) is {chi}: the obstacle would overlap the body by more than the body's size along the contact normal ({nx:.6}, {ny:.6}) there (max - min of x . n over the mesh's vertices, {d}), pushing the body through itself; a gap below minus the body's size is a sign or unit mistake",
+        x = point(*.at), chi = shown(*.chi), d = shown(*.extent), nx = .normal[0], ny = .normal[1]
     )]
-    Gap { problem: String, part: String, at: [f64; 2], chi: f64, diameter: f64 },
+    /// `extent`: the body's extent along the unit `normal` ([`Extent::along`]).
+    Gap { problem: String, part: String, at: [f64; 2], chi: f64, normal: [f64; 2], extent: f64 },
     #[error(
         "{problem}: the node at {x} on the closure of the contact part ({part}) has u_{fixed} prescribed by {by} and u_{free} free, and the contact normal there ({nx:.6}, {ny:.6}) acts on the free u_{free}: the contact condition u . n <= chi is imposed only at nodes with no prescribed component, so it would not hold there and the body could pass the obstacle at that node. Prescribe both components there, or let the contact part and the part or point that prescribes one component not meet",
         x = point(*.at), nx = .normal[0], ny = .normal[1], fixed = .fixed + 1, free = 2 - .fixed
@@ -153,16 +155,24 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
     let outward: Vec<Option<[f64; 2]>> =
         outward_normals(mesh, nodes).into_iter().zip(&mesh.boundary).map(|(n, e)| (e.part == Part::Contact).then_some(n)).collect();
     let diameter = super::consistent::diameter(mesh);
+    let extent = Extent::of(mesh);
+    // the normal at each node and sampled point first: a normal nearly tangent or reversed is
+    // named as such, never as a corner where it merely turns fast (battery 11, N6)
+    check_nodes(mesh, nodes, dofs, problem, &outward, &extent)?;
+    check_sampled(mesh, nodes, problem, &extent)?;
     check_corners(mesh, dofs, problem, diameter)?;
-    check_nodes(mesh, nodes, dofs, problem, &outward, diameter)?;
-    check_sampled(mesh, nodes, problem, diameter)?;
     check_prescribed(mesh, nodes, dofs, problem, diameter)
 }
 
-/// The largest angle (radians) between a contact vertex's normal and the normal on one of its
-/// contact edges next to it ([`check_corners`]): far below any corner of a body, far above what a
-/// smooth normal turns over [`PART_END`](crate::mesh::PART_END) of the body's size.
-pub const CORNER_ANGLE: f64 = 1e-6;
+/// The largest angle (radians, 0.057 degrees) between a contact vertex's normal and the normal
+/// on one of its contact edges next to it ([`check_corners`]). A real angle, not round-off: a
+/// smooth normal reaches it over [`PART_END`](crate::mesh::PART_END) of the body's size only by
+/// turning 1e6 radians per body size (a jump for every purpose), and a normal evaluated from
+/// expressions at far translated coordinates keeps its direction to about 1e-9 (battery 11, N6:
+/// `["x - 0.5", "-1e-3"]` turned by 1e-6 over 1e-9 of the size and was called a corner at the
+/// former 1e-6). Below it, the one direction a node holds differs from the other side's by less
+/// than 1e-3 of a displacement along it.
+pub const CORNER_ANGLE: f64 = 1e-3;
 
 /// Every contact vertex against the normal on each of its contact edges, at the vertex (with
 /// that edge's outward normal) and next to it ([`PART_END`](crate::mesh::PART_END) of the body's
@@ -204,7 +214,7 @@ fn check_nodes(
     dofs: &DofMap,
     problem: &dyn Problem,
     outward: &[Option<[f64; 2]>],
-    diameter: f64,
+    extent: &Extent,
 ) -> Result<(), Box<ContactDataError>> {
     let cos_max = MAX_NORMAL_ANGLE_DEGREES.to_radians().cos();
     // per contact node, the most favourable of its contact edges: (n . n_out, edge)
@@ -230,9 +240,9 @@ fn check_nodes(
             let (problem, part) = (problem_name(problem), contact_part(problem));
             return Err(Box::new(ContactDataError::Normal { problem, part, at, edge, normal: c.normal, outward, dot }));
         }
-        if c.gap < -diameter {
+        if let Some(extent) = extent.overlapped(c.gap, c.normal) {
             let (problem, part) = (problem_name(problem), contact_part(problem));
-            return Err(Box::new(ContactDataError::Gap { problem, part, at, chi: c.gap, diameter }));
+            return Err(Box::new(ContactDataError::Gap { problem, part, at, chi: c.gap, normal: c.normal, extent }));
         }
     }
     Ok(())
@@ -245,7 +255,7 @@ fn check_nodes(
 /// along every contact edge), each against the body's outward normal there: a stretch of bad
 /// data longer than that spacing is refused on every mesh, not only on meshes that put a node
 /// in it. At a vertex, the more favourable of its contact edges' normals counts.
-fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, diameter: f64) -> Result<(), Box<ContactDataError>> {
+fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, extent: &Extent) -> Result<(), Box<ContactDataError>> {
     use super::consistent::boundary::sample;
     let cos_max = MAX_NORMAL_ANGLE_DEGREES.to_radians().cos();
     let points = sample(mesh, nodes, Some(Part::Contact));
@@ -254,11 +264,11 @@ fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, diameter: 
     let mut at_vertex: std::collections::HashMap<usize, f64> = std::collections::HashMap::new();
     for (p, _) in &points {
         let chi = problem.gap(p.at);
-        if chi < -diameter {
-            let (problem, part) = (problem_name(problem), contact_part(problem));
-            return Err(Box::new(ContactDataError::Gap { problem, part, at: p.at, chi, diameter }));
-        }
         let n = problem.contact_normal(p.at, p.normal);
+        if let Some(extent) = extent.overlapped(chi, n) {
+            let (problem, part) = (problem_name(problem), contact_part(problem));
+            return Err(Box::new(ContactDataError::Gap { problem, part, at: p.at, chi, normal: n, extent }));
+        }
         let dot = n[0] * p.normal[0] + n[1] * p.normal[1];
         dots.push((n, dot));
         if let Some(v) = vertex(mesh, p.edge, p.t)
@@ -281,6 +291,50 @@ fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, diameter: 
         }
     }
     Ok(())
+}
+
+/// The body's extent along a direction: max - min of x . n over the mesh's vertices, read off
+/// their convex hull (collinear points dropped, so a polygon's hull is its corners). A gap
+/// below minus it asks the obstacle to push the body through its whole thickness along n
+/// (battery 11, N2: a plate 0.1 thick was pushed 5 through its clamped top, certified, under
+/// the former bound, the diagonal of the bounding box, 10).
+pub(super) struct Extent {
+    hull: Vec<[f64; 2]>,
+}
+
+impl Extent {
+    pub(super) fn of(mesh: &Mesh) -> Extent {
+        let mut v = mesh.vertices.clone();
+        v.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+        v.dedup();
+        let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+        let mut hull: Vec<[f64; 2]> = Vec::new();
+        for pass in [v.clone(), v.into_iter().rev().collect()] {
+            let start = hull.len();
+            for p in pass {
+                while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
+                    hull.pop();
+                }
+                hull.push(p);
+            }
+        }
+        Extent { hull }
+    }
+
+    /// The extent along `n` (normalised here).
+    pub(super) fn along(&self, n: [f64; 2]) -> f64 {
+        let len = n[0].hypot(n[1]);
+        let dots = self.hull.iter().map(|v| (v[0] * n[0] + v[1] * n[1]) / len);
+        let (lo, hi) = dots.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)));
+        hi - lo
+    }
+
+    /// The extent along `n` where the gap `chi` is below minus it; None otherwise, and where
+    /// `chi` or `n` is not a number or `n` is zero (the data watch names those).
+    fn overlapped(&self, chi: f64, n: [f64; 2]) -> Option<f64> {
+        let extent = self.along(n);
+        (extent.is_finite() && chi < -extent).then_some(extent)
+    }
 }
 
 /// The mesh vertex at parameter `t` of boundary edge `edge`, if `t` is one of its ends.

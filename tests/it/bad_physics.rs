@@ -98,17 +98,18 @@ fn the_adaptive_loop_and_a_study_refuse_it_too() {
 
 #[test]
 fn a_gap_deeper_than_the_body_is_refused() {
-    // the unit square's diameter is sqrt(2) = 1.414...
-    let (code, err) = run("deep", SQUARE, r#"chi = "0.001""#, r#"chi = "-1.5""#, SOLVE);
+    // the unit square is 1 thick along its contact side's normal (battery 11, N2: the bound was
+    // the bounding box's diameter, sqrt(2) = 1.414..., which let -1.4 through)
+    let (code, err) = run("deep", SQUARE, r#"chi = "0.001""#, r#"chi = "-1.4""#, SOLVE);
     assert_eq!(code, 1, "{err}");
     assert!(
         err.contains("the gap `contact.chi` at (")
-            && err.contains("is -1.5")
+            && err.contains("is -1.4")
             && err.contains("more than the body's size")
-            && err.contains("1.414"),
+            && err.contains("over the mesh's vertices, 1)"),
         "{err}"
     );
-    let (code, err) = run("shallow", SQUARE, r#"chi = "0.001""#, r#"chi = "-1.4""#, SOLVE);
+    let (code, err) = run("shallow", SQUARE, r#"chi = "0.001""#, r#"chi = "-0.9""#, SOLVE);
     assert_eq!(code, 0, "{err}");
 }
 
