@@ -806,6 +806,12 @@ fn drift_outcome(report: &study::drift::DriftReport, against: Option<&std::path:
         }
         (0, Some(dir)) => {
             println!("drift: none ({studies} of {} compared with {} at every level{not_compared})", dir.display(), results.display());
+            if report.self_comparison {
+                println!(
+                    "note: {} is the stored results folder itself: each record was compared with itself and nothing was rerun; this checks that the folder reads back, not its numbers (a study page does not quote it as a drift check)",
+                    dir.display()
+                );
+            }
             Ok(())
         }
         (rows, None) => bail!(

@@ -61,6 +61,9 @@ fn drift_status(report: Option<&serde_json::Value>, study: &str, runs: &[RunReco
     };
     let stale = entry.and_then(|e| records_not_compared(e, runs));
     match entry {
+        Some(_) if r["self_comparison"].as_bool() == Some(true) => {
+            format!("not checked: the drift report of {date}{against} compared this folder with itself (nothing was rerun)")
+        }
         None => format!("not checked in the drift report of {date}{against} (it did not include this study)"),
         Some(_) if let Some(why) = stale => format!("not checked: the drift report of {date}{against} {why}"),
         Some(e) => match e["drift"].as_u64() {

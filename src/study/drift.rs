@@ -557,6 +557,16 @@ pub struct DriftReport {
     /// With `against`: the declared studies the folder does not hold, which were not compared.
     #[serde(default)]
     pub not_compared: Vec<String>,
+    /// `against` is the stored results folder itself (the same folder by another path, a
+    /// symlink): every record was compared with itself. That checks the folder's readers, not
+    /// its numbers, and a study page never quotes it as a rerun (battery 11, N1).
+    #[serde(default)]
+    pub self_comparison: bool,
+}
+
+/// Whether `against` and `results` are one folder (after resolving symlinks and `.`/`..`).
+pub fn same_folder(against: &Path, results: &Path) -> bool {
+    matches!((against.canonicalize(), results.canonicalize()), (Ok(a), Ok(r)) if a == r)
 }
 
 impl DriftReport {
@@ -734,6 +744,7 @@ pub fn check(
         rows: Vec::new(),
         changes: BTreeMap::new(),
         not_compared,
+        self_comparison: opts.against.as_deref().is_some_and(|a| same_folder(a, &opts.results)),
     };
     // a deep study in its tiers (unless --deep): quick forms, some runs to the end
     let planned: Vec<(Manifest, bool)> = manifests

@@ -9,6 +9,9 @@
 //!   as the deformation, yet the solve was certified and an estimate printed; one decision
 //!   (`adapt::resolution`) now makes `solve` warn where the estimate is at round-off and refuse
 //!   (as every level of `adapt` does) where the round-off exceeds 1e-2 of the deformation above it.
+//! * N1: `drift --against` the stored folder itself (the same path, `./DIR/`, a symlink) compared
+//!   every record with itself and said "no drift", and the study page quoted it as a rerun; drift
+//!   now says so, and the page says "not checked".
 
 use super::common::{scratch, signorini_in};
 
@@ -77,4 +80,28 @@ fn a_rigid_translation_that_drowns_the_deformation_in_round_off_is_not_silent() 
     let (code, out, err) = signorini_in(&dir, &["solve", "--problem", "rt.toml", "--mesh", "structured:8"]);
     assert_eq!(code, 0, "{out}{err}");
     assert!(!err.contains("warning"), "{err}");
+}
+
+#[test]
+fn drift_against_the_stored_folder_itself_says_so_and_the_page_does_not_quote_it() {
+    let dir = scratch("b11-self");
+    std::fs::create_dir_all(dir.join("exp")).unwrap();
+    std::fs::write(
+        dir.join("exp/st.toml"),
+        "description = \"N1\"\n[defaults]\nproblem = \"ex72\"\nmesh = \"structured:4\"\n[[run]]\nid = \"a\"\nlevels = 2\n",
+    )
+    .unwrap();
+    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "x"]);
+    assert_eq!(code, 0, "{err}");
+    std::os::unix::fs::symlink(dir.join("x"), dir.join("link")).unwrap();
+    for against in ["x", "./x/", "link"] {
+        let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "exp", "--against", against, "--results", "x"]);
+        assert_eq!(code, 0, "{against}: {out}{err}");
+        assert!(out.contains("is the stored results folder itself") && out.contains("nothing was rerun"), "{against}: {out}");
+    }
+    let (code, _, err) = signorini_in(&dir, &["report", "--experiments", "exp", "--results", "x"]);
+    assert_eq!(code, 0, "{err}");
+    let page = std::fs::read_to_string(dir.join("x/report/st.html")).unwrap();
+    assert!(page.contains("compared this folder with itself") && !page.contains("<b>no drift</b>"), "{page}");
+    std::fs::remove_dir_all(&dir).ok();
 }
