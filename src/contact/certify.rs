@@ -106,12 +106,20 @@ pub struct KktInput<'a> {
     pub active: &'a [bool],
 }
 
+impl KktInput<'_> {
+    /// s_i = |F_i| + (sum_T |K_T| |u|)_i + (sum_T |K_T| 1)_i max|u| (module docs): the scale of
+    /// r_i's round-off, against which the equations and the sign are judged.
+    pub fn scale(&self, i: usize) -> f64 {
+        self.rhs[i].abs() + self.magnitude[i] + self.row_norm[i] * self.u_max
+    }
+}
+
 /// Check the KKT conditions (module docs) and return their relative values, or the error naming
 /// the first condition (in the order equations, sign, penetration, complementarity) that exceeds
 /// `tolerance`, with the point where it is worst.
 pub fn certify(input: &KktInput, tolerance: f64) -> Result<Certificate, KktError> {
-    let KktInput { nodes, dofs, rhs, ku, magnitude, row_norm, u_max, normal_displacement, active } = *input;
-    let scale = |i: usize| rhs[i].abs() + magnitude[i] + row_norm[i] * u_max;
+    let KktInput { nodes, dofs, rhs, ku, normal_displacement, active, .. } = *input;
+    let scale = |i: usize| input.scale(i);
     // |a| / s, with 0 / 0 = 0 (a row without terms) and a / 0 = inf
     let relative = |a: f64, s: f64| if a == 0.0 { 0.0 } else { a / s };
     let mut node_of = vec![usize::MAX; dofs.n_free];

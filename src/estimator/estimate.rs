@@ -20,8 +20,9 @@
 //! Gamma_{p,I} is the set of interior edges through p (the edge itself for a midpoint);
 //! Gamma_{p,N} and Gamma_{p,C} are the Neumann and contact edges of the patch's elements.
 //! Lambda_h^C is the union of Gamma_{p,C} over contact nodes with positive discrete contact force
-//! lambda_p = <lambda_h, psi_p n>_h (Theorem 6.1); "positive" means above `LAMBDA_POSITIVE` times
-//! the scale of nodal forces max(|F|, |K u_h|), since inactive nodes carry round-off. Vector norms are the largest component.
+//! lambda_p = <lambda_h, psi_p n>_h (Theorem 6.1); "positive" means above its own round-off and
+//! above 1e-10 times the largest contact force (`DiscreteSolution::positive_forces`), since
+//! inactive nodes carry round-off. Vector norms are the largest component.
 //! Norms are maxima over a declared sampling: the element quadrature points or a dense lattice
 //! (elements), Gauss points or equispaced points with the end points (edges).
 
@@ -35,8 +36,6 @@ use crate::mesh::{Mesh, dist};
 use crate::problems::{Part, Problem};
 use rayon::prelude::*;
 
-/// Threshold, relative to the force scale, above which lambda_p counts as positive (Lambda_h^C).
-pub const LAMBDA_POSITIVE: f64 = 1e-10;
 /// Gauss points per edge for the "quadrature" sampling of edge terms.
 pub const EDGE_GAUSS: usize = crate::contact::sampling::EDGE_GAUSS;
 
@@ -291,7 +290,8 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
     let local = local::element_locals(mesh, problem, sol, config, &stress, &edge_s);
     let jump = local::interior_jumps(mesh, sol, &stress, &edge_s);
     let patches = Patches::new(mesh, sol);
-    let positive = |p: usize| sol.dofs.contact_index[p].is_some_and(|k| sol.lambda[k] > LAMBDA_POSITIVE * sol.force_scale);
+    let positive_forces = sol.positive_forces();
+    let positive = |p: usize| sol.dofs.contact_index[p].is_some_and(|k| positive_forces[k]);
     let lambda_c = LambdaC::new(mesh, sol, config, &positive);
     let (h_min, _) = mesh.h_range();
     let l_h = config.log_factor.value(h_min);

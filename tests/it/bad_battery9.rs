@@ -3,6 +3,10 @@
 //!   (`target/drift/full`); each started its studies over while the other compared, and one
 //!   reported stored runs as missing (a false drift, exit 1). The scratch folder is locked for
 //!   the whole command: the second waits, saying who holds it, and both find no drift.
+//! * S1: a rigid translation of the Dirichlet data and the gap by 3e7 times the deformation
+//!   hid every contact force from eta_7 (positive meant 1e-10 of max(|F|, |K u|), which grows
+//!   with the translation); positive now means above the force's own round-off bound and 1e-10
+//!   of the largest contact force.
 //! * S3: an exact solution large against its variation (u = (0.5 - 1e-9 x, 0)) was refused as
 //!   a gradient contradiction, blaming an `exact.grad` the file does not write: two difference
 //!   quotients agreed by chance far below their round-off. A mismatch must now exceed the
@@ -68,6 +72,36 @@ fn two_drifts_in_one_checkout_take_turns_and_neither_reports_a_false_drift() {
         o2.contains("the scratch folder target/drift/full is being written by process") && o2.contains("waiting for it to finish"),
         "{o2}"
     );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The estimator's seven terms from `solve`'s output.
+fn etas(out: &str) -> Vec<f64> {
+    let line = out.lines().find(|l| l.starts_with("estimator: eta1..7 = ")).unwrap_or_else(|| panic!("{out}"));
+    line["estimator: eta1..7 = ".len()..].split(',').next().unwrap().split_whitespace().map(|v| v.parse().unwrap()).collect()
+}
+
+#[test]
+fn a_rigid_translation_of_the_data_keeps_the_contact_forces_of_eta_7() {
+    let dir = scratch("battery9-s1");
+    let plain = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/problems/ex72.toml")).unwrap();
+    let mut seen = Vec::new();
+    for t in ["0", "3e6", "1e9"] {
+        let text = plain
+            .replace("dirichlet = [0.1, 0]", &format!("dirichlet = [\"{t} + 0.1\", \"0\"]"))
+            .replace("chi = \"-0.2", &format!("chi = \"{t} - 0.2"));
+        assert!(text.contains(&format!("chi = \"{t} - 0.2")), "{text}");
+        std::fs::write(dir.join("shifted.toml"), text).unwrap();
+        let (code, out, err) = signorini_in(&dir, &["solve", "--problem", "shifted.toml", "--mesh", "structured:8"]);
+        assert_eq!(code, 0, "{t}: {err}");
+        seen.push(etas(&out));
+    }
+    let eta7 = |e: &Vec<f64>| e[6];
+    assert!(eta7(&seen[0]) > 1e-3, "{seen:?}");
+    for e in &seen[1..] {
+        // a translation by 1e9 leaves u_h about 7 significant digits of the deformation
+        assert!((eta7(e) - eta7(&seen[0])).abs() <= 1e-3 * eta7(&seen[0]), "eta_7 moved by the translation: {seen:?}");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
 

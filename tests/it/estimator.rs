@@ -264,6 +264,7 @@ fn check_scaling(problem: &dyn Problem, spec: &str) {
     sol_k.u = sol.u.iter().map(|u| [K * u[0], K * u[1]]).collect();
     // lambda_h scales by k as well (the set Lambda_h^C of positive forces does not change)
     sol_k.lambda = sol.lambda.iter().map(|l| K * l).collect();
+    sol_k.lambda_floor = sol.lambda_floor.iter().map(|l| K * l).collect();
     sol_k.force_scale = K * sol.force_scale;
     // (b) the discrete solution of the scaled problem
     let sol_s = solve_on(&scaled, &m);

@@ -35,10 +35,26 @@ pub fn assert_kkt(problem: &dyn Problem, spec: &str) {
     assert!(k.max_inactive_lambda <= 1e-10 * k.force_scale, "{name}: lambda off the active set {:e}", k.max_inactive_lambda);
     assert!(k.max_complementarity <= 1e-10 * k.force_scale, "{name}: complementarity {:e}", k.max_complementarity);
     assert!(sol.free_residual < 1e-10, "{name}: equations at free nodes {:e}", sol.free_residual);
+    // the round-off bound of a contact force holds where the force is round-off: off the
+    // active set (what Lambda_h^C, and so eta_7, counts rests on it)
+    assert_inactive_forces_within_roundoff(&sol, &name);
     // active nodes are exactly in contact
     for (i, c) in sol.dofs.contact.iter().enumerate() {
         if sol.active[i] {
             assert!((sol.normal_displacement(i) - c.gap).abs() < 1e-12, "{name}: active node not on the obstacle");
+        }
+    }
+}
+
+/// Off the active set a contact force is round-off: below its bound `lambda_floor`, and so not
+/// counted as positive (Lambda_h^C, eta_7 rest on it).
+pub fn assert_inactive_forces_within_roundoff(sol: &DiscreteSolution, name: &str) {
+    let positive = sol.positive_forces();
+    for (i, &active) in sol.active.iter().enumerate() {
+        if !active {
+            let (l, floor) = (sol.lambda[i], sol.lambda_floor[i]);
+            assert!(l.abs() <= floor, "{name}: inactive lambda {l:e} above its round-off bound {floor:e}");
+            assert!(!positive[i], "{name}: an inactive node counted as a positive force");
         }
     }
 }
