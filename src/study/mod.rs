@@ -184,7 +184,7 @@ fn set_up(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &RunOpt
         // (--fresh holds every run's lock: none is computed by another process)
         writer.refuse_foreign_runs_in_progress(manifest)?;
     }
-    let checked = store.check()?;
+    let checked = writer.check()?;
     let mut runs = checked.runs;
     writer.remove_orphans(&runs)?;
     let mut stale = store::stale::damaged(&checked.faults);

@@ -12,6 +12,11 @@
 //! * N1: `drift --against` the stored folder itself (the same path, `./DIR/`, a symlink) compared
 //!   every record with itself and said "no drift", and the study page quoted it as a rerun; drift
 //!   now says so, and the page says "not checked".
+//! * N5: `drift --against W`, `report --results W` and `figures --results W` while `run --fresh`
+//!   rewrote W reported both runs as drifted ("run present -> (missing)", with the advice to
+//!   rerun W with --fresh), "W holds no study", or a missing run. Every reader now asks the
+//!   folder's locks first (`study::store::Store::check`, shared and without waiting) and names
+//!   the process that writes it.
 
 use super::common::{scratch, signorini_in};
 
@@ -103,5 +108,52 @@ fn drift_against_the_stored_folder_itself_says_so_and_the_page_does_not_quote_it
     assert_eq!(code, 0, "{err}");
     let page = std::fs::read_to_string(dir.join("x/report/st.html")).unwrap();
     assert!(page.contains("compared this folder with itself") && !page.contains("<b>no drift</b>"), "{page}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A study of one run that takes a few seconds (Example 7.1, 19 adaptive levels from
+/// structured:8), so that readers reliably start while it is computed again.
+const N5_STUDY: &str =
+    "description = \"battery 11 N5\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:8\"\n[[run]]\nid = \"a\"\nlevels = 19\n";
+
+#[test]
+fn readers_of_a_folder_being_written_name_the_writer_instead_of_a_verdict() {
+    let dir = scratch("b11-n5");
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    std::fs::write(dir.join("experiments/s.toml"), N5_STUDY).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "res"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "w"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let writer = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["run", "experiments/s.toml", "--results", "w", "--fresh"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let checkpoint = dir.join("w/s/.partial/a.json");
+    let start = std::time::Instant::now();
+    while !checkpoint.exists() {
+        assert!(start.elapsed().as_secs() < 120, "{} never appeared", checkpoint.display());
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let named = format!("is being written by process {}", writer.id());
+    let readers: [&[&str]; 3] = [
+        &["drift", "--study", "s", "--results", "res", "--against", "w", "--report", "drift.json"],
+        &["report", "--results", "w", "--out", "page"],
+        &["figures", "--results", "w"],
+    ];
+    for args in readers {
+        let (code, out, err) = signorini_in(&dir, args);
+        assert_ne!(code, 0, "{args:?} read a folder being written: {out}{err}");
+        assert!(err.contains(&named) && !err.contains("missing") && !err.contains("holds no study"), "{args:?}: {err}");
+    }
+    assert!(!dir.join("drift.json").exists() && !dir.join("w/drift-report.json").exists(), "a drift report of a folder being written");
+    let status = { writer }.wait().unwrap();
+    assert!(status.success());
+    // written, the folder reads: the same run again, no drift
+    let (code, out, err) = signorini_in(&dir, &["drift", "--study", "s", "--results", "res", "--against", "w", "--report", "drift.json"]);
+    assert_eq!(code, 0, "{out}{err}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -208,6 +208,53 @@ fn own(mut file: std::fs::File, path: &Path) -> Result<Lock> {
     Ok(Lock { _file: file })
 }
 
+/// A study folder another process is writing, found by a reader: what it writes, who, and the
+/// lock that says so. Its records are what the writer has not finished changing (`run --fresh`
+/// has removed them, a run's record is not there yet), so a reader names the writer instead of
+/// reporting them as missing or drifted (battery 11, N5).
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "{what} is being written by {holder}: what it holds now is not what it will hold, so nothing was read; run this again when that process has finished (the lock is {})",
+    lock.display()
+)]
+pub struct BeingWritten {
+    pub what: String,
+    pub holder: String,
+    pub lock: PathBuf,
+}
+
+/// The writer of `dir`, if another process writes it now: the holder of the study lock, or else
+/// of a run lock. A reader asks before it reads ([`super::Store::check`]), taking each lock
+/// *shared* and without waiting, so readers never block one another; the run locks are looked
+/// at under the shared study lock, which a process takes exclusively to claim a run lock
+/// ([`Lock::run`]): a reader's look never makes a run's owner find its lock taken. Lock files
+/// are opened for reading and never made: a reader changes nothing (a read-only checkout stays
+/// readable). A process that holds a lock of the folder itself must not ask (its own lock
+/// would count): writers check through their guard ([`super::Writer::check`]).
+pub(super) fn writer_of(dir: &StudyDir) -> Option<BeingWritten> {
+    let shared = |path: &Path| -> Option<Result<std::fs::File, std::fs::File>> {
+        let file = std::fs::File::open(path).ok()?;
+        Some(match file.try_lock_shared() {
+            Err(std::fs::TryLockError::WouldBlock) => Err(file),
+            _ => Ok(file),
+        })
+    };
+    let written =
+        |mut file: std::fs::File, path: &Path, what: String| BeingWritten { what, holder: holder(&mut file), lock: path.to_path_buf() };
+    let study = dir.root.join(".lock");
+    let _study = match shared(&study) {
+        Some(Err(file)) => return Some(written(file, &study, dir.root.display().to_string())),
+        held => held,
+    };
+    for id in runs_of(dir, std::iter::empty()) {
+        let path = run_lock_file(dir, &id);
+        if let Some(Err(file)) = shared(&path) {
+            return Some(written(file, &path, format!("run {id} of {}", dir.root.display())));
+        }
+    }
+    None
+}
+
 fn run_lock_file(dir: &StudyDir, id: &str) -> PathBuf {
     dir.root.join(".locks").join(format!("{id}.lock"))
 }

@@ -24,7 +24,7 @@
 pub mod check;
 pub mod checkpoint;
 mod lock;
-pub use lock::{Held, scratch_folder};
+pub use lock::{BeingWritten, Held, scratch_folder};
 pub mod shelf;
 pub mod stale;
 pub mod write;
@@ -183,12 +183,22 @@ impl Store {
         serde_json::from_str(&text).with_context(|| format!("reading {}", file.display()))
     }
 
+    /// [`Store::scan`] for a reader: refused first, naming the process, if another process
+    /// writes the folder now ([`BeingWritten`]); then the folder's records and faults as they are.
+    /// A process holding a lock of the folder checks through its guard ([`Writer::check`]).
+    pub fn check(&self) -> Result<Checked> {
+        if let Some(written) = lock::writer_of(&self.dir) {
+            return Err(written.into());
+        }
+        self.scan()
+    }
+
     /// Read the folder and check that it holds together: every record's run id is its file
     /// name (so each run is stored once) and its study is this one; every mesh snapshot a record
     /// saves exists and parses, as the level it names; `levels.csv` and `provenance.json` are
     /// what the records render ([`check::summary_faults`]). A record that does not parse is an error
     /// naming it.
-    pub fn check(&self) -> Result<Checked> {
+    fn scan(&self) -> Result<Checked> {
         let files = self.dir.read_run_files().with_context(|| format!("reading the runs in {}", self.dir.root.join("runs").display()))?;
         let mut faults = Vec::new();
         for (file, text, record) in &files {

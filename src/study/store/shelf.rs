@@ -92,14 +92,19 @@ impl Shelf {
         self.studies.get(study).map_or(&[], |s| &s.not_as_declared)
     }
 
-    /// The studies under `results` (folders holding a `runs/` folder), by name: what
-    /// [`Shelf::open`] is given for a whole folder.
+    /// The studies under `results` (folders holding a `runs/` folder, or one another process
+    /// writes now: `run --fresh` removes `runs/` before it writes it again, and a reader then
+    /// names that process, through [`Store::check`], rather than finding no study), by name:
+    /// what [`Shelf::open`] is given for a whole folder.
     pub fn in_folder(results: &Path) -> std::io::Result<Vec<String>> {
         let read = std::fs::read_dir(results).map_err(|e| std::io::Error::new(e.kind(), format!("reading {}: {e}", results.display())))?;
         let mut out = Vec::new();
         for e in read {
             let e = e?;
-            if e.path().join("runs").is_dir() {
+            let d = e.path();
+            if d.join("runs").is_dir()
+                || super::lock::writer_of(&crate::records::StudyDir::new(results, &e.file_name().to_string_lossy())).is_some()
+            {
                 out.push(e.file_name().to_string_lossy().into_owned());
             }
         }

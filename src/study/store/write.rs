@@ -9,7 +9,7 @@
 
 use super::check::{files_in, orphans};
 use super::lock::Lock;
-use super::{Store, checkpoint};
+use super::{Checked, Store, checkpoint};
 use crate::records::{self, Batch, ReferenceRecord, RunRecord, StudyDir};
 use crate::study::manifest::Manifest;
 use crate::study::provenance::{self, Provenance};
@@ -66,6 +66,12 @@ impl RunWriter<'_> {
 }
 
 impl Writer<'_> {
+    /// The folder checked as a whole ([`Store::scan`]) by the process that holds its study lock
+    /// (a reader's [`Store::check`] would find this process's own locks and refuse).
+    pub fn check(&self) -> Result<Checked> {
+        self.store.scan()
+    }
+
     /// The lock of a stored run this process does not compute, to remove it: at once, or
     /// refused naming the process that computes it.
     pub fn claim_run(&self, id: &str) -> Result<RunWriter<'_>> {
@@ -236,7 +242,7 @@ impl Writer<'_> {
     /// A record at fault is left as it is, and so are the summaries (never rendered from it):
     /// `run` refuses the folder naming it.
     pub fn repair(&self, manifest: &Manifest, quick: bool) -> Result<()> {
-        let checked = self.store.check()?;
+        let checked = self.check()?;
         self.remove_orphans(&checked.runs)?;
         if checked.faults.iter().any(|f| f.record.is_some()) {
             return Ok(());
@@ -250,7 +256,7 @@ impl Writer<'_> {
     /// the commit naming it, so an edit is never rendered into `levels.csv` and then passed as
     /// sound. Faults of the summaries alone are not the records': the commit renders them anew.
     fn sound_records(&self, committing: &str) -> Result<Vec<RunRecord>> {
-        let checked = self.store.check()?;
+        let checked = self.check()?;
         let at_fault: Vec<String> =
             checked.faults.iter().filter(|f| f.record.as_deref().is_some_and(|r| r != committing)).map(|f| format!("\n  {f}")).collect();
         if !at_fault.is_empty() {
