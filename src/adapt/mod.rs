@@ -94,6 +94,16 @@ impl AdaptConfig {
         if self.stop_ndof == Some(0) {
             return bad("stop_ndof", "a number of unknowns >= 1", "0".into());
         }
+        if let (Some(stop), Some(max)) = (self.stop_ndof, self.max_ndof)
+            && stop > max
+        {
+            // the loop stops before a level above max_ndof, so no level could reach stop_ndof
+            return bad(
+                "stop_ndof",
+                &format!("a number of unknowns <= max_ndof = {max} (no level above max_ndof is solved, so this stop is never reached)"),
+                stop.to_string(),
+            );
+        }
         if !(self.theta > 0.0 && self.theta <= 1.0) {
             return bad("theta", "a number in (0, 1]", ConfigError::number(self.theta));
         }

@@ -326,7 +326,12 @@ pub fn write_pages(
     let claims =
         crate::analysis::claims::claims(shelf, roles).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
     let drift = match crate::records::read_text(drift_report) {
-        Ok(t) => Some(serde_json::from_str(&t).with_context(|| format!("reading the drift report {}", drift_report.display()))?),
+        Ok(t) => Some(serde_json::from_str(&t).with_context(|| {
+            format!(
+                "reading the drift report {} (drift writes it whole, so it was cut or edited since): run `signorini drift` to write it again, or remove it and the pages say \"not checked\"",
+                drift_report.display()
+            )
+        })?),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
         Err(e) => return Err(e).with_context(|| format!("reading the drift report {}", drift_report.display())),
     };

@@ -83,7 +83,14 @@ impl Batch {
         });
         if let Err(e) = written {
             let _ = std::fs::remove_file(&tmp);
-            return Err(step("writing", &tmp)(e));
+            // named by the file meant (the temporary name means nothing to a reader), and the
+            // folder a full disk must be cleared in
+            let what = format!(
+                "{} (through the temporary file {}, removed)",
+                path.display(),
+                tmp.file_name().unwrap_or_default().to_string_lossy()
+            );
+            return Err(std::io::Error::new(e.kind(), format!("writing {what}: {e}")));
         }
         self.staged.push((tmp, path.to_path_buf(), crate::base::digest::sha256_hex(bytes)));
         Ok(())

@@ -157,3 +157,38 @@ fn readers_of_a_folder_being_written_name_the_writer_instead_of_a_verdict() {
     assert_eq!(code, 0, "{out}{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Battery 11, a minor note: `stop_ndof` above `max_ndof` (a stop no level can reach, since no
+/// level above `max_ndof` is solved) was accepted; the one validation of the command line and
+/// the manifests refuses it, naming the key.
+#[test]
+fn a_stop_no_level_can_reach_is_refused_on_the_command_line_and_in_a_manifest() {
+    let dir = scratch("b11-stop");
+    let (code, _, err) = signorini_in(&dir, &["adapt", "--problem", "ex71", "--max-ndof", "500", "--stop-ndof", "1000"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("--stop-ndof") && err.contains("max_ndof = 500") && err.contains("never reached"), "{err}");
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    let manifest = "description = \"stop above max\"\n[defaults]\nproblem = \"ex71\"\nlevels = 5\nmax_ndof = 500\nstop_ndof = 1000\n[[run]]\nid = \"a\"\n";
+    std::fs::write(dir.join("experiments/s.toml"), manifest).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "res"]);
+    assert_ne!(code, 0, "{err}");
+    assert!(err.contains("experiments/s.toml") && err.contains("stop_ndof") && err.contains("never reached"), "{err}");
+    assert!(!dir.join("res").exists(), "a refused manifest wrote results");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Battery 11, a minor note: a cut drift report made `report` fail with the parser's words
+/// alone; the refusal now says how it came about and what to do.
+#[test]
+fn a_cut_drift_report_is_refused_with_what_to_do() {
+    let dir = scratch("b11-cut-report");
+    let repo = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::write(dir.join("cut.json"), "{\"studies\": [").unwrap();
+    // from the repository (its records name their problem files relative to it)
+    let (cut, page) = (dir.join("cut.json"), dir.join("page"));
+    let args = ["report", "--study", "ex71", "--drift-report", cut.to_str().unwrap(), "--out", page.to_str().unwrap()];
+    let (code, out, err) = signorini_in(repo, &args);
+    assert_ne!(code, 0, "{out}{err}");
+    assert!(err.contains("cut.json") && err.contains("run `signorini drift` to write it again"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

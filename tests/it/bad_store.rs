@@ -170,6 +170,8 @@ fn a_full_disk_leaves_the_folder_consistent_without_temporary_files() {
         let (code, out) = run_with(&dir, &["run", m, "--results", &results], Some(limit));
         assert_ne!(code, 0, "a limit of {limit} bytes must stop the run: {out}");
         assert!(out.contains("File too large") || out.contains("too large"), "the error names the failed write: {out}");
+        // named by the file meant, not only by its temporary name (battery 11)
+        assert!(out.contains("(through the temporary file ."), "the error names the file meant: {out}");
         let present = consistent(&dir.join(&results).join("study"));
         // the limit lifted, the study completes from what is there
         let (code, out) = signorini(&dir, &["run", m, "--results", &results]);
