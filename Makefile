@@ -4,6 +4,8 @@ CARGO ?= cargo
 # cargo builds into $(CARGO_TARGET_DIR) when it is set, target/ otherwise
 BIN := $(or $(CARGO_TARGET_DIR),target)/release/signorini
 SCRATCH := $(or $(CARGO_TARGET_DIR),target)/test-scratch
+# each step of make test timed into target/test-steps (its last line lists them)
+TIMED := scripts/timed.sh
 
 .PHONY: all build test cluster-test figures reproduce drift crosscheck bench roundoff meshes mesh clean
 
@@ -23,25 +25,25 @@ build:
 # clippy reads them, which `cargo check` and clippy share; the cross-check's Python environment):
 # the last line gives their time apart from the checks' own.
 test: build
-	@mkdir -p target && date +%s > target/test-started
+	@mkdir -p target && date +%s > target/test-started && rm -f target/test-steps
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-before-test
-	$(CARGO) build --release --locked --all-targets
-	$(CARGO) check --release --locked --all-targets
-	crosscheck/setup.sh
+	$(TIMED) build-tests $(CARGO) build --release --locked --all-targets
+	$(TIMED) check $(CARGO) check --release --locked --all-targets
+	$(TIMED) venv crosscheck/setup.sh
 	@date +%s > target/test-compiled
-	$(CARGO) fmt --check
-	$(CARGO) clippy --release --locked --all-targets -- -D warnings
+	$(TIMED) fmt $(CARGO) fmt --check
+	$(TIMED) clippy $(CARGO) clippy --release --locked --all-targets -- -D warnings
 	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || command -v google-chrome >/dev/null || [ -n "$$CHROMIUM" ] || echo "NOTE: no chromium on this machine: the browser check of the study pages (tests/it/report_page.rs) is SKIPPED (apt-get install chromium; CI installs it)"
 	@# the tests' scratch folders (std::env::temp_dir) under target/, emptied first, not left in /tmp
 	@rm -rf $(SCRATCH) && mkdir -p $(SCRATCH)
-	TMPDIR=$(abspath $(SCRATCH)) $(CARGO) test --release --locked
-	$(CARGO) run --release --locked --example own_problem
-	$(BIN) drift
-	$(BIN) report
-	SIGNORINI=$(abspath $(BIN)) CROSSCHECK_OUT=target/crosscheck-report crosscheck/run.sh
+	TMPDIR=$(abspath $(SCRATCH)) $(TIMED) cargo-test $(CARGO) test --release --locked
+	$(TIMED) example $(CARGO) run --release --locked --example own_problem
+	$(TIMED) drift $(BIN) drift
+	$(TIMED) report $(BIN) report
+	SIGNORINI=$(abspath $(BIN)) CROSSCHECK_OUT=target/crosscheck-report $(TIMED) crosscheck crosscheck/run.sh
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-after-test
 	@diff target/status-before-test target/status-after-test >/dev/null || { echo "make test changed files git sees (before/after below); test outputs belong under target/"; diff target/status-before-test target/status-after-test; exit 1; }
-	@echo "make test: PASSED in $$(( $$(date +%s) - $$(cat target/test-started) )) s after make build: $$(( $$(cat target/test-compiled) - $$(cat target/test-started) )) s compiling the tests, the example and clippy's dependencies and installing the cross-check's Python environment, then $$(( $$(date +%s) - $$(cat target/test-compiled) )) s of checks (fmt, clippy, cargo test, the example, drift: none, study pages, NGSolve cross-check; the tree unchanged)"
+	@echo "make test: PASSED in $$(( $$(date +%s) - $$(cat target/test-started) )) s after make build: $$(( $$(cat target/test-compiled) - $$(cat target/test-started) )) s compiling the tests, the example and clippy's dependencies and installing the cross-check's Python environment, then $$(( $$(date +%s) - $$(cat target/test-compiled) )) s of checks (fmt, clippy, cargo test, the example, drift: none, study pages, NGSolve cross-check; the tree unchanged). Seconds per step: $$(tr '\n' ' ' < target/test-steps)"
 
 # A one-node Slurm cluster on this machine (as root; installs slurm-wlm and munge with apt-get
 # if missing), a study submitted as an array of shards, a task cancelled mid-run, two arrays at
