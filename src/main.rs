@@ -397,14 +397,18 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
         return Err(solve::SolveError::Data(bad)).with_context(|| format!("estimating on {mesh_name}"));
     }
     est.terms.check_finite().with_context(|| format!("estimating on {mesh_name}"))?;
-    match adapt::resolution(problem.as_ref(), &sol, &est) {
+    let warnings = match adapt::resolution(problem.as_ref(), &mesh, &sol, &est) {
         adapt::Resolution::Unresolved(e) => return Err(e).with_context(|| format!("solving {} on {mesh_name}", problem.name())),
-        adapt::Resolution::AtRoundoff => say!(
-            "warning: the estimate is at the round-off of u_h: u_h is exact to round-off (a rigid motion), or a displacement far larger than its variation (a rigid translation in the data) left it no digits of the deformation; its terms measure round-off, not the discretisation error"
-        ),
-        adapt::Resolution::Resolved => {}
+        adapt::Resolution::AtRoundoff => vec![
+            "the estimate is at the round-off of u_h: u_h is exact to round-off (a rigid motion, or a field the P2 space reproduces), or a displacement far larger than its variation (a rigid translation in the data) left it no digits of the deformation; its terms measure round-off, not the discretisation error".to_string(),
+        ],
+        adapt::Resolution::Resolved(caveats) => caveats.iter().map(ToString::to_string).collect(),
+    };
+    for w in &warnings {
+        say!("warning: {w}");
     }
-    let report = report::SolveReport::new(problem.name(), &mesh_name, &mesh, &sol, error, &est, &probes)?;
+    let report =
+        report::SolveReport { warnings, ..report::SolveReport::new(problem.name(), &mesh_name, &mesh, &sol, error, &est, &probes)? };
     Ok((mesh, sol, est.element, report))
 }
 
@@ -460,6 +464,9 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
             r.pdas_iterations,
             r.t_level
         );
+        for c in l.caveats {
+            say!("warning: level {}: {c}", r.level);
+        }
         // an interrupt (SIGINT) stops after the level just printed, as `run` does
         if study::interrupted() { std::ops::ControlFlow::Break(()) } else { std::ops::ControlFlow::Continue(()) }
     })?;

@@ -5,8 +5,13 @@
 //! interrupted deep run resumes.
 
 pub mod replay;
+mod roundoff;
 
-use crate::base::number::shown;
+pub use roundoff::{
+    Caveat, NO_DEFORMATION, RESOLVED_DEFORMATION, RESOLVED_FORCES, ROUNDOFF_ESTIMATE, Resolution, Unresolved, WARNED_FORCES, WARNED_SHAPE,
+    deformation, force_roundoff, resolution,
+};
+
 use crate::contact::PdasOptions;
 use crate::contact::norms::{self, Reference};
 use crate::contact::solve::{self, DiscreteSolution, SolveError};
@@ -61,7 +66,8 @@ pub enum AdaptError {
     /// the observer).
     #[error("refining level {level} (levels 0 to {level} were solved): {error}")]
     Refine { level: usize, error: crate::mesh::MeshError },
-    /// Level `level`'s u_h does not resolve its deformation ([`resolution`]).
+    /// Level `level`'s u_h does not resolve its deformation, or its contact forces are at their
+    /// round-off ([`resolution`]).
     #[error("level {level}: {error}")]
     Unresolved { level: usize, error: Unresolved },
 }
@@ -157,99 +163,8 @@ pub struct Level<'a> {
     pub continues: bool,
     /// The active set the next level starts from, if it continues with warm starts.
     pub next_active: Option<&'a [bool]>,
-}
-
-/// The estimate is at round-off when eta_h is at most this many times (2 mu + |zeta|) delta, delta
-/// the round-off u_h carries: the larger of its measured round-off floor
-/// ([`DiscreteSolution::roundoff`], one step of iterative refinement, `roundoff_floor` in the
-/// level records) and f64::EPSILON max |u_h| (the representation of its values). eta_h for an
-/// error of size delta (the estimator's terms are stresses times lengths) is about
-/// (2 mu + |zeta|) delta: an exact discrete solution (a rigid translation) gives 6 to 24 of it
-/// (structured:4 to 128), a real estimate 1e15 and more; the deepest stored levels, with
-/// estimates down to 2.2e-5 of (2 mu + |zeta|) max |u_h| and floors near 1e-12 of it, 1e7 and
-/// more. The scale is the round-off, not the displacement: a rigid motion of the body moves
-/// max |u_h| but not the deformation the estimate measures (battery 8: a translation by 5e10 of
-/// Example 7.2 stopped at level 0 as "exact" with an accurate estimate of 8e2, 2.3e4 times its
-/// round-off scale; it is refused here as round-off only from a translation of about 1e12,
-/// where u_h's round-off reaches percents of the deformation).
-pub const ROUNDOFF_ESTIMATE: f64 = 1e3;
-
-/// The round-off u_h carries (see [`ROUNDOFF_ESTIMATE`]): invariant under rigid motions up to
-/// the representation of u_h's values.
-fn roundoff_scale(sol: &DiscreteSolution) -> f64 {
-    let u_max = sol.u.iter().fold(0.0f64, |a, v| a.max(v[0].abs()).max(v[1].abs()));
-    sol.roundoff.max(f64::EPSILON * u_max)
-}
-
-/// Whether `est`'s eta_h is at round-off ([`ROUNDOFF_ESTIMATE`]): its indicators are noise, and
-/// the maximum strategy marks nothing (the loop stops, `AdaptTermination::NothingMarked`).
-fn estimate_at_roundoff(problem: &dyn Problem, sol: &DiscreteSolution, est: &Estimate) -> bool {
-    let m = problem.material();
-    est.terms.eta_h <= ROUNDOFF_ESTIMATE * (2.0 * m.mu + m.zeta.abs()) * roundoff_scale(sol)
-}
-
-/// The largest share of the deformation's size the round-off of u_h may reach while the
-/// estimate is above round-off ([`resolution`]): beyond it u_h keeps fewer than 2 digits of the
-/// deformation, and the contact set and the estimate are the round-off's (battery 11, N3:
-/// Example 7.2 translated rigidly by 1e12 lost an active node and eta_7, by 1e16 every active
-/// node, all certified; both are now estimates at round-off, which `solve` says and at which
-/// `adapt` stops). Not 1e-3: Example 7.2 translated by 5e10 keeps its estimate to 1e-2 with a
-/// measured round-off of 2.6e-3 to 4.9e-3 of the deformation (`structured:8`, and level 1 from
-/// `structured:4`), and `tests/it/bad_battery8_contact.rs` holds it accepted; the stored studies
-/// stay below 1e-9 of it.
-pub const RESOLVED_DEFORMATION: f64 = 1e-2;
-
-/// The deformation's size: the spread of u_h over the P2 nodes, the largest over the two
-/// components of max - min. A rigid translation does not move it; it bounds the deformation's
-/// part of u_h from above (a rotation adds to it), so a refusal by it is never too eager.
-pub fn deformation(sol: &DiscreteSolution) -> f64 {
-    (0..2)
-        .map(|i| {
-            let (lo, hi) = sol.u.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), u| (lo.min(u[i]), hi.max(u[i])));
-            hi - lo
-        })
-        .fold(0.0, f64::max)
-}
-
-/// A solution whose round-off reaches the deformation it is meant to resolve.
-#[derive(Debug, thiserror::Error)]
-#[error(
-    "u_h does not resolve the deformation: its round-off {} is {:.1e} of the deformation's size {} (the spread of u_h over the nodes, max - min of a component; at most {RESOLVED_DEFORMATION:e} is kept), with u_h up to {} in size: a displacement that large against its variation (a rigid translation in the data) leaves u_h too few digits of the deformation, so its contact set and estimate would be round-off's. Give the data without the rigid part (subtract the translation from the Dirichlet data and the gap)",
-    shown(*.roundoff), .roundoff / .deformation, shown(*.deformation), shown(*.u_max)
-)]
-pub struct Unresolved {
-    pub roundoff: f64,
-    pub deformation: f64,
-    pub u_max: f64,
-}
-
-/// What a solve's estimate measures ([`resolution`]).
-#[derive(Debug)]
-pub enum Resolution {
-    /// The estimate measures the discretisation error.
-    Resolved,
-    /// eta_h is at u_h's round-off ([`ROUNDOFF_ESTIMATE`]): an exact discrete solution (a rigid
-    /// motion); the maximum strategy marks nothing.
-    AtRoundoff,
-    /// u_h's round-off exceeds [`RESOLVED_DEFORMATION`] of its deformation while eta_h is above
-    /// round-off: nothing of the solve is to be reported or kept.
-    Unresolved(Unresolved),
-}
-
-/// The one decision, for `solve`, every level of `adapt` and every study, of whether a solve's
-/// estimate measures the discretisation error, is round-off of an exact discrete solution, or
-/// comes from a u_h whose round-off reaches its deformation. An estimate at round-off comes first:
-/// a rigid translation with no deformation at all is exact, not unresolved.
-pub fn resolution(problem: &dyn Problem, sol: &DiscreteSolution, est: &Estimate) -> Resolution {
-    if estimate_at_roundoff(problem, sol, est) {
-        return Resolution::AtRoundoff;
-    }
-    let (roundoff, deformation) = (roundoff_scale(sol), deformation(sol));
-    if roundoff > RESOLVED_DEFORMATION * deformation {
-        let u_max = sol.u.iter().fold(0.0f64, |a, v| a.max(v[0].abs()).max(v[1].abs()));
-        return Resolution::Unresolved(Unresolved { roundoff, deformation, u_max });
-    }
-    Resolution::Resolved
+    /// What the level's numbers keep fewer digits of than they should ([`resolution`]).
+    pub caveats: &'a [Caveat],
 }
 
 /// Mark by the maximum strategy: eta_T >= theta max eta_T.
@@ -318,7 +233,7 @@ pub enum AdaptTermination {
     /// stops at the last level is reported here).
     StoppedByObserver,
     /// The estimate of the last level solved is zero on every element, or at round-off
-    /// ([`estimate_at_roundoff`]): the maximum strategy marks nothing, so the next level would
+    /// ([`Resolution::AtRoundoff`]): the maximum strategy marks nothing, so the next level would
     /// be the same mesh again (not solved).
     NothingMarked,
 }
@@ -336,7 +251,7 @@ impl AdaptTermination {
                 Some(format!("stopped: the last level has at least stop_ndof = {} unknowns", config.stop_ndof.unwrap_or(0)))
             }
             AdaptTermination::NothingMarked => Some(format!(
-                "stopped: the estimate is zero, or at round-off (eta_h at most {ROUNDOFF_ESTIMATE:e} (2 mu + lambda) delta, delta the round-off of u_h: the larger of its round-off floor and 2.2e-16 max |u_h|; the discrete solution is exact to round-off), so nothing is marked and the next level would be the same mesh"
+                "stopped: the estimate is zero, or at round-off (u_h has no deformation above {NO_DEFORMATION} delta, or eta_h is at most {ROUNDOFF_ESTIMATE:e} (2 mu + lambda) delta, delta the round-off of u_h: the larger of its round-off floor and 2.2e-16 max |u_h|: u_h is a rigid motion or a field the P2 space reproduces, to round-off, or a rigid translation in the data left it no digits of the deformation), so nothing is marked and the next level would be the same mesh"
             )),
         }
     }
@@ -381,6 +296,8 @@ pub struct Solved {
     pub solution: DiscreteSolution,
     pub estimate: Estimate,
     pub marks: Vec<bool>,
+    /// What its numbers keep fewer digits of than they should ([`resolution`]).
+    pub caveats: Vec<Caveat>,
 }
 
 /// SOLVE, ESTIMATE and MARK on the mesh of level `level`, the contact solve started from
@@ -416,10 +333,10 @@ pub fn solve_level(
     }
     est.terms.check_finite().map_err(|error| AdaptError::Estimate { level, error })?;
     let t_estimate = t0.elapsed().as_secs_f64();
-    let at_roundoff = match resolution(problem, &sol, &est) {
+    let (at_roundoff, caveats) = match resolution(problem, mesh, &sol, &est) {
         Resolution::Unresolved(error) => return Err(AdaptError::Unresolved { level, error }),
-        Resolution::AtRoundoff => true,
-        Resolution::Resolved => false,
+        Resolution::AtRoundoff => (true, Vec::new()),
+        Resolution::Resolved(caveats) => (false, caveats),
     };
     let error = reference.map(|r| norms::linf_error(mesh, &sol, r));
     let marks = match config.refine {
@@ -470,7 +387,7 @@ pub fn solve_level(
         t_roundoff: sol.timings.roundoff,
         mem_peak_mib: None,
     };
-    Ok(Solved { record, solution: sol, estimate: est, marks })
+    Ok(Solved { record, solution: sol, estimate: est, marks, caveats })
 }
 
 /// Run the loop from `mesh`. `reference` gives the displacement errors are measured against
@@ -540,7 +457,7 @@ pub fn run_from(
         let previous = records.last().and_then(LevelRecord::measured_peak);
         let measured = crate::base::memory::reset_peak_resident();
         let started_from = initial_active.take().filter(|_| config.warm_start);
-        let Solved { mut record, solution: sol, estimate: est, marks } =
+        let Solved { mut record, solution: sol, estimate: est, marks, caveats } =
             solve_level(problem, &mesh, level, config, reference, started_from.clone(), previous)?;
         let entry = LevelHistory {
             level,
@@ -572,6 +489,7 @@ pub fn run_from(
             history: &entry,
             continues: next.is_some(),
             next_active: next.as_ref().and_then(|n| n.as_ref().ok()).and_then(|(_, a)| a.as_deref()),
+            caveats: &caveats,
         });
         records.push(record);
         history.levels.push(entry);

@@ -14,6 +14,7 @@ pub mod locate;
 mod msh_nodes;
 mod msh_sections;
 pub mod overlap;
+pub mod precision;
 pub mod refine;
 
 use crate::problems::{Curve, Part, Problem};
@@ -113,6 +114,13 @@ pub enum MeshError {
         crate::base::number::point([*.x, *.y])
     )]
     Overlap { a: usize, b: usize, x: f64, y: f64 },
+    /// The coordinates are so large against an element that its shape keeps fewer than 3
+    /// digits ([`precision::SHAPE_ROUNDOFF_REFUSED`]).
+    #[error(
+        "triangle {t} lies at coordinates up to {} but is only {} high: f64 keeps its shape to {delta:.1e} of its size (2.2e-16 x {} / {}; at most {:e} is accepted), so the element geometry, and what is computed on it, would be round-off's; translate the mesh (and the problem's data) nearer the origin",
+        crate::base::number::shown(*.offset), crate::base::number::shown(*.height), crate::base::number::shown(*.offset), crate::base::number::shown(*.height), precision::SHAPE_ROUNDOFF_REFUSED
+    )]
+    FarFromOrigin { t: usize, delta: f64, offset: f64, height: f64 },
     #[error("triangle {t} refers to vertex {v}, but the mesh has {n} vertices")]
     BadVertex { t: usize, v: usize, n: usize },
     #[error(
@@ -432,8 +440,9 @@ impl Mesh {
         min
     }
 
-    /// Check positive areas, conformity (every edge in one or two triangles), and that the tagged
-    /// edges are exactly the boundary edges: every solve, at every level. That no two triangles
+    /// Check positive areas, element shapes the coordinates resolve
+    /// ([`precision::SHAPE_ROUNDOFF_REFUSED`]), conformity (every edge in one or two triangles),
+    /// and that the tagged edges are exactly the boundary edges: every solve, at every level. That no two triangles
     /// overlap is checked where a mesh enters ([`Mesh::check_overlap`]: the Gmsh reader, which
     /// names the file's lines; a mesh built by hand should be checked with it too), not at every
     /// level: about 3 us a triangle, and refinement keeps it (bisection of a mesh without
@@ -452,6 +461,7 @@ impl Mesh {
                 return Err(MeshError::NonPositiveArea { t, area });
             }
         }
+        self.check_shape_roundoff()?;
         // every edge once per triangle, sorted: an edge's triangles are a run of equal keys (a
         // sort rather than a hash map: 5x faster on the meshes of the benchmark)
         let mut keys: Vec<(usize, usize)> = Vec::with_capacity(3 * self.triangles.len());

@@ -76,6 +76,13 @@ pub struct SolveReport {
     pub probes: Vec<Probe>,
     pub pdas_log: Vec<PdasIteration>,
     pub timings: SolveTimings,
+    /// The round-off u_h carries ([`DiscreteSolution::roundoff`], `roundoff_floor` in the level
+    /// records).
+    pub roundoff_floor: f64,
+    /// What the solve's numbers keep fewer digits of than they should, or that its estimate is
+    /// at round-off (`adapt::resolution`, which the caller asks; the same sentences `solve`
+    /// writes to standard error).
+    pub warnings: Vec<String>,
 }
 
 /// Which points the error norms are taken over.
@@ -130,6 +137,8 @@ impl SolveReport {
             probes,
             pdas_log: sol.pdas.clone(),
             timings: sol.timings.clone(),
+            roundoff_floor: sol.roundoff,
+            warnings: Vec::new(),
         })
     }
 

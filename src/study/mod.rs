@@ -524,11 +524,14 @@ fn run_one(
     let config = AdaptConfig::for_run(spec);
     let start = start_of(study, spec, run, meshes, &prepared, &config, progress)?;
     let Some(result) = loop_of(study, spec, run, meshes, &prepared, &config, start, progress)? else { return Ok(None) };
+    // why a run ended before its last level is said here, not stored (a record field would
+    // change every stored record)
+    let stopped = result.termination.note(&config).map(|note| format!(" ({note})")).unwrap_or_default();
     let (levels, history) = (result.records, result.history);
     if progress {
         let last = levels.last().expect("at least one level");
         crate::base::note::line(format_args!(
-            "{study}/{}: {} levels, final NDF {}, estimate {:.3e}",
+            "{study}/{}: {} levels, final NDF {}, estimate {:.3e}{stopped}",
             spec.id,
             levels.len(),
             last.ndof,
@@ -582,6 +585,7 @@ fn start_of(
             history: &c.history.levels[l],
             continues: true,
             next_active: None,
+            caveats: &solved.caveats,
         };
         save_level(study, spec, run, meshes, &level, problem)?;
     }
@@ -631,6 +635,9 @@ fn loop_of(
                 r.err_quadrature.map(|e| format!(" error {e:.3e}")).unwrap_or_default()
             ));
             pb.inc(1);
+            for c in level.caveats {
+                crate::base::note::line(format_args!("warning: {study}/{}: level {}: {c}", spec.id, r.level));
+            }
             let kept_level = keep_level(study, spec, run, meshes, &level, prepared).and_then(|()| {
                 kept.levels.push(r.clone());
                 kept.history.levels.push(level.history.clone());
