@@ -561,15 +561,11 @@ struct RunFlags {
 
 fn run_studies(
     manifests: &[std::path::PathBuf],
-    jobs: Option<usize>,
     shard: Option<&str>,
     results: Option<std::path::PathBuf>,
     flags: RunFlags,
 ) -> Result<()> {
     let RunFlags { quick, fresh, replace, wait, plan } = flags;
-    if let Some(j) = jobs {
-        rayon::ThreadPoolBuilder::new().num_threads(threads(j)?).build_global().context("setting the thread count")?;
-    }
     let shard = shard.map(study::parse_shard).transpose()?;
     let results = results.unwrap_or_else(|| if quick { "target/quick-results".into() } else { "results".into() });
     // parse and check every run of every manifest first: a mistake in the last one should not
@@ -653,6 +649,40 @@ fn check_quick_beside_full(manifest: &study::manifest::Manifest, results: &std::
         );
     }
     Ok(())
+}
+
+/// How many times the cores available to this process `RAYON_NUM_THREADS` may ask for: more
+/// only adds overhead (the results do not depend on the thread count), and thousands of threads
+/// make a tiny solve take minutes (battery 12, F6: 20000 threads ran a 162-unknown solve past
+/// 100 s, where 2 threads take 3 ms).
+const MAX_THREADS_PER_CORE: usize = 8;
+
+/// Build rayon's global pool once, at startup, before anything uses it: `--jobs J` of `run`
+/// ([`threads`]), else `RAYON_NUM_THREADS` as rayon reads it (a positive integer; anything else
+/// means one thread per core), refused above [`MAX_THREADS_PER_CORE`] times the cores. Built
+/// lazily, a pool that cannot start its threads (an address-space limit, a process limit) made
+/// the first parallel call panic (battery 12, F6: `RAYON_NUM_THREADS=2000` under `prlimit
+/// --as=4e9`, exit 101); here the failure is an error naming where the thread count came from.
+fn start_threads(jobs: Option<usize>) -> Result<()> {
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let env = std::env::var("RAYON_NUM_THREADS").ok().and_then(|v| v.trim().parse::<usize>().ok()).filter(|&n| n > 0);
+    let (builder, from) = match (jobs, env) {
+        (Some(j), _) => {
+            let n = threads(j)?;
+            (rayon::ThreadPoolBuilder::new().num_threads(n), format!("--jobs {j} ({n} threads)"))
+        }
+        (None, Some(n)) if n > MAX_THREADS_PER_CORE * cores => bail!(
+            "RAYON_NUM_THREADS={n} is more than {MAX_THREADS_PER_CORE} times the {cores} core(s) available to this process: the results do not depend on the thread count, and thousands of threads on a few cores only add overhead (a tiny solve can take minutes). Nothing was computed; set it to at most {} or unset it (one thread per core)",
+            MAX_THREADS_PER_CORE * cores
+        ),
+        (None, Some(n)) => (rayon::ThreadPoolBuilder::new(), format!("RAYON_NUM_THREADS={n}")),
+        (None, None) => (rayon::ThreadPoolBuilder::new(), format!("one thread per core ({cores})")),
+    };
+    builder.build_global().map_err(|e| {
+        anyhow::anyhow!(
+            "starting the solver's threads ({from}) failed: {e}. An address-space limit (ulimit -v) or a limit on processes (ulimit -u) can stop threads from starting; nothing was computed. Ask for fewer threads (RAYON_NUM_THREADS, at least 1) or raise the limit"
+        )
+    })
 }
 
 /// The thread count for `--jobs J`: at least 1; more than the cores available to this process
@@ -1066,7 +1096,11 @@ fn main() -> ExitCode {
     if matches!(cli.command, Command::Run { .. } | Command::Drift { .. } | Command::Adapt(_)) {
         install_interrupt_handler();
     }
-    let result = match &cli.command {
+    let jobs = match &cli.command {
+        Command::Run { jobs, .. } => *jobs,
+        _ => None,
+    };
+    let result = start_threads(jobs).and_then(|()| match &cli.command {
         Command::Solve { args, json } => run_solve(args).map(|(_, _, _, r)| {
             if *json {
                 println!("{}", serde_json::to_string_pretty(&r).expect("a report serialises"));
@@ -1082,15 +1116,15 @@ fn main() -> ExitCode {
             let report = report.as_deref().map(|f| ReportFile { path: f, merge: *merge });
             run_drift(*quick, *deep, against.as_deref(), report, accept, study, experiments, results)
         }
-        Command::Run { manifests, quick, jobs, shard, fresh, replace, results, wait, plan } => {
+        Command::Run { manifests, quick, jobs: _, shard, fresh, replace, results, wait, plan } => {
             let flags = RunFlags { quick: *quick, fresh: *fresh, replace: *replace, wait: *wait, plan: *plan };
-            run_studies(manifests, *jobs, shard.as_deref(), results.clone(), flags)
+            run_studies(manifests, shard.as_deref(), results.clone(), flags)
         }
         Command::Export { args, out } => run_export(args, out),
         Command::Report { results, figures, out, study, drift_report, experiments } => {
             run_report(results.as_deref(), figures.as_deref(), out.as_deref(), study, drift_report.as_deref(), experiments)
         }
-    };
+    });
     // what was computed and kept stays; output that could not be written is an error
     let result = result.and_then(|()| stdout_result().map_err(|e| anyhow::anyhow!("writing standard output: {e}")));
     match result {
