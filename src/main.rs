@@ -559,12 +559,7 @@ struct RunFlags {
     plan: bool,
 }
 
-fn run_studies(
-    manifests: &[std::path::PathBuf],
-    shard: Option<&str>,
-    results: Option<std::path::PathBuf>,
-    flags: RunFlags,
-) -> Result<()> {
+fn run_studies(manifests: &[std::path::PathBuf], shard: Option<&str>, results: Option<std::path::PathBuf>, flags: RunFlags) -> Result<()> {
     let RunFlags { quick, fresh, replace, wait, plan } = flags;
     let shard = shard.map(study::parse_shard).transpose()?;
     let results = results.unwrap_or_else(|| if quick { "target/quick-results".into() } else { "results".into() });
