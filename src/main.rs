@@ -191,7 +191,8 @@ enum Command {
         #[arg(long, value_name = "STUDY")]
         study: Vec<String>,
         /// The drift report the pages quote [default: target/drift/report.json, or
-        /// DIR/drift-report.json with --results DIR].
+        /// DIR/drift-report.json with --results DIR, and every target/drift/report*.json drift
+        /// wrote: each page quotes the newest that covers its study].
         #[arg(long, value_name = "FILE")]
         drift_report: Option<std::path::PathBuf>,
         /// Folder of the study manifests, whose run roles the CLAIMS rows read.
@@ -797,6 +798,19 @@ fn default_report(quick: bool, against: Option<&std::path::Path>, only: &[String
     }
 }
 
+/// The reports `drift` wrote under `target/drift/` by default ([`default_report`] without
+/// --against: `report[_quick][-STUDY...].json`), sorted by name: what `report` reads besides its
+/// default, so that the command a page advises makes it "checked".
+fn written_drift_reports() -> Vec<std::path::PathBuf> {
+    let Ok(dir) = std::fs::read_dir("target/drift") else { return Vec::new() };
+    let mut files: Vec<std::path::PathBuf> = dir
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("report") && n.ends_with(".json")))
+        .collect();
+    files.sort();
+    files
+}
+
 /// The verdict line of a drift run: none, or what moved and what to do about it.
 fn drift_outcome(report: &study::drift::DriftReport, against: Option<&std::path::Path>, results: &std::path::Path) -> Result<()> {
     let n = report.studies.len();
@@ -834,6 +848,14 @@ fn drift_outcome(report: &study::drift::DriftReport, against: Option<&std::path:
             if report.self_comparison {
                 println!(
                     "note: {} is the stored results folder itself: each record was compared with itself and nothing was rerun; this checks that the folder reads back, not its numbers (a study page does not quote it as a drift check)",
+                    dir.display()
+                );
+            } else if !report.copies.is_empty() {
+                say!(
+                    "note: the records of {} in {} are byte-identical to the stored ones, timings (t_*) included: no rerun reproduces timings, so {} is a copy of the stored folder, not a rerun; this checks that the copy reads back, not its numbers (a study page does not quote it as a drift check). To check the numbers, rerun into it: `signorini run experiments/STUDY.toml --fresh --results {}`",
+                    report.copies.join(", "),
+                    dir.display(),
+                    dir.display(),
                     dir.display()
                 );
             }
@@ -1024,7 +1046,25 @@ fn run_report(
     let figures = figures.map_or_else(|| under("figures", "figures"), |f| f.to_path_buf());
     let out = out.map_or_else(|| under("target/report", "report"), |o| o.to_path_buf());
     output_folder("--out", &out, "report writes its pages into a folder there")?;
-    let drift = drift_report.map_or_else(|| under("target/drift/report.json", "drift-report.json"), |d| d.to_path_buf());
+    // --drift-report FILE alone; by default the default report and every one drift writes under
+    // target/drift/, each page quoting the newest that covers its study
+    let files = match drift_report {
+        Some(d) => vec![d.to_path_buf()],
+        None => {
+            let default = under("target/drift/report.json", "drift-report.json");
+            let others = written_drift_reports().into_iter().filter(|f| *f != default);
+            std::iter::once(default.clone()).chain(others).collect()
+        }
+    };
+    // the command after which the page says "checked": drift of the folder the page shows
+    let mut advice = "signorini drift --study STUDY".to_string();
+    if !tracked {
+        advice += &format!(" --results {}", results.display());
+    }
+    if experiments != std::path::Path::new("experiments") {
+        advice += &format!(" --experiments {}", experiments.display());
+    }
+    let drift = signorini::page::DriftReports::read(&files, &advice)?;
     let shelf = study::store::Shelf::open_folder(&results, &study::manifest::declared(experiments, &[])?)?;
     for page in signorini::page::write_pages(&shelf, &figures, &out, studies, &drift, &roles)? {
         println!("wrote {}", page.display());
