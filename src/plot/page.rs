@@ -125,7 +125,7 @@ fn drift_status(reports: &DriftReports, study: &str, runs: &[RunRecord]) -> Stri
             "not checked: the drift report of {date}{against} compared these records with byte-identical ones, timings included: a copy of this folder, not a rerun"
         ),
         None => format!("not checked in the drift report of {date}{against} (it did not include this study; {advice})"),
-        Some(_) if let Some(why) = stale => format!("not checked: the drift report of {date}{against} {why}"),
+        Some(_) if let Some(why) = stale => format!("not checked: the drift report of {date}{against} {why}; {advice}"),
         Some(e) => match e["drift"].as_u64() {
             Some(0) => format!("<b>no drift</b>: rerun and compared at {scope}{against} on {date}, {} run(s)", e["runs"]),
             Some(n) => format!("<b class=\"bad\">drift</b>: {n} field(s) moved ({scope}{against}, {date}); see the drift report"),
@@ -156,10 +156,7 @@ fn records_not_compared(entry: &serde_json::Value, runs: &[RunRecord]) -> Option
     };
     let (changed, gone) = sides.into_iter().map(differences).min_by_key(|(c, g)| c.len() + g.len())?;
     if !changed.is_empty() {
-        return Some(format!(
-            "predates these records or compared others (run(s) {} changed since); rerun <code>signorini drift</code>",
-            escape(&changed.join(", "))
-        ));
+        return Some(format!("predates these records or compared others (run(s) {} changed since)", escape(&changed.join(", "))));
     }
     if !gone.is_empty() {
         return Some(format!("compared run(s) {} that these records no longer hold", escape(&gone.join(", "))));
