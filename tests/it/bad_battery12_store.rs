@@ -50,9 +50,12 @@ fn grid(nx: usize, ny: usize, at: [f64; 2], size: [f64; 2]) -> Grid {
     (v, t, b)
 }
 
+/// The physical group of each side of a grid.
+type Groups<'a> = &'a dyn Fn(&str) -> &'static str;
+
 /// An MSH 4.1 file of the bodies given, each a grid with a function naming the physical group
 /// of each side; one surface group "body".
-fn msh(bodies: &[(Grid, &dyn Fn(&str) -> &'static str)]) -> String {
+fn msh(bodies: &[(Grid, Groups)]) -> String {
     let (mut nodes, mut tris, mut lines) = (Vec::new(), Vec::new(), Vec::<([usize; 2], &str)>::new());
     for ((v, t, b), group) in bodies {
         let o = nodes.len();
