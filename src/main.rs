@@ -450,7 +450,8 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
             r.h_min,
             or_dash(r.err_quadrature, true),
             r.terms.estimate,
-            or_dash(r.efficiency, false),
+            // in exponent form far from 1 (an exact solution's 5.6e14 printed 18 digits)
+            or_dash(r.efficiency, r.efficiency.is_some_and(|e| !(1e-3..1e4).contains(&e.abs()))),
             r.terms.eta1,
             r.terms.eta2,
             r.terms.eta3,
@@ -583,9 +584,14 @@ fn run_studies(manifests: &[std::path::PathBuf], shard: Option<&str>, results: O
         check_shard(&parsed, shard)?;
     }
     if plan {
+        // a study given twice (`run M.toml M.toml`) declares the same runs (checked above) and
+        // stores each run once: each listed once
+        let mut listed = std::collections::BTreeSet::new();
         for m in &parsed {
             for (_, p) in m.runs.iter().enumerate().filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1)) {
-                println!("{}/{}", m.study, p.spec.id);
+                if listed.insert((m.study.clone(), p.spec.id.clone())) {
+                    println!("{}/{}", m.study, p.spec.id);
+                }
             }
         }
         return Ok(());

@@ -15,6 +15,8 @@
 //!   a file `report` never read, so the page said "not checked" forever (and without the
 //!   `--results` the page was made with). `report` now reads every report drift writes there,
 //!   and the advice carries `--results`: after it, the page says "checked".
+//! * Minor notes: `solve --json` now carries `roundoff_floor`; `run --plan M.toml M.toml` lists
+//!   each run once; `adapt`'s efficiency column prints values far from 1 in exponent form.
 
 use super::common::{scratch, signorini_in};
 use std::path::Path;
@@ -260,5 +262,23 @@ fn the_pages_drift_advice_makes_the_next_page_checked() {
         let said = drift_paragraph(&dir.join(page));
         assert!(said.contains("<b>no drift</b>: rerun and compared at every level"), "after `{advice}`: {said}");
     }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Minor notes: `solve --json` carries u_h's round-off floor (the level records did, the JSON
+/// did not); `run --plan M.toml M.toml` listed every run twice, though the run stores each once.
+#[test]
+fn solve_json_carries_the_roundoff_floor_and_a_plan_lists_each_run_once() {
+    let dir = scratch("b12-minor");
+    let (code, out, err) = signorini_in(&dir, &["solve", "--problem", "ex72", "--mesh", "structured:4", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let floor = json["roundoff_floor"].as_f64().unwrap_or_else(|| panic!("no roundoff_floor: {out}"));
+    assert!(floor > 0.0 && floor < 1e-10, "{floor}");
+    std::fs::create_dir_all(dir.join("exp")).unwrap();
+    std::fs::write(dir.join("exp/st.toml"), STUDY.replace("levels = 3\n", "levels = 3\n[[run]]\nid = \"b\"\nlevels = 2\n")).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "exp/st.toml", "exp/st.toml", "--plan"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out, "st/a\nst/b\n");
     std::fs::remove_dir_all(&dir).ok();
 }
