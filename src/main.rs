@@ -191,7 +191,8 @@ enum Command {
         #[arg(long, value_name = "STUDY")]
         study: Vec<String>,
         /// The drift report the pages quote [default: target/drift/report.json, or
-        /// DIR/drift-report.json with --results DIR].
+        /// DIR/drift-report.json with --results DIR, and every target/drift/report*.json drift
+        /// wrote: each page quotes the newest that covers its study].
         #[arg(long, value_name = "FILE")]
         drift_report: Option<std::path::PathBuf>,
         /// Folder of the study manifests, whose run roles the CLAIMS rows read.
@@ -453,7 +454,8 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
             r.h_min,
             or_dash(r.err_quadrature, true),
             r.terms.estimate,
-            or_dash(r.efficiency, false),
+            // in exponent form far from 1 (an exact solution's 5.6e14 printed 18 digits)
+            or_dash(r.efficiency, r.efficiency.is_some_and(|e| !(1e-3..1e4).contains(&e.abs()))),
             r.terms.eta1,
             r.terms.eta2,
             r.terms.eta3,
@@ -566,17 +568,8 @@ struct RunFlags {
     plan: bool,
 }
 
-fn run_studies(
-    manifests: &[std::path::PathBuf],
-    jobs: Option<usize>,
-    shard: Option<&str>,
-    results: Option<std::path::PathBuf>,
-    flags: RunFlags,
-) -> Result<()> {
+fn run_studies(manifests: &[std::path::PathBuf], shard: Option<&str>, results: Option<std::path::PathBuf>, flags: RunFlags) -> Result<()> {
     let RunFlags { quick, fresh, replace, wait, plan } = flags;
-    if let Some(j) = jobs {
-        rayon::ThreadPoolBuilder::new().num_threads(threads(j)?).build_global().context("setting the thread count")?;
-    }
     let shard = shard.map(study::parse_shard).transpose()?;
     let results = results.unwrap_or_else(|| if quick { "target/quick-results".into() } else { "results".into() });
     // parse and check every run of every manifest first: a mistake in the last one should not
@@ -598,9 +591,14 @@ fn run_studies(
         check_shard(&parsed, shard)?;
     }
     if plan {
+        // a study given twice (`run M.toml M.toml`) declares the same runs (checked above) and
+        // stores each run once: each listed once
+        let mut listed = std::collections::BTreeSet::new();
         for m in &parsed {
             for (_, p) in m.runs.iter().enumerate().filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1)) {
-                println!("{}/{}", m.study, p.spec.id);
+                if listed.insert((m.study.clone(), p.spec.id.clone())) {
+                    println!("{}/{}", m.study, p.spec.id);
+                }
             }
         }
         return Ok(());
@@ -660,6 +658,40 @@ fn check_quick_beside_full(manifest: &study::manifest::Manifest, results: &std::
         );
     }
     Ok(())
+}
+
+/// How many times the cores available to this process `RAYON_NUM_THREADS` may ask for: more
+/// only adds overhead (the results do not depend on the thread count), and thousands of threads
+/// make a tiny solve take minutes (battery 12, F6: 20000 threads ran a 162-unknown solve past
+/// 100 s, where 2 threads take 3 ms).
+const MAX_THREADS_PER_CORE: usize = 8;
+
+/// Build rayon's global pool once, at startup, before anything uses it: `--jobs J` of `run`
+/// ([`threads`]), else `RAYON_NUM_THREADS` as rayon reads it (a positive integer; anything else
+/// means one thread per core), refused above [`MAX_THREADS_PER_CORE`] times the cores. Built
+/// lazily, a pool that cannot start its threads (an address-space limit, a process limit) made
+/// the first parallel call panic (battery 12, F6: `RAYON_NUM_THREADS=2000` under `prlimit
+/// --as=4e9`, exit 101); here the failure is an error naming where the thread count came from.
+fn start_threads(jobs: Option<usize>) -> Result<()> {
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let env = std::env::var("RAYON_NUM_THREADS").ok().and_then(|v| v.trim().parse::<usize>().ok()).filter(|&n| n > 0);
+    let (builder, from) = match (jobs, env) {
+        (Some(j), _) => {
+            let n = threads(j)?;
+            (rayon::ThreadPoolBuilder::new().num_threads(n), format!("--jobs {j} ({n} threads)"))
+        }
+        (None, Some(n)) if n > MAX_THREADS_PER_CORE * cores => bail!(
+            "RAYON_NUM_THREADS={n} is more than {MAX_THREADS_PER_CORE} times the {cores} core(s) available to this process: the results do not depend on the thread count, and thousands of threads on a few cores only add overhead (a tiny solve can take minutes). Nothing was computed; set it to at most {} or unset it (one thread per core)",
+            MAX_THREADS_PER_CORE * cores
+        ),
+        (None, Some(n)) => (rayon::ThreadPoolBuilder::new(), format!("RAYON_NUM_THREADS={n}")),
+        (None, None) => (rayon::ThreadPoolBuilder::new(), format!("one thread per core ({cores})")),
+    };
+    builder.build_global().map_err(|e| {
+        anyhow::anyhow!(
+            "starting the solver's threads ({from}) failed: {e}. An address-space limit (ulimit -v) or a limit on processes (ulimit -u) can stop threads from starting; nothing was computed. Ask for fewer threads (RAYON_NUM_THREADS, at least 1) or raise the limit"
+        )
+    })
 }
 
 /// The thread count for `--jobs J`: at least 1; more than the cores available to this process
@@ -779,6 +811,19 @@ fn default_report(quick: bool, against: Option<&std::path::Path>, only: &[String
     }
 }
 
+/// The reports `drift` wrote under `target/drift/` by default ([`default_report`] without
+/// --against: `report[_quick][-STUDY...].json`), sorted by name: what `report` reads besides its
+/// default, so that the command a page advises makes it "checked".
+fn written_drift_reports() -> Vec<std::path::PathBuf> {
+    let Ok(dir) = std::fs::read_dir("target/drift") else { return Vec::new() };
+    let mut files: Vec<std::path::PathBuf> = dir
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("report") && n.ends_with(".json")))
+        .collect();
+    files.sort();
+    files
+}
+
 /// The verdict line of a drift run: none, or what moved and what to do about it.
 fn drift_outcome(report: &study::drift::DriftReport, against: Option<&std::path::Path>, results: &std::path::Path) -> Result<()> {
     let n = report.studies.len();
@@ -816,6 +861,14 @@ fn drift_outcome(report: &study::drift::DriftReport, against: Option<&std::path:
             if report.self_comparison {
                 println!(
                     "note: {} is the stored results folder itself: each record was compared with itself and nothing was rerun; this checks that the folder reads back, not its numbers (a study page does not quote it as a drift check)",
+                    dir.display()
+                );
+            } else if !report.copies.is_empty() {
+                say!(
+                    "note: the records of {} in {} are byte-identical to the stored ones, timings (t_*) included: no rerun reproduces timings, so {} is a copy of the stored folder, not a rerun; this checks that the copy reads back, not its numbers (a study page does not quote it as a drift check). To check the numbers, rerun into it: `signorini run experiments/STUDY.toml --fresh --results {}`",
+                    report.copies.join(", "),
+                    dir.display(),
+                    dir.display(),
                     dir.display()
                 );
             }
@@ -1006,7 +1059,25 @@ fn run_report(
     let figures = figures.map_or_else(|| under("figures", "figures"), |f| f.to_path_buf());
     let out = out.map_or_else(|| under("target/report", "report"), |o| o.to_path_buf());
     output_folder("--out", &out, "report writes its pages into a folder there")?;
-    let drift = drift_report.map_or_else(|| under("target/drift/report.json", "drift-report.json"), |d| d.to_path_buf());
+    // --drift-report FILE alone; by default the default report and every one drift writes under
+    // target/drift/, each page quoting the newest that covers its study
+    let files = match drift_report {
+        Some(d) => vec![d.to_path_buf()],
+        None => {
+            let default = under("target/drift/report.json", "drift-report.json");
+            let others = written_drift_reports().into_iter().filter(|f| *f != default);
+            std::iter::once(default.clone()).chain(others).collect()
+        }
+    };
+    // the command after which the page says "checked": drift of the folder the page shows
+    let mut advice = "signorini drift --study STUDY".to_string();
+    if !tracked {
+        advice += &format!(" --results {}", results.display());
+    }
+    if experiments != std::path::Path::new("experiments") {
+        advice += &format!(" --experiments {}", experiments.display());
+    }
+    let drift = signorini::page::DriftReports::read(&files, &advice)?;
     let shelf = study::store::Shelf::open_folder(&results, &study::manifest::declared(experiments, &[])?)?;
     for page in signorini::page::write_pages(&shelf, &figures, &out, studies, &drift, &roles)? {
         println!("wrote {}", page.display());
@@ -1073,7 +1144,11 @@ fn main() -> ExitCode {
     if matches!(cli.command, Command::Run { .. } | Command::Drift { .. } | Command::Adapt(_)) {
         install_interrupt_handler();
     }
-    let result = match &cli.command {
+    let jobs = match &cli.command {
+        Command::Run { jobs, .. } => *jobs,
+        _ => None,
+    };
+    let result = start_threads(jobs).and_then(|()| match &cli.command {
         Command::Solve { args, json } => run_solve(args).map(|(_, _, _, r)| {
             if *json {
                 println!("{}", serde_json::to_string_pretty(&r).expect("a report serialises"));
@@ -1089,15 +1164,15 @@ fn main() -> ExitCode {
             let report = report.as_deref().map(|f| ReportFile { path: f, merge: *merge });
             run_drift(*quick, *deep, against.as_deref(), report, accept, study, experiments, results)
         }
-        Command::Run { manifests, quick, jobs, shard, fresh, replace, results, wait, plan } => {
+        Command::Run { manifests, quick, jobs: _, shard, fresh, replace, results, wait, plan } => {
             let flags = RunFlags { quick: *quick, fresh: *fresh, replace: *replace, wait: *wait, plan: *plan };
-            run_studies(manifests, *jobs, shard.as_deref(), results.clone(), flags)
+            run_studies(manifests, shard.as_deref(), results.clone(), flags)
         }
         Command::Export { args, out } => run_export(args, out),
         Command::Report { results, figures, out, study, drift_report, experiments } => {
             run_report(results.as_deref(), figures.as_deref(), out.as_deref(), study, drift_report.as_deref(), experiments)
         }
-    };
+    });
     // what was computed and kept stays; output that could not be written is an error
     let result = result.and_then(|()| stdout_result().map_err(|e| anyhow::anyhow!("writing standard output: {e}")));
     match result {

@@ -4,8 +4,9 @@
 //!
 //! Everything on the page is read from files the other commands wrote: the records and
 //! `provenance.json` under the results folder, the PNGs under the figures folder, CLAIMS rows
-//! recomputed from the records ([`crate::analysis::claims`]), and the drift report `signorini drift` wrote
-//! (`target/drift/report.json` by default), whose date and scope the page states.
+//! recomputed from the records ([`crate::analysis::claims`]), and the drift reports `signorini
+//! drift` wrote ([`DriftReports`]: for each study the newest that covers it), whose date and
+//! scope the page states.
 
 use crate::analysis::claims::Claim;
 use crate::analysis::studies::{self, Study};
@@ -41,12 +42,68 @@ pub fn claim_studies(id: &str) -> &'static [Study] {
     }
 }
 
+/// The drift reports the pages may quote, and the command a page advises where none covers its
+/// study. `report --drift-report FILE` quotes that file alone; by default, the default report
+/// and every one `drift` writes under `target/drift/` (`report-STUDY.json` for `drift --study
+/// STUDY`), so the command a page advises makes the next page "checked" (battery 12, F5: the
+/// advised `signorini drift --study S` wrote `target/drift/report-S.json`, which `report` never
+/// read, and the page said "not checked" forever).
+pub struct DriftReports {
+    /// The reports read, in the order given (the default or named one first).
+    reports: Vec<serde_json::Value>,
+    /// The command that checks a study, `STUDY` in place of its name.
+    advice: String,
+}
+
+impl DriftReports {
+    /// Read `files` (those that do not exist are skipped; one that cannot be read or parsed is
+    /// an error naming it); `advice` is the command a page advises, `STUDY` in place of the study.
+    pub fn read(files: &[PathBuf], advice: &str) -> anyhow::Result<DriftReports> {
+        use anyhow::Context;
+        let mut reports = Vec::new();
+        for file in files {
+            match crate::records::read_text(file) {
+                Ok(t) => reports.push(serde_json::from_str(&t).with_context(|| {
+                    format!(
+                        "reading the drift report {} (drift writes it whole, so it was cut or edited since): run `signorini drift` to write it again, or remove it and the pages say \"not checked\"",
+                        file.display()
+                    )
+                })?),
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(e) => return Err(e).with_context(|| format!("reading the drift report {}", file.display())),
+            }
+        }
+        Ok(DriftReports { reports, advice: advice.to_string() })
+    }
+
+    /// The report that speaks for `study` with the records `runs`: among those with an entry
+    /// for it, one that compared exactly these records before one that did not, then the newest
+    /// by its own date (the first given on a tie); where none has an entry, the first report.
+    fn for_study(&self, study: &str, runs: &[RunRecord]) -> Option<&serde_json::Value> {
+        let entry = |r: &serde_json::Value| r["studies"].as_array().and_then(|s| s.iter().find(|e| e["study"] == study).cloned());
+        let rank = |r: &serde_json::Value| {
+            entry(r)
+                .map(|e| (records_not_compared(&e, runs).is_none(), e["date"].as_str().or(r["date"].as_str()).unwrap_or("").to_string()))
+        };
+        let mut best: Option<(&serde_json::Value, (bool, String))> = None;
+        for r in &self.reports {
+            if let Some(k) = rank(r)
+                && best.as_ref().is_none_or(|(_, b)| k > *b)
+            {
+                best = Some((r, k));
+            }
+        }
+        best.map(|(r, _)| r).or(self.reports.first())
+    }
+}
+
 /// What the page says about drift: the report's date, whether it compared this study and what
 /// it found, for the records `runs` the page shows: a report that did not compare exactly these
 /// (by their hashes, `records` and `against_records` of its entry) says nothing about them.
-fn drift_status(report: Option<&serde_json::Value>, study: &str, runs: &[RunRecord]) -> String {
-    let Some(r) = report else {
-        return "not checked: no drift report found (run <code>signorini drift --study STUDY</code>)".replace("STUDY", &escape(study));
+fn drift_status(reports: &DriftReports, study: &str, runs: &[RunRecord]) -> String {
+    let advice = format!("run <code>{}</code>", escape(&reports.advice.replace("STUDY", study)));
+    let Some(r) = reports.for_study(study, runs) else {
+        return format!("not checked: no drift report found ({advice})");
     };
     let date = r["date"].as_str().unwrap_or("an unknown date");
     let against = r["against"].as_str().map(|a| format!(" against {}", escape(a))).unwrap_or_default();
@@ -64,8 +121,11 @@ fn drift_status(report: Option<&serde_json::Value>, study: &str, runs: &[RunReco
         Some(_) if r["self_comparison"].as_bool() == Some(true) => {
             format!("not checked: the drift report of {date}{against} compared this folder with itself (nothing was rerun)")
         }
-        None => format!("not checked in the drift report of {date}{against} (it did not include this study)"),
-        Some(_) if let Some(why) = stale => format!("not checked: the drift report of {date}{against} {why}"),
+        Some(e) if crate::study::drift::compared_a_copy(e) => format!(
+            "not checked: the drift report of {date}{against} compared these records with byte-identical ones, timings included: a copy of this folder, not a rerun"
+        ),
+        None => format!("not checked in the drift report of {date}{against} (it did not include this study; {advice})"),
+        Some(_) if let Some(why) = stale => format!("not checked: the drift report of {date}{against} {why}; {advice}"),
         Some(e) => match e["drift"].as_u64() {
             Some(0) => format!("<b>no drift</b>: rerun and compared at {scope}{against} on {date}, {} run(s)", e["runs"]),
             Some(n) => format!("<b class=\"bad\">drift</b>: {n} field(s) moved ({scope}{against}, {date}); see the drift report"),
@@ -96,10 +156,7 @@ fn records_not_compared(entry: &serde_json::Value, runs: &[RunRecord]) -> Option
     };
     let (changed, gone) = sides.into_iter().map(differences).min_by_key(|(c, g)| c.len() + g.len())?;
     if !changed.is_empty() {
-        return Some(format!(
-            "predates these records or compared others (run(s) {} changed since); rerun <code>signorini drift</code>",
-            escape(&changed.join(", "))
-        ));
+        return Some(format!("predates these records or compared others (run(s) {} changed since)", escape(&changed.join(", "))));
     }
     if !gone.is_empty() {
         return Some(format!("compared run(s) {} that these records no longer hold", escape(&gone.join(", "))));
@@ -262,13 +319,7 @@ details{margin-top:4px;color:#444}summary{cursor:pointer;color:#06c}";
 
 /// The page of `study`: `shelf` holds its records, `figures` its PNGs, `claims` every CLAIMS
 /// row (those of the study are shown), `drift` the drift report if one was found.
-pub fn study_page(
-    shelf: &Shelf,
-    figures: &Path,
-    study: &str,
-    claims: &[Claim],
-    drift: Option<&serde_json::Value>,
-) -> std::io::Result<String> {
+pub fn study_page(shelf: &Shelf, figures: &Path, study: &str, claims: &[Claim], drift: &DriftReports) -> std::io::Result<String> {
     let runs = shelf.runs(study)?;
     let rows: Vec<&Claim> = claims.iter().filter(|c| claim_studies(c.id).contains(&study)).collect();
     let mut s = String::new();
@@ -308,7 +359,7 @@ pub fn write_pages(
     figures: &Path,
     out: &Path,
     studies: &[String],
-    drift_report: &Path,
+    drift: &DriftReports,
     roles: &crate::analysis::roles::Roles,
 ) -> anyhow::Result<Vec<PathBuf>> {
     use anyhow::Context;
@@ -325,16 +376,6 @@ pub fn write_pages(
     // integrity check when the shelf was opened
     let claims =
         crate::analysis::claims::claims(shelf, roles).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
-    let drift = match crate::records::read_text(drift_report) {
-        Ok(t) => Some(serde_json::from_str(&t).with_context(|| {
-            format!(
-                "reading the drift report {} (drift writes it whole, so it was cut or edited since): run `signorini drift` to write it again, or remove it and the pages say \"not checked\"",
-                drift_report.display()
-            )
-        })?),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
-        Err(e) => return Err(e).with_context(|| format!("reading the drift report {}", drift_report.display())),
-    };
     crate::base::input::create_folder(out)?;
     let mut written = Vec::new();
     for study in &chosen {
@@ -346,7 +387,7 @@ pub fn write_pages(
                 incomplete.join(", ")
             ));
         }
-        let page = study_page(shelf, figures, study, &claims, drift.as_ref())?;
+        let page = study_page(shelf, figures, study, &claims, drift)?;
         let path = out.join(format!("{study}.html"));
         crate::records::write_atomic(&path, page.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
         written.push(path);

@@ -68,6 +68,10 @@ pub struct SolveReport {
     pub certificate_tolerance: f64,
     /// Largest |F - K u_h| over unknowns other than contact normals, relative to max |F|.
     pub free_residual: f64,
+    /// u_h's round-off floor ([`DiscreteSolution::roundoff`]: one step of iterative
+    /// refinement), as a level record's `roundoff_floor`: an estimate near it measures round-off
+    /// (the warning `solve` prints on stderr then), so a JSON reader can tell too (battery 12).
+    pub roundoff_floor: f64,
     pub error: Option<LinfError>,
     pub error_sampling: NormPoints,
     pub estimator: Terms,
@@ -126,6 +130,7 @@ impl SolveReport {
             certificate: sol.certificate,
             certificate_tolerance: crate::contact::certify::TOLERANCE,
             free_residual: sol.free_residual,
+            roundoff_floor: sol.roundoff,
             error,
             error_sampling: NormPoints {
                 quadrature: crate::contact::sampling::Sampling::Quadrature.describe(),

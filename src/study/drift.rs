@@ -562,6 +562,21 @@ pub struct DriftReport {
     /// its numbers, and a study page never quotes it as a rerun (battery 11, N1).
     #[serde(default)]
     pub self_comparison: bool,
+    /// With `against`: the studies whose records there are byte-identical to the stored ones,
+    /// timings (`t_*`) included ([`compared_a_copy`]): a copy of the stored folder, not a rerun.
+    #[serde(default)]
+    pub copies: Vec<String>,
+}
+
+/// Whether a drift report's study entry compared the stored records with records byte-identical
+/// to them (their hashes, `records` and `against_records`), timings (`t_*`) included: no rerun
+/// reproduces a run's timings, so the other folder is a copy of the stored one, or the folder
+/// itself. That checks that the copy reads back, not the numbers, and a study page never quotes
+/// it as a rerun (battery 12, F4: `drift --against` a `cp -r` copy said "no drift: rerun and
+/// compared"). The folder itself ([`same_folder`]) is the case where every record is its own copy.
+pub fn compared_a_copy(entry: &Value) -> bool {
+    let stored = entry.get("records").and_then(Value::as_object);
+    stored.is_some_and(|s| !s.is_empty() && entry.get("against_records").and_then(Value::as_object) == Some(s))
 }
 
 /// Whether `against` and `results` are one folder (after resolving symlinks and `.`/`..`).
@@ -745,6 +760,7 @@ pub fn check(
         changes: BTreeMap::new(),
         not_compared,
         self_comparison: opts.against.as_deref().is_some_and(|a| same_folder(a, &opts.results)),
+        copies: Vec::new(),
     };
     // a deep study in its tiers (unless --deep): quick forms, some runs to the end
     let planned: Vec<(Manifest, bool)> = manifests
@@ -793,6 +809,9 @@ pub fn check(
             serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": c.rows.len(), "quick": quick, "records": hashes(&stored) });
         if opts.against.is_some() {
             entry["against_records"] = serde_json::to_value(hashes(&fresh))?;
+            if compared_a_copy(&entry) {
+                report.copies.push(m.study.clone());
+            }
         }
         report.studies.push(entry);
         report.rows.extend(c.rows);

@@ -383,7 +383,7 @@ fn report_refuses_an_image_that_is_not_a_png() {
         &figs,
         &out,
         &[study.into()],
-        &figs.join("none.json"),
+        &signorini::page::DriftReports::read(&[figs.join("none.json")], "signorini drift --study STUDY").unwrap(),
         crate::common::roles(),
     )
     .unwrap_err();
