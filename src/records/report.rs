@@ -80,9 +80,6 @@ pub struct SolveReport {
     pub probes: Vec<Probe>,
     pub pdas_log: Vec<PdasIteration>,
     pub timings: SolveTimings,
-    /// The round-off u_h carries ([`DiscreteSolution::roundoff`], `roundoff_floor` in the level
-    /// records).
-    pub roundoff_floor: f64,
     /// What the solve's numbers keep fewer digits of than they should, or that its estimate is
     /// at round-off (`adapt::resolution`, which the caller asks; the same sentences `solve`
     /// writes to standard error).
@@ -142,7 +139,6 @@ impl SolveReport {
             probes,
             pdas_log: sol.pdas.clone(),
             timings: sol.timings.clone(),
-            roundoff_floor: sol.roundoff,
             warnings: Vec::new(),
         })
     }
