@@ -141,20 +141,10 @@ fn a_second_body_does_not_widen_the_gap_bound_of_a_thin_plate() {
 /// The binary in `dir` with RAYON_NUM_THREADS = `threads`, under an address-space limit of
 /// `bytes` if given: (exit code or None for a signal, stderr).
 fn with_threads(dir: &Path, threads: usize, bytes: Option<u64>, args: &[&str]) -> (Option<i32>, String) {
-    use std::os::unix::process::CommandExt;
     let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"));
     cmd.args(args).current_dir(dir).env("RAYON_NUM_THREADS", threads.to_string());
     if let Some(bytes) = bytes {
-        // SAFETY: setrlimit only, between fork and exec
-        unsafe {
-            cmd.pre_exec(move || {
-                let lim = libc::rlimit { rlim_cur: bytes, rlim_max: bytes };
-                if libc::setrlimit(libc::RLIMIT_AS, &lim) != 0 {
-                    return Err(std::io::Error::last_os_error());
-                }
-                Ok(())
-            });
-        }
+        super::common::limit(&mut cmd, libc::RLIMIT_AS, bytes);
     }
     let o = cmd.output().unwrap();
     (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())

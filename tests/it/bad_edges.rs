@@ -4,7 +4,6 @@
 //! it kept.
 
 use std::io::BufRead;
-use std::os::unix::process::CommandExt;
 use std::process::{Command, Stdio};
 
 /// The binary with `args`, under an address-space limit of `bytes` (RLIMIT_AS, as
@@ -12,16 +11,7 @@ use std::process::{Command, Stdio};
 fn limited(bytes: u64, args: &[&str]) -> (Option<i32>, String, String) {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_signorini"));
     cmd.args(args);
-    // SAFETY: setrlimit only, between fork and exec
-    unsafe {
-        cmd.pre_exec(move || {
-            let lim = libc::rlimit { rlim_cur: bytes, rlim_max: bytes };
-            if libc::setrlimit(libc::RLIMIT_AS, &lim) != 0 {
-                return Err(std::io::Error::last_os_error());
-            }
-            Ok(())
-        });
-    }
+    super::common::limit(&mut cmd, libc::RLIMIT_AS, bytes);
     let o = cmd.output().unwrap();
     (o.status.code(), String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
 }
@@ -78,16 +68,7 @@ fn bad_unwritable_stderr_exits_with_the_error_status() {
     let file = dir.join("err.txt");
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_signorini"));
     cmd.args(["solve", "--problem", "nope", "--mesh", "structured:4"]).stderr(std::fs::File::create(&file).unwrap());
-    // SAFETY: setrlimit only, between fork and exec
-    unsafe {
-        cmd.pre_exec(|| {
-            let lim = libc::rlimit { rlim_cur: 40, rlim_max: 40 };
-            if libc::setrlimit(libc::RLIMIT_FSIZE, &lim) != 0 {
-                return Err(std::io::Error::last_os_error());
-            }
-            Ok(())
-        });
-    }
+    super::common::limit(&mut cmd, libc::RLIMIT_FSIZE, 40);
     let status = cmd.status().unwrap();
     assert_eq!(status.code(), Some(1), "file-size limit: {status:?}");
     let written = std::fs::read_to_string(&file).unwrap();

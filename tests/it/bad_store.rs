@@ -4,7 +4,6 @@
 //! file, what a killed run leaves is cleaned by the next run and ignored by drift, and a run that
 //! executes nothing changes no file. After every case the folder lists exactly the runs present.
 
-use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -25,16 +24,7 @@ fn run_with(dir: &Path, args: &[&str], fsize: Option<u64>) -> (i32, String) {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_signorini"));
     cmd.current_dir(dir).args(args);
     if let Some(limit) = fsize {
-        // SAFETY: setrlimit only, between fork and exec
-        unsafe {
-            cmd.pre_exec(move || {
-                let lim = libc::rlimit { rlim_cur: limit, rlim_max: limit };
-                if libc::setrlimit(libc::RLIMIT_FSIZE, &lim) != 0 {
-                    return Err(std::io::Error::last_os_error());
-                }
-                Ok(())
-            });
-        }
+        super::common::limit(&mut cmd, libc::RLIMIT_FSIZE, limit);
     }
     let o = cmd.output().unwrap();
     (o.status.code().unwrap_or(-1), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
