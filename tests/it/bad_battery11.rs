@@ -197,3 +197,47 @@ fn a_cut_drift_report_is_refused_with_what_to_do() {
     assert!(err.contains("cut.json") && err.contains("run `signorini drift` to write it again"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// N5's look at the locks opened each lock file to read it: a named pipe there (`.lock` or
+/// `.locks/RUN.lock`) blocked the open, and `report`, `figures` and `drift` hung. A lock file that
+/// is not a regular file is refused by its metadata, naming it, as writers refuse it.
+#[test]
+fn a_reader_refuses_a_lock_file_that_is_a_pipe_without_hanging() {
+    let dir = scratch("b11-n5-fifo");
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    std::fs::write(
+        dir.join("experiments/s.toml"),
+        "description = \"fifo\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\n[[run]]\nid = \"a\"\nlevels = 3\n",
+    )
+    .unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "res"]);
+    assert_eq!(code, 0, "{out}{err}");
+    for lock in ["res/s/.lock", "res/s/.locks/a.lock"] {
+        let path = dir.join(lock);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::remove_file(&path).ok();
+        let made = std::process::Command::new("mkfifo").arg(&path).status().unwrap();
+        assert!(made.success());
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+            .current_dir(&dir)
+            .args(["report", "--results", "res", "--out", "page"])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = std::time::Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if start.elapsed().as_secs() > 60 {
+                child.kill().ok();
+                panic!("report hung on the named pipe {lock}");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let o = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{lock}: {err}");
+        assert!(err.contains(&format!("the lock file res/s/{}", lock.trim_start_matches("res/s/"))) && err.contains("named pipe"), "{err}");
+        std::fs::remove_file(&path).unwrap();
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -229,30 +229,36 @@ pub struct BeingWritten {
 /// at under the shared study lock, which a process takes exclusively to claim a run lock
 /// ([`Lock::run`]): a reader's look never makes a run's owner find its lock taken. Lock files
 /// are opened for reading and never made: a reader changes nothing (a read-only checkout stays
-/// readable). A process that holds a lock of the folder itself must not ask (its own lock
+/// readable); one that is not a regular file is an error naming it. A process that holds a
+/// lock of the folder itself must not ask (its own lock
 /// would count): writers check through their guard ([`super::Writer::check`]).
-pub(super) fn writer_of(dir: &StudyDir) -> Option<BeingWritten> {
-    let shared = |path: &Path| -> Option<Result<std::fs::File, std::fs::File>> {
-        let file = std::fs::File::open(path).ok()?;
-        Some(match file.try_lock_shared() {
+pub(super) fn writer_of(dir: &StudyDir) -> Result<Option<BeingWritten>> {
+    // a lock file that is not a regular file (a named pipe would block the open itself) is
+    // refused by its metadata, never opened, as a writer refuses it ([`open`])
+    let shared = |path: &Path| -> Result<Option<std::result::Result<std::fs::File, std::fs::File>>> {
+        if let Err(e) = crate::base::input::check_target(path) {
+            bail!("the lock file {} is {}, not a file: remove it", path.display(), e.found);
+        }
+        let Ok(file) = std::fs::File::open(path) else { return Ok(None) };
+        Ok(Some(match file.try_lock_shared() {
             Err(std::fs::TryLockError::WouldBlock) => Err(file),
             _ => Ok(file),
-        })
+        }))
     };
     let written =
         |mut file: std::fs::File, path: &Path, what: String| BeingWritten { what, holder: holder(&mut file), lock: path.to_path_buf() };
     let study = dir.root.join(".lock");
-    let _study = match shared(&study) {
-        Some(Err(file)) => return Some(written(file, &study, dir.root.display().to_string())),
+    let _study = match shared(&study)? {
+        Some(Err(file)) => return Ok(Some(written(file, &study, dir.root.display().to_string()))),
         held => held,
     };
     for id in runs_of(dir, std::iter::empty()) {
         let path = run_lock_file(dir, &id);
-        if let Some(Err(file)) = shared(&path) {
-            return Some(written(file, &path, format!("run {id} of {}", dir.root.display())));
+        if let Some(Err(file)) = shared(&path)? {
+            return Ok(Some(written(file, &path, format!("run {id} of {}", dir.root.display()))));
         }
     }
-    None
+    Ok(None)
 }
 
 fn run_lock_file(dir: &StudyDir, id: &str) -> PathBuf {

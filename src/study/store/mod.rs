@@ -187,7 +187,7 @@ impl Store {
     /// writes the folder now ([`BeingWritten`]); then the folder's records and faults as they are.
     /// A process holding a lock of the folder checks through its guard ([`Writer::check`]).
     pub fn check(&self) -> Result<Checked> {
-        if let Some(written) = lock::writer_of(&self.dir) {
+        if let Some(written) = lock::writer_of(&self.dir)? {
             return Err(written.into());
         }
         self.scan()

@@ -94,7 +94,8 @@ impl Shelf {
 
     /// The studies under `results` (folders holding a `runs/` folder, or one another process
     /// writes now: `run --fresh` removes `runs/` before it writes it again, and a reader then
-    /// names that process, through [`Store::check`], rather than finding no study), by name:
+    /// names that process, through [`Store::check`], rather than finding no study; so is one
+    /// whose lock file is not a file, which the check refuses naming it), by name:
     /// what [`Shelf::open`] is given for a whole folder.
     pub fn in_folder(results: &Path) -> std::io::Result<Vec<String>> {
         let read = std::fs::read_dir(results).map_err(|e| std::io::Error::new(e.kind(), format!("reading {}: {e}", results.display())))?;
@@ -103,7 +104,7 @@ impl Shelf {
             let e = e?;
             let d = e.path();
             if d.join("runs").is_dir()
-                || super::lock::writer_of(&crate::records::StudyDir::new(results, &e.file_name().to_string_lossy())).is_some()
+                || !matches!(super::lock::writer_of(&crate::records::StudyDir::new(results, &e.file_name().to_string_lossy())), Ok(None))
             {
                 out.push(e.file_name().to_string_lossy().into_owned());
             }
