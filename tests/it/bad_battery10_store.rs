@@ -29,7 +29,7 @@
 //!   --fresh and --wait, which drift has not; M5 `report` on an incomplete study wrote its page
 //!   without a word (now the page and stderr name the missing runs).
 
-use super::common::{scratch, signorini_in};
+use super::common::{scratch, signorini_in, stored_study};
 
 const STUDY: &str = r#"description = "battery 10: two short runs"
 [defaults]
@@ -47,10 +47,7 @@ theta = 0.3
 /// A scratch folder with `exp/st.toml` ([`STUDY`]) run into `res/`.
 fn stored(name: &str) -> std::path::PathBuf {
     let dir = scratch(name);
-    std::fs::create_dir_all(dir.join("exp")).unwrap();
-    std::fs::write(dir.join("exp/st.toml"), STUDY).unwrap();
-    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "res"]);
-    assert_eq!(code, 0, "{err}");
+    stored_study(&dir, "exp/st.toml", STUDY, "res");
     dir
 }
 
@@ -210,10 +207,7 @@ fn drift_section(page: &std::path::Path) -> String {
 #[test]
 fn the_page_quotes_a_drift_report_only_for_the_records_it_compared() {
     let dir = scratch("battery10-f5");
-    std::fs::create_dir_all(dir.join("exp")).unwrap();
-    std::fs::write(dir.join("exp/st.toml"), STUDY).unwrap();
-    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "x"]);
-    assert_eq!(code, 0, "{err}");
+    stored_study(&dir, "exp/st.toml", STUDY, "x");
     // a copy of the folder compared with it (the folder with itself is no check: battery 11, N1)
     let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "y"]);
     assert_eq!(code, 0, "{err}");
@@ -281,10 +275,7 @@ fn messages_say_what_is_true_in_the_command_s_own_terms() {
 #[test]
 fn drift_advises_drift_when_interrupted_or_refused_by_a_lock() {
     let dir = scratch("battery10-drift-advice");
-    std::fs::create_dir_all(dir.join("exp")).unwrap();
-    std::fs::write(dir.join("exp/long.toml"), LONG).unwrap();
-    let (code, _, err) = signorini_in(&dir, &["run", "exp/long.toml", "--results", "res"]);
-    assert_eq!(code, 0, "{err}");
+    stored_study(&dir, "exp/long.toml", LONG, "res");
     // M4: a run of the study holds its lock (here: this test, through the library)
     let store = signorini::study::store::Store::new(&dir.join("res"), "long");
     let held = store.lock_run("long", false).unwrap();

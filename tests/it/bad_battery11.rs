@@ -18,7 +18,7 @@
 //!   folder's locks first (`study::store::Store::check`, shared and without waiting) and names
 //!   the process that writes it.
 
-use super::common::{scratch, signorini_in};
+use super::common::{scratch, signorini_in, stored_study};
 
 const TANGENT: &str = "dirichlet = [0, -0.01]\n[material]\nE = 100\nnu = 0.3\nmodel = \"plane_strain\"\n[parts]\ncontact = \"y < 1e-12\"\ndirichlet = \"y > 1 - 1e-12\"\n[contact]\nnormal = [\"x - 0.5\", \"-1e-3\"]\nchi = 0\n";
 
@@ -95,14 +95,12 @@ fn a_rigid_translation_that_drowns_the_deformation_in_round_off_is_not_silent() 
 #[test]
 fn drift_against_the_stored_folder_itself_says_so_and_the_page_does_not_quote_it() {
     let dir = scratch("b11-self");
-    std::fs::create_dir_all(dir.join("exp")).unwrap();
-    std::fs::write(
-        dir.join("exp/st.toml"),
+    stored_study(
+        &dir,
+        "exp/st.toml",
         "description = \"N1\"\n[defaults]\nproblem = \"ex72\"\nmesh = \"structured:4\"\n[[run]]\nid = \"a\"\nlevels = 2\n",
-    )
-    .unwrap();
-    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "x"]);
-    assert_eq!(code, 0, "{err}");
+        "x",
+    );
     std::os::unix::fs::symlink(dir.join("x"), dir.join("link")).unwrap();
     for against in ["x", "./x/", "link"] {
         let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "exp", "--against", against, "--results", "x"]);
@@ -124,10 +122,7 @@ const N5_STUDY: &str =
 #[test]
 fn readers_of_a_folder_being_written_name_the_writer_instead_of_a_verdict() {
     let dir = scratch("b11-n5");
-    std::fs::create_dir_all(dir.join("experiments")).unwrap();
-    std::fs::write(dir.join("experiments/s.toml"), N5_STUDY).unwrap();
-    let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "res"]);
-    assert_eq!(code, 0, "{out}{err}");
+    stored_study(&dir, "experiments/s.toml", N5_STUDY, "res");
     let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "w"]);
     assert_eq!(code, 0, "{out}{err}");
     let writer = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
@@ -204,14 +199,12 @@ fn a_cut_drift_report_is_refused_with_what_to_do() {
 #[test]
 fn a_reader_refuses_a_lock_file_that_is_a_pipe_without_hanging() {
     let dir = scratch("b11-n5-fifo");
-    std::fs::create_dir_all(dir.join("experiments")).unwrap();
-    std::fs::write(
-        dir.join("experiments/s.toml"),
+    stored_study(
+        &dir,
+        "experiments/s.toml",
         "description = \"fifo\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\n[[run]]\nid = \"a\"\nlevels = 3\n",
-    )
-    .unwrap();
-    let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "res"]);
-    assert_eq!(code, 0, "{out}{err}");
+        "res",
+    );
     for lock in ["res/s/.lock", "res/s/.locks/a.lock"] {
         let path = dir.join(lock);
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();

@@ -18,7 +18,7 @@
 //! * Minor notes: `solve --json` now carries `roundoff_floor`; `run --plan M.toml M.toml` lists
 //!   each run once; `adapt`'s efficiency column prints values far from 1 in exponent form.
 
-use super::common::{scratch, signorini_in};
+use super::common::{scratch, signorini_in, stored_study};
 use std::path::Path;
 
 /// A structured grid of `nx` x `ny` cells on [x0, x0 + w] x [y0, y0 + h], two triangles a
@@ -190,10 +190,7 @@ fn drift_paragraph(page: &Path) -> String {
 #[test]
 fn drift_against_a_copy_of_the_stored_folder_is_no_rerun() {
     let dir = scratch("b12-copy");
-    std::fs::create_dir_all(dir.join("exp")).unwrap();
-    std::fs::write(dir.join("exp/st.toml"), STUDY).unwrap();
-    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "res"]);
-    assert_eq!(code, 0, "{err}");
+    stored_study(&dir, "exp/st.toml", STUDY, "res");
     let status = std::process::Command::new("cp").args(["-r", "res", "cp1"]).current_dir(&dir).status().unwrap();
     assert!(status.success());
     let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "exp", "--against", "cp1", "--results", "res"]);

@@ -169,3 +169,14 @@ pub fn limit(cmd: &mut std::process::Command, resource: libc::__rlimit_resource_
         });
     }
 }
+
+/// Write the manifest `manifest` (a path relative to `dir`, its folder made) with `text`, and run
+/// its study into `results` (relative to `dir`), which must succeed: the stored study a test of
+/// the store, drift or the pages starts from.
+pub fn stored_study(dir: &std::path::Path, manifest: &str, text: &str, results: &str) {
+    let path = dir.join(manifest);
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    std::fs::write(&path, text).unwrap();
+    let (code, out, err) = signorini_in(dir, &["run", manifest, "--results", results]);
+    assert_eq!(code, 0, "{out}{err}");
+}
