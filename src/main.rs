@@ -172,6 +172,10 @@ enum Command {
         /// Draw only these studies' figures (repeatable) [default: every study the results hold].
         #[arg(long, value_name = "STUDY")]
         study: Vec<String>,
+        /// If another process is writing a study of the results folder, wait for it to finish
+        /// instead of refusing (what the Slurm finish job does).
+        #[arg(long)]
+        wait: bool,
     },
     /// Write one self-contained HTML page per study for a browser (OUT/STUDY.html): its figures
     /// embedded, its CLAIMS rows, the drift status from the last drift report, the run table and
@@ -198,6 +202,10 @@ enum Command {
         /// Folder of the study manifests, whose run roles the CLAIMS rows read.
         #[arg(long, default_value = "experiments")]
         experiments: std::path::PathBuf,
+        /// If another process is writing a study of the results folder, wait for it to finish
+        /// instead of refusing (what the Slurm finish job does).
+        #[arg(long)]
+        wait: bool,
     },
     /// Solve as `solve` does and write the mesh and solution for the NGSolve cross-check
     /// (OUT/mesh.vtu, OUT/case.json: the report `solve --json` prints).
@@ -1019,12 +1027,16 @@ fn run_figures(
     figures: Option<&std::path::Path>,
     experiments: &std::path::Path,
     only: &[String],
+    wait: bool,
 ) -> Result<()> {
     let tracked = results.is_none_or(is_tracked_results);
     let results = match results {
         Some(r) if !tracked => r.to_path_buf(),
         _ => std::path::PathBuf::from("results"),
     };
+    if wait {
+        study::store::Shelf::wait_for_writers(&results)?;
+    }
     let figures = figures.map(|f| f.to_path_buf()).unwrap_or_else(|| if tracked { "figures".into() } else { results.join("figures") });
     output_folder("--figures", &figures, "figures writes its PNG and SVG files into a folder there")?;
     // what the figures and CLAIMS rows need, checked when the manifests are read
@@ -1051,10 +1063,14 @@ fn run_report(
     studies: &[String],
     drift_report: Option<&std::path::Path>,
     experiments: &std::path::Path,
+    wait: bool,
 ) -> Result<()> {
     let roles = signorini::analysis::roles::read(experiments)?;
     let tracked = results.is_none_or(is_tracked_results);
     let results = results.map_or_else(|| std::path::PathBuf::from("results"), |r| r.to_path_buf());
+    if wait {
+        study::store::Shelf::wait_for_writers(&results)?;
+    }
     let under = |tracked_default: &str, scratch: &str| if tracked { tracked_default.into() } else { results.join(scratch) };
     let figures = figures.map_or_else(|| under("figures", "figures"), |f| f.to_path_buf());
     let out = out.map_or_else(|| under("target/report", "report"), |o| o.to_path_buf());
@@ -1157,8 +1173,8 @@ fn main() -> ExitCode {
             }
         }),
         Command::Adapt(args) => run_adapt(args),
-        Command::Figures { results, figures, experiments, study } => {
-            run_figures(results.as_deref(), figures.as_deref(), experiments, study)
+        Command::Figures { results, figures, experiments, study, wait } => {
+            run_figures(results.as_deref(), figures.as_deref(), experiments, study, *wait)
         }
         Command::Drift { quick, deep, against, report, merge, accept, study, experiments, results } => {
             let report = report.as_deref().map(|f| ReportFile { path: f, merge: *merge });
@@ -1169,8 +1185,8 @@ fn main() -> ExitCode {
             run_studies(manifests, shard.as_deref(), results.clone(), flags)
         }
         Command::Export { args, out } => run_export(args, out),
-        Command::Report { results, figures, out, study, drift_report, experiments } => {
-            run_report(results.as_deref(), figures.as_deref(), out.as_deref(), study, drift_report.as_deref(), experiments)
+        Command::Report { results, figures, out, study, drift_report, experiments, wait } => {
+            run_report(results.as_deref(), figures.as_deref(), out.as_deref(), study, drift_report.as_deref(), experiments, *wait)
         }
     });
     // what was computed and kept stays; output that could not be written is an error

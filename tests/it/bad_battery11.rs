@@ -16,7 +16,9 @@
 //!   rewrote W reported both runs as drifted ("run present -> (missing)", with the advice to
 //!   rerun W with --fresh), "W holds no study", or a missing run. Every reader now asks the
 //!   folder's locks first (`study::store::Store::check`, shared and without waiting) and names
-//!   the process that writes it.
+//!   the process that writes it. Given `--wait`, `figures` and `report` wait for it instead
+//!   (the Slurm finish job of one array while a second array of the same study still held the
+//!   folder was refused, and `make cluster-test` failed).
 
 use super::common::{scratch, signorini_in, stored_study};
 
@@ -139,6 +141,15 @@ fn readers_of_a_folder_being_written_name_the_writer_instead_of_a_verdict() {
         std::thread::sleep(std::time::Duration::from_millis(5));
     }
     let named = format!("is being written by process {}", writer.id());
+    // a reader given --wait waits for the writer, then reads (the Slurm finish job while a
+    // second array of the same study holds the folder: refused, it failed `make cluster-test`)
+    let waiting = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["figures", "--results", "w", "--wait"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
     let readers: [&[&str]; 3] = [
         &["drift", "--study", "s", "--results", "res", "--against", "w", "--report", "drift.json"],
         &["report", "--results", "w", "--out", "page"],
@@ -152,6 +163,11 @@ fn readers_of_a_folder_being_written_name_the_writer_instead_of_a_verdict() {
     assert!(!dir.join("drift.json").exists() && !dir.join("w/drift-report.json").exists(), "a drift report of a folder being written");
     let status = { writer }.wait().unwrap();
     assert!(status.success());
+    let waited = waiting.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&waited.stderr);
+    assert!(waited.status.success(), "figures --wait: {err}");
+    assert!(err.contains(&named) && err.contains("waiting for it to finish"), "figures --wait did not wait: {err}");
+    assert!(dir.join("w/CLAIMS.md").exists(), "figures --wait drew nothing");
     // written, the folder reads: the same run again, no drift
     let (code, out, err) = signorini_in(&dir, &["drift", "--study", "s", "--results", "res", "--against", "w", "--report", "drift.json"]);
     assert_eq!(code, 0, "{out}{err}");

@@ -261,6 +261,20 @@ pub(super) fn writer_of(dir: &StudyDir) -> Result<Option<BeingWritten>> {
     Ok(None)
 }
 
+/// Wait until no other process writes `dir` ([`writer_of`]): for each writer found, block on a
+/// shared lock of the lock file it holds (saying who it is), then look again, since another
+/// writer may have started meanwhile. What a reader given `--wait` does before it reads (the
+/// Slurm finish job of one array, while another array's tasks still hold the folder). A writer
+/// that starts after the wait makes the read refuse as without `--wait`: never a silent read.
+pub(super) fn wait_for_writers(dir: &StudyDir) -> Result<()> {
+    while let Some(written) = writer_of(dir)? {
+        crate::base::note::line(format_args!("{} is being written by {}; waiting for it to finish", written.what, written.holder));
+        let file = std::fs::File::open(&written.lock).with_context(|| format!("opening the lock file {}", written.lock.display()))?;
+        file.lock_shared().with_context(|| format!("waiting for the lock {}", written.lock.display()))?;
+    }
+    Ok(())
+}
+
 fn run_lock_file(dir: &StudyDir, id: &str) -> PathBuf {
     dir.root.join(".locks").join(format!("{id}.lock"))
 }

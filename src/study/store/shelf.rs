@@ -113,6 +113,20 @@ impl Shelf {
         Ok(out)
     }
 
+    /// Wait until no other process writes any study folder under `results` (`figures --wait`,
+    /// `report --wait`): what a reader does, before it opens the shelf, where another process
+    /// may still be writing (a Slurm array's finish job, while a second array of the same study
+    /// holds the folder). A writer that starts after the wait is refused by the read as usual.
+    pub fn wait_for_writers(results: &Path) -> anyhow::Result<()> {
+        if !results.is_dir() {
+            return Ok(());
+        }
+        for study in Shelf::in_folder(results)? {
+            super::lock::wait_for_writers(&crate::records::StudyDir::new(results, &study))?;
+        }
+        Ok(())
+    }
+
     /// The results folder the studies are in (for messages).
     pub fn root(&self) -> &Path {
         &self.root
