@@ -108,8 +108,9 @@ enum Command {
         /// If another process is running the same study, wait for it instead of refusing.
         #[arg(long)]
         wait: bool,
-        /// Check the manifests (and the shard) as a run does, print the runs it would compute,
-        /// one STUDY/RUN a line, and run nothing (scripts/slurm/submit.sh checks --tasks with it).
+        /// Check the manifests (and the shard) and the results folder as a run does, print its
+        /// runs, one STUDY/RUN a line (those it would keep or replace say so), and run nothing
+        /// (scripts/slurm/submit.sh checks --tasks with it).
         #[arg(long)]
         plan: bool,
     },
@@ -598,21 +599,25 @@ fn run_studies(manifests: &[std::path::PathBuf], shard: Option<&str>, results: O
     if let Some(shard) = shard {
         check_shard(&parsed, shard)?;
     }
+    let options = study::RunOptions { quick, shard, fresh, replace, results: results.clone(), progress: true, wait_for_lock: wait };
     if plan {
         // a study given twice (`run M.toml M.toml`) declares the same runs (checked above) and
         // stores each run once: each listed once
         let mut listed = std::collections::BTreeSet::new();
         for m in &parsed {
-            for (_, p) in m.runs.iter().enumerate().filter(|(i, _)| shard.is_none_or(|(k, n)| i % n == k - 1)) {
-                if listed.insert((m.study.clone(), p.spec.id.clone())) {
-                    println!("{}/{}", m.study, p.spec.id);
+            for (spec, doing) in study::plan(m, &options)? {
+                if listed.insert((m.study.clone(), spec.id.clone())) {
+                    match doing {
+                        study::Planned::Compute => println!("{}/{}", m.study, spec.id),
+                        study::Planned::Keep => println!("{}/{} (kept: stored with this spec, nothing computed)", m.study, spec.id),
+                        study::Planned::Replace(why) => println!("{}/{} (replaces the stored run: {})", m.study, spec.id, why.join("; ")),
+                    }
                 }
             }
         }
         return Ok(());
     }
     for manifest in &parsed {
-        let options = study::RunOptions { quick, shard, fresh, replace, results: results.clone(), progress: true, wait_for_lock: wait };
         let executed = study::run_study(manifest, &options)?;
         say!("{}: {} run(s) executed, results in {}", manifest.study, executed.len(), results.join(&manifest.study).display());
     }

@@ -47,8 +47,8 @@ done
 case $bin in */*) ;; *) bin=./$bin ;; esac
 # the manifest as a run checks it, and the last task's shard must hold a run: a task beyond the
 # study's runs would fail, and the finish job (afterok) would then never start
-plan=$("$bin" run --plan --shard "$tasks/$tasks" "$manifest" 2>&1 >/dev/null) ||
-    fail "--tasks $tasks: $bin run --plan --shard $tasks/$tasks $manifest refused it: ${plan#error: }"
+plan=$("$bin" run --plan --shard "$tasks/$tasks" --results "$results" "$manifest" 2>&1 >/dev/null) ||
+    fail "--tasks $tasks: $bin run --plan --shard $tasks/$tasks --results $results $manifest refused it: ${plan#error: }"
 logs=${logs:-$results/slurm-logs}
 mkdir -p "$logs"
 here=$(cd "$(dirname "$0")" && pwd)

@@ -181,20 +181,25 @@ fn file_type(t: &std::fs::FileType) -> &'static str {
 /// The longest line of an error message that quotes a user's input in full.
 pub const EXCERPT_LINE: usize = 2000;
 
-/// `message` with every line longer than [`EXCERPT_LINE`] characters cut to its first 1000 and
-/// the count of the rest: what every error that quotes a user's input shows of it (a manifest
-/// of one 200 MB line must not come back as a 200 MB message). Errors of manifests, problem
+/// `message` with every line longer than [`EXCERPT_LINE`] characters cut to its first and last
+/// 500 and the count of those between: what every error that quotes a user's input shows of it
+/// (a manifest of one 200 MB line must not come back as a 200 MB message). The end is kept
+/// because the reason follows the quote (`cannot parse "...": the ( at character 4001 nests ...`;
+/// battery 13: cut after the first 1000, the reason was lost). Errors of manifests, problem
 /// files and meshes format their text through it.
 pub fn excerpt(message: &str) -> String {
     if message.lines().all(|l| l.chars().count() <= EXCERPT_LINE) {
         return message.to_string();
     }
+    const KEPT: usize = 500;
     let short = |l: &str| {
         let n = l.chars().count();
         if n <= EXCERPT_LINE {
             l.to_string()
         } else {
-            format!("{}... ({} more characters)", l.chars().take(1000).collect::<String>(), n - 1000)
+            let head: String = l.chars().take(KEPT).collect();
+            let tail: String = l.chars().skip(n - KEPT).collect();
+            format!("{head} ... ({} characters cut) ... {tail}", n - 2 * KEPT)
         }
     };
     message.split('\n').map(short).collect::<Vec<_>>().join("\n")
@@ -207,9 +212,9 @@ mod tests {
     #[test]
     fn an_excerpt_is_bounded_and_short_lines_are_kept() {
         assert_eq!(excerpt("a\nb c"), "a\nb c");
-        let long = format!("got \"{}\"\nnext", "x".repeat(10_000));
+        let long = format!("got \"{}\": the reason\nnext", "x".repeat(10_000));
         let e = excerpt(&long);
-        assert!(e.len() < 1100 && e.ends_with("... (9006 more characters)\nnext"), "{e}");
+        assert!(e.len() < 1100 && e.contains(" ... (9018 characters cut) ... ") && e.ends_with("x\": the reason\nnext"), "{e}");
         assert!(e.starts_with("got \"xxx"));
     }
 

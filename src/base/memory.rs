@@ -129,8 +129,16 @@ pub fn check_memory_measured(what: &str, ndof: f64, measured: Option<(f64, f64)>
     if available.is_some_and(|a| a.by_address_space) {
         let reserve = thread_reserve();
         needed += reserve;
-        basis +=
-            &format!(", + {} of address space the threads reserve: stacks, malloc arenas, dense-product buffers", human_bytes(reserve));
+        // the reserve dwarfs a small level's own need: say where it comes from (battery 13:
+        // "needs 1.7 GiB" for 626 unknowns read like a bug)
+        let workers = rayon::current_num_threads();
+        basis += &format!(
+            ", + {} of address space the threads reserve whatever the size: per each of {workers} worker(s) a 64 MiB malloc arena \
+             and a 2 MiB stack, and per worker and the main thread twice the CPU's largest cache ({}) for the dense products' \
+             packing buffer (fewer threads, RAYON_NUM_THREADS, reserve less)",
+            human_bytes(reserve),
+            human_bytes(largest_cache())
+        );
     }
     if needed > available.map_or(UNKNOWN_MEMORY_LIMIT, |a| a.bytes) {
         return Err(MemoryError { what: what.to_string(), ndof, needed, basis, available });

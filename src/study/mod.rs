@@ -165,6 +165,60 @@ pub fn run_study(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<String>> 
     })
 }
 
+/// What `run` would do with a planned run ([`plan`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Planned {
+    /// Not stored (or `--fresh`): computed.
+    Compute,
+    /// Stored with its spec: kept, nothing computed.
+    Keep,
+    /// Stored with another spec: replaced (`--replace`), with what differs.
+    Replace(Vec<String>),
+}
+
+/// What `run --plan` prints: each run of `manifest` in `opts`' shard and what `run` would do
+/// with it, read from the results folder through the same check and the same refusal as `run`'s
+/// set-up (a folder `run` refuses, damaged or with runs stored with another spec, is refused
+/// here too; battery 13: the plan listed three runs and exited 0 where `run` refused). Changes
+/// nothing. A folder another process writes now is read as it is, with a note that says so.
+pub fn plan(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<(RunSpec, Planned)>> {
+    let store = Store::of(&opts.results, manifest);
+    let in_shard = |i: usize| opts.shard.is_none_or(|(k, n)| i % n == k - 1);
+    let planned: Vec<RunSpec> =
+        manifest.runs.iter().enumerate().filter(|(i, _)| in_shard(*i)).map(|(_, p)| effective_spec(p, opts.quick)).collect();
+    if opts.fresh || !store.dir().root.exists() {
+        return Ok(planned.into_iter().map(|s| (s, Planned::Compute)).collect());
+    }
+    let checked = match store.check() {
+        Ok(checked) => checked,
+        Err(e) => match e.downcast_ref::<store::BeingWritten>() {
+            Some(w) => {
+                crate::base::note::line(format_args!("{}: {w}", manifest.study));
+                return Ok(planned.into_iter().map(|s| (s, Planned::Compute)).collect());
+            }
+            None => return Err(e),
+        },
+    };
+    let mut stale = store::stale::damaged(&checked.faults);
+    stale.extend(store::stale::stale_runs(manifest, &checked.runs, &planned));
+    if !stale.is_empty() && !opts.replace {
+        return Err(store::stale::refusal(manifest, store.dir(), &stale));
+    }
+    Ok(planned
+        .into_iter()
+        .map(|spec| {
+            let damaged = stale.iter().any(|s| matches!(s, store::Stale::Damaged { file, .. } if *file == spec.id));
+            let doing = match checked.runs.iter().find(|r| r.run.id == spec.id) {
+                None => Planned::Compute,
+                Some(_) if damaged => Planned::Replace(vec!["its record does not hold together".to_string()]),
+                Some(r) if r.run == spec => Planned::Keep,
+                Some(r) => Planned::Replace(store::stale::spec_differences(&r.run, &spec)),
+            };
+            (spec, doing)
+        })
+        .collect())
+}
+
 /// Under the study lock: `--fresh`, the orphans of unfinished runs removed, stored runs whose
 /// spec differs refused (or with `--replace` undeclared ones removed), the summaries in line
 /// with the runs stored.

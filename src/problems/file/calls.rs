@@ -14,6 +14,11 @@
 /// The functions of two arguments (exmex's binary operators with call syntax).
 pub(super) const TWO_ARGUMENTS: [&str; 3] = ["min", "max", "atan2"];
 
+/// The deepest nesting of parentheses an expression may have. exmex's parse of nested calls
+/// takes time quadratic in their depth (battery 13: `abs(abs(...))` 40k deep took 2 s, 200k deep
+/// over 120 s); no expression a problem needs comes near this.
+pub(super) const MAX_NESTING: usize = 1000;
+
 /// An open parenthesis: where it is (character index), the function it calls (if a name
 /// precedes it) and the character indices of the commas directly inside it.
 struct Open {
@@ -53,6 +58,12 @@ pub(super) fn infix(text: &str) -> Result<String, String> {
             continue;
         }
         match ch {
+            '(' if open.len() == MAX_NESTING => {
+                return Err(format!(
+                    "the `(` at character {} nests parentheses deeper than {MAX_NESTING} (the most an expression may have)",
+                    i + 1
+                ));
+            }
             '(' => open.push(Open { at: i, call: name.take(), commas: Vec::new() }),
             ',' => match open.last_mut() {
                 Some(o) => o.commas.push(i),
@@ -121,6 +132,14 @@ mod tests {
         assert_eq!(infix("min(1, max(0, s))").unwrap(), "((1)min( ((0)max( s))))");
         assert_eq!(infix("atan2 (y, x) + 1e-3").unwrap(), "((y)atan2( x)) + 1e-3");
         assert_eq!(infix("sqrt(x) * 2").unwrap(), "sqrt(x) * 2");
+    }
+
+    #[test]
+    fn nesting_is_bounded() {
+        let deep = |n: usize| format!("{}0{}", "abs(".repeat(n), ")".repeat(n));
+        assert!(infix(&deep(super::MAX_NESTING)).is_ok());
+        let why = infix(&deep(super::MAX_NESTING + 1)).unwrap_err();
+        assert!(why.contains("character 4004 nests parentheses deeper than 1000"), "{why}");
     }
 
     #[test]

@@ -58,27 +58,30 @@ pub(super) fn refused_name(text: &str, known: &[&str]) -> Option<String> {
         i = end;
         let name: String = chars[start..end].iter().map(|&(_, c)| c).collect();
         let called = chars[end..].iter().find(|&&(_, c)| !c.is_whitespace()).is_some_and(|&(_, c)| c == '(');
-        let at = format!("at character {} of {text:?}", start + 1);
+        // made only for a message: formatting `text` for every name made a long expression's
+        // check quadratic (battery 13: 200k nested calls took over 120 s)
+        let at = || format!("at character {} of {text:?}", start + 1);
         if name == "log" {
             return Some(format!(
-                "`log` {at} is ambiguous (exmex reads it as the natural logarithm, many readers as log10): write ln or log10"
+                "`log` {} is ambiguous (exmex reads it as the natural logarithm, many readers as log10): write ln or log10",
+                at()
             ));
         }
         if FUNCTIONS.contains(&name.as_str()) || (!called && (CONSTANTS.contains(&name.as_str()) || known.contains(&name.as_str()))) {
             continue;
         }
         let what = if exmex_ops.iter().any(|o| o.repr() == name) {
-            format!("`{name}` {at} is not one of the functions and constants an expression may use")
+            format!("`{name}` {} is not one of the functions and constants an expression may use", at())
         } else if called && (known.contains(&name.as_str()) || CONSTANTS.contains(&name.as_str())) {
-            format!("`{name}` {at} is a variable or constant, not a function (a product needs `*`, as in {name}*(...))")
+            format!("`{name}` {} is a variable or constant, not a function (a product needs `*`, as in {name}*(...))", at())
         } else if called {
-            format!("unknown function `{name}` {at}")
+            format!("unknown function `{name}` {}", at())
         } else {
             let known = if known.is_empty() { "none here".to_string() } else { known.join(", ") };
             let after_number =
                 chars[..start].iter().rev().find(|&&(_, c)| !c.is_whitespace()).is_some_and(|&(_, c)| c.is_ascii_digit() || c == '.');
             let hint = if after_number { format!("; {PRODUCT}") } else { String::new() };
-            return Some(format!("unknown variable `{name}` {at} (variables and constants here: {known}{hint})"));
+            return Some(format!("unknown variable `{name}` {} (variables and constants here: {known}{hint})", at()));
         };
         return Some(format!("{what} (functions: {}; constants: {})", functions(), CONSTANTS.join(", ")));
     }

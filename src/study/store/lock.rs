@@ -51,6 +51,7 @@ impl Lock {
     /// [`STUDY_LOCK_PATIENCE`] ([`patience`]) even without `wait` (two shards started at the same moment
     /// both run); past that it is refused naming the holder, unless `wait`, then waits for it.
     pub(super) fn study(dir: &StudyDir, wait: bool) -> Result<Lock> {
+        check_run_lock_folder(dir)?;
         let path = dir.root.join(".lock");
         let file = open(&path)?;
         let patience = patience();
@@ -247,6 +248,7 @@ pub(super) fn writer_of(dir: &StudyDir) -> Result<Option<BeingWritten>> {
     };
     let written =
         |mut file: std::fs::File, path: &Path, what: String| BeingWritten { what, holder: holder(&mut file), lock: path.to_path_buf() };
+    check_run_lock_folder(dir)?;
     let study = dir.root.join(".lock");
     let _study = match shared(&study)? {
         Some(Err(file)) => return Ok(Some(written(file, &study, dir.root.display().to_string()))),
@@ -273,6 +275,19 @@ pub(super) fn wait_for_writers(dir: &StudyDir) -> Result<()> {
         file.lock_shared().with_context(|| format!("waiting for the lock {}", written.lock.display()))?;
     }
     Ok(())
+}
+
+/// The folder of the run locks (`STUDY/.locks`), where it exists, is a folder: one that is a file
+/// is named by every writer (which takes the study lock first) and reader, also where every
+/// run is finished and no run lock is opened (battery 13: `run` then said "0 run(s) executed").
+fn check_run_lock_folder(dir: &StudyDir) -> Result<()> {
+    let folder = dir.root.join(".locks");
+    match std::fs::symlink_metadata(&folder) {
+        Ok(m) if !m.is_dir() && !folder.is_dir() => {
+            bail!("{} is a file, not the folder of the run locks: remove it (it holds no run)", folder.display())
+        }
+        _ => Ok(()),
+    }
 }
 
 fn run_lock_file(dir: &StudyDir, id: &str) -> PathBuf {
