@@ -176,17 +176,18 @@ fn num(v: Option<f64>) -> String {
 
 fn run_table(runs: &[RunRecord]) -> String {
     let mut s = String::from(
-        "<table><tr><th>run</th><th>problem</th><th>refinement</th><th>levels</th><th>final NDF</th><th>final estimate</th><th>final error</th><th>efficiency</th></tr>\n",
+        "<table><tr><th>run</th><th>problem</th><th>refinement</th><th>estimator</th><th>levels</th><th>final NDF</th><th>final estimate</th><th>final error</th><th>efficiency</th></tr>\n",
     );
     for r in runs {
         let last = r.levels.last();
         let _ = writeln!(
             s,
-            "<tr><td>{}</td><td>{}</td><td>{:?}{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{:?}{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             escape(&r.run.id),
             escape(&r.run.problem),
             r.run.refine,
             if matches!(r.run.refine, crate::records::Refine::Adaptive) { format!(", θ = {}", r.run.theta) } else { String::new() },
+            escape(&estimator_settings(&r.run.estimator)),
             r.levels.len(),
             last.map_or("–".into(), |l| l.ndof.to_string()),
             num(last.map(|l| l.terms.estimate)),
@@ -195,6 +196,23 @@ fn run_table(runs: &[RunRecord]) -> String {
         );
     }
     s + "</table>\n"
+}
+
+/// The estimator settings of a run that differ from the defaults (`contact_term = as_written;
+/// c0 = 1`), as the manifest's `[estimator]` keys; "default" where none do. Runs that differ
+/// only there had the same refinement cell (battery 13).
+fn estimator_settings(config: &crate::estimator::estimate::EstimatorConfig) -> String {
+    let (Ok(serde_json::Value::Object(set)), Ok(serde_json::Value::Object(default))) =
+        (serde_json::to_value(config), serde_json::to_value(crate::estimator::estimate::EstimatorConfig::default()))
+    else {
+        return "–".into();
+    };
+    let differ: Vec<String> = set
+        .iter()
+        .filter(|(k, v)| default.get(*k) != Some(*v))
+        .map(|(k, v)| format!("{k} = {}", v.as_str().map_or_else(|| v.to_string(), str::to_string)))
+        .collect();
+    if differ.is_empty() { "default".into() } else { differ.join("; ") }
 }
 
 fn claims_table(claims: &[&Claim]) -> String {

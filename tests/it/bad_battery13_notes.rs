@@ -10,6 +10,8 @@
 //!   same check and refusal as `run` and says which runs are kept or replaced.
 //! * `.locks` (the folder of the run locks) as a regular file was not named where every run was
 //!   finished (`run` said "0 run(s) executed"): every writer and reader now names it.
+//! * The study page's run table gave runs that differ only in their estimator the same cell: an
+//!   estimator column names the settings that differ from the defaults.
 //! * The memory refusal under an address-space limit said "needs 1.7 GiB" for 626 unknowns
 //!   without saying that the threads' reserve (twice the CPU's largest cache per thread) is most
 //!   of it.
@@ -88,5 +90,22 @@ fn a_lock_folder_that_is_a_file_is_named_also_when_every_run_is_finished() {
         assert_eq!(code, 1, "{args:?}: {err}");
         assert!(err.contains(".locks is a file, not the folder of the run locks"), "{args:?}: {err}");
     }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The run table of a study page gave runs that differ only in their estimator the same
+/// refinement cell ("Adaptive, θ = 0.5"); its estimator column names the settings that differ
+/// from the defaults.
+#[test]
+fn the_run_table_tells_runs_apart_by_their_estimator() {
+    let dir = scratch("b13-page");
+    let study = STUDY.replace("levels = 3\n", "levels = 3\nestimator = { log_factor = \"one\", c0 = 1.0 }\n");
+    stored_study(&dir, "exp/s.toml", &study, "res");
+    let (code, _, err) = signorini_in(&dir, &["report", "--results", "res", "--experiments", "exp", "--out", "page"]);
+    assert_eq!(code, 0, "{err}");
+    let page = std::fs::read_to_string(dir.join("page/s.html")).unwrap();
+    assert!(page.contains("<th>estimator</th>"), "no estimator column");
+    assert!(page.contains("<td>Adaptive, θ = 0.5</td><td>default</td>"), "run a");
+    assert!(page.contains("<td>Adaptive, θ = 0.5</td><td>log_factor = one; c0 = 1.0</td>"), "run b");
     std::fs::remove_dir_all(&dir).ok();
 }
