@@ -303,8 +303,9 @@ pub fn check_held(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Pro
 
 /// The body of every triangle: the edge-connected components of the mesh, numbered in the
 /// order of their first triangle. The one split of the mesh into bodies: the rigid-motion check
-/// and the gap bound (`plausible::Extent`) both take it.
-pub(super) fn bodies(nodes: &P2Nodes) -> Vec<usize> {
+/// the gap bound (`plausible::Extent`) and what a solve resolves (`adapt::resolution`, per
+/// body) take it.
+pub fn bodies(nodes: &P2Nodes) -> Vec<usize> {
     let n = nodes.elements.len();
     let mut body = vec![usize::MAX; n];
     let mut stack = Vec::new();

@@ -147,6 +147,10 @@ pub struct DiscreteSolution {
     /// step of iterative refinement in working precision ([`ContactSolver::correction`] for the
     /// residual F - K u_h computed element by element). No error of u_h below it is measurable.
     pub roundoff: f64,
+    /// Per P2 node, the larger Cartesian component of the same refinement step: the round-off
+    /// of each separate body of the mesh (`adapt::resolution` takes it per body, so that one
+    /// body's rigid motion does not set another's round-off).
+    pub roundoff_at: Vec<f64>,
     pub strategy: Strategy,
     /// The KKT conditions' relative values, each within [`certify::TOLERANCE`].
     pub certificate: Certificate,
@@ -264,7 +268,8 @@ pub fn solve(
     let contact_timings = solver.timings.clone();
     drop(solver);
     let zero = vec![[0.0; 2]; dirichlet.len()];
-    let roundoff = dofs.displacement(&correction, &zero).iter().fold(0.0f64, |a, v| a.max(v[0].abs()).max(v[1].abs()));
+    let roundoff_at: Vec<f64> = dofs.displacement(&correction, &zero).iter().map(|v| v[0].abs().max(v[1].abs())).collect();
+    let roundoff = roundoff_at.iter().fold(0.0f64, |a, v| a.max(*v));
     // how far one refinement step would move each lambda_p: (K c)_p
     let moved = assembly::stiffness_times(mesh, &nodes, &dofs, problem.material(), &correction).ku;
     let lambda_floor = contact_terms.iter().zip(&moved[dofs.n_interior..]).map(|(&terms, &kc)| lambda_roundoff(terms, kc)).collect();
@@ -290,6 +295,7 @@ pub fn solve(
         free_residual,
         force_scale,
         roundoff,
+        roundoff_at,
         strategy,
         certificate,
         timings,
