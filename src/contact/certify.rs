@@ -303,7 +303,7 @@ pub fn check_held(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Pro
 
 /// The body of every triangle: the edge-connected components of the mesh, numbered in the
 /// order of their first triangle. The one split of the mesh into bodies: the rigid-motion check
-/// and the gap bound (`plausible::Extent`) both take it.
+/// and the gap bound (`chord::Chords`) both take it.
 pub(super) fn bodies(nodes: &P2Nodes) -> Vec<usize> {
     let n = nodes.elements.len();
     let mut body = vec![usize::MAX; n];
