@@ -62,6 +62,7 @@ fn main() -> anyhow::Result<()> {
         AdaptTermination::StopNdofReached => "a level reached stop_ndof",
         AdaptTermination::StoppedByObserver => "stopped by the observer",
         AdaptTermination::NothingMarked => "the estimate is zero: nothing to mark",
+        AdaptTermination::FarFromOrigin { .. } => "the next mesh is too fine for its coordinates (far from the origin)",
     };
     let kkt = result.solution.kkt();
     println!("stopped: {why}; final mesh {} triangles, max penetration {:.1e}", result.mesh.n_triangles(), kkt.max_penetration);

@@ -380,6 +380,9 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
                 std::ops::ControlFlow::Continue(())
             }
         })?;
+        if result.termination.is_error() {
+            bail!("{}", result.termination.note(&config).unwrap_or_default());
+        }
         let last = result.records.last().context("the adaptive loop solved no level")?;
         if let Some(min) = args.adapt_min_ndof.filter(|&min| last.ndof < min) {
             let why = result.termination.note(&config).unwrap_or_else(|| "the last level --adapt-levels allows".into());
@@ -481,7 +484,9 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
         // an interrupt (SIGINT) stops after the level just printed, as `run` does
         if study::interrupted() { std::ops::ControlFlow::Break(()) } else { std::ops::ControlFlow::Continue(()) }
     })?;
-    if let Some(note) = result.termination.note(&config) {
+    // a stop the user must act on is the error this command ends with (after --save), as the
+    // memory stop is
+    if let Some(note) = result.termination.note(&config).filter(|_| !result.termination.is_error()) {
         println!("# {note}");
     }
     let level = result.records.last().map_or(0, |r| r.level);
@@ -492,6 +497,9 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
     }
     if study::interrupted() {
         bail!(AdaptInterrupted { level, saved: args.save.clone() });
+    }
+    if result.termination.is_error() {
+        bail!("{}", result.termination.note(&config).unwrap_or_default());
     }
     Ok(())
 }

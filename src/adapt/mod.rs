@@ -221,7 +221,7 @@ fn transfer_active_set(old_mesh: &Mesh, old: &DiscreteSolution, refinement: &Ref
 }
 
 /// Why [`run`] stopped.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum AdaptTermination {
     /// All `AdaptConfig::levels` levels were solved.
     LevelsReached,
@@ -236,6 +236,12 @@ pub enum AdaptTermination {
     /// ([`Resolution::AtRoundoff`]): the maximum strategy marks nothing, so the next level would
     /// be the same mesh again (not solved).
     NothingMarked,
+    /// The refined mesh of level `level` (of `ndof` unknowns) has an element whose shape f64 no
+    /// longer resolves at its coordinates (`worst`, [`Mesh::shape_roundoff_refused`]: a mesh far
+    /// from the origin refined deep, battery 13, F5); levels `0..level` were solved and seen by
+    /// the observer, that one was not. A stop, not an error of the loop, so that a study keeps
+    /// the levels solved; the command line exits 1 as for the memory stop ([`Self::is_error`]).
+    FarFromOrigin { level: usize, ndof: usize, worst: crate::mesh::precision::ShapeRoundoff },
 }
 
 impl AdaptTermination {
@@ -253,7 +259,20 @@ impl AdaptTermination {
             AdaptTermination::NothingMarked => Some(format!(
                 "stopped: the estimate is zero, or at round-off (u_h has no deformation above {NO_DEFORMATION} delta, or eta_h is at most {ROUNDOFF_ESTIMATE:e} (2 mu + lambda) delta, delta the round-off of u_h: the larger of its round-off floor and 2.2e-16 max |u_h|: u_h is a rigid motion or a field the P2 space reproduces, to round-off, or a rigid translation in the data left it no digits of the deformation), so nothing is marked and the next level would be the same mesh"
             )),
+            AdaptTermination::FarFromOrigin { level, ndof, worst } => Some(format!(
+                "stopped before level {level} (levels 0 to {} were solved): its refined mesh ({ndof} unknowns) is too fine for its coordinates: {}; or stop the loop before this level: at most {level} levels (levels = {level}, --levels {level}) or at most {} unknowns (max_ndof, --max-ndof)",
+                level - 1,
+                crate::mesh::MeshError::from(worst),
+                ndof - 1
+            )),
         }
+    }
+
+    /// Whether the command line ends with an error (exit 1) after the levels it printed, as for
+    /// the memory stop: the loop could not reach the levels asked for, for a reason the user
+    /// acts on (a study keeps the levels solved, with the note on its summary line).
+    pub fn is_error(self) -> bool {
+        matches!(self, AdaptTermination::FarFromOrigin { .. })
     }
 }
 
@@ -479,6 +498,15 @@ pub fn run_from(
             record.t_refine = t0.elapsed().as_secs_f64();
             Some(refined)
         };
+        // a refined mesh whose element shapes f64 no longer resolves ends the loop before its
+        // level, as the memory check does, not as an error of its solve (Mesh::check)
+        let far = match &next {
+            Some(Ok((m, _))) => {
+                m.shape_roundoff_refused().map(|worst| AdaptTermination::FarFromOrigin { level: level + 1, ndof: m.p2_ndof(), worst })
+            }
+            _ => None,
+        };
+        let next = if far.is_some() { None } else { next };
         record.t_level = t_level.elapsed().as_secs_f64();
         record.mem_peak_mib = crate::base::memory::peak_resident().filter(|_| measured).map(|b| b / (1024.0 * 1024.0));
         let flow = observer(Level {
@@ -502,6 +530,8 @@ pub fn run_from(
             termination = AdaptTermination::StopNdofReached;
         } else if next.is_none() && unmarked && level + 1 < config.levels {
             termination = AdaptTermination::NothingMarked;
+        } else if let Some(far) = far {
+            termination = far;
         }
         match next {
             Some(Ok((m, active))) => {

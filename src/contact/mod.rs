@@ -7,6 +7,7 @@
 
 pub mod active_set;
 pub mod certify;
+mod chord;
 pub mod consistent;
 pub mod norms;
 pub mod plausible;

@@ -26,9 +26,10 @@
 //!   held along one of them only and could pass the obstacle along the other (battery 10: the
 //!   corner of two contact sides took the bottom's normal and passed the side wall by 8% of the
 //!   gap, certified). Refused, naming the node and both normals ([`ContactDataError::Corner`]).
-//! * **The obstacle does not overlap the body by more than its size.** A gap chi(p) < -D, D the
-//!   body's extent along the contact normal n at p (max - min of x . n over the vertices of
-//!   the edge-connected body holding p, [`Extent`]), asks the body to move through its whole thickness along n at p:
+//! * **The obstacle does not overlap the body by more than its thickness.** A gap chi(p) < -D,
+//!   D the body's chord through p along the contact normal n (the length of the piece of the
+//!   line p + t n inside the edge-connected body holding p, [`Chords`]), asks the body to move
+//!   through its whole thickness along n at p:
 //!   outside linear (small-strain) elasticity everywhere it happens, and in practice a sign or
 //!   unit mistake. Checked at the contact nodes and on the same sampling as the normal; a gap
 //!   or normal that is not a finite number at a sampled point is named as the data watch names
@@ -56,6 +57,7 @@
 //! it is evaluated; Young's modulus, Poisson's ratio and the Lamé constants are checked when a
 //! problem file is read (`problems::file`).
 
+use super::chord::Chords;
 use crate::base::number::{point, shown};
 use crate::fem::assembly::DofMap;
 use crate::mesh::{Mesh, P2Nodes};
@@ -87,11 +89,11 @@ pub enum ContactDataError {
     /// `node`: the node's normal; `side`: the normal on `edge` next to the node; `angle` in radians.
     Corner { problem: String, part: String, at: [f64; 2], edge: [[f64; 2]; 2], node: [f64; 2], side: [f64; 2], angle: f64 },
     #[error(
-        "{problem}: the gap `contact.chi` at {x} on the contact part ({part}) is {chi}: the obstacle would overlap the body by more than the body's size along the contact normal ({nx:.6}, {ny:.6}) there (max - min of x . n over the vertices of the body holding it, {d}), pushing the body through itself; a gap below minus the body's size is a sign or unit mistake",
-        x = point(*.at), chi = shown(*.chi), d = shown(*.extent), nx = .normal[0], ny = .normal[1]
+        "{problem}: the gap `contact.chi` at {x} on the contact part ({part}) is {chi}: the obstacle would overlap the body by more than the body's thickness along the contact normal ({nx:.6}, {ny:.6}) there (the length of the line through that point along n inside the body, {d}), pushing the body through itself; a gap below minus the body's thickness is a sign or unit mistake",
+        x = point(*.at), chi = shown(*.chi), d = shown(*.chord), nx = .normal[0], ny = .normal[1]
     )]
-    /// `extent`: the body's extent along the unit `normal` ([`Extent::along`]).
-    Gap { problem: String, part: String, at: [f64; 2], chi: f64, normal: [f64; 2], extent: f64 },
+    /// `chord`: the body's chord through `at` along the unit `normal` ([`Chords`]).
+    Gap { problem: String, part: String, at: [f64; 2], chi: f64, normal: [f64; 2], chord: f64 },
     #[error(
         "{problem}: the node at {x} on the closure of the contact part ({part}) has u_{fixed} prescribed by {by} and u_{free} free, and the contact normal there ({nx:.6}, {ny:.6}) acts on the free u_{free}: the contact condition u . n <= chi is imposed only at nodes with no prescribed component, so it would not hold there and the body could pass the obstacle at that node. Prescribe both components there, or let the contact part and the part or point that prescribes one component not meet",
         x = point(*.at), nx = .normal[0], ny = .normal[1], fixed = .fixed + 1, free = 2 - .fixed
@@ -155,11 +157,11 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
     let outward: Vec<Option<[f64; 2]>> =
         outward_normals(mesh, nodes).into_iter().zip(&mesh.boundary).map(|(n, e)| (e.part == Part::Contact).then_some(n)).collect();
     let diameter = super::consistent::diameter(mesh);
-    let extent = Extent::of(mesh, nodes);
+    let chords = Chords::of(mesh, nodes);
     // the normal at each node and sampled point first: a normal nearly tangent or reversed is
     // named as such, never as a corner where it merely turns fast (battery 11, N6)
-    check_nodes(mesh, nodes, dofs, problem, &outward, &extent)?;
-    check_sampled(mesh, nodes, problem, &extent)?;
+    check_nodes(mesh, nodes, dofs, problem, &outward, &chords)?;
+    check_sampled(mesh, nodes, problem, &chords)?;
     check_corners(mesh, dofs, problem, diameter)?;
     check_prescribed(mesh, nodes, dofs, problem, diameter)
 }
@@ -214,7 +216,7 @@ fn check_nodes(
     dofs: &DofMap,
     problem: &dyn Problem,
     outward: &[Option<[f64; 2]>],
-    extent: &Extent,
+    chords: &Chords,
 ) -> Result<(), Box<ContactDataError>> {
     let cos_max = MAX_NORMAL_ANGLE_DEGREES.to_radians().cos();
     // per contact node, the most favourable of its contact edges: (n . n_out, edge)
@@ -247,9 +249,9 @@ fn check_nodes(
             let (problem, part) = (problem_name(problem), contact_part(problem));
             return Err(Box::new(ContactDataError::Normal { problem, part, at, edge, normal: c.normal, outward, dot }));
         }
-        if let Some(extent) = extent.overlapped(c.gap, c.normal, &edges[k]) {
+        if let Some(chord) = chords.overlapped(c.gap, at, c.normal, &edges[k]) {
             let (problem, part) = (problem_name(problem), contact_part(problem));
-            return Err(Box::new(ContactDataError::Gap { problem, part, at, chi: c.gap, normal: c.normal, extent }));
+            return Err(Box::new(ContactDataError::Gap { problem, part, at, chi: c.gap, normal: c.normal, chord }));
         }
     }
     Ok(())
@@ -262,7 +264,7 @@ fn check_nodes(
 /// along every contact edge), each against the body's outward normal there: a stretch of bad
 /// data longer than that spacing is refused on every mesh, not only on meshes that put a node
 /// in it. At a vertex, the more favourable of its contact edges' normals counts.
-fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, extent: &Extent) -> Result<(), Box<ContactDataError>> {
+fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, chords: &Chords) -> Result<(), Box<ContactDataError>> {
     use super::consistent::boundary::sample;
     let cos_max = MAX_NORMAL_ANGLE_DEGREES.to_radians().cos();
     let points = sample(mesh, nodes, Some(Part::Contact));
@@ -272,9 +274,9 @@ fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, extent: &E
     for (p, _) in &points {
         let chi = problem.gap(p.at);
         let n = problem.contact_normal(p.at, p.normal);
-        if let Some(extent) = extent.overlapped(chi, n, &[p.edge]) {
+        if let Some(chord) = chords.overlapped(chi, p.at, n, &[p.edge]) {
             let (problem, part) = (problem_name(problem), contact_part(problem));
-            return Err(Box::new(ContactDataError::Gap { problem, part, at: p.at, chi, normal: n, extent }));
+            return Err(Box::new(ContactDataError::Gap { problem, part, at: p.at, chi, normal: n, chord }));
         }
         let dot = n[0] * p.normal[0] + n[1] * p.normal[1];
         dots.push((n, dot));
@@ -298,70 +300,6 @@ fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, extent: &E
         }
     }
     Ok(())
-}
-
-/// Each body's extent along a direction: max - min of x . n over the vertices of an
-/// edge-connected body of the mesh (the split [`check_held`](super::certify::check_held)
-/// makes), read off its convex hull (collinear points dropped, so a polygon's hull is its
-/// corners); a point of the boundary takes the body of the triangle holding its edge. A gap below
-/// minus it asks the obstacle to push the body through its whole thickness along n (battery 11,
-/// N2: a plate 0.1 thick was pushed 5 through its clamped top, certified, under the former bound,
-/// the diagonal of the bounding box, 10; battery 12, F2: the same plate with a second, unrelated
-/// body meshed 5 above it, when the extent was the whole mesh's).
-pub(super) struct Extent {
-    /// Per body, its hull.
-    hulls: Vec<Vec<[f64; 2]>>,
-    /// Per boundary edge of the mesh, its body.
-    body_of_edge: Vec<usize>,
-}
-
-impl Extent {
-    pub(super) fn of(mesh: &Mesh, nodes: &P2Nodes) -> Extent {
-        let body = super::certify::bodies(nodes);
-        let mut vertices: Vec<Vec<[f64; 2]>> = vec![Vec::new(); body.iter().copied().max().map_or(0, |b| b + 1)];
-        let mut body_of_edge = vec![0; mesh.boundary.len()];
-        for (t, tri) in mesh.triangles.iter().enumerate() {
-            vertices[body[t]].extend(tri.iter().map(|&v| mesh.vertices[v]));
-            for &b in nodes.element_boundary[t].iter().flatten() {
-                body_of_edge[b] = body[t];
-            }
-        }
-        Extent { hulls: vertices.into_iter().map(hull).collect(), body_of_edge }
-    }
-
-    /// The extent along `n` (normalised here) of the body holding boundary edge `edge`.
-    fn along(&self, n: [f64; 2], edge: usize) -> f64 {
-        let len = n[0].hypot(n[1]);
-        let dots = self.hulls[self.body_of_edge[edge]].iter().map(|v| (v[0] * n[0] + v[1] * n[1]) / len);
-        let (lo, hi) = dots.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)));
-        hi - lo
-    }
-
-    /// The extent along `n` where the gap `chi` is below minus it, for a point on the boundary
-    /// `edges` (at a vertex two bodies share, the larger of their extents counts); None otherwise,
-    /// and where `chi` or `n` is not a number or `n` is zero (the data watch names those).
-    fn overlapped(&self, chi: f64, n: [f64; 2], edges: &[usize]) -> Option<f64> {
-        let extent = edges.iter().map(|&e| self.along(n, e)).fold(f64::NEG_INFINITY, f64::max);
-        (extent.is_finite() && chi < -extent).then_some(extent)
-    }
-}
-
-/// The convex hull of `v` (Andrew's monotone chain), collinear points dropped.
-fn hull(mut v: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
-    v.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
-    v.dedup();
-    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
-    let mut hull: Vec<[f64; 2]> = Vec::new();
-    for pass in [v.clone(), v.into_iter().rev().collect()] {
-        let start = hull.len();
-        for p in pass {
-            while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-    }
-    hull
 }
 
 /// The mesh vertex at parameter `t` of boundary edge `edge`, if `t` is one of its ends.

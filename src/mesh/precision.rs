@@ -46,16 +46,27 @@ impl Mesh {
         worst
     }
 
+    /// The worst element where the mesh's element shapes keep fewer than 3 digits
+    /// ([`SHAPE_ROUNDOFF_REFUSED`]), None where every element keeps them: what [`Mesh::check`]
+    /// refuses and what ends the adaptive loop before a refined mesh's level.
+    pub fn shape_roundoff_refused(&self) -> Option<ShapeRoundoff> {
+        Some(self.shape_roundoff()).filter(|worst| worst.delta > SHAPE_ROUNDOFF_REFUSED)
+    }
+
     /// Refuse a mesh whose element shapes keep fewer than 3 digits
     /// ([`SHAPE_ROUNDOFF_REFUSED`]): part of [`Mesh::check`], before anything reads the geometry
     /// (the rigid-motion check would misread a segment as a line).
     pub(super) fn check_shape_roundoff(&self) -> Result<(), MeshError> {
-        let worst = self.shape_roundoff();
-        if worst.delta > SHAPE_ROUNDOFF_REFUSED {
-            let ShapeRoundoff { delta, triangle, offset, height } = worst;
-            return Err(MeshError::FarFromOrigin { t: triangle, delta, offset, height });
+        match self.shape_roundoff_refused() {
+            Some(worst) => Err(worst.into()),
+            None => Ok(()),
         }
-        Ok(())
+    }
+}
+
+impl From<ShapeRoundoff> for MeshError {
+    fn from(ShapeRoundoff { delta, triangle, offset, height }: ShapeRoundoff) -> MeshError {
+        MeshError::FarFromOrigin { t: triangle, delta, offset, height }
     }
 }
 

@@ -105,13 +105,15 @@ pub fn compute(
     if out.termination == adapt::AdaptTermination::StoppedByObserver {
         return Ok(None); // on_level stopped it (an interrupt)
     }
-    let why = format!(
-        "the reference loop stops after {REFERENCE_LEVELS} levels, and marking with theta = {} added about {:.0} unknowns per level \
+    let why = out.termination.note(&config).unwrap_or_else(|| {
+        format!(
+            "the reference loop stops after {REFERENCE_LEVELS} levels, and marking with theta = {} added about {:.0} unknowns per level \
          (the largest level-to-level growth was {}); lower reference.theta (more elements marked per level) or reference.min_ndof",
-        spec.theta,
-        last.ndof.saturating_sub(out.records[0].ndof) as f64 / (out.records.len() - 1).max(1) as f64,
-        out.records.windows(2).map(|w| w[1].ndof.saturating_sub(w[0].ndof)).max().unwrap_or(0)
-    );
+            spec.theta,
+            last.ndof.saturating_sub(out.records[0].ndof) as f64 / (out.records.len() - 1).max(1) as f64,
+            out.records.windows(2).map(|w| w[1].ndof.saturating_sub(w[0].ndof)).max().unwrap_or(0)
+        )
+    });
     Err(ReferenceError::Short { ndof: last.ndof, levels: out.records.len(), min_ndof: spec.min_ndof, why })
 }
 

@@ -42,7 +42,7 @@ fn bad_contact_data_on_a_stretch_between_nodes_is_refused_on_every_mesh_before_l
     let cases = [
         ("reversed", "normal", format!("normal = [\"1 - 3*{band}\", \"0\"]"), "reversed against"),
         ("tangent", "normal", format!("normal = [\"1 - 0.99*{band}\", \"{band}\"]"), "nearly tangent"),
-        ("deep", "chi", format!("chi = \"-0.2 + 0.5*abs(y - 0.5) - 10*{band}\""), "below minus the body's size"),
+        ("deep", "chi", format!("chi = \"-0.2 + 0.5*abs(y - 0.5) - 10*{band}\""), "more than the body's thickness"),
         ("nan", "chi", "chi = \"-0.2 + 0.5*abs(y - 0.5) + 0*sqrt(abs(y - 0.53) - 0.002)\"".to_string(), "`contact.chi` is NaN"),
     ];
     for (name, key, line, says) in &cases {

@@ -105,8 +105,8 @@ fn a_gap_deeper_than_the_body_is_refused() {
     assert!(
         err.contains("the gap `contact.chi` at (")
             && err.contains("is -1.4")
-            && err.contains("more than the body's size")
-            && err.contains("over the vertices of the body holding it, 1)"),
+            && err.contains("more than the body's thickness")
+            && err.contains("inside the body, 1)"),
         "{err}"
     );
     let (code, err) = run("shallow", SQUARE, r#"chi = "0.001""#, r#"chi = "-0.9""#, SOLVE);

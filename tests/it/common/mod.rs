@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod browser;
+pub mod msh;
 
 use signorini::contact::PdasOptions;
 use signorini::mesh::{Mesh, MeshSpec};

@@ -1,0 +1,184 @@
+//! A body's thickness along the contact normal at a point of its boundary: the chord, the length
+//! of the piece of the line p + t n inside the body that holds p. The gap bound of
+//! [`plausible`](super::plausible) takes it (a gap chi(p) below minus the chord pushes the body
+//! through itself along n at p). Neither the body's extent along n (battery 13, F1: an L-shaped
+//! body's 0.1-thick flange was pushed 0.5 through its clamped top, certified, because the column
+//! on its end made the extent 5) nor the whole mesh's (battery 12, F2: a second body 5 above a
+//! thin plate) bounds it.
+//!
+//! The body is bounded by its boundary edges, straight between the mesh's vertices (a point of a
+//! curved edge lies off that chord by less than the edge's length). The line crosses them at
+//! parameters that, sorted, enter and leave the body in turn; a vertex on the line counts on one
+//! side of it, as for a line moved an infinitesimal step to that side, and both sides are tried
+//! (the larger chord counts: a point at a corner takes the more favourable of its two sides, as
+//! the normal check does). The boundary edges are in an R*-tree ([`rstar`], as in
+//! [`mesh::locate`](crate::mesh::locate)), built at the first negative gap, so that a point
+//! costs the edges near its line, not all of them: near linear at 1e7 unknowns.
+
+use crate::mesh::{Mesh, P2Nodes};
+use rstar::primitives::{GeomWithData, Rectangle};
+use rstar::{AABB, RTree, RTreeObject, SelectionFunction};
+
+type Boxed = GeomWithData<Rectangle<[f64; 2]>, usize>;
+
+/// Every body's chords through points of its boundary ([`Chords::overlapped`]).
+pub(super) struct Chords {
+    /// Per boundary edge of the mesh, its two vertices.
+    ends: Vec<[[f64; 2]; 2]>,
+    /// Per boundary edge of the mesh, its body (the split `certify::bodies` makes).
+    body_of_edge: Vec<usize>,
+    /// The boundary edges' bounding boxes, built when a gap is first negative (most problems
+    /// have none, and a chord is never needed where the gap is not).
+    tree: std::cell::OnceCell<RTree<Boxed>>,
+}
+
+impl Chords {
+    pub(super) fn of(mesh: &Mesh, nodes: &P2Nodes) -> Chords {
+        let body = super::certify::bodies(nodes);
+        let mut body_of_edge = vec![0; mesh.boundary.len()];
+        for (t, local) in nodes.element_boundary.iter().enumerate() {
+            for &b in local.iter().flatten() {
+                body_of_edge[b] = body[t];
+            }
+        }
+        let ends = mesh.boundary.iter().map(|e| e.v.map(|v| mesh.vertices[v])).collect();
+        Chords { ends, body_of_edge, tree: std::cell::OnceCell::new() }
+    }
+
+    /// The chord where the gap `chi` at `p` is below minus it, for a point on the boundary
+    /// `edges` (at a vertex two bodies share, the larger of their chords counts); None
+    /// otherwise, where `chi` is not negative or not a number, and where `n` is zero or not a
+    /// number (the data watch names those).
+    pub(super) fn overlapped(&self, chi: f64, p: [f64; 2], n: [f64; 2], edges: &[usize]) -> Option<f64> {
+        if !(chi < 0.0) {
+            return None;
+        }
+        let chord = edges.iter().filter_map(|&e| self.through(p, n, e)).fold(f64::NEG_INFINITY, f64::max);
+        (chord.is_finite() && chi < -chord).then_some(chord)
+    }
+
+    /// The chord through `p` along `n` (normalised here) of the body holding boundary edge
+    /// `edge`, `p` on that edge (or on the curve it is the chord of). None where the line does
+    /// not cross the body's boundary within the edge's length of `p`: `n` along the edge, whose
+    /// normal check refuses it.
+    fn through(&self, p: [f64; 2], n: [f64; 2], edge: usize) -> Option<f64> {
+        let len = n[0].hypot(n[1]);
+        if !(len > 0.0 && len.is_finite()) {
+            return None;
+        }
+        let line = Line { p, d: [n[0] / len, n[1] / len] };
+        let tree = self.tree.get_or_init(|| self.boxes());
+        let body = self.body_of_edge[edge];
+        let near: Vec<[[f64; 2]; 2]> = tree
+            .locate_with_selection_function(line)
+            .map(|g| g.data)
+            .filter(|&e| self.body_of_edge[e] == body)
+            .map(|e| self.ends[e])
+            .collect();
+        let [a, b] = self.ends[edge];
+        let reach = (b[0] - a[0]).hypot(b[1] - a[1]);
+        [false, true].into_iter().filter_map(|strict| line.chord(&near, strict, reach)).reduce(f64::max)
+    }
+
+    fn boxes(&self) -> RTree<Boxed> {
+        let boxes = self.ends.iter().enumerate().map(|(e, &[a, b])| {
+            let lo = [a[0].min(b[0]), a[1].min(b[1])];
+            let hi = [a[0].max(b[0]), a[1].max(b[1])];
+            GeomWithData::new(Rectangle::from_corners(lo, hi), e)
+        });
+        RTree::bulk_load(boxes.collect())
+    }
+}
+
+/// The line through `p` along the unit vector `d`.
+#[derive(Clone, Copy)]
+struct Line {
+    p: [f64; 2],
+    d: [f64; 2],
+}
+
+impl Line {
+    /// The signed distance of `v` from the line.
+    fn across(&self, v: [f64; 2]) -> f64 {
+        self.d[0] * (v[1] - self.p[1]) - self.d[1] * (v[0] - self.p[0])
+    }
+
+    /// The parameter of `v`'s projection on the line (0 at `p`).
+    fn along(&self, v: [f64; 2]) -> f64 {
+        self.d[0] * (v[0] - self.p[0]) + self.d[1] * (v[1] - self.p[1])
+    }
+
+    /// The chord through `p`: the parameters where the line crosses the `edges` (a closed
+    /// boundary), sorted, enter and leave the body in turn; the crossing nearest `p` (within
+    /// `reach`) ends the piece holding `p`. A vertex on the line counts on the side `strict`
+    /// says (false: with the vertices at positive distance), so each vertex is on one side and
+    /// the crossings come in pairs.
+    fn chord(&self, edges: &[[[f64; 2]; 2]], strict: bool, reach: f64) -> Option<f64> {
+        let side = |c: f64| if strict { c > 0.0 } else { c >= 0.0 };
+        let mut s: Vec<f64> = edges
+            .iter()
+            .filter_map(|&[a, b]| {
+                let (ca, cb) = (self.across(a), self.across(b));
+                (side(ca) != side(cb)).then(|| {
+                    let (sa, sb) = (self.along(a), self.along(b));
+                    sa + (sb - sa) * ca / (ca - cb)
+                })
+            })
+            .collect();
+        s.sort_by(f64::total_cmp);
+        let nearest = s.iter().map(|x| x.abs()).fold(f64::INFINITY, f64::min);
+        if !s.len().is_multiple_of(2) || nearest > reach {
+            return None;
+        }
+        // the piece each crossing at p (two at a vertex the line touches) ends
+        let pieces = s.iter().enumerate().filter(|(_, x)| x.abs() == nearest);
+        pieces.map(|(i, &x)| if i.is_multiple_of(2) { s[i + 1] - x } else { x - s[i - 1] }).reduce(f64::max)
+    }
+}
+
+/// The boxes the line meets: a box with its four corners strictly on one side (beyond a
+/// round-off margin of the coordinates) holds no edge that crosses it.
+impl SelectionFunction<Boxed> for Line {
+    fn should_unpack_parent(&self, envelope: &AABB<[f64; 2]>) -> bool {
+        let (lo, hi) = (envelope.lower(), envelope.upper());
+        let corners = [lo, hi, [lo[0], hi[1]], [hi[0], lo[1]]];
+        let scale = corners.iter().chain([&self.p]).fold(0.0f64, |m, c| m.max(c[0].abs()).max(c[1].abs()));
+        let margin = 1e-12 * scale;
+        let c = corners.map(|v| self.across(v));
+        !(c.iter().all(|&c| c > margin) || c.iter().all(|&c| c < -margin))
+    }
+
+    fn should_unpack_leaf(&self, leaf: &Boxed) -> bool {
+        self.should_unpack_parent(&leaf.envelope())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An L: a flange [0, 10] x [0, 0.1] and a column [0, 0.5] x [0.1, 5], as one closed
+    /// boundary of straight edges (the flange's bottom split at x = 5).
+    fn l_shape() -> Vec<[[f64; 2]; 2]> {
+        let v = [[0.0, 0.0], [5.0, 0.0], [10.0, 0.0], [10.0, 0.1], [0.5, 0.1], [0.5, 5.0], [0.0, 5.0]];
+        (0..v.len()).map(|i| [v[i], v[(i + 1) % v.len()]]).collect()
+    }
+
+    #[test]
+    fn the_chord_is_the_piece_of_the_line_holding_the_point() {
+        let l = l_shape();
+        let down = |p| Line { p, d: [0.0, -1.0] };
+        let chord = |p, strict| down(p).chord(&l, strict, 1.0);
+        // the flange: 0.1 thick, whatever the column
+        assert_eq!(chord([3.0, 0.0], false), Some(0.1));
+        assert_eq!(chord([3.0, 0.0], true), Some(0.1));
+        // through the column: 5
+        assert_eq!(chord([0.25, 0.0], false), Some(5.0));
+        // at the vertex (5, 0) between two bottom edges, and at the corner (10, 0) whose line
+        // runs along the flange's end: the side that keeps the body gives 0.1
+        assert_eq!(chord([5.0, 0.0], false).into_iter().chain(chord([5.0, 0.0], true)).reduce(f64::max), Some(0.1));
+        assert_eq!(chord([10.0, 0.0], false).into_iter().chain(chord([10.0, 0.0], true)).reduce(f64::max), Some(0.1));
+        // a point off the boundary by more than the reach has no chord
+        assert_eq!(down([3.0, -2.0]).chord(&l, false, 1.0), None);
+    }
+}
