@@ -302,7 +302,7 @@ pub fn check_held(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Pro
 }
 
 /// The body of every triangle: the edge-connected components of the mesh, numbered in the
-/// order of their first triangle. The one split of the mesh into bodies: the rigid-motion check
+/// order of their first triangle. The one split of the mesh into bodies: the rigid-motion check,
 /// the gap bound (`chord::Chords`) and what a solve resolves (`adapt::resolution`, per body)
 /// take it.
 pub fn bodies(nodes: &P2Nodes) -> Vec<usize> {

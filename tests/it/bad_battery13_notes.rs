@@ -88,7 +88,7 @@ fn a_lock_folder_that_is_a_file_is_named_also_when_every_run_is_finished() {
     for args in [&["run", "exp/s.toml", "--results", "res"][..], &["figures", "--results", "res", "--experiments", "exp"]] {
         let (code, _, err) = signorini_in(&dir, args);
         assert_eq!(code, 1, "{args:?}: {err}");
-        assert!(err.contains(".locks is a file, not the folder of the run locks"), "{args:?}: {err}");
+        assert!(err.contains(".locks is a regular file, not a folder: move it away"), "{args:?}: {err}");
     }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -282,9 +282,10 @@ pub(super) fn wait_for_writers(dir: &StudyDir) -> Result<()> {
 /// run is finished and no run lock is opened (battery 13: `run` then said "0 run(s) executed").
 fn check_run_lock_folder(dir: &StudyDir) -> Result<()> {
     let folder = dir.root.join(".locks");
-    match std::fs::symlink_metadata(&folder) {
-        Ok(m) if !m.is_dir() && !folder.is_dir() => {
-            bail!("{} is a file, not the folder of the run locks: remove it (it holds no run)", folder.display())
+    match std::fs::metadata(&folder) {
+        Ok(m) if !m.is_dir() => {
+            let what = if m.is_file() { "a regular file" } else { "not a regular file either" };
+            bail!("{} is {what}, not a folder: move it away (it is where the run locks go, and holds no run)", folder.display())
         }
         _ => Ok(()),
     }
