@@ -264,17 +264,33 @@ pub(super) fn writer_of(dir: &StudyDir) -> Result<Option<BeingWritten>> {
 }
 
 /// Wait until no other process writes `dir` ([`writer_of`]): for each writer found, block on a
-/// shared lock of the lock file it holds (saying who it is), then look again, since another
-/// writer may have started meanwhile. What a reader given `--wait` does before it reads (the
-/// Slurm finish job of one array, while another array's tasks still hold the folder). A writer
-/// that starts after the wait makes the read refuse as without `--wait`: never a silent read.
+/// shared lock of the lock file it holds (saying who it is, once per process), then look again;
+/// and where no lock is held, wait until every process seen writing has ended. A `run` holds no
+/// lock for a moment between committing one run and claiming the next (battery 14, F2: `figures
+/// --wait` woke in that moment and then met the next run's lock, exit 1, or read the study with
+/// its later runs missing, exit 0). What a reader given `--wait` does before it reads (the Slurm
+/// finish job of one array, while another array's tasks still hold the folder). A process that
+/// starts writing after the wait makes the read refuse as without `--wait`: never a silent read.
 pub(super) fn wait_for_writers(dir: &StudyDir) -> Result<()> {
-    while let Some(written) = writer_of(dir)? {
-        crate::base::note::line(format_args!("{} is being written by {}; waiting for it to finish", written.what, written.holder));
+    let mut seen: Vec<u32> = Vec::new();
+    loop {
+        let Some(written) = writer_of(dir)? else {
+            if !seen.iter().any(|&pid| running(pid)) {
+                return Ok(());
+            }
+            std::thread::sleep(std::time::Duration::from_millis(100));
+            continue;
+        };
+        match named_pid(&written.holder) {
+            Some(pid) if seen.contains(&pid) => {}
+            pid => {
+                seen.extend(pid);
+                crate::base::note::line(format_args!("{} is being written by {}; waiting for it to finish", written.what, written.holder));
+            }
+        }
         let file = std::fs::File::open(&written.lock).with_context(|| format!("opening the lock file {}", written.lock.display()))?;
         file.lock_shared().with_context(|| format!("waiting for the lock {}", written.lock.display()))?;
     }
-    Ok(())
 }
 
 /// The folder of the run locks (`STUDY/.locks`), where it exists, is a folder: one that is a file
