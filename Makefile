@@ -77,11 +77,17 @@ crosscheck: build
 # then whole solves in fresh processes, ours, NGSolve's (sparsecholesky) and NGSolve's with MKL
 # PARDISO interleaved (medians of 3 at N = 256 and 512; PARDISO from crosscheck/.venv-bench, the
 # bench's own venv with pinned MKL), the structured:1024 scale point, and the table of the targets
-# with met / not met. About 30 minutes; results/bench/{ngsolve_bench,solver}.json.
+# with met / not met. About 30 minutes; results/bench/{ngsolve_bench,solver}.json. Then the graded
+# section (issue 42): the deep study's levels nearest 2e6 NDF rebuilt from their stored histories
+# and structured:512, each factorised phase by phase (orderings with their flops and METIS's as the
+# anchor, symbolic, supernode sizes, numeric rate), about 5 minutes, results/bench/graded.json.
+# Alone: `cargo run --release --locked --features bench-metis --bin bench -- --graded-only`
+# (`--graded-ndof 9e6` for the deep study's last levels: about 13 GiB; `--graded-save DIR` writes
+# each mesh as VTU and its node graph for shared/tools/ordstat).
 bench: build
 	crosscheck/setup.sh && crosscheck/setup.sh bench
 	crosscheck/.venv/bin/python crosscheck/crosscheck.py --out-dir results/bench bench --sizes 32,64,128,256,512
-	$(CARGO) run --release --locked --bin bench
+	$(CARGO) run --release --locked --features bench-metis --bin bench
 
 # How far round-off moves the stored numbers: every study rerun three ways that change only the
 # order of floating-point operations (nested dissection forced, minimum degree forced, one thread

@@ -6,7 +6,9 @@
 //! active-set iteration. Then what a user sees: whole contact solves in fresh processes (mesh,
 //! assembly, ordering, factorisation, active set, displacement and contact force), interleaved
 //! with NGSolve's whole linear solves of the same system in fresh processes, medians of three,
-//! and one scale point; the table of the targets of issue 15 with met / not met.
+//! and one scale point; the table of the targets of issue 15 with met / not met. Then the
+//! graded section (bench/graded.rs, alone with `--graded-only`): a factorisation's phases on the
+//! deep study's graded levels beside the grid's and METIS's, in `results/bench/graded.json`.
 //! Speed lives here, never in timed tests.
 
 use anyhow::Result;
@@ -74,7 +76,31 @@ struct Args {
     /// Run the adaptive point in this process.
     #[arg(long, hide = true)]
     adaptive_child: bool,
+    /// The graded section (bench/graded.rs): the level nearest this NDF of each of
+    /// `--graded-runs`, rebuilt from its stored history, and structured:N of about the same
+    /// NDF, each factorised phase by phase (0: no graded section). Levels near 9e6 NDF need
+    /// about 13 GiB.
+    #[arg(long, default_value_t = 2e6)]
+    graded_ndof: f64,
+    /// The runs of experiments/deep.toml the graded section measures.
+    #[arg(long, value_delimiter = ',', default_value = graded::RUNS)]
+    graded_runs: Vec<String>,
+    /// Only the graded section (no structured sizes, NGSolve, scale or adaptive point).
+    #[arg(long)]
+    graded_only: bool,
+    /// The graded section's output file.
+    #[arg(long, default_value = "results/bench/graded.json")]
+    graded_out: std::path::PathBuf,
+    /// Write each graded case's mesh (VTU) and node graph (ordstat's binary) into this folder.
+    #[arg(long)]
+    graded_save: Option<std::path::PathBuf>,
+    /// Run one graded case (a run id, or structured:N) in this process.
+    #[arg(long, hide = true)]
+    graded_child: Option<String>,
 }
+
+#[path = "bench/graded.rs"]
+mod graded;
 
 /// The manifest of the adaptive point.
 const DEEP_MANIFEST: &str = "experiments/deep.toml";
@@ -638,6 +664,14 @@ fn main() -> Result<()> {
         println!("ROW {}", serde_json::to_string(&adaptive_run(&args.adaptive)?)?);
         return Ok(());
     }
+    if let Some(case) = &args.graded_child {
+        return graded::child(case, args.graded_ndof, args.graded_save.as_deref());
+    }
+    let graded =
+        graded::Options { ndof: args.graded_ndof, runs: &args.graded_runs, out: &args.graded_out, save: args.graded_save.as_deref() };
+    if args.graded_only {
+        return graded::section(&graded);
+    }
     if !args.factor_rate.is_empty() {
         factor_rates(&args.factor_rate, args.repeats)?;
         return Ok(());
@@ -705,6 +739,9 @@ fn main() -> Result<()> {
     });
     records::write_json(&args.out, &doc)?;
     println!("wrote {}", args.out.display());
+    if args.graded_ndof > 0.0 {
+        graded::section(&graded)?;
+    }
     Ok(())
 }
 

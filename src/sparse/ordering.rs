@@ -66,7 +66,7 @@ pub(crate) struct Graph {
 }
 
 impl Graph {
-    fn new(matrix: &SymCsc, n: usize, coords: &[[f64; 2]]) -> Self {
+    pub(crate) fn new(matrix: &SymCsc, n: usize, coords: &[[f64; 2]]) -> Self {
         let same = |a: [f64; 2], b: [f64; 2]| a[0].to_bits() == b[0].to_bits() && a[1].to_bits() == b[1].to_bits();
         let mut first = vec![0];
         for i in 1..n {
@@ -115,6 +115,17 @@ impl Graph {
 
     pub(crate) fn n_nodes(&self) -> usize {
         self.first.len() - 1
+    }
+
+    /// The position of every node, from the positions of the unknowns.
+    pub(crate) fn node_coords(&self, coords: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        self.first[..self.n_nodes()].iter().map(|&i| coords[i]).collect()
+    }
+
+    /// The adjacency compressed by rows, without the diagonal: node i's neighbours are
+    /// `adj[ptr[i]..ptr[i + 1]]`.
+    pub(crate) fn csr(&self) -> (&[u32], &[u32]) {
+        (&self.ptr, &self.adj)
     }
 
     /// The unknowns of node k.
@@ -272,24 +283,17 @@ pub(crate) fn fill_reducing_then<T: Send>(
     coords: &[[f64; 2]],
     then: impl FnOnce(&Graph, &[usize]) -> (T, f64) + Send,
 ) -> (T, OrderingChoice) {
-    use faer::dyn_stack::{MemBuffer, MemStack};
-    use faer::sparse::linalg::amd;
     let graph = Graph::new(matrix, n_order, coords);
     let nodes = graph.n_nodes();
-    let node_coords: Vec<[f64; 2]> = graph.first[..nodes].iter().map(|&i| coords[i]).collect();
+    let node_coords = graph.node_coords(coords);
     let reach = reach(&graph, &node_coords);
     let grading = grading(&reach);
     let forced = forced_here();
     let with_amd = amd_is_candidate(nodes, grading, forced);
     let minimum_degree = || {
-        let pattern = faer::sparse::SymbolicSparseColMatRef::new_checked(nodes, nodes, &graph.ptr, None, &graph.adj);
-        let (mut fwd, mut inv) = (vec![0u32; nodes], vec![0u32; nodes]);
-        let ordered = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(nodes, graph.adj.len())).ok().and_then(|mut mem| {
-            amd::order_maybe_unsorted(&mut fwd, &mut inv, pattern, amd::Control::default(), MemStack::new(&mut mem)).ok()
-        });
-        let order: Vec<usize> = fwd.into_iter().map(|i| i as usize).collect();
+        let (order, ordered) = minimum_degree(&graph);
         // AMD counts the flops of the node graph; ours weighs each node by its unknowns
-        let flops = if ordered.is_some() { factorisation_flops(&graph, &order) } else { f64::INFINITY };
+        let flops = if ordered { factorisation_flops(&graph, &order) } else { f64::INFINITY };
         (order, flops)
     };
     let nested = || nested_dissection(&graph, &node_coords, &reach);
@@ -319,6 +323,20 @@ pub(crate) fn fill_reducing_then<T: Send>(
     (out, OrderingChoice { method, flops_nested_dissection: nd_flops, flops_minimum_degree: amd_flops, grading })
 }
 
+/// AMD's order of the nodes of `graph` (`order[new] = old`), and whether AMD ran (false: it
+/// could not get its workspace, and the order is not one).
+pub(crate) fn minimum_degree(graph: &Graph) -> (Vec<usize>, bool) {
+    use faer::dyn_stack::{MemBuffer, MemStack};
+    use faer::sparse::linalg::amd;
+    let nodes = graph.n_nodes();
+    let pattern = faer::sparse::SymbolicSparseColMatRef::new_checked(nodes, nodes, &graph.ptr, None, &graph.adj);
+    let (mut fwd, mut inv) = (vec![0u32; nodes], vec![0u32; nodes]);
+    let ordered = MemBuffer::try_new(amd::order_maybe_unsorted_scratch::<u32>(nodes, graph.adj.len()))
+        .ok()
+        .and_then(|mut mem| amd::order_maybe_unsorted(&mut fwd, &mut inv, pattern, amd::Control::default(), MemStack::new(&mut mem)).ok());
+    (fwd.into_iter().map(|i| i as usize).collect(), ordered.is_some())
+}
+
 /// Whether [`fill_reducing`] computes AMD: when forced, on small meshes and on graded ones.
 fn amd_is_candidate(nodes: usize, grading: f64, forced: Option<Method>) -> bool {
     match forced {
@@ -339,7 +357,7 @@ pub fn grading(reach: &[[f64; 2]]) -> f64 {
 }
 
 /// How far the neighbours of every node of `graph` (at `coords`) lie from it along each axis.
-fn reach(graph: &Graph, coords: &[[f64; 2]]) -> Vec<[f64; 2]> {
+pub(crate) fn reach(graph: &Graph, coords: &[[f64; 2]]) -> Vec<[f64; 2]> {
     (0..graph.n_nodes())
         .into_par_iter()
         .map(|i| {
@@ -351,7 +369,7 @@ fn reach(graph: &Graph, coords: &[[f64; 2]]) -> Vec<[f64; 2]> {
 
 /// Nested dissection of all nodes of `graph` (at `coords`, with their `reach`), as
 /// `order[new] = old`.
-fn nested_dissection(graph: &Graph, coords: &[[f64; 2]], reach: &[[f64; 2]]) -> Vec<usize> {
+pub(crate) fn nested_dissection(graph: &Graph, coords: &[[f64; 2]], reach: &[[f64; 2]]) -> Vec<usize> {
     let n = graph.n_nodes();
     assert!(coords.len() >= n && reach.len() >= n && n < u32::MAX as usize);
     // side[i]: which half of the current split node i is in; the halves being split at the
@@ -487,6 +505,13 @@ impl Dissection<'_> {
 /// order (each node's unknowns together), from the column counts of the node graph
 /// ([`super::etree::tree_and_counts`], `Counts::flops`).
 fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
+    let weight = |p: usize| graph.weight(order[p]);
+    ordered_counts(graph, order).flops(order.len(), &weight)
+}
+
+/// The elimination tree and column counts of the node graph with the nodes in the given order
+/// ([`super::etree::tree_and_counts`], each node weighted by its unknowns).
+pub(crate) fn ordered_counts(graph: &Graph, order: &[usize]) -> super::etree::Counts {
     let mut position = vec![0u32; order.len()];
     for (new, &old) in order.iter().enumerate() {
         position[old] = new as u32;
@@ -494,7 +519,7 @@ fn factorisation_flops(graph: &Graph, order: &[usize]) -> f64 {
     let weight = |p: usize| graph.weight(order[p]);
     let adjacency =
         Adjacency::gather(order.len(), &|p| graph.degree(order[p]), &|p, f| graph.neighbours(order[p]).for_each(|q| f(position[q])));
-    super::etree::tree_and_counts(&adjacency, order.len(), &weight).flops(order.len(), &weight)
+    super::etree::tree_and_counts(&adjacency, order.len(), &weight)
 }
 
 #[cfg(test)]
