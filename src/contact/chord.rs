@@ -1,5 +1,6 @@
 //! A body's thickness along the contact normal at a point of its boundary: the chord, the length
-//! of the piece of the line p + t n inside the body that holds p. The gap bound of
+//! of the line p + t n inside the body that holds p, from p into the body (the piece holding p
+//! and every piece beyond it on that side; holes between do not count). The gap bound of
 //! [`plausible`](super::plausible) takes it (a gap chi(p) below minus the chord pushes the body
 //! through itself along n at p). Neither the body's extent along n (battery 13, F1: an L-shaped
 //! body's 0.1-thick flange was pushed 0.5 through its clamped top, certified, because the column
@@ -110,9 +111,14 @@ impl Line {
 
     /// The chord through `p`: the parameters where the line crosses the `edges` (a closed
     /// boundary), sorted, enter and leave the body in turn; the crossing nearest `p` (within
-    /// `reach`) ends the piece holding `p`. A vertex on the line counts on the side `strict`
-    /// says (false: with the vertices at positive distance), so each vertex is on one side and
-    /// the crossings come in pairs.
+    /// `reach`) ends the piece holding `p`, and the chord is that piece and every piece beyond
+    /// it on the same side of `p`: all the body's material the line meets going into the body
+    /// from `p`. Only the material counts, not the holes between: a hole behind the contact face
+    /// is room the face may move into (battery 14, F1: a 0.01 ligament under a 0.85 tall hole
+    /// was refused at a gap of -0.02, the first piece alone), and the body is pushed through
+    /// itself only where the gap exceeds all of it. A vertex on the line counts on the side
+    /// `strict` says (false: with the vertices at positive distance), so each vertex is on one
+    /// side and the crossings come in pairs.
     fn chord(&self, edges: &[[[f64; 2]; 2]], strict: bool, reach: f64) -> Option<f64> {
         let side = |c: f64| if strict { c > 0.0 } else { c >= 0.0 };
         let mut s: Vec<f64> = edges
@@ -130,9 +136,18 @@ impl Line {
         if !s.len().is_multiple_of(2) || nearest > reach {
             return None;
         }
-        // the piece each crossing at p (two at a vertex the line touches) ends
-        let pieces = s.iter().enumerate().filter(|(_, x)| x.abs() == nearest);
-        pieces.map(|(i, &x)| if i.is_multiple_of(2) { s[i + 1] - x } else { x - s[i - 1] }).reduce(f64::max)
+        // from each crossing at p (two at a vertex the line touches), the pieces inside the body
+        // on its side: [s[j], s[j + 1]] for even j from an entry, [s[j - 1], s[j]] for odd j down
+        // from an exit
+        let inside = |i: usize| -> f64 {
+            if i.is_multiple_of(2) {
+                s[i..].chunks_exact(2).map(|w| w[1] - w[0]).sum()
+            } else {
+                s[..=i].chunks_exact(2).map(|w| w[1] - w[0]).sum()
+            }
+        };
+        let at_p = s.iter().enumerate().filter(|(_, x)| x.abs() == nearest);
+        at_p.map(|(i, _)| inside(i)).reduce(f64::max)
     }
 }
 
@@ -180,5 +195,23 @@ mod tests {
         assert_eq!(chord([10.0, 0.0], false).into_iter().chain(chord([10.0, 0.0], true)).reduce(f64::max), Some(0.1));
         // a point off the boundary by more than the reach has no chord
         assert_eq!(down([3.0, -2.0]).chord(&l, false, 1.0), None);
+    }
+
+    /// A unit block with a hole [3/8, 5/8] x [0.01, 0.86] behind its bottom face: the line up
+    /// from the face meets 0.01 of material, the hole, then 0.14: the chord is 0.15, while the
+    /// line from a point beside the hole meets the whole height.
+    #[test]
+    fn the_chord_counts_the_material_beyond_a_hole_and_not_the_hole() {
+        let square = |lo: [f64; 2], hi: [f64; 2]| {
+            let v = [lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]];
+            (0..4).map(move |i| [v[i], v[(i + 1) % 4]])
+        };
+        let block: Vec<[[f64; 2]; 2]> = square([0.0, 0.0], [1.0, 1.0]).chain(square([0.375, 0.01], [0.625, 0.86])).collect();
+        let up = |x: f64| Line { p: [x, 0.0], d: [0.0, -1.0] }.chord(&block, false, 1.0).unwrap();
+        assert!((up(0.5) - 0.15).abs() < 1e-12, "{}", up(0.5));
+        assert!((up(0.2) - 1.0).abs() < 1e-12, "{}", up(0.2));
+        // from the top, going down the same way
+        let down = Line { p: [0.5, 1.0], d: [0.0, 1.0] }.chord(&block, false, 1.0).unwrap();
+        assert!((down - 0.15).abs() < 1e-12, "{down}");
     }
 }
