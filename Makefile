@@ -83,7 +83,7 @@ crosscheck: build
 # anchor, symbolic, supernode sizes, numeric rate), about 5 minutes, results/bench/graded.json.
 # Alone: `cargo run --release --locked --features bench-metis --bin bench -- --graded-only`
 # (`--graded-ndof 9e6` for the deep study's last levels: about 13 GiB; `--graded-save DIR` writes
-# each mesh as VTU and its node graph for shared/tools/ordstat).
+# each mesh as VTU and its node graph, for an independent count of fill and flops).
 bench: build
 	crosscheck/setup.sh && crosscheck/setup.sh bench
 	crosscheck/.venv/bin/python crosscheck/crosscheck.py --out-dir results/bench bench --sizes 32,64,128,256,512

@@ -91,7 +91,7 @@ struct Args {
     /// The graded section's output file.
     #[arg(long, default_value = "results/bench/graded.json")]
     graded_out: std::path::PathBuf,
-    /// Write each graded case's mesh (VTU) and node graph (ordstat's binary) into this folder.
+    /// Write each graded case's mesh (VTU) and node graph (n, entries, then ptr and adj as int32) into this folder.
     #[arg(long)]
     graded_save: Option<std::path::PathBuf>,
     /// Run one graded case (a run id, or structured:N) in this process.

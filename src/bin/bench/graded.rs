@@ -375,8 +375,8 @@ fn supernodes(sn: &symbolic::Symbolic, plan: &cholesky::Plan) -> Supernodes {
     }
 }
 
-/// The case's mesh as VTU (for `shared/tools/ordstat/vtu2graph.py`) and its node graph in
-/// ordstat's binary format (n, entries, then ptr and adj as int32), for the check against CHOLMOD.
+/// The case's mesh as VTU and its node graph in
+/// a binary format (n, entries, then ptr and adj as int32), for a check against CHOLMOD's counts.
 fn save_case(dir: &Path, case: &str, mesh: &Mesh, nodes: &P2Nodes, graph: &NodeGraph) -> Result<()> {
     std::fs::create_dir_all(dir)?;
     let stem: String = case.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect();
