@@ -4,6 +4,11 @@
 //!   zero H^1 capacity: each mesh solved another problem). The solve now refuses a point
 //!   constraint whose reaction is above its round-off (`contact::point`), so solve, adapt and
 //!   studies all refuse it; the rollers' u_2 = 0, whose reaction is zero, is still accepted.
+//! * F5: a run record truncated (or not JSON, or a link to another file) stopped run, run
+//!   --plan, drift --against and run --replace alike with the JSON parser's error and no
+//!   remedy. It is now a fault of its run (named by the file stem) in the store's check, refused
+//!   with the `--replace` advice, and `run --replace` removes the file (a link, never its
+//!   target) and computes the run again.
 
 use super::common::{scratch, signorini_in};
 use std::path::Path;
@@ -58,4 +63,65 @@ fn the_rollers_point_with_zero_reaction_is_accepted() {
     assert_ne!(moved, rollers());
     let (code, _, err) = solve(&dir, &moved, "structured:8");
     assert_eq!(code, 0, "{err}");
+}
+
+/// Battery 14's two-run study (repro truncated_record_replace.sh).
+const TWO_RUNS: &str = "description = \"s\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\ntheta = 0.5\nlevels = 4\nquick_levels = 2\n[[run]]\nid = \"a\"\nrefine = \"adaptive\"\n[[run]]\nid = \"c\"\nrefine = \"uniform\"\n";
+
+fn stored_two_runs(name: &str) -> std::path::PathBuf {
+    let dir = scratch(name);
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    std::fs::write(dir.join("experiments/s.toml"), TWO_RUNS).unwrap();
+    for results in ["res", "fresh"] {
+        let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", results]);
+        assert_eq!(code, 0, "{out}{err}");
+    }
+    dir
+}
+
+#[test]
+fn a_truncated_record_is_a_fault_of_its_run_that_replace_recomputes() {
+    let dir = stored_two_runs("b14-f5");
+    let record = dir.join("res/s/runs/c.json");
+    let text = std::fs::read(&record).unwrap();
+    std::fs::write(&record, &text[..100]).unwrap();
+    for args in [&["run", "experiments/s.toml", "--results", "res"][..], &["run", "experiments/s.toml", "--results", "res", "--plan"]] {
+        let (code, out, err) = signorini_in(&dir, args);
+        assert_eq!(code, 1, "{args:?}: {out}{err}");
+        assert!(err.contains("runs/c.json") && err.contains("is not a run record (truncated, or not JSON)"), "{args:?}: {err}");
+        assert!(err.contains("--replace"), "{args:?}: {err}");
+    }
+    let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "experiments", "--results", "res", "--against", "fresh"]);
+    assert_ne!(code, 0, "{out}{err}");
+    assert!(format!("{out}{err}").contains("runs/c.json"), "{out}{err}");
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "res", "--replace"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let both = format!("{out}{err}");
+    assert!(both.contains("s/c: removing the stored run") && both.contains("1 run(s) executed"), "{both}");
+    assert!(std::fs::read(&record).unwrap().len() > 100, "run c stored again");
+    let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "experiments", "--results", "res", "--against", "fresh"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("drift: none"), "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_record_that_links_to_another_file_is_removed_and_its_target_kept() {
+    let dir = stored_two_runs("b14-f5-link");
+    let target = dir.join("elsewhere.txt");
+    std::fs::write(&target, "root:x:0:0:root:/root:/bin/bash\n").unwrap();
+    let record = dir.join("res/s/runs/c.json");
+    std::fs::remove_file(&record).unwrap();
+    std::os::unix::fs::symlink(&target, &record).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "res"]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(err.contains("runs/c.json") && err.contains("is not a run record") && err.contains("--replace"), "{err}");
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "res", "--replace"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "root:x:0:0:root:/root:/bin/bash\n", "the link's target untouched");
+    assert!(!std::fs::symlink_metadata(&record).unwrap().file_type().is_symlink(), "the link replaced by the record");
+    let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "experiments", "--results", "res", "--against", "fresh"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("drift: none"), "{out}");
+    std::fs::remove_dir_all(&dir).ok();
 }
