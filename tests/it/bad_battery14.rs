@@ -4,6 +4,10 @@
 //!   zero H^1 capacity: each mesh solved another problem). The solve now refuses a point
 //!   constraint whose reaction is above its round-off (`contact::point`), so solve, adapt and
 //!   studies all refuse it; the rollers' u_2 = 0, whose reaction is zero, is still accepted.
+//! * F4: `adapt --uniform --problem patch` (exact to round-off) printed efficiencies of
+//!   round-off over round-off without a word, where `solve` warns and the adaptive loop stops.
+//!   Every level at round-off now says so (the text `solve` gives) in `adapt`, uniform too, and
+//!   in a study run's warnings and summary line; nothing stored changes.
 //! * F5: a run record truncated (or not JSON, or a link to another file) stopped run, run
 //!   --plan, drift --against and run --replace alike with the JSON parser's error and no
 //!   remedy. It is now a fault of its run (named by the file stem) in the store's check, refused
@@ -123,5 +127,38 @@ fn a_record_that_links_to_another_file_is_removed_and_its_target_kept() {
     let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "experiments", "--results", "res", "--against", "fresh"]);
     assert_eq!(code, 0, "{out}{err}");
     assert!(out.contains("drift: none"), "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+const AT_ROUNDOFF: &str = "the estimate is at the round-off of u_h";
+
+#[test]
+fn every_uniform_level_at_round_off_says_so() {
+    let dir = scratch("b14-f4");
+    let (code, out, err) = signorini_in(&dir, &["solve", "--problem", "patch", "--mesh", "structured:4"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(format!("{out}{err}").contains(AT_ROUNDOFF), "solve: {out}{err}");
+    let (code, out, err) = signorini_in(&dir, &["adapt", "--uniform", "--problem", "patch", "--levels", "3"]);
+    assert_eq!(code, 0, "{out}{err}");
+    for level in 0..3 {
+        assert!(err.contains(&format!("warning: level {level}: {AT_ROUNDOFF}")), "level {level}: {err}");
+    }
+    // Example 7.1 is not at round-off: no such warning
+    let (code, out, err) = signorini_in(&dir, &["adapt", "--uniform", "--problem", "ex71", "--levels", "3"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(!err.contains(AT_ROUNDOFF), "{err}");
+    // a study: a warning per level and the run's summary line
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    std::fs::write(
+        dir.join("experiments/p.toml"),
+        "description = \"p\"\n[defaults]\nproblem = \"patch\"\nmesh = \"structured:4\"\nlevels = 3\n[[run]]\nid = \"u\"\nrefine = \"uniform\"\n",
+    )
+    .unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/p.toml", "--results", "res"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let both = format!("{out}{err}");
+    assert!(both.contains(&format!("warning: p/u: level 2: {AT_ROUNDOFF}")), "{both}");
+    let summary = both.lines().find(|l| l.starts_with("p/u: 3 levels")).unwrap_or_else(|| panic!("{both}"));
+    assert!(summary.contains("level(s) 0, 1, 2 at the round-off of u_h"), "{summary}");
     std::fs::remove_dir_all(&dir).ok();
 }
