@@ -7,7 +7,7 @@
 //! is zero up to round-off. So the solve refuses a point constraint whose reaction is above
 //! its round-off, and everything that solves (solve, adapt, studies) gets the refusal.
 
-use crate::fem::assembly::{DofMap, PointRows};
+use crate::fem::assembly::DofMap;
 use crate::mesh::P2Nodes;
 use crate::problems::{Part, Problem};
 
@@ -35,24 +35,23 @@ pub struct PointReactionError {
 }
 
 /// Refuse the first point-constraint component prescribed by the constraint alone (not also by
-/// Gamma_D, whose reaction it then shares) whose reaction `reactions.residual` is above its
-/// round-off bound, [`super::solve::lambda_roundoff`] of the same two sources as a contact
-/// force's: the sum of the terms, and u_h's round-off (one step of iterative refinement c
-/// moves the reaction by (K c)_p, `moved`). The terms are the point's own
-/// (`reactions.magnitude`) plus every unknown's (`all_terms`: sum of |F_i| + (sum_T |K_T|
-/// |u_h|)_i): a rigid motion's reaction balances all the nodal forces, and the point's own
-/// terms with (K c)_p alone, 4 times, were exceeded 1.9 times on ex72_rollers' uniform level 11
-/// (2.6e5 unknowns). Measured with `all_terms` (ex72_rollers, adaptive as written to 3.5e5
-/// unknowns and uniform to 2.6e5): the reaction is at most 9e-5 of the bound on every level, a
-/// margin of 1e4; battery 14's u_1 = 0.3 at the centre of Example 7.2 is 3e8 (structured:64)
-/// to 1e11 (structured:4) times its bound.
+/// Gamma_D, whose reaction it then shares) whose reaction (`reactions`, K u - F at its node) is
+/// above its round-off bound (`bounds`). The solve bounds it with `lambda_roundoff`, from the
+/// same two sources as a contact force's: the sum of the terms, and u_h's round-off (one step
+/// of iterative refinement c moves the reaction by (K c)_p). The terms are the point's own plus
+/// every unknown's (sum of |F_i| + (sum_T |K_T| |u_h|)_i): a rigid motion's reaction balances
+/// all the nodal forces; the point's own terms with (K c)_p alone, 4 times, were exceeded 1.9
+/// times on ex72_rollers' uniform level 11 (2.6e5 unknowns). Measured with every unknown's
+/// terms (ex72_rollers, adaptive as written to 3.5e5 unknowns and uniform to 2.6e5): the
+/// reaction is at most 9e-5 of the bound on every level, a margin of 1e4; battery 14's u_1 =
+/// 0.3 at the centre of Example 7.2 is 3e8 (structured:64) to 1e11 (structured:4) times its
+/// bound.
 pub fn check_reactions(
     nodes: &P2Nodes,
     dofs: &DofMap,
     problem: &dyn Problem,
-    reactions: &PointRows,
-    moved: &[[f64; 2]],
-    all_terms: f64,
+    reactions: &[[f64; 2]],
+    bounds: &[[f64; 2]],
     force_scale: f64,
 ) -> Result<(), Box<PointReactionError>> {
     let on_dirichlet = problem.dirichlet_components();
@@ -62,8 +61,7 @@ pub fn check_reactions(
             if nodes.part[p] == Some(Part::Dirichlet) && on_dirichlet[i] {
                 continue;
             }
-            let reaction = reactions.residual[k][i];
-            let bound = super::solve::lambda_roundoff(reactions.magnitude[k][i] + all_terms, moved[k][i]);
+            let (reaction, bound) = (reactions[k][i], bounds[k][i]);
             if reaction.abs() > bound {
                 let problem = super::plausible::problem_name(problem);
                 return Err(Box::new(PointReactionError {

@@ -281,7 +281,13 @@ pub fn solve(
     let u = dofs.displacement(&out.u, &dirichlet);
     let reactions = assembly::point_reactions(mesh, &nodes, &dofs, problem, &u, true);
     let moved_points = assembly::point_reactions(mesh, &nodes, &dofs, problem, &correction_at, false).residual;
-    super::point::check_reactions(&nodes, &dofs, problem, &reactions, &moved_points, all_terms, force_scale)?;
+    let point_bounds: Vec<[f64; 2]> = reactions
+        .magnitude
+        .iter()
+        .zip(&moved_points)
+        .map(|(m, kc)| std::array::from_fn(|i| lambda_roundoff(m[i] + all_terms, kc[i])))
+        .collect();
+    super::point::check_reactions(&nodes, &dofs, problem, &reactions.residual, &point_bounds, force_scale)?;
     let reactions = reactions.residual;
     let timings = SolveTimings {
         assembly: assembly_time,
