@@ -412,9 +412,7 @@ fn run_solve(args: &SolveArgs) -> Result<Solved> {
     est.terms.check_finite().with_context(|| format!("estimating on {mesh_name}"))?;
     let warnings = match adapt::resolution(problem.as_ref(), &mesh, &sol, &est) {
         adapt::Resolution::Unresolved(e) => return Err(e).with_context(|| format!("solving {} on {mesh_name}", problem.name())),
-        adapt::Resolution::AtRoundoff => vec![
-            "the estimate is at the round-off of u_h: u_h is exact to round-off (a rigid motion, or a field the P2 space reproduces), or a displacement far larger than its variation (a rigid translation in the data) left it no digits of the deformation; its terms measure round-off, not the discretisation error".to_string(),
-        ],
+        adapt::Resolution::AtRoundoff => vec![adapt::Caveat::AtRoundoff.to_string()],
         adapt::Resolution::Resolved(caveats) => caveats.iter().map(ToString::to_string).collect(),
     };
     for w in &warnings {

@@ -354,7 +354,7 @@ pub fn solve_level(
     let t_estimate = t0.elapsed().as_secs_f64();
     let (at_roundoff, caveats) = match resolution(problem, mesh, &sol, &est) {
         Resolution::Unresolved(error) => return Err(AdaptError::Unresolved { level, error }),
-        Resolution::AtRoundoff => (true, Vec::new()),
+        Resolution::AtRoundoff => (true, vec![Caveat::AtRoundoff]),
         Resolution::Resolved(caveats) => (false, caveats),
     };
     let error = reference.map(|r| norms::linf_error(mesh, &sol, r));

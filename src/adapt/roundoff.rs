@@ -236,9 +236,14 @@ pub enum Unresolved {
     Forces { floor: f64, largest: f64, sunk: usize, u_max: f64 },
 }
 
-/// What a resolved solve keeps fewer digits of than it should: a warning, not a refusal.
+/// What a resolved solve keeps fewer digits of than it should, or that its estimate is at
+/// round-off: a warning, not a refusal (`solve`, every level of `adapt` and of a study's runs).
 #[derive(Clone, Debug)]
 pub enum Caveat {
+    /// The solve is [`Resolution::AtRoundoff`]: its estimate's terms, and an efficiency index
+    /// against an error at round-off too, measure round-off (battery 14, F4: a uniform loop
+    /// went on through such levels without a word).
+    AtRoundoff,
     /// The contact forces' round-off bound is above [`WARNED_FORCES`] of the largest force.
     Forces { floor: f64, largest: f64 },
     /// The element shapes' relative round-off is above [`WARNED_SHAPE`].
@@ -248,6 +253,9 @@ pub enum Caveat {
 impl std::fmt::Display for Caveat {
     fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
         match self {
+            Caveat::AtRoundoff => f.write_str(
+                "the estimate is at the round-off of u_h: u_h is exact to round-off (a rigid motion, or a field the P2 space reproduces), or a displacement far larger than its variation (a rigid translation in the data) left it no digits of the deformation; its terms measure round-off, not the discretisation error",
+            ),
             Caveat::Forces { floor, largest } => write!(
                 f,
                 "the contact forces keep fewer than 6 digits: their round-off bound reaches {} against a largest force of {} ({:.1e} of it), so a force near the edge of the contact zone may fall under it and leave Lambda_h^C and eta_7 (a rigid translation in the data makes the bound grow; give the data without it)",

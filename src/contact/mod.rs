@@ -11,6 +11,7 @@ mod chord;
 pub mod consistent;
 pub mod norms;
 pub mod plausible;
+pub mod point;
 pub mod sampling;
 pub mod solve;
 

@@ -26,6 +26,8 @@ pub enum SolveError {
     ContactData(#[from] Box<super::plausible::ContactDataError>),
     #[error(transparent)]
     Exact(#[from] super::consistent::ExactError),
+    #[error(transparent)]
+    PointReaction(#[from] Box<super::point::PointReactionError>),
     /// No boundary edge of the mesh is in the contact part.
     #[error("the problem's contact part matches no boundary edge of the mesh: there is nothing to be in contact (the problem declares: {})", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") })]
     NoContact { declared: Vec<String> },
@@ -257,6 +259,8 @@ pub fn solve(
     let certificate = certify::certify(&kkt, certify::TOLERANCE)?;
     // per contact row: the magnitude of the terms r_i sums
     let contact_terms: Vec<f64> = (dofs.n_interior..dofs.n_free).map(|i| rhs[i].abs() + magnitude[i]).collect();
+    // the same over every unknown: a point constraint's reaction balances all the nodal forces
+    let all_terms: f64 = rhs.iter().zip(&magnitude).map(|(f, m)| f.abs() + m).sum();
     drop((magnitude, row_norm));
     let r: Vec<f64> = rhs.iter().zip(&ku).map(|(f, k)| f - k).collect();
     let f_scale = rhs.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(f64::MIN_POSITIVE);
@@ -268,13 +272,23 @@ pub fn solve(
     let contact_timings = solver.timings.clone();
     drop(solver);
     let zero = vec![[0.0; 2]; dirichlet.len()];
-    let roundoff_at: Vec<f64> = dofs.displacement(&correction, &zero).iter().map(|v| v[0].abs().max(v[1].abs())).collect();
+    let correction_at = dofs.displacement(&correction, &zero);
+    let roundoff_at: Vec<f64> = correction_at.iter().map(|v| v[0].abs().max(v[1].abs())).collect();
     let roundoff = roundoff_at.iter().fold(0.0f64, |a, v| a.max(*v));
     // how far one refinement step would move each lambda_p: (K c)_p
     let moved = assembly::stiffness_times(mesh, &nodes, &dofs, problem.material(), &correction).ku;
     let lambda_floor = contact_terms.iter().zip(&moved[dofs.n_interior..]).map(|(&terms, &kc)| lambda_roundoff(terms, kc)).collect();
     let u = dofs.displacement(&out.u, &dirichlet);
-    let reactions = assembly::point_reactions(mesh, &nodes, &dofs, problem, &u);
+    let reactions = assembly::point_reactions(mesh, &nodes, &dofs, problem, &u, true);
+    let moved_points = assembly::point_reactions(mesh, &nodes, &dofs, problem, &correction_at, false).residual;
+    let point_bounds: Vec<[f64; 2]> = reactions
+        .magnitude
+        .iter()
+        .zip(&moved_points)
+        .map(|(m, kc)| std::array::from_fn(|i| lambda_roundoff(m[i] + all_terms, kc[i])))
+        .collect();
+    super::point::check_reactions(&nodes, &dofs, problem, &reactions.residual, &point_bounds, force_scale)?;
+    let reactions = reactions.residual;
     let timings = SolveTimings {
         assembly: assembly_time,
         contact: contact_timings,

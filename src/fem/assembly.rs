@@ -408,44 +408,60 @@ fn element_load(
 /// two components, from the elements around it (stiffness times the full displacement `u`,
 /// body force and Neumann traction as [`assemble`] integrates them): at a prescribed component
 /// the reaction force the constraint exerts (with its sign reversed), at a free one the
-/// equilibrium residual (zero to round-off).
-pub fn point_reactions(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem, u: &[[f64; 2]]) -> Vec<[f64; 2]> {
-    if dofs.points.is_empty() {
-        return Vec::new();
-    }
+/// equilibrium residual (zero to round-off). With `load` false, K u alone (for the step of
+/// iterative refinement that measures u_h's round-off, [`crate::contact::point`]).
+pub fn point_reactions(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem, u: &[[f64; 2]], load: bool) -> PointRows {
     let stiff_rule = element::triangle_rule(2);
     let load_rule = element::triangle_rule(LOAD_DEGREE);
     let load_basis: Vec<[f64; N_NODES]> = load_rule.points.iter().map(|q| element::p2_values(q[0], q[1])).collect();
     let breaks = problem.load_breaks();
-    dofs.points
+    let (residual, magnitude) = dofs
+        .points
         .iter()
         .map(|&(p, _)| {
-            let mut r = [0.0; 2];
+            let (mut r, mut m) = ([0.0; 2], [0.0; 2]);
             for (t, el) in nodes.elements.iter().enumerate() {
                 let Some(a) = el.iter().position(|&q| q == p) else { continue };
                 let corners = mesh.corners(t);
                 let map = Affine::new(corners);
                 let k = element_stiffness(&map, problem.material(), &stiff_rule);
-                let f = element_load(&map, corners, &|x| problem.body_force(x), &breaks, &load_rule, &load_basis);
-                for (i, ri) in r.iter_mut().enumerate() {
+                let f = if load {
+                    element_load(&map, corners, &|x| problem.body_force(x), &breaks, &load_rule, &load_basis)
+                } else {
+                    [0.0; 12]
+                };
+                for i in 0..2 {
                     let row = 2 * a + i;
-                    *ri += (0..12).map(|l| k[row][l] * u[el[l / 2]][l % 2]).sum::<f64>() - f[row];
+                    let terms = (0..12).map(|l| k[row][l] * u[el[l / 2]][l % 2]);
+                    r[i] += terms.clone().sum::<f64>() - f[row];
+                    m[i] += terms.map(f64::abs).sum::<f64>() + f[row].abs();
                 }
             }
             for (be, bn) in mesh.boundary.iter().zip(&nodes.boundary_nodes) {
-                let Some(i) = bn.iter().position(|&q| q == p).filter(|_| be.part == Part::Neumann) else { continue };
+                let Some(i) = bn.iter().position(|&q| q == p).filter(|_| load && be.part == Part::Neumann) else { continue };
                 let (a, b) = (mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
                 let (normal, len) = edge_normal(a, b);
                 for (s, w, x) in edge_points(a, b) {
                     let g = problem.traction(x, normal);
                     let phi = edge_basis(s)[i];
-                    r[0] -= w * len * g[0] * phi;
-                    r[1] -= w * len * g[1] * phi;
+                    for c in 0..2 {
+                        r[c] -= w * len * g[c] * phi;
+                        m[c] += (w * len * g[c] * phi).abs();
+                    }
                 }
             }
-            r
+            (r, m)
         })
-        .collect()
+        .unzip();
+    PointRows { residual, magnitude }
+}
+
+/// [`point_reactions`]' rows, one per point constraint.
+pub struct PointRows {
+    /// K u - F at the point's node, per Cartesian component.
+    pub residual: Vec<[f64; 2]>,
+    /// The magnitude of the terms of that sum: sum_T |K_T| |u| term by term, plus |F| and |traction|.
+    pub magnitude: Vec<[f64; 2]>,
 }
 
 /// K u on the unknowns, element by element: for every triangle its stiffness in the local frames

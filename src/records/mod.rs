@@ -407,6 +407,9 @@ fn read_if_present<T: serde::de::DeserializeOwned>(path: &Path) -> std::io::Resu
     }
 }
 
+/// A record file `runs/*.json`: its path, its text, and the run it holds or why it holds none.
+pub type RunFile = (PathBuf, String, Result<RunRecord, serde_json::Error>);
+
 /// Where a study's records live: `results/STUDY/`.
 #[derive(Clone, Debug)]
 pub struct StudyDir {
@@ -457,15 +460,18 @@ impl StudyDir {
         Some((run, level.parse().ok()?))
     }
 
-    /// Every finished run of the study, in file-name order.
+    /// Every finished run of the study, in file-name order; a record that does not parse is an
+    /// error naming it.
     pub fn read_runs(&self) -> std::io::Result<Vec<RunRecord>> {
-        Ok(self.read_run_files()?.into_iter().map(|(_, _, r)| r).collect())
+        self.read_run_files()?.into_iter().map(|(f, _, r)| r.map_err(RecordError::parse(f))).collect()
     }
 
     /// Every record file `runs/*.json` with its text and the run it holds, in file-name order
     /// (what the store's integrity check reads: a record's run id must be its file name, its
-    /// text what [`json_bytes`] writes for it).
-    pub fn read_run_files(&self) -> std::io::Result<Vec<(PathBuf, String, RunRecord)>> {
+    /// text what [`json_bytes`] writes for it). A file whose text is no record (truncated, not
+    /// JSON, a link to another file) comes with the parser's error, for the check to name as a
+    /// fault of its run (battery 14, F5: an error here left `run --replace` no way past it).
+    pub fn read_run_files(&self) -> std::io::Result<Vec<RunFile>> {
         let dir = self.root.join("runs");
         let mut files: Vec<PathBuf> = match std::fs::read_dir(&dir) {
             Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|e| e == "json")).collect(),
@@ -477,7 +483,7 @@ impl StudyDir {
             .into_iter()
             .map(|f| {
                 let text = read_text(&f)?;
-                let record = serde_json::from_str(&text).map_err(RecordError::parse(&f))?;
+                let record = serde_json::from_str(&text);
                 Ok((f, text, record))
             })
             .collect()

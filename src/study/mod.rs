@@ -577,10 +577,17 @@ fn run_one(
     let Some(prepared) = prepare(study, spec, manifest_file, progress)? else { return Ok(None) };
     let config = AdaptConfig::for_run(spec);
     let start = start_of(study, spec, run, meshes, &prepared, &config, progress)?;
-    let Some(result) = loop_of(study, spec, run, meshes, &prepared, &config, start, progress)? else { return Ok(None) };
-    // why a run ended before its last level is said here, not stored (a record field would
-    // change every stored record)
-    let stopped = result.termination.note(&config).map(|note| format!(" ({note})")).unwrap_or_default();
+    let Some((result, at_roundoff)) = loop_of(study, spec, run, meshes, &prepared, &config, start, progress)? else { return Ok(None) };
+    // why a run ended before its last level, and which levels measure round-off, are said here,
+    // not stored (a record field would change every stored record)
+    let mut stopped = result.termination.note(&config).map(|note| format!(" ({note})")).unwrap_or_default();
+    if !at_roundoff.is_empty() {
+        let list: Vec<String> = at_roundoff.iter().map(ToString::to_string).collect();
+        stopped += &format!(
+            " (warning: level(s) {} at the round-off of u_h: their estimate and efficiency measure round-off, not the discretisation error)",
+            list.join(", ")
+        );
+    }
     let (levels, history) = (result.records, result.history);
     if progress {
         let last = levels.last().expect("at least one level");
@@ -652,8 +659,9 @@ fn start_of(
     Ok(start)
 }
 
-/// The adaptive loop of a run from `start`, with its progress bar, snapshots and checkpoints.
-/// `None` when interrupted.
+/// The adaptive loop of a run from `start`, with its progress bar, snapshots and checkpoints,
+/// and the levels it solved at round-off ([`adapt::Caveat::AtRoundoff`], for the run's summary
+/// line). `None` when interrupted.
 #[allow(clippy::too_many_arguments)]
 fn loop_of(
     study: &str,
@@ -664,8 +672,9 @@ fn loop_of(
     config: &AdaptConfig,
     start: adapt::Start,
     progress: bool,
-) -> Result<Option<adapt::AdaptResult>> {
+) -> Result<Option<(adapt::AdaptResult, Vec<usize>)>> {
     let problem = prepared.problem.as_ref();
+    let mut at_roundoff = Vec::new();
     let pb = Progress::new(progress, spec.levels as u64, &format!("{study}/{}", spec.id));
     pb.inc(start.level as u64);
     let mut level_error: Option<anyhow::Error> = None;
@@ -692,6 +701,9 @@ fn loop_of(
             for c in level.caveats {
                 crate::base::note::line(format_args!("warning: {study}/{}: level {}: {c}", spec.id, r.level));
             }
+            if level.caveats.iter().any(|c| matches!(c, adapt::Caveat::AtRoundoff)) {
+                at_roundoff.push(r.level);
+            }
             let kept_level = keep_level(study, spec, run, meshes, &level, prepared).and_then(|()| {
                 kept.levels.push(r.clone());
                 kept.history.levels.push(level.history.clone());
@@ -714,7 +726,7 @@ fn loop_of(
     if let Some(e) = level_error {
         return Err(e);
     }
-    Ok((!stopped).then_some(result))
+    Ok((!stopped).then_some((result, at_roundoff)))
 }
 
 /// Rebuild level `level` of a stored run from its refinement history and solve it again

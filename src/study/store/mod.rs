@@ -196,44 +196,55 @@ impl Store {
     /// Read the folder and check that it holds together: every record's run id is its file
     /// name (so each run is stored once) and its study is this one; every mesh snapshot a record
     /// saves exists and parses, as the level it names; `levels.csv` and `provenance.json` are
-    /// what the records render ([`check::summary_faults`]). A record that does not parse is an error
-    /// naming it.
+    /// what the records render ([`check::summary_faults`]). A record file that does not parse is
+    /// a fault of the run its file stem names.
     fn scan(&self) -> Result<Checked> {
         let files = self.dir.read_run_files().with_context(|| format!("reading the runs in {}", self.dir.root.join("runs").display()))?;
         let mut faults = Vec::new();
-        for (file, text, record) in &files {
+        let mut runs = Vec::new();
+        for (file, text, record) in files {
             let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
             let mut fault =
                 |file: &std::path::Path, what: String| faults.push(Fault { file: file.to_path_buf(), what, record: Some(stem.clone()) });
+            // a file that is no record (truncated, not JSON, a link to another file) is a fault
+            // of the run its name says, which `run --replace` removes and computes again
+            let record = match record {
+                Ok(record) => record,
+                Err(e) => {
+                    fault(&file, format!("is not a run record (truncated, or not JSON): {e}"));
+                    continue;
+                }
+            };
             if record.run.id != stem {
                 fault(
-                    file,
+                    &file,
                     format!("holds run {}, not {stem} (a record's run id is its file name: a copy or a renamed file?)", record.run.id),
                 );
+                runs.push(record);
                 continue;
             }
             // what the harness writes for this record, byte for byte: an unknown field (which
             // serde would drop silently), a hand edit that reformats, or a record of another
             // version of the format is a fault of its run
-            if let Ok(written) = crate::records::json_bytes(file, record)
+            if let Ok(written) = crate::records::json_bytes(&file, &record)
                 && written != text.as_bytes()
             {
-                let (stored, expected) = check::first_difference(text, &String::from_utf8_lossy(&written));
+                let (stored, expected) = check::first_difference(&text, &String::from_utf8_lossy(&written));
                 fault(
-                    file,
+                    &file,
                     format!(
                         "is not what the harness writes for the run it holds: {stored}, written {expected} (an unknown field or a hand edit?)"
                     ),
                 );
             }
             if record.study != self.study {
-                fault(file, format!("is a record of study {}, not {}", record.study, self.study));
+                fault(&file, format!("is a record of study {}, not {}", record.study, self.study));
             }
-            for (path, what) in check::snapshot_faults(&self.dir, record) {
+            for (path, what) in check::snapshot_faults(&self.dir, &record) {
                 fault(&path, what);
             }
+            runs.push(record);
         }
-        let runs: Vec<RunRecord> = files.into_iter().map(|(_, _, r)| r).collect();
         faults.extend(check::summary_faults(&self.dir, &self.study, &runs));
         faults.extend(check::reference_faults(&self.dir, &runs));
         let leftovers = check::orphans(&self.dir, &runs)?;

@@ -1,0 +1,80 @@
+//! A point constraint must take no force. A displacement prescribed at a single point is no
+//! constraint of the continuous problem in 2-D (a point has zero H^1 capacity): the force it
+//! takes on a mesh tends to zero as h -> 0, so each mesh would solve another problem (battery
+//! 14, F3: u = (0.3, 0) at the centre of Example 7.2 gave a different solution on every mesh
+//! and an estimate that grew with refinement). Its one meaningful use is removing a rigid
+//! motion (rollers: u_2 = 0 at one point), which the loads leave in equilibrium: the reaction
+//! is zero up to round-off. So the solve refuses a point constraint whose reaction is above
+//! its round-off, and everything that solves (solve, adapt, studies) gets the refusal.
+
+use crate::fem::assembly::DofMap;
+use crate::mesh::P2Nodes;
+use crate::problems::{Part, Problem};
+
+/// A point constraint whose reaction is above its round-off.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "{problem}: the point constraint at {at} prescribes u_{component} = {value}, and holding it there takes a force of {reaction} ({relative} of the nodal forces' scale {scale}, {ratio} times its round-off {bound}): a point constraint is for removing a rigid motion (rollers: u_2 = 0 at one point), which takes no force; a displacement prescribed at a single point is no constraint of the continuous problem (a point has zero H^1 capacity), so each mesh would solve another problem. Give the prescribed displacement on a part (`[parts] dirichlet` with `dirichlet`) instead",
+    at = crate::base::number::point(*.at),
+    value = crate::base::number::shown(*.value),
+    reaction = crate::base::number::shown(*.reaction),
+    relative = crate::base::number::shown(.reaction.abs() / .scale),
+    scale = crate::base::number::shown(*.scale),
+    ratio = format!("{:.1e}", .reaction.abs() / .bound),
+    bound = crate::base::number::shown(*.bound)
+)]
+pub struct PointReactionError {
+    pub problem: String,
+    pub at: [f64; 2],
+    /// 1 or 2.
+    pub component: usize,
+    pub value: f64,
+    pub reaction: f64,
+    pub bound: f64,
+    pub scale: f64,
+}
+
+/// Refuse the first point-constraint component prescribed by the constraint alone (not also by
+/// Gamma_D, whose reaction it then shares) whose reaction (`reactions`, K u - F at its node) is
+/// above its round-off bound (`bounds`). The solve bounds it with `lambda_roundoff`, from the
+/// same two sources as a contact force's: the sum of the terms, and u_h's round-off (one step
+/// of iterative refinement c moves the reaction by (K c)_p). The terms are the point's own plus
+/// every unknown's (sum of |F_i| + (sum_T |K_T| |u_h|)_i): a rigid motion's reaction balances
+/// all the nodal forces; the point's own terms with (K c)_p alone, 4 times, were exceeded 1.9
+/// times on ex72_rollers' uniform level 11 (2.6e5 unknowns). Measured with every unknown's
+/// terms (ex72_rollers, adaptive as written to 3.5e5 unknowns and uniform to 2.6e5): the
+/// reaction is at most 9e-5 of the bound on every level, a margin of 1e4; battery 14's u_1 =
+/// 0.3 at the centre of Example 7.2 is 3e8 (structured:64) to 1e11 (structured:4) times its
+/// bound.
+pub fn check_reactions(
+    nodes: &P2Nodes,
+    dofs: &DofMap,
+    problem: &dyn Problem,
+    reactions: &[[f64; 2]],
+    bounds: &[[f64; 2]],
+    force_scale: f64,
+) -> Result<(), Box<PointReactionError>> {
+    let on_dirichlet = problem.dirichlet_components();
+    for (k, &(p, u)) in dofs.points.iter().enumerate() {
+        for i in 0..2 {
+            let Some(value) = u[i] else { continue };
+            if nodes.part[p] == Some(Part::Dirichlet) && on_dirichlet[i] {
+                continue;
+            }
+            let (reaction, bound) = (reactions[k][i], bounds[k][i]);
+            if reaction.abs() > bound {
+                let problem = super::plausible::problem_name(problem);
+                return Err(Box::new(PointReactionError {
+                    problem,
+                    at: nodes.coords[p],
+                    component: i + 1,
+                    value,
+                    reaction,
+                    bound,
+                    scale: force_scale,
+                }));
+            }
+        }
+    }
+    Ok(())
+}
