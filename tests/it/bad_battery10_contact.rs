@@ -96,6 +96,21 @@ fn outward_gives_a_flat_contact_group_its_own_normal_beside_a_circle_group() {
     let (code, out, err) = signorini_in(&dir, &["solve", "--problem", "p.toml", "--mesh", &mesh, "--probe", "0.5,0", "--probe", "0.75,0"]);
     assert_eq!(code, 1, "{out}{err}");
     assert!(err.contains("the point constraint at (1, 0) prescribes u_1 = 0") && err.contains("removing a rigid motion"), "{err}");
+    // what is left to check positively on this mesh: the flat group in contact beside the (free)
+    // arc, held at the floor along its own normal (0, -1). The arc and the bottom both in contact
+    // need the meeting vertex out of contact, which only a point constraint taking a force did
+    let flat = problem
+        .replace("[[point_constraints]]\nat = [1, 0]\nu = [0, 0]\n", "")
+        .replace("contact = [\"arc\", \"bottom\"]", "contact = [\"bottom\"]\nneumann = [\"arc\"]")
+        .replace("[curves]\narc = { circle = { centre = [0, 0], radius = 1 } }\n", "");
+    std::fs::write(dir.join("p.toml"), &flat).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["solve", "--problem", "p.toml", "--mesh", &mesh, "--probe", "0.5,0", "--probe", "0.75,0"]);
+    assert_eq!(code, 0, "{err}");
+    for at in ["0.5, 0", "0.75, 0"] {
+        let u = probe(&out, at);
+        assert!(u[1] >= -0.02 - 1e-12, "{at}: {u:?} passes the floor y = -0.02");
+    }
+    assert!((probe(&out, "0.75, 0")[1] + 0.02).abs() < 1e-9, "the bottom presses on the floor: {out}");
     // without the point constraint the meeting vertex is a corner: refused, with both normals
     std::fs::write(dir.join("p.toml"), problem.replace("[[point_constraints]]\nat = [1, 0]\nu = [0, 0]\n", "")).unwrap();
     let (code, _, err) = signorini_in(&dir, &["solve", "--problem", "p.toml", "--mesh", &mesh]);
