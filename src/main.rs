@@ -1066,6 +1066,21 @@ fn run_figures(
     Ok(())
 }
 
+/// A reader given `--wait` (`figures`, `report`): `read` again while it is refused because a
+/// process started writing the folder after its wait (each attempt waits for the writers first).
+/// A second Slurm array's task may start at any moment: `make cluster-test` failed when one did
+/// between the finish job's wait and its read.
+fn again_while_written(wait: bool, mut read: impl FnMut() -> Result<()>) -> Result<()> {
+    loop {
+        match read() {
+            Err(e) if wait && e.chain().any(|c| c.downcast_ref::<study::store::BeingWritten>().is_some()) => {
+                say!("{e:#}; waiting for it (--wait)");
+            }
+            done => return done,
+        }
+    }
+}
+
 /// `report`: the study pages, with the defaults of a scratch folder when --results names one.
 fn run_report(
     results: Option<&std::path::Path>,
@@ -1185,7 +1200,7 @@ fn main() -> ExitCode {
         }),
         Command::Adapt(args) => run_adapt(args),
         Command::Figures { results, figures, experiments, study, wait } => {
-            run_figures(results.as_deref(), figures.as_deref(), experiments, study, *wait)
+            again_while_written(*wait, || run_figures(results.as_deref(), figures.as_deref(), experiments, study, *wait))
         }
         Command::Drift { quick, deep, against, report, merge, accept, study, experiments, results } => {
             let report = report.as_deref().map(|f| ReportFile { path: f, merge: *merge });
@@ -1196,9 +1211,9 @@ fn main() -> ExitCode {
             run_studies(manifests, shard.as_deref(), results.clone(), flags)
         }
         Command::Export { args, out } => run_export(args, out),
-        Command::Report { results, figures, out, study, drift_report, experiments, wait } => {
+        Command::Report { results, figures, out, study, drift_report, experiments, wait } => again_while_written(*wait, || {
             run_report(results.as_deref(), figures.as_deref(), out.as_deref(), study, drift_report.as_deref(), experiments, *wait)
-        }
+        }),
     });
     // what was computed and kept stays; output that could not be written is an error
     let result = result.and_then(|()| stdout_result().map_err(|e| anyhow::anyhow!("writing standard output: {e}")));

@@ -2,7 +2,8 @@
 //! woke in the moment between its commit of one run and its claim of the next, when it holds
 //! no lock: they met the next run's lock (exit 1, despite `--wait`) or read the study with its
 //! later runs missing (exit 0). A reader given `--wait` now waits until every process it saw
-//! writing has ended (`study::store::lock::wait_for_writers`).
+//! writing has ended (`study::store::lock::wait_for_writers`), and reads again, after waiting, where
+//! a process starts writing during its read (`make cluster-test` met one: a second array's task).
 
 use super::common::scratch;
 
