@@ -128,49 +128,12 @@ fn contact_forces_at_their_round_off_are_refused_and_fewer_than_six_digits_warne
 /// An n x n Gmsh grid of the unit square moved by (t, t) (groups left, contact on the right,
 /// free), and Example 7.2's data moved with it.
 fn far_square(dir: &Path, n: usize, t: f64) {
-    let id = |i: usize, j: usize| j * (n + 1) + i + 1;
-    let mut nodes = String::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            nodes += &format!("{:?} {:?} 0\n", t + i as f64 / n as f64, t + j as f64 / n as f64);
-        }
-    }
-    let mut groups: [Vec<(usize, usize)>; 3] = Default::default();
-    for k in 0..n {
-        groups[2].push((id(k, 0), id(k + 1, 0)));
-        groups[2].push((id(k + 1, n), id(k, n)));
-        groups[1].push((id(n, k), id(n, k + 1)));
-        groups[0].push((id(0, k + 1), id(0, k)));
-    }
-    let mut tris = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            tris.push((id(i, j), id(i + 1, j), id(i + 1, j + 1)));
-            tris.push((id(i, j), id(i + 1, j + 1), id(i, j + 1)));
-        }
-    }
-    let count = tris.len() + groups.iter().map(Vec::len).sum::<usize>();
-    let nn = (n + 1) * (n + 1);
-    let mut msh = format!(
-        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n4\n1 1 \"left\"\n1 2 \"contact\"\n1 3 \"free\"\n2 4 \"body\"\n$EndPhysicalNames\n$Entities\n0 3 1 0\n1 0 0 0 1 1 0 1 1 0\n2 0 0 0 1 1 0 1 2 0\n3 0 0 0 1 1 0 1 3 0\n1 0 0 0 1 1 0 1 4 0\n$EndEntities\n$Nodes\n1 {nn} 1 {nn}\n2 1 0 {nn}\n"
-    );
-    msh += &(1..=nn).map(|k| format!("{k}\n")).collect::<String>();
-    msh += &nodes;
-    msh += &format!("$EndNodes\n$Elements\n4 {count} 1 {count}\n");
-    let mut tag = 1;
-    for (g, edges) in groups.iter().enumerate() {
-        msh += &format!("1 {} 1 {}\n", g + 1, edges.len());
-        for (a, b) in edges {
-            msh += &format!("{tag} {a} {b}\n");
-            tag += 1;
-        }
-    }
-    msh += &format!("2 1 2 {}\n", tris.len());
-    for (a, b, c) in &tris {
-        msh += &format!("{tag} {a} {b} {c}\n");
-        tag += 1;
-    }
-    msh += "$EndElements\n";
+    let sides: super::common::msh::Groups = &|side| match side {
+        "left" => "left",
+        "right" => "contact",
+        _ => "free",
+    };
+    let msh = super::common::msh::msh(&[(super::common::msh::grid(n, n, [t, t], [1.0, 1.0]), sides)]);
     std::fs::write(dir.join("far.msh"), msh).unwrap();
     std::fs::write(
         dir.join("far.toml"),

@@ -91,62 +91,14 @@ fn an_exact_rigid_translation_stops_as_exact_and_a_far_one_is_refused_naming_the
 /// Two 8 x 8 unit squares in one Gmsh file: A at [0, 1]^2 (groups left, contact on the right,
 /// free), B at [3, 4] x [0, 1] (leftB, freeB).
 fn two_squares(dir: &Path) {
-    let n = 8;
-    let mut coords = Vec::new();
-    let mut tris = Vec::new();
-    // groups: left, contact, free, leftB, freeB
-    let mut groups: [Vec<(usize, usize)>; 5] = Default::default();
-    for (body, ox) in [(0usize, 0.0), (1, 3.0)] {
-        let base = coords.len();
-        let id = |i: usize, j: usize| base + j * (n + 1) + i + 1;
-        for j in 0..=n {
-            for i in 0..=n {
-                coords.push((ox + i as f64 / n as f64, j as f64 / n as f64));
-            }
-        }
-        let (left, right, free) = if body == 0 { (0, 1, 2) } else { (3, 4, 4) };
-        for k in 0..n {
-            groups[free].push((id(k, 0), id(k + 1, 0)));
-            groups[free].push((id(k + 1, n), id(k, n)));
-            groups[right].push((id(n, k), id(n, k + 1)));
-            groups[left].push((id(0, k + 1), id(0, k)));
-        }
-        for j in 0..n {
-            for i in 0..n {
-                tris.push((id(i, j), id(i + 1, j), id(i + 1, j + 1)));
-                tris.push((id(i, j), id(i + 1, j + 1), id(i, j + 1)));
-            }
-        }
-    }
-    let names = ["left", "contact", "free", "leftB", "freeB"];
-    let nn = coords.len();
-    let count = tris.len() + groups.iter().map(Vec::len).sum::<usize>();
-    let mut msh = String::from("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n6\n");
-    for (g, name) in names.iter().enumerate() {
-        msh += &format!("1 {} \"{name}\"\n", g + 1);
-    }
-    msh += "2 6 \"body\"\n$EndPhysicalNames\n$Entities\n0 5 1 0\n";
-    for g in 1..=5 {
-        msh += &format!("{g} 0 0 0 4 1 0 1 {g} 0\n");
-    }
-    msh += &format!("1 0 0 0 4 1 0 1 6 0\n$EndEntities\n$Nodes\n1 {nn} 1 {nn}\n2 1 0 {nn}\n");
-    msh += &(1..=nn).map(|k| format!("{k}\n")).collect::<String>();
-    msh += &coords.iter().map(|(x, y)| format!("{x:?} {y:?} 0\n")).collect::<String>();
-    msh += &format!("$EndNodes\n$Elements\n6 {count} 1 {count}\n");
-    let mut tag = 1;
-    for (g, edges) in groups.iter().enumerate() {
-        msh += &format!("1 {} 1 {}\n", g + 1, edges.len());
-        for (a, b) in edges {
-            msh += &format!("{tag} {a} {b}\n");
-            tag += 1;
-        }
-    }
-    msh += &format!("2 1 2 {}\n", tris.len());
-    for (a, b, c) in &tris {
-        msh += &format!("{tag} {a} {b} {c}\n");
-        tag += 1;
-    }
-    msh += "$EndElements\n";
+    use super::common::msh::{Groups, grid, msh};
+    let a: Groups = &|side| match side {
+        "left" => "left",
+        "right" => "contact",
+        _ => "free",
+    };
+    let b: Groups = &|side| if side == "left" { "leftB" } else { "freeB" };
+    let msh = msh(&[(grid(8, 8, [0.0, 0.0], [1.0, 1.0]), a), (grid(8, 8, [3.0, 0.0], [1.0, 1.0]), b)]);
     std::fs::write(dir.join("two.msh"), msh).unwrap();
 }
 
