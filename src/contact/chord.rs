@@ -12,11 +12,16 @@
 //! parameters that, sorted, enter and leave the body in turn; a vertex on the line counts on one
 //! side of it, as for a line moved an infinitesimal step to that side, and both sides are tried
 //! (the larger chord counts: a point at a corner takes the more favourable of its two sides, as
-//! the normal check does). The boundary edges are in an R*-tree ([`rstar`], as in
+//! the normal check does). The sum stops at a piece whose far end lies on Gamma_D where the
+//! displacement along n is prescribed: that end is held, so material beyond it is no room for
+//! the face (battery 15, F1: a C-shaped body's clamped 0.1 flange was pushed 0.15 through its
+//! clamped top, certified, because its upper arm across open air added to the sum; a block's
+//! 0.01 floor over a clamped hole likewise). The boundary edges are in an R*-tree ([`rstar`], as in
 //! [`mesh::locate`](crate::mesh::locate)), built at the first negative gap, so that a point
 //! costs the edges near its line, not all of them: near linear at 1e7 unknowns.
 
 use crate::mesh::{Mesh, P2Nodes};
+use crate::problems::Part;
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{AABB, RTree, RTreeObject, SelectionFunction};
 
@@ -28,13 +33,17 @@ pub(super) struct Chords {
     ends: Vec<[[f64; 2]; 2]>,
     /// Per boundary edge of the mesh, its body (the split `certify::bodies` makes).
     body_of_edge: Vec<usize>,
+    /// Per boundary edge of the mesh, whether it lies on Gamma_D.
+    on_dirichlet: Vec<bool>,
+    /// The displacement components Gamma_D prescribes (`Problem::dirichlet_components`).
+    prescribed: [bool; 2],
     /// The boundary edges' bounding boxes, built when a gap is first negative (most problems
     /// have none, and a chord is never needed where the gap is not).
     tree: std::cell::OnceCell<RTree<Boxed>>,
 }
 
 impl Chords {
-    pub(super) fn of(mesh: &Mesh, nodes: &P2Nodes) -> Chords {
+    pub(super) fn of(mesh: &Mesh, nodes: &P2Nodes, prescribed: [bool; 2]) -> Chords {
         let body = super::certify::bodies(nodes);
         let mut body_of_edge = vec![0; mesh.boundary.len()];
         for (t, local) in nodes.element_boundary.iter().enumerate() {
@@ -43,7 +52,8 @@ impl Chords {
             }
         }
         let ends = mesh.boundary.iter().map(|e| e.v.map(|v| mesh.vertices[v])).collect();
-        Chords { ends, body_of_edge, tree: std::cell::OnceCell::new() }
+        let on_dirichlet = mesh.boundary.iter().map(|e| e.part == Part::Dirichlet).collect();
+        Chords { ends, body_of_edge, on_dirichlet, prescribed, tree: std::cell::OnceCell::new() }
     }
 
     /// The chord where the gap `chi` at `p` is below minus it, for a point on the boundary
@@ -70,15 +80,28 @@ impl Chords {
         let line = Line { p, d: [n[0] / len, n[1] / len] };
         let tree = self.tree.get_or_init(|| self.boxes());
         let body = self.body_of_edge[edge];
-        let near: Vec<[[f64; 2]; 2]> = tree
+        let held = self.holds_along(line.d);
+        let near: Vec<Edge> = tree
             .locate_with_selection_function(line)
             .map(|g| g.data)
             .filter(|&e| self.body_of_edge[e] == body)
-            .map(|e| self.ends[e])
+            .map(|e| Edge { ends: self.ends[e], held: held && self.on_dirichlet[e] })
             .collect();
         let [a, b] = self.ends[edge];
         let reach = (b[0] - a[0]).hypot(b[1] - a[1]);
         [false, true].into_iter().filter_map(|strict| line.chord(&near, strict, reach)).reduce(f64::max)
+    }
+
+    /// Whether Gamma_D holds the displacement along the unit vector `d`: both components
+    /// prescribed, or the one prescribed component along `d` (a roller whose free direction
+    /// has a part along `d` lets its edge move that way, and holds nothing).
+    fn holds_along(&self, d: [f64; 2]) -> bool {
+        match self.prescribed {
+            [true, true] => true,
+            [true, false] => d[1].abs() <= 1e-12,
+            [false, true] => d[0].abs() <= 1e-12,
+            [false, false] => false,
+        }
     }
 
     fn boxes(&self) -> RTree<Boxed> {
@@ -89,6 +112,14 @@ impl Chords {
         });
         RTree::bulk_load(boxes.collect())
     }
+}
+
+/// A boundary edge as the chord sees it: its two vertices, and whether it lies on Gamma_D holding
+/// the displacement along the line ([`Chords::holds_along`]).
+#[derive(Clone, Copy)]
+struct Edge {
+    ends: [[f64; 2]; 2],
+    held: bool,
 }
 
 /// The line through `p` along the unit vector `d`.
@@ -118,35 +149,48 @@ impl Line {
     /// was refused at a gap of -0.02, the first piece alone), and the body is pushed through
     /// itself only where the gap exceeds all of it. A vertex on the line counts on the side
     /// `strict` says (false: with the vertices at positive distance), so each vertex is on one
-    /// side and the crossings come in pairs.
-    fn chord(&self, edges: &[[[f64; 2]; 2]], strict: bool, reach: f64) -> Option<f64> {
+    /// side and the crossings come in pairs. The sum ends with the first piece whose far end
+    /// is on a held edge: material beyond a held end is no room for the face.
+    fn chord(&self, edges: &[Edge], strict: bool, reach: f64) -> Option<f64> {
         let side = |c: f64| if strict { c > 0.0 } else { c >= 0.0 };
-        let mut s: Vec<f64> = edges
+        // (parameter, held) of each crossing
+        let mut s: Vec<(f64, bool)> = edges
             .iter()
-            .filter_map(|&[a, b]| {
+            .filter_map(|&Edge { ends: [a, b], held }| {
                 let (ca, cb) = (self.across(a), self.across(b));
                 (side(ca) != side(cb)).then(|| {
                     let (sa, sb) = (self.along(a), self.along(b));
-                    sa + (sb - sa) * ca / (ca - cb)
+                    (sa + (sb - sa) * ca / (ca - cb), held)
                 })
             })
             .collect();
-        s.sort_by(f64::total_cmp);
-        let nearest = s.iter().map(|x| x.abs()).fold(f64::INFINITY, f64::min);
+        s.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let nearest = s.iter().map(|x| x.0.abs()).fold(f64::INFINITY, f64::min);
         if !s.len().is_multiple_of(2) || nearest > reach {
             return None;
         }
         // from each crossing at p (two at a vertex the line touches), the pieces inside the body
-        // on its side: [s[j], s[j + 1]] for even j from an entry, [s[j - 1], s[j]] for odd j down
-        // from an exit
+        // on its side, nearest first, up to the first whose far end is held: [s[j], s[j + 1]]
+        // for even j from an entry (far end s[j + 1]), [s[j - 1], s[j]] for odd j down from an
+        // exit (far end s[j - 1])
+        let upto_held = |pieces: &mut dyn Iterator<Item = (f64, bool)>| -> f64 {
+            let mut sum = 0.0;
+            for (length, far_held) in pieces {
+                sum += length;
+                if far_held {
+                    break;
+                }
+            }
+            sum
+        };
         let inside = |i: usize| -> f64 {
             if i.is_multiple_of(2) {
-                s[i..].chunks_exact(2).map(|w| w[1] - w[0]).sum()
+                upto_held(&mut s[i..].chunks_exact(2).map(|w| (w[1].0 - w[0].0, w[1].1)))
             } else {
-                s[..=i].chunks_exact(2).map(|w| w[1] - w[0]).sum()
+                upto_held(&mut s[..=i].chunks_exact(2).rev().map(|w| (w[1].0 - w[0].0, w[0].1)))
             }
         };
-        let at_p = s.iter().enumerate().filter(|(_, x)| x.abs() == nearest);
+        let at_p = s.iter().enumerate().filter(|(_, x)| x.0.abs() == nearest);
         at_p.map(|(i, _)| inside(i)).reduce(f64::max)
     }
 }
@@ -174,9 +218,9 @@ mod tests {
 
     /// An L: a flange [0, 10] x [0, 0.1] and a column [0, 0.5] x [0.1, 5], as one closed
     /// boundary of straight edges (the flange's bottom split at x = 5).
-    fn l_shape() -> Vec<[[f64; 2]; 2]> {
+    fn l_shape() -> Vec<Edge> {
         let v = [[0.0, 0.0], [5.0, 0.0], [10.0, 0.0], [10.0, 0.1], [0.5, 0.1], [0.5, 5.0], [0.0, 5.0]];
-        (0..v.len()).map(|i| [v[i], v[(i + 1) % v.len()]]).collect()
+        (0..v.len()).map(|i| Edge { ends: [v[i], v[(i + 1) % v.len()]], held: false }).collect()
     }
 
     #[test]
@@ -202,16 +246,26 @@ mod tests {
     /// line from a point beside the hole meets the whole height.
     #[test]
     fn the_chord_counts_the_material_beyond_a_hole_and_not_the_hole() {
-        let square = |lo: [f64; 2], hi: [f64; 2]| {
-            let v = [lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]];
-            (0..4).map(move |i| [v[i], v[(i + 1) % 4]])
+        let block = |hole_held: bool| -> Vec<Edge> {
+            let square = |lo: [f64; 2], hi: [f64; 2], held: bool| {
+                let v = [lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]];
+                (0..4).map(move |i| Edge { ends: [v[i], v[(i + 1) % 4]], held })
+            };
+            square([0.0, 0.0], [1.0, 1.0], false).chain(square([0.375, 0.01], [0.625, 0.86], hole_held)).collect()
         };
-        let block: Vec<[[f64; 2]; 2]> = square([0.0, 0.0], [1.0, 1.0]).chain(square([0.375, 0.01], [0.625, 0.86])).collect();
-        let up = |x: f64| Line { p: [x, 0.0], d: [0.0, -1.0] }.chord(&block, false, 1.0).unwrap();
+        let free = block(false);
+        let up = |x: f64| Line { p: [x, 0.0], d: [0.0, -1.0] }.chord(&free, false, 1.0).unwrap();
         assert!((up(0.5) - 0.15).abs() < 1e-12, "{}", up(0.5));
         assert!((up(0.2) - 1.0).abs() < 1e-12, "{}", up(0.2));
         // from the top, going down the same way
-        let down = Line { p: [0.5, 1.0], d: [0.0, 1.0] }.chord(&block, false, 1.0).unwrap();
+        let down = Line { p: [0.5, 1.0], d: [0.0, 1.0] }.chord(&free, false, 1.0).unwrap();
         assert!((down - 0.15).abs() < 1e-12, "{down}");
+        // a clamped hole holds the ligament's far end: the chord is the ligament (battery 15,
+        // F1), going up and going down
+        let clamped = block(true);
+        let up = Line { p: [0.5, 0.0], d: [0.0, -1.0] }.chord(&clamped, false, 1.0).unwrap();
+        assert!((up - 0.01).abs() < 1e-12, "{up}");
+        let down = Line { p: [0.5, 1.0], d: [0.0, 1.0] }.chord(&clamped, false, 1.0).unwrap();
+        assert!((down - 0.14).abs() < 1e-12, "{down}");
     }
 }

@@ -157,7 +157,7 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
     let outward: Vec<Option<[f64; 2]>> =
         outward_normals(mesh, nodes).into_iter().zip(&mesh.boundary).map(|(n, e)| (e.part == Part::Contact).then_some(n)).collect();
     let diameter = super::consistent::diameter(mesh);
-    let chords = Chords::of(mesh, nodes);
+    let chords = Chords::of(mesh, nodes, problem.dirichlet_components());
     // the normal at each node and sampled point first: a normal nearly tangent or reversed is
     // named as such, never as a corner where it merely turns fast (battery 11, N6)
     check_nodes(mesh, nodes, dofs, problem, &outward, &chords)?;
