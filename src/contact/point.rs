@@ -78,3 +78,65 @@ pub fn check_reactions(
     }
     Ok(())
 }
+
+/// A point constraint's value on a component that Gamma_D also prescribes at that point, and
+/// differs from Gamma_D's value there.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "{problem}: the point constraint at {at} prescribes u_{component} = {value}, but the point is on the Dirichlet part ({part}), which already sets u_{component} = {dirichlet} there: one node cannot take both values. The point value is redundant there: drop it, or write \"free\" for u_{component} in `u` (a point constraint on Gamma_D can only prescribe a component `dirichlet` leaves \"free\")",
+    at = crate::base::number::point(*.at),
+    value = crate::base::number::shown(*.value),
+    dirichlet = crate::base::number::shown(*.dirichlet)
+)]
+pub struct PointOnDirichletError {
+    pub problem: String,
+    pub at: [f64; 2],
+    /// 1 or 2.
+    pub component: usize,
+    pub value: f64,
+    pub dirichlet: f64,
+    /// How the problem declares Gamma_D (`parts.dirichlet = ...`), or "Gamma_D".
+    pub part: String,
+}
+
+/// Refuse a point constraint's value on a component Gamma_D also prescribes at its vertex
+/// unless it equals Gamma_D's value there (battery 14: `u = [0.25, 0]` at a rollers' point with
+/// `dirichlet = [0.1, "free"]` was accepted, one of the two values silently dropped). Equal
+/// values are redundant but harmless and stay accepted. Equal is to 1e-12 of the prescribed
+/// displacements' scale (the largest |value| of the Dirichlet data at Gamma_D's nodes and of the
+/// point values): the same value written two ways (`0.1` at the point, an expression of the
+/// constants in `dirichlet`) differs by a few ulps of that scale, 1e-16; a difference above
+/// 1e-12 of it is one the user wrote, not round-off. The solve calls this once per mesh, after
+/// numbering the unknowns ([`DofMap::new`]), before anything is assembled; a value on a
+/// component of a *contact* node is no equality Gamma_C sets (the point's node leaves the
+/// contact nodes, and `contact::plausible` and [`check_reactions`] judge it).
+pub fn check_on_dirichlet(nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Problem) -> Result<(), Box<PointOnDirichletError>> {
+    let on_dirichlet = problem.dirichlet_components();
+    let on_gamma_d = |p: usize| nodes.part[p] == Some(Part::Dirichlet);
+    let shared: Vec<(usize, usize, f64)> = dofs
+        .points
+        .iter()
+        .filter(|(p, _)| on_gamma_d(*p))
+        .flat_map(|&(p, u)| (0..2).filter_map(move |i| u[i].filter(|_| on_dirichlet[i]).map(|v| (p, i, v))))
+        .collect();
+    if shared.is_empty() {
+        return Ok(());
+    }
+    let data = (0..nodes.len()).filter(|&p| on_gamma_d(p)).flat_map(|p| {
+        let g = problem.dirichlet(nodes.coords[p]);
+        (0..2).filter(|&i| on_dirichlet[i]).map(move |i| g[i].abs())
+    });
+    let points = dofs.points.iter().flat_map(|(_, u)| u.iter().flatten().map(|v| v.abs()));
+    let scale = data.chain(points).fold(0.0f64, f64::max);
+    for (p, i, value) in shared {
+        let dirichlet = problem.dirichlet(nodes.coords[p])[i];
+        // a datum that is not a finite number is named by the data watch after assembly
+        if !(value.is_finite() && dirichlet.is_finite()) || (value - dirichlet).abs() <= 1e-12 * scale {
+            continue;
+        }
+        let part = problem.declared_parts().into_iter().find(|d| d.starts_with("parts.dirichlet")).unwrap_or_else(|| "Gamma_D".into());
+        let problem = super::plausible::problem_name(problem);
+        return Err(Box::new(PointOnDirichletError { problem, at: nodes.coords[p], component: i + 1, value, dirichlet, part }));
+    }
+    Ok(())
+}

@@ -28,6 +28,8 @@ pub enum SolveError {
     Exact(#[from] super::consistent::ExactError),
     #[error(transparent)]
     PointReaction(#[from] Box<super::point::PointReactionError>),
+    #[error(transparent)]
+    PointOnDirichlet(#[from] Box<super::point::PointOnDirichletError>),
     /// No boundary edge of the mesh is in the contact part.
     #[error("the problem's contact part matches no boundary edge of the mesh: there is nothing to be in contact (the problem declares: {})", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") })]
     NoContact { declared: Vec<String> },
@@ -216,6 +218,7 @@ pub fn solve(
     let t0 = Instant::now();
     let nodes = P2Nodes::new(mesh);
     let dofs = DofMap::new(&nodes, problem);
+    super::point::check_on_dirichlet(&nodes, &dofs, problem)?;
     certify::check_held(mesh, &nodes, &dofs, problem)?;
     super::plausible::check_contact_data(mesh, &nodes, &dofs, problem)?;
     super::consistent::check_exact(problem, mesh, &nodes)?;

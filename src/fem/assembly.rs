@@ -107,7 +107,9 @@ impl DofMap {
     }
 
     /// The prescribed value of every node's fixed components (0 elsewhere): the problem's
-    /// Dirichlet data on Gamma_D, then the point constraints' values at their vertices.
+    /// Dirichlet data on Gamma_D, then the point constraints' values at their vertices (on a
+    /// component Gamma_D also prescribes, the solve has checked the two are equal:
+    /// `contact::point::check_on_dirichlet`).
     pub fn prescribed(&self, nodes: &P2Nodes, problem: &dyn Problem) -> Vec<[f64; 2]> {
         let mut values: Vec<[f64; 2]> = (0..nodes.len())
             .map(|p| {

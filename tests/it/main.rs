@@ -16,6 +16,7 @@ mod bad_battery13_notes;
 mod bad_battery13b;
 mod bad_battery14;
 mod bad_battery14_wait;
+mod bad_battery14b;
 mod bad_battery15;
 mod bad_battery7;
 mod bad_battery8_contact;
