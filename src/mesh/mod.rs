@@ -136,8 +136,9 @@ pub enum MeshError {
     PartInsideEdge { mesh: String, x: f64, y: f64, here: Part, edge: Part, a: [f64; 2], b: [f64; 2] },
     /// A point the problem requires to be a vertex (`origin`: where it declares it) is not one;
     /// `outside` says so with the mesh's extent when it lies outside the mesh's bounding box.
-    #[error("{origin}: {} is not a vertex of the mesh{}", crate::base::number::point([*.x, *.y]), outside.as_ref().map(|o| format!(" (it lies outside the mesh, {o})")).unwrap_or_default())]
-    MissingVertex { origin: String, x: f64, y: f64, outside: Option<String> },
+    /// `remedy` says which meshes have a vertex there ([`vertex_remedy`]).
+    #[error("{origin}: {} is not a vertex of the mesh{}{remedy}", crate::base::number::point([*.x, *.y]), outside.as_ref().map(|o| format!(" (it lies outside the mesh, {o})")).unwrap_or_default())]
+    MissingVertex { origin: String, x: f64, y: f64, outside: Option<String>, remedy: String },
     /// A load break line x = c that no element crosses (`origin`: where the problem declares it).
     #[error("{origin}: the line x = {c} does not cross the mesh ({extent}): a load break is a line x = c inside the body")]
     LoadBreakOutside { origin: String, c: f64, extent: String },
@@ -515,7 +516,9 @@ impl Mesh {
             if !self.vertices.iter().any(|v| dist(*v, *p) < 1e-12) {
                 let inside = (x0..=x1).contains(&p[0]) && (y0..=y1).contains(&p[1]);
                 let outside = (!inside).then(|| format!("which spans x in [{x0}, {x1}], y in [{y0}, {y1}]"));
-                return Err(MeshError::MissingVertex { origin: origin.clone(), x: p[0], y: p[1], outside });
+                let all: Vec<[f64; 2]> = points.iter().map(|(_, p)| *p).collect();
+                let remedy = if outside.is_some() { String::new() } else { vertex_remedy(*p, &all) };
+                return Err(MeshError::MissingVertex { origin: origin.clone(), x: p[0], y: p[1], outside, remedy });
             }
         }
         Ok(())
@@ -547,6 +550,35 @@ impl Mesh {
         (lo, hi)
     }
 }
+
+/// What to do about a required vertex `p` the mesh lacks: the mesh given must have it, as no
+/// mesh inserts one and refinement only keeps the vertices it starts from. Names the smallest
+/// structured:N (and symmetric:N) with a vertex at `p` and at every point of `all` (the
+/// problem's required vertices) in the unit square, when `p` is in it and one with N <=
+/// [`REMEDY_MAX_N`] does.
+fn vertex_remedy(p: [f64; 2], all: &[[f64; 2]]) -> String {
+    let head = ": a required vertex (a point constraint's point, a `required_vertices` entry, a kink of chi) must be a vertex of the mesh given; none is inserted, and refinement only keeps the vertices it starts from";
+    let gmsh = "a Gmsh mesh needs a point there";
+    let in_square = |q: &[f64; 2]| (0.0..=1.0).contains(&q[0]) && (0.0..=1.0).contains(&q[1]);
+    let on_grid = |n: usize, q: [f64; 2]| dist(q.map(|c| (c * n as f64).round() * (1.0 / n as f64)), q) < 1e-12;
+    let n = (1..=REMEDY_MAX_N).find(|&n| on_grid(n, p) && all.iter().filter(|q| in_square(q)).all(|&q| on_grid(n, q)));
+    let in_square = in_square(&p);
+    match n {
+        Some(n) if in_square => {
+            let even = if n % 2 == 0 { n } else { 2 * n };
+            format!(
+                "{head}. structured:N and symmetric:N have their vertices at (i/N, j/N): structured:{n} (or symmetric:{even}) and its multiples have one there and at every other required vertex in the unit square; {gmsh}"
+            )
+        }
+        _ if in_square => format!(
+            "{head}. No structured:N or symmetric:N with N <= {REMEDY_MAX_N} has one there (their vertices are at (i/N, j/N)); {gmsh}"
+        ),
+        _ => format!("{head}; {gmsh}"),
+    }
+}
+
+/// The largest N [`vertex_remedy`] tries.
+const REMEDY_MAX_N: usize = 4096;
 
 #[inline]
 pub fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
