@@ -56,6 +56,35 @@ macro_rules! print {
     ($($arg:tt)*) => { stdout_write(format_args!($($arg)*), false) };
 }
 
+/// The files this command wrote, in order, each complete (written to a temporary name and
+/// renamed). A failed standard output then names them: they are kept and valid, and only the
+/// printed report was lost (battery 14: `export > /dev/full` said only "No space left on device").
+static WRITTEN: std::sync::Mutex<Vec<std::path::PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Print `line` for the file `path` just written, and remember the file ([`WRITTEN`]). Every
+/// "wrote" line of this file comes here.
+fn wrote(path: &std::path::Path, line: std::fmt::Arguments) {
+    let mut written = WRITTEN.lock().unwrap_or_else(|e| e.into_inner());
+    if !written.iter().any(|w| w == path) {
+        written.push(path.to_path_buf());
+    }
+    drop(written);
+    println!("{line}");
+}
+
+/// The error of a failed standard output (`e`): with the files written, which it did not touch.
+fn stdout_error(e: &str) -> anyhow::Error {
+    let written = WRITTEN.lock().unwrap_or_else(|e| e.into_inner());
+    if written.is_empty() {
+        return anyhow::anyhow!("writing standard output: {e}");
+    }
+    let files: Vec<String> = written.iter().map(|f| f.display().to_string()).collect();
+    anyhow::anyhow!(
+        "writing standard output: {e}. Only the printed report was lost: the files were written before, complete and valid: {}",
+        files.join(", ")
+    )
+}
+
 #[derive(Parser)]
 #[command(name = "signorini", version, about = "P2 finite elements for the Signorini problem and its supremum-norm a posteriori estimator")]
 struct Cli {
@@ -491,7 +520,7 @@ fn run_adapt(args: &AdaptArgs) -> Result<()> {
     if let Some(path) = &args.save {
         let doc = report::solution_vtu(&result.mesh, &result.solution, &result.estimate.element);
         signorini::records::write_atomic(path, doc.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
-        println!("# wrote {} (level {level}, NDF {})", path.display(), result.mesh.p2_ndof());
+        wrote(path, format_args!("# wrote {} (level {level}, NDF {})", path.display(), result.mesh.p2_ndof()));
     }
     if study::interrupted() {
         bail!(AdaptInterrupted { level, saved: args.save.clone() });
@@ -1059,10 +1088,11 @@ fn run_figures(
     // what the figures and CLAIMS rows read: every study, through the integrity check
     let shelf = study::store::Shelf::open_folder(&results, &study::manifest::declared(experiments, &[])?)?;
     for f in signorini::plot::draw_studies(&shelf, &figures, &roles, drawn.as_deref())? {
-        println!("wrote {}", f.display());
+        wrote(&f, format_args!("wrote {}", f.display()));
     }
     signorini::claims::write(&shelf, &roles).with_context(|| format!("writing {}", results.join("CLAIMS.md").display()))?;
-    println!("wrote {}", results.join("CLAIMS.md").display());
+    let claims = results.join("CLAIMS.md");
+    wrote(&claims, format_args!("wrote {}", claims.display()));
     Ok(())
 }
 
@@ -1122,7 +1152,7 @@ fn run_report(
     let drift = signorini::page::DriftReports::read(&files, &advice)?;
     let shelf = study::store::Shelf::open_folder(&results, &study::manifest::declared(experiments, &[])?)?;
     for page in signorini::page::write_pages(&shelf, &figures, &out, studies, &drift, &roles)? {
-        println!("wrote {}", page.display());
+        wrote(&page, format_args!("wrote {}", page.display()));
     }
     Ok(())
 }
@@ -1146,7 +1176,7 @@ fn run_export(args: &SolveArgs, out: &std::path::Path) -> Result<()> {
     }
     let (mesh, sol, indicator, r) = run_solve(args)?;
     for f in report::export_case(out, &mesh, &sol, &indicator, &r)? {
-        println!("wrote {}", f.display());
+        wrote(&f, format_args!("wrote {}", f.display()));
     }
     Ok(())
 }
@@ -1216,7 +1246,7 @@ fn main() -> ExitCode {
         }),
     });
     // what was computed and kept stays; output that could not be written is an error
-    let result = result.and_then(|()| stdout_result().map_err(|e| anyhow::anyhow!("writing standard output: {e}")));
+    let result = result.and_then(|()| stdout_result().map_err(|e| stdout_error(&e)));
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e)
