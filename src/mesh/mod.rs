@@ -557,7 +557,7 @@ impl Mesh {
 /// problem's required vertices) in the unit square, when `p` is in it and one with N <=
 /// [`REMEDY_MAX_N`] does.
 fn vertex_remedy(p: [f64; 2], all: &[[f64; 2]]) -> String {
-    let head = ": a required vertex (a point constraint's point, a `required_vertices` entry, a kink of chi) must be a vertex of the mesh given; none is inserted, and refinement only keeps the vertices it starts from";
+    let head = ": a required vertex (a `required_vertices` entry, a point constraint's point) must be a vertex of the mesh given; none is inserted, and refinement only keeps the vertices it starts from";
     let gmsh = "a Gmsh mesh needs a point there";
     let in_square = |q: &[f64; 2]| (0.0..=1.0).contains(&q[0]) && (0.0..=1.0).contains(&q[1]);
     let on_grid = |n: usize, q: [f64; 2]| dist(q.map(|c| (c * n as f64).round() * (1.0 / n as f64)), q) < 1e-12;
