@@ -1019,7 +1019,7 @@ fn run_drift(
     signorini::records::write_json(&file, &written).with_context(|| {
         format!("writing the drift report {} (--report FILE writes it elsewhere; the comparison above stands)", file.display())
     })?;
-    println!("report: {}", file.display());
+    wrote(&file, format_args!("report: {}", file.display()));
     drift_outcome(&report, against, results)
 }
 

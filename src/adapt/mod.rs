@@ -60,6 +60,10 @@ pub enum AdaptError {
     /// A start at or beyond the last level: nothing is left to solve.
     #[error("nothing to solve: the loop starts at level {start} and has {levels} levels")]
     NothingToSolve { start: usize, levels: usize },
+    /// A start at a later level whose mesh is above `max_ndof`: nothing is left to solve (the
+    /// loop never hands out such a start: the level before it does not continue).
+    #[error("nothing to solve: the loop starts at level {start}, whose mesh has {ndof} unknowns, above max_ndof {max}")]
+    BeyondMaxNdof { start: usize, ndof: usize, max: usize },
     #[error(transparent)]
     Replay(#[from] replay::ReplayError),
     /// Refining level `level` into the next failed (levels `0..=level` were solved and seen by
@@ -469,6 +473,9 @@ pub fn run_from(
             && level > 0
             && mesh.p2_ndof() > max
         {
+            if state.is_none() {
+                return Err(AdaptError::BeyondMaxNdof { start: level, ndof: mesh.p2_ndof(), max });
+            }
             termination = AdaptTermination::MaxNdofReached;
             break;
         }
@@ -506,7 +513,14 @@ pub fn run_from(
             }
             _ => None,
         };
-        let next = if far.is_some() { None } else { next };
+        // a refined mesh above max_ndof is not solved: the loop ends here, and this level says
+        // it does not continue, so a run interrupted now keeps no checkpoint of a level it
+        // would never solve (battery 16, F1: resuming from one solved nothing and panicked)
+        let over = match (&next, config.max_ndof) {
+            (Some(Ok((m, _))), Some(max)) => m.p2_ndof() > max,
+            _ => false,
+        };
+        let next = if far.is_some() || over { None } else { next };
         record.t_level = t_level.elapsed().as_secs_f64();
         record.mem_peak_mib = crate::base::memory::peak_resident().filter(|_| measured).map(|b| b / (1024.0 * 1024.0));
         let flow = observer(Level {
@@ -532,6 +546,8 @@ pub fn run_from(
             termination = AdaptTermination::NothingMarked;
         } else if let Some(far) = far {
             termination = far;
+        } else if over {
+            termination = AdaptTermination::MaxNdofReached;
         }
         match next {
             Some(Ok((m, active))) => {
@@ -542,6 +558,9 @@ pub fn run_from(
             None => break,
         }
     }
-    let (mesh, solution, estimate) = state.expect("the first level is always solved");
+    // every way out of the loop above solved a level first (first < levels), or returned
+    let Some((mesh, solution, estimate)) = state else {
+        return Err(AdaptError::NothingToSolve { start: first, levels: config.levels });
+    };
     Ok(AdaptResult { mesh, solution, estimate, records, history, termination })
 }

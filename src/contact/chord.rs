@@ -16,19 +16,49 @@
 //! displacement along n is prescribed: that end is held, so material beyond it is no room for
 //! the face (battery 15, F1: a C-shaped body's clamped 0.1 flange was pushed 0.15 through its
 //! clamped top, certified, because its upper arm across open air added to the sum; a block's
-//! 0.01 floor over a clamped hole likewise). The boundary edges are in an R*-tree ([`rstar`], as in
+//! 0.01 floor over a clamped hole likewise). A held end is where its Dirichlet data put it: data
+//! that move it towards the face by `toward` leave the face that much less room, and data that
+//! move it away leave more ([`Room::left`]; battery 16, F2: a 0.1 plate whose top is held at
+//! u_y = -0.05 took chi = -0.08, certified, with its bottom face ending above its top, and one
+//! held at +0.05 was refused at -0.12). So a gap that is not negative is checked too where the
+//! Dirichlet data move a held end (`[0, -0.2]` on a 0.1 plate's top with chi = 0.01 turned the
+//! plate inside out). The boundary edges are in an R*-tree ([`rstar`], as in
 //! [`mesh::locate`](crate::mesh::locate)), built at the first negative gap, so that a point
 //! costs the edges near its line, not all of them: near linear at 1e7 unknowns.
 
 use crate::mesh::{Mesh, P2Nodes};
-use crate::problems::Part;
+use crate::problems::{Part, Problem};
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{AABB, RTree, RTreeObject, SelectionFunction};
 
 type Boxed = GeomWithData<Rectangle<[f64; 2]>, usize>;
 
+/// What the line from a point of the contact part meets going into its body: the body's
+/// material along it (the chord) and, where the sum stopped at a held end, that end.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Room {
+    pub material: f64,
+    pub held: Option<HeldEnd>,
+}
+
+/// The end of a chord on Gamma_D ([`Room`]): where, and how far the Dirichlet data move it
+/// towards the contact face along the line (negative: away from it).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct HeldEnd {
+    pub at: [f64; 2],
+    pub toward: f64,
+}
+
+impl Room {
+    /// The room the face has along the line before the body passes through itself: the
+    /// material, less what the Dirichlet data move a held end towards the face.
+    pub(super) fn left(&self) -> f64 {
+        self.material - self.held.map_or(0.0, |h| h.toward)
+    }
+}
+
 /// Every body's chords through points of its boundary ([`Chords::overlapped`]).
-pub(super) struct Chords {
+pub(super) struct Chords<'a> {
     /// Per boundary edge of the mesh, its two vertices.
     ends: Vec<[[f64; 2]; 2]>,
     /// Per boundary edge of the mesh, its body (the split `certify::bodies` makes).
@@ -37,13 +67,19 @@ pub(super) struct Chords {
     on_dirichlet: Vec<bool>,
     /// The displacement components Gamma_D prescribes (`Problem::dirichlet_components`).
     prescribed: [bool; 2],
+    /// The problem, whose Dirichlet data place a held end.
+    problem: &'a dyn Problem,
+    /// Whether the Dirichlet data are nonzero at some node of Gamma_D (then a gap that is not
+    /// negative can be too small as well: a held end moved towards the face).
+    moving: bool,
     /// The boundary edges' bounding boxes, built when a gap is first negative (most problems
     /// have none, and a chord is never needed where the gap is not).
     tree: std::cell::OnceCell<RTree<Boxed>>,
 }
 
-impl Chords {
-    pub(super) fn of(mesh: &Mesh, nodes: &P2Nodes, prescribed: [bool; 2]) -> Chords {
+impl<'a> Chords<'a> {
+    pub(super) fn of(mesh: &Mesh, nodes: &P2Nodes, problem: &'a dyn Problem) -> Chords<'a> {
+        let prescribed = problem.dirichlet_components();
         let body = super::certify::bodies(nodes);
         let mut body_of_edge = vec![0; mesh.boundary.len()];
         for (t, local) in nodes.element_boundary.iter().enumerate() {
@@ -53,26 +89,30 @@ impl Chords {
         }
         let ends = mesh.boundary.iter().map(|e| e.v.map(|v| mesh.vertices[v])).collect();
         let on_dirichlet = mesh.boundary.iter().map(|e| e.part == Part::Dirichlet).collect();
-        Chords { ends, body_of_edge, on_dirichlet, prescribed, tree: std::cell::OnceCell::new() }
+        let moving = (0..nodes.coords.len()).filter(|&p| nodes.part[p] == Some(Part::Dirichlet)).any(|p| {
+            let u = problem.dirichlet(nodes.coords[p]);
+            (0..2).any(|i| prescribed[i] && u[i] != 0.0)
+        });
+        Chords { ends, body_of_edge, on_dirichlet, prescribed, problem, moving, tree: std::cell::OnceCell::new() }
     }
 
-    /// The chord where the gap `chi` at `p` is below minus it, for a point on the boundary
-    /// `edges` (at a vertex two bodies share, the larger of their chords counts); None
-    /// otherwise, where `chi` is not negative or not a number, and where `n` is zero or not a
-    /// number (the data watch names those).
-    pub(super) fn overlapped(&self, chi: f64, p: [f64; 2], n: [f64; 2], edges: &[usize]) -> Option<f64> {
-        if !(chi < 0.0) {
+    /// The room where the gap `chi` at `p` is below minus what it leaves ([`Room::left`]), for a
+    /// point on the boundary `edges` (at a vertex two bodies share, the larger room counts);
+    /// None otherwise, where `chi` is not a number, where it is not negative and the Dirichlet
+    /// data move nothing, and where `n` is zero or not a number (the data watch names those).
+    pub(super) fn overlapped(&self, chi: f64, p: [f64; 2], n: [f64; 2], edges: &[usize]) -> Option<Room> {
+        if !(chi < 0.0 || (chi.is_finite() && self.moving)) {
             return None;
         }
-        let chord = edges.iter().filter_map(|&e| self.through(p, n, e)).fold(f64::NEG_INFINITY, f64::max);
-        (chord.is_finite() && chi < -chord).then_some(chord)
+        let room = edges.iter().filter_map(|&e| self.through(p, n, e)).max_by(|a, b| a.left().total_cmp(&b.left()))?;
+        (room.left().is_finite() && chi < -room.left()).then_some(room)
     }
 
     /// The chord through `p` along `n` (normalised here) of the body holding boundary edge
     /// `edge`, `p` on that edge (or on the curve it is the chord of). None where the line does
     /// not cross the body's boundary within the edge's length of `p`: `n` along the edge, whose
     /// normal check refuses it.
-    fn through(&self, p: [f64; 2], n: [f64; 2], edge: usize) -> Option<f64> {
+    fn through(&self, p: [f64; 2], n: [f64; 2], edge: usize) -> Option<Room> {
         let len = n[0].hypot(n[1]);
         if !(len > 0.0 && len.is_finite()) {
             return None;
@@ -89,7 +129,20 @@ impl Chords {
             .collect();
         let [a, b] = self.ends[edge];
         let reach = (b[0] - a[0]).hypot(b[1] - a[1]);
-        [false, true].into_iter().filter_map(|strict| line.chord(&near, strict, reach)).reduce(f64::max)
+        let room = |(material, end): (f64, Option<([f64; 2], [f64; 2])>)| Room {
+            material,
+            held: end.map(|(at, inward)| {
+                // the data's displacement of the end along the line, towards the face: -u . m,
+                // m the direction into the body (the components held along the line only)
+                let u = self.problem.dirichlet(at);
+                let along: f64 = (0..2).filter(|&i| self.prescribed[i]).map(|i| u[i] * inward[i]).sum();
+                HeldEnd { at, toward: -along }
+            }),
+        };
+        [false, true]
+            .into_iter()
+            .filter_map(|strict| line.chord(&near, strict, reach).map(room))
+            .max_by(|a, b| a.left().total_cmp(&b.left()))
     }
 
     /// Whether Gamma_D holds the displacement along the unit vector `d`: both components
@@ -150,8 +203,10 @@ impl Line {
     /// itself only where the gap exceeds all of it. A vertex on the line counts on the side
     /// `strict` says (false: with the vertices at positive distance), so each vertex is on one
     /// side and the crossings come in pairs. The sum ends with the first piece whose far end
-    /// is on a held edge: material beyond a held end is no room for the face.
-    fn chord(&self, edges: &[Edge], strict: bool, reach: f64) -> Option<f64> {
+    /// is on a held edge: material beyond a held end is no room for the face. Returns the sum
+    /// and, where it stopped at a held end, that end and the direction into the body (the
+    /// larger sum of the two crossings at a vertex on the line).
+    fn chord(&self, edges: &[Edge], strict: bool, reach: f64) -> Option<(f64, Option<([f64; 2], [f64; 2])>)> {
         let side = |c: f64| if strict { c > 0.0 } else { c >= 0.0 };
         // (parameter, held) of each crossing
         let mut s: Vec<(f64, bool)> = edges
@@ -173,25 +228,26 @@ impl Line {
         // on its side, nearest first, up to the first whose far end is held: [s[j], s[j + 1]]
         // for even j from an entry (far end s[j + 1]), [s[j - 1], s[j]] for odd j down from an
         // exit (far end s[j - 1])
-        let upto_held = |pieces: &mut dyn Iterator<Item = (f64, bool)>| -> f64 {
+        // (length, far end's parameter, far end held) of each piece, nearest first
+        let upto_held = |pieces: &mut dyn Iterator<Item = (f64, f64, bool)>, inward: [f64; 2]| {
             let mut sum = 0.0;
-            for (length, far_held) in pieces {
+            for (length, far, far_held) in pieces {
                 sum += length;
                 if far_held {
-                    break;
+                    return (sum, Some(([self.p[0] + far * self.d[0], self.p[1] + far * self.d[1]], inward)));
                 }
             }
-            sum
+            (sum, None)
         };
-        let inside = |i: usize| -> f64 {
+        let inside = |i: usize| {
             if i.is_multiple_of(2) {
-                upto_held(&mut s[i..].chunks_exact(2).map(|w| (w[1].0 - w[0].0, w[1].1)))
+                upto_held(&mut s[i..].chunks_exact(2).map(|w| (w[1].0 - w[0].0, w[1].0, w[1].1)), self.d)
             } else {
-                upto_held(&mut s[..=i].chunks_exact(2).rev().map(|w| (w[1].0 - w[0].0, w[0].1)))
+                upto_held(&mut s[..=i].chunks_exact(2).rev().map(|w| (w[1].0 - w[0].0, w[0].0, w[0].1)), [-self.d[0], -self.d[1]])
             }
         };
         let at_p = s.iter().enumerate().filter(|(_, x)| x.0.abs() == nearest);
-        at_p.map(|(i, _)| inside(i)).reduce(f64::max)
+        at_p.map(|(i, _)| inside(i)).max_by(|a, b| a.0.total_cmp(&b.0))
     }
 }
 
@@ -227,7 +283,7 @@ mod tests {
     fn the_chord_is_the_piece_of_the_line_holding_the_point() {
         let l = l_shape();
         let down = |p| Line { p, d: [0.0, -1.0] };
-        let chord = |p, strict| down(p).chord(&l, strict, 1.0);
+        let chord = |p, strict| down(p).chord(&l, strict, 1.0).map(|c| c.0);
         // the flange: 0.1 thick, whatever the column
         assert_eq!(chord([3.0, 0.0], false), Some(0.1));
         assert_eq!(chord([3.0, 0.0], true), Some(0.1));
@@ -254,18 +310,22 @@ mod tests {
             square([0.0, 0.0], [1.0, 1.0], false).chain(square([0.375, 0.01], [0.625, 0.86], hole_held)).collect()
         };
         let free = block(false);
-        let up = |x: f64| Line { p: [x, 0.0], d: [0.0, -1.0] }.chord(&free, false, 1.0).unwrap();
+        let up = |x: f64| Line { p: [x, 0.0], d: [0.0, -1.0] }.chord(&free, false, 1.0).unwrap().0;
         assert!((up(0.5) - 0.15).abs() < 1e-12, "{}", up(0.5));
         assert!((up(0.2) - 1.0).abs() < 1e-12, "{}", up(0.2));
         // from the top, going down the same way
-        let down = Line { p: [0.5, 1.0], d: [0.0, 1.0] }.chord(&free, false, 1.0).unwrap();
+        let down = Line { p: [0.5, 1.0], d: [0.0, 1.0] }.chord(&free, false, 1.0).unwrap().0;
         assert!((down - 0.15).abs() < 1e-12, "{down}");
         // a clamped hole holds the ligament's far end: the chord is the ligament (battery 15,
         // F1), going up and going down
         let clamped = block(true);
-        let up = Line { p: [0.5, 0.0], d: [0.0, -1.0] }.chord(&clamped, false, 1.0).unwrap();
+        // and the held end is named, with the direction into the body
+        let (up, end) = Line { p: [0.5, 0.0], d: [0.0, -1.0] }.chord(&clamped, false, 1.0).unwrap();
         assert!((up - 0.01).abs() < 1e-12, "{up}");
-        let down = Line { p: [0.5, 1.0], d: [0.0, 1.0] }.chord(&clamped, false, 1.0).unwrap();
+        let (at, inward) = end.expect("a held end");
+        assert!((at[0] - 0.5).abs() < 1e-12 && (at[1] - 0.01).abs() < 1e-12 && inward == [0.0, 1.0], "{at:?} {inward:?}");
+        let (down, end) = Line { p: [0.5, 1.0], d: [0.0, 1.0] }.chord(&clamped, false, 1.0).unwrap();
         assert!((down - 0.14).abs() < 1e-12, "{down}");
+        assert_eq!(end.map(|e| e.1), Some([-0.0, -1.0]));
     }
 }

@@ -28,8 +28,9 @@
 //!   gap, certified). Refused, naming the node and both normals ([`ContactDataError::Corner`]).
 //! * **The obstacle does not overlap the body by more than its thickness.** A gap chi(p) < -D,
 //!   D the body's chord through p along the contact normal n (the length of the piece of the
-//!   line p + t n inside the edge-connected body holding p, [`Chords`]), asks the body to move
-//!   through its whole thickness along n at p:
+//!   line p + t n inside the edge-connected body holding p, up to a held end of Gamma_D, which
+//!   counts where its Dirichlet data put it: [`Chords`]), asks the body to move through its
+//!   whole thickness along n at p:
 //!   outside linear (small-strain) elasticity everywhere it happens, and in practice a sign or
 //!   unit mistake. Checked at the contact nodes and on the same sampling as the normal; a gap
 //!   or normal that is not a finite number at a sampled point is named as the data watch names
@@ -89,11 +90,14 @@ pub enum ContactDataError {
     /// `node`: the node's normal; `side`: the normal on `edge` next to the node; `angle` in radians.
     Corner { problem: String, part: String, at: [f64; 2], edge: [[f64; 2]; 2], node: [f64; 2], side: [f64; 2], angle: f64 },
     #[error(
-        "{problem}: the gap `contact.chi` at {x} on the contact part ({part}) is {chi}: the obstacle would overlap the body by more than the body's thickness along the contact normal ({nx:.6}, {ny:.6}) there (the length of the line through that point along n inside the body, {d}), pushing the body through itself; a gap below minus the body's thickness is a sign or unit mistake",
-        x = point(*.at), chi = shown(*.chi), d = shown(*.chord), nx = .normal[0], ny = .normal[1]
+        "{problem}: the gap `contact.chi` at {x} on the contact part ({part}) is {chi}: the obstacle would overlap the body by more than the body's thickness along the contact normal ({nx:.6}, {ny:.6}) there (the length of the line through that point along n inside the body, {d}{held}), pushing the body through itself; a gap below minus the body's thickness is a sign or unit mistake",
+        x = point(*.at), chi = shown(*.chi), d = shown(*.chord), nx = .normal[0], ny = .normal[1],
+        held = held_text(.held, *.chord)
     )]
-    /// `chord`: the body's chord through `at` along the unit `normal` ([`Chords`]).
-    Gap { problem: String, part: String, at: [f64; 2], chi: f64, normal: [f64; 2], chord: f64 },
+    /// `chord`: the body's chord through `at` along the unit `normal` ([`Chords`]); `held`:
+    /// the end on Gamma_D it stops at, and how far the Dirichlet data move that end towards the
+    /// contact face (negative: away), where they move it.
+    Gap { problem: String, part: String, at: [f64; 2], chi: f64, normal: [f64; 2], chord: f64, held: Option<([f64; 2], f64)> },
     #[error(
         "{problem}: the node at {x} on the closure of the contact part ({part}) has u_{fixed} prescribed by {by} and u_{free} free, and the contact normal there ({nx:.6}, {ny:.6}) acts on the free u_{free}: the contact condition u . n <= chi is imposed only at nodes with no prescribed component, so it would not hold there and the body could pass the obstacle at that node. Prescribe both components there, or let the contact part and the part or point that prescribes one component not meet",
         x = point(*.at), nx = .normal[0], ny = .normal[1], fixed = .fixed + 1, free = 2 - .fixed
@@ -157,7 +161,7 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
     let outward: Vec<Option<[f64; 2]>> =
         outward_normals(mesh, nodes).into_iter().zip(&mesh.boundary).map(|(n, e)| (e.part == Part::Contact).then_some(n)).collect();
     let diameter = super::consistent::diameter(mesh);
-    let chords = Chords::of(mesh, nodes, problem.dirichlet_components());
+    let chords = Chords::of(mesh, nodes, problem);
     // the normal at each node and sampled point first: a normal nearly tangent or reversed is
     // named as such, never as a corner where it merely turns fast (battery 11, N6)
     check_nodes(mesh, nodes, dofs, problem, &outward, &chords)?;
@@ -249,9 +253,9 @@ fn check_nodes(
             let (problem, part) = (problem_name(problem), contact_part(problem));
             return Err(Box::new(ContactDataError::Normal { problem, part, at, edge, normal: c.normal, outward, dot }));
         }
-        if let Some(chord) = chords.overlapped(c.gap, at, c.normal, &edges[k]) {
+        if let Some(room) = chords.overlapped(c.gap, at, c.normal, &edges[k]) {
             let (problem, part) = (problem_name(problem), contact_part(problem));
-            return Err(Box::new(ContactDataError::Gap { problem, part, at, chi: c.gap, normal: c.normal, chord }));
+            return Err(Box::new(ContactDataError::gap(problem, part, at, c.gap, c.normal, room)));
         }
     }
     Ok(())
@@ -274,9 +278,9 @@ fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, chords: &C
     for (p, _) in &points {
         let chi = problem.gap(p.at);
         let n = problem.contact_normal(p.at, p.normal);
-        if let Some(chord) = chords.overlapped(chi, p.at, n, &[p.edge]) {
+        if let Some(room) = chords.overlapped(chi, p.at, n, &[p.edge]) {
             let (problem, part) = (problem_name(problem), contact_part(problem));
-            return Err(Box::new(ContactDataError::Gap { problem, part, at: p.at, chi, normal: n, chord }));
+            return Err(Box::new(ContactDataError::gap(problem, part, p.at, chi, n, room)));
         }
         let dot = n[0] * p.normal[0] + n[1] * p.normal[1];
         dots.push((n, dot));
@@ -300,6 +304,27 @@ fn check_sampled(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem, chords: &C
         }
     }
     Ok(())
+}
+
+impl ContactDataError {
+    /// [`ContactDataError::Gap`] of the `room` a chord left (its held end kept where the
+    /// Dirichlet data move it).
+    fn gap(problem: String, part: String, at: [f64; 2], chi: f64, normal: [f64; 2], room: super::chord::Room) -> ContactDataError {
+        let held = room.held.filter(|h| h.toward != 0.0).map(|h| (h.at, h.toward));
+        ContactDataError::Gap { problem, part, at, chi, normal, chord: room.material, held }
+    }
+}
+
+/// The part of the Gap message on a held end the Dirichlet data move (empty where none).
+fn held_text(held: &Option<([f64; 2], f64)>, chord: f64) -> String {
+    let Some((at, toward)) = *held else { return String::new() };
+    let way = if toward > 0.0 { "towards" } else { "away from" };
+    format!(
+        ", up to its end at {} on the Dirichlet part, which the Dirichlet data move {} {way} the contact face: {} of room",
+        point(at),
+        shown(toward.abs()),
+        shown(chord - toward)
+    )
 }
 
 /// The mesh vertex at parameter `t` of boundary edge `edge`, if `t` is one of its ends.
