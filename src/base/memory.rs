@@ -100,9 +100,9 @@ pub const UNKNOWN_MEMORY_LIMIT: f64 = 1024.0 * 1024.0 * MIB;
 
 /// A solve that would not fit in memory.
 #[derive(Debug, thiserror::Error)]
-#[error("{what} has {ndof:.0} unknowns: solving needs about {} (estimate: {basis}), but {}", human_bytes(*.needed), match .available {
-    Some(a) if a.by_address_space => format!("this process's address-space limit (ulimit -v) leaves {}", human_bytes(a.bytes)),
-    Some(a) => format!("this machine has {} available (MemAvailable in /proc/meminfo)", human_bytes(a.bytes)),
+#[error("{what} has {ndof:.0} unknowns: solving needs about {} (estimate: {basis}), but {}", apart(*.needed, .available.map_or(0.0, |a| a.bytes))[0], match .available {
+    Some(a) if a.by_address_space => format!("this process's address-space limit (ulimit -v) leaves {}", apart(*.needed, a.bytes)[1]),
+    Some(a) => format!("this machine has {} available (MemAvailable in /proc/meminfo)", apart(*.needed, a.bytes)[1]),
     None => format!("this machine's available memory is unknown (no /proc/meminfo) and more than {} is refused", human_bytes(UNKNOWN_MEMORY_LIMIT)),
 })]
 pub struct MemoryError {
@@ -112,6 +112,19 @@ pub struct MemoryError {
     /// how `needed` was estimated
     pub basis: String,
     pub available: Option<Available>,
+}
+
+/// `a` and `b` as [`human_bytes`], with as many decimals (up to 4) as it takes for two
+/// different sizes to read differently (battery 16: "needs about 1.7 GiB ... leaves 1.7 GiB").
+fn apart(a: f64, b: f64) -> [String; 2] {
+    let mut pair = [human_bytes(a), human_bytes(b)];
+    for decimals in 2..=4 {
+        if pair[0] != pair[1] || a == b {
+            break;
+        }
+        pair = [a, b].map(|v| human_bytes_to(v, decimals));
+    }
+    pair
 }
 
 /// Refuse a solve with `ndof` unknowns before allocating anything, if its memory estimate exceeds
@@ -177,6 +190,11 @@ pub fn level_estimate(ndof: f64, measured: Option<(f64, f64)>, resident_bound: b
 
 /// Bytes in binary units: "3.4 GiB".
 pub fn human_bytes(b: f64) -> String {
+    human_bytes_to(b, 1)
+}
+
+/// [`human_bytes`] with `decimals` decimals.
+fn human_bytes_to(b: f64, decimals: usize) -> String {
     let units = ["B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"];
     let mut v = b;
     let mut u = 0;
@@ -184,7 +202,7 @@ pub fn human_bytes(b: f64) -> String {
         v /= 1024.0;
         u += 1;
     }
-    if u == 0 { format!("{v:.0} B") } else { format!("{v:.1} {}", units[u]) }
+    if u == 0 { format!("{v:.0} B") } else { format!("{v:.decimals$} {}", units[u]) }
 }
 
 /// Reset this process's peak resident set (Linux: writing 5 to `/proc/self/clear_refs` sets
@@ -200,4 +218,15 @@ pub fn peak_resident() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     Some(line.split_whitespace().nth(1)?.parse::<f64>().ok()? * 1024.0)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn two_different_sizes_read_differently() {
+        let g = 1024.0 * 1024.0 * 1024.0;
+        assert_eq!(super::apart(1.70 * g, 1.74 * g), ["1.70 GiB".to_string(), "1.74 GiB".to_string()]);
+        assert_eq!(super::apart(1.2 * g, 1.7 * g), ["1.2 GiB".to_string(), "1.7 GiB".to_string()]);
+        assert_eq!(super::apart(g, g), ["1.0 GiB".to_string(), "1.0 GiB".to_string()]);
+    }
 }
