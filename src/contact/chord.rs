@@ -129,7 +129,7 @@ impl<'a> Chords<'a> {
             .collect();
         let [a, b] = self.ends[edge];
         let reach = (b[0] - a[0]).hypot(b[1] - a[1]);
-        let room = |(material, end): (f64, Option<([f64; 2], [f64; 2])>)| Room {
+        let room = |(material, end): Sum| Room {
             material,
             held: end.map(|(at, inward)| {
                 // the data's displacement of the end along the line, towards the face: -u . m,
@@ -175,6 +175,10 @@ struct Edge {
     held: bool,
 }
 
+/// A chord's material and, where it stopped at a held end, that end's point and the direction
+/// into the body ([`Line::chord`]).
+type Sum = (f64, Option<([f64; 2], [f64; 2])>);
+
 /// The line through `p` along the unit vector `d`.
 #[derive(Clone, Copy)]
 struct Line {
@@ -206,7 +210,7 @@ impl Line {
     /// is on a held edge: material beyond a held end is no room for the face. Returns the sum
     /// and, where it stopped at a held end, that end and the direction into the body (the
     /// larger sum of the two crossings at a vertex on the line).
-    fn chord(&self, edges: &[Edge], strict: bool, reach: f64) -> Option<(f64, Option<([f64; 2], [f64; 2])>)> {
+    fn chord(&self, edges: &[Edge], strict: bool, reach: f64) -> Option<Sum> {
         let side = |c: f64| if strict { c > 0.0 } else { c >= 0.0 };
         // (parameter, held) of each crossing
         let mut s: Vec<(f64, bool)> = edges

@@ -106,7 +106,7 @@ fn a_gap_deeper_than_the_body_is_refused() {
         err.contains("the gap `contact.chi` at (")
             && err.contains("is -1.4")
             && err.contains("more than the body's thickness")
-            && err.contains("inside the body, 1)"),
+            && err.contains("inside the body, 1,"),
         "{err}"
     );
     let (code, err) = run("shallow", SQUARE, r#"chi = "0.001""#, r#"chi = "-0.9""#, SOLVE);
