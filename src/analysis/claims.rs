@@ -22,7 +22,7 @@ use crate::analysis::verdict::{self, RateReport, RateVerdict};
 use crate::analysis::{problem_names, studies};
 // the paper's C_0 (Section 7, the estimator's default): a reliability row holds when the
 // smallest reliable C_0 of its runs is at most this
-use crate::estimator::estimate::{C0_PAPER, c0_paper};
+use crate::estimator::estimate::{C0_PAPER, LogFactor, c0_paper};
 use crate::records::{MeshSnapshot, RunRecord};
 use crate::study::store::Shelf;
 pub use criterion::{Criterion, Evidence, Kind};
@@ -389,11 +389,16 @@ fn latest_mesh(shelf: &Shelf, study: &str, run: &str) -> std::io::Result<Option<
     Ok(shelf.latest_mesh(study, run)?)
 }
 
-/// The C_0 row: overestimation and the smallest reliable C_0, all runs with an error.
+/// The C_0 row: overestimation and the smallest reliable C_0, over every run on the shelf with
+/// an error whose eta_h carries the paper's log factor l_h^2 (6.3), which (6.1) bounds; a run
+/// of the log-factor ablation does not estimate with that eta_h. It read four studies while
+/// its text said "in all experiments", and another row found a larger C_0 in the deep study
+/// (battery 15, F2).
 fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
     let mut rows = Vec::new();
-    for study in [studies::EX71, studies::EX72, studies::C0_SWEEP, studies::FB] {
-        for r in ctx.shelf.runs(study)? {
+    let names: Vec<String> = ctx.shelf.studies().map(str::to_owned).collect();
+    for study in &names {
+        for r in ctx.shelf.runs(study)?.into_iter().filter(|r| r.run.estimator.log_factor == LogFactor::Squared) {
             if let Some(row) = c0_text(&format!("{study}/{}", r.run.id), &r, ctx.err_field()) {
                 rows.push(row);
             }
@@ -417,7 +422,7 @@ fn c0_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 format!("smallest reliable C_0 {worst:.1e} over {} runs: {C0_PAPER} is {:.1} decades above it", rows.len(), (C0_PAPER / worst).log10())
             },
         },
-        claim: concat!("Section 7: C_0 = ", c0_paper!(), " is consistent with the reliability bound (6.1): C_0 eta_h >= ||u - u_h||_Linf at every level, in all experiments").into(),
+        claim: concat!("Section 7: C_0 = ", c0_paper!(), " is consistent with the reliability bound (6.1): C_0 eta_h >= ||u - u_h||_Linf at every level, in all experiments (every stored run with an error, of every study; the log-factor ablation's runs aside, whose eta_h (6.1) does not bound)").into(),
         measured: if rows.is_empty() {
             String::new()
         } else {

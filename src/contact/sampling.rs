@@ -5,8 +5,9 @@
 
 use crate::base::element;
 
-/// Degree of the quadrature rule whose points the "quadrature" norm uses (collapsed Gauss,
-/// 3 x 3 = 9 points per element; declared in every record).
+/// Degree of the quadrature rule whose points the "quadrature" norm uses (Radon's symmetric
+/// 7-point rule, [`element::symmetric_rule_5`]: a maximum over its points does not depend on
+/// how an element's vertices are labelled; declared in every record).
 pub const QUADRATURE_DEGREE: usize = 5;
 /// Order of the barycentric lattice of the "dense" norm (28 points per element).
 pub const LATTICE_ORDER: usize = 6;
@@ -26,7 +27,7 @@ impl Sampling {
     /// Reference points of the sampling on the reference triangle.
     pub fn points(self) -> Vec<[f64; 2]> {
         match self {
-            Sampling::Quadrature => element::triangle_rule(QUADRATURE_DEGREE).points,
+            Sampling::Quadrature => element::symmetric_rule_5().points,
             Sampling::Dense => element::lattice(LATTICE_ORDER),
         }
     }
@@ -44,7 +45,9 @@ impl Sampling {
 
     pub fn describe(self) -> String {
         match self {
-            Sampling::Quadrature => format!("collapsed Gauss points of the degree-{QUADRATURE_DEGREE} rule per element"),
+            Sampling::Quadrature => {
+                format!("the 7 points of Radon's symmetric degree-{QUADRATURE_DEGREE} rule per element (centroid and two orbits of 3)")
+            }
             Sampling::Dense => format!("barycentric lattice of order {LATTICE_ORDER} per element"),
         }
     }

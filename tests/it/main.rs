@@ -12,6 +12,7 @@ mod bad_battery11;
 mod bad_battery12_resolution;
 mod bad_battery12_store;
 mod bad_battery13;
+mod bad_battery13_mirror;
 mod bad_battery13_notes;
 mod bad_battery13b;
 mod bad_battery14;
