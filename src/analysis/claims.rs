@@ -487,7 +487,7 @@ fn efficiency_size_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()>
                 format!("smallest reliable C_0 per problem {c0s}: one problem's C_0 is {:.0}x another's", hi / lo)
             },
         },
-        claim: concat!("How large the efficiency index C_0 eta_h / error is, per problem and contact term, over the levels of each run's error-rate fit (the paper plots it in Fig. 2b and uses one C_0 = ", c0_paper!(), " for both examples; no claim on its size), and the smallest reliable C_0 per problem (the largest over its runs of max error / eta_h)").into(),
+        claim: concat!("How large the efficiency index C_0 eta_h / error is, per problem and contact term, over the levels of each run's error-rate fit (the paper plots it in Fig. 2b and uses one C_0 = ", c0_paper!(), " for both examples; no claim on its size), and the smallest reliable C_0 per problem over these runs (the largest of their max error / eta_h; over every stored run of every study: row c0)").into(),
         measured: if rows.is_empty() { "no data".into() } else { format!("estimate / error: {}. Smallest reliable C_0: {c0s}", rows.join("; ")) },
         verdict: reported.verdict(Kind::Beyond, (!rows.is_empty()).then_some(Evidence::Bool(true)).as_ref()),
         criterion: reported,

@@ -157,7 +157,11 @@ fn without_path(text: &str, file: &std::path::Path) -> String {
 /// where it differs.)
 pub fn first_difference(a: &str, b: &str) -> (String, String) {
     let (al, bl): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
-    let i = (0..al.len().max(bl.len())).find(|&i| al.get(i) != bl.get(i)).unwrap_or(al.len().min(bl.len()));
+    let Some(i) = (0..al.len().max(bl.len())).find(|&i| al.get(i) != bl.get(i)) else {
+        // the same lines: what differs is how they end (`lines` drops "\r\n" and a last "\n";
+        // battery 17: a CRLF levels.csv read "line 72: (none)" on both sides)
+        return (line_endings(a), line_endings(b));
+    };
     let (la, lb): (Vec<char>, Vec<char>) = (al.get(i).unwrap_or(&"").chars().collect(), bl.get(i).unwrap_or(&"").chars().collect());
     let at = la.iter().zip(&lb).take_while(|(x, y)| x == y).count();
     let from = at.saturating_sub(20);
@@ -169,6 +173,13 @@ pub fn first_difference(a: &str, b: &str) -> (String, String) {
         format!("line {}: {}", i + 1, text.unwrap_or("(none)".into()))
     };
     (cut(al.get(i)), cut(bl.get(i)))
+}
+
+/// How the lines of `text` end: "\r\n" (Windows) or "\n", and whether the last one does.
+fn line_endings(text: &str) -> String {
+    let crlf = if text.contains("\r\n") { "\\r\\n (Windows line endings)" } else { "\\n" };
+    let last = if text.ends_with('\n') { "the last line ends with one" } else { "the last line has no line end" };
+    format!("the same lines, ending with {crlf}; {last}")
 }
 
 /// The summaries of a study against what its records render: `levels.csv` byte for byte,
@@ -285,4 +296,19 @@ pub fn reference_faults(dir: &StudyDir, runs: &[RunRecord]) -> Vec<Fault> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    /// Battery 17, F3: texts with the same lines differ in their line ends; the message says so
+    /// rather than "line 72: (none)" on both sides.
+    #[test]
+    fn the_same_lines_with_other_line_ends_are_named_as_such() {
+        let (a, b) = super::first_difference("a,b\r\n1,2\r\n", "a,b\n1,2\n");
+        assert!(a.contains("\\r\\n (Windows line endings)") && b.contains("ending with \\n;"), "{a} / {b}");
+        let (a, b) = super::first_difference("a,b\n1,2", "a,b\n1,2\n");
+        assert!(a.contains("the last line has no line end") && b.contains("the last line ends with one"), "{a} / {b}");
+        let (a, b) = super::first_difference("a,b\n1,2\n", "a,b\n1,3\n");
+        assert_eq!((a.as_str(), b.as_str()), ("line 2: 1,2", "line 2: 1,3"));
+    }
 }
