@@ -404,8 +404,11 @@ fn first_history_difference(s: &crate::records::History, f: &crate::records::His
 /// each present on both sides with the same refinement history, level for level, and the same
 /// NDF. Rows under run `reference KEY`. (Without `--deep` the fresh side is the stored one
 /// rebuilt in one solve, its meshes checked by their fingerprints on the way, so only a missing
-/// file shows here; `--deep` computes it by the adaptive loop and compares every level.)
-fn compare_references(study: &str, stored: &Store, fresh: &Store, runs: &[RunRecord]) -> Vec<DriftRow> {
+/// file shows here; `--deep` computes it by the adaptive loop and compares every level.) Against
+/// another folder (`against`), whose files no replay checks, the record of the last level is
+/// compared too, as levels are (the fields a one-solve replay cannot give left out), and the
+/// final active set exactly (battery 17, F2: a hand-edited `last.eta_h` passed as "none").
+fn compare_references(study: &str, stored: &Store, fresh: &Store, runs: &[RunRecord], spec: &DriftSpec, against: bool) -> Vec<DriftRow> {
     let mut out = Vec::new();
     let keys: std::collections::BTreeSet<String> = runs.iter().filter_map(|r| crate::records::ReferenceRecord::key_of(&r.run)).collect();
     let describe = |r: &Option<crate::records::ReferenceRecord>| {
@@ -420,6 +423,14 @@ fn compare_references(study: &str, stored: &Store, fresh: &Store, runs: &[RunRec
                     out.push(row(study, &label, Some(level), &format!("history.{field}"), sv, fv, None, "exact".into()));
                 } else if a.rebuild.ndof != b.rebuild.ndof || a.rebuild.history.levels.len() != b.rebuild.history.levels.len() {
                     out.push(row(study, &label, None, "history", describe(&s), describe(&f), None, "exact".into()));
+                } else if against {
+                    let skip = crate::study::reference::NOT_REPLAYED;
+                    for r in level_differences(&a.rebuild.last, &b.rebuild.last, spec, skip) {
+                        out.push(DriftRow { study: study.to_string(), run: label.clone(), field: format!("last.{}", r.field), ..r });
+                    }
+                    if a.rebuild.final_active != b.rebuild.final_active {
+                        out.push(row(study, &label, None, "final_active", "stored set".into(), "another set".into(), None, "exact".into()));
+                    }
                 }
             }
             _ => out.push(row(study, &label, None, "history", describe(&s), describe(&f), None, "exact".into())),
@@ -790,7 +801,7 @@ pub fn check(
             replay_tier(m, &stored, opts.progress, &mut c)?;
         }
         c.rows.extend(checked.faults.iter().map(|f| fault_row(&stored_store, f)));
-        c.rows.extend(compare_references(&m.study, &stored_store, &fresh_store, &stored));
+        c.rows.extend(compare_references(&m.study, &stored_store, &fresh_store, &stored, &m.drift, opts.against.is_some()));
         if opts.against.is_some() {
             c.rows.extend(compare_provenance(&m.study, &stored_store, &fresh_store));
         }

@@ -67,7 +67,7 @@ pub enum ReferenceError {
 
 /// Fields of the last level a one-solve replay cannot give as the loop did: the active-set
 /// iteration starts from the set the loop ended with, so it takes fewer iterations.
-const NOT_REPLAYED: &[&str] = &["pdas_iterations"];
+pub(crate) const NOT_REPLAYED: &[&str] = &["pdas_iterations"];
 
 /// The adaptive loop of a reference solution: the maximum strategy with `spec.theta`, the
 /// estimator with `spec.contact_term` (otherwise the defaults), as many levels as it takes.
