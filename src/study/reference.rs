@@ -65,10 +65,6 @@ pub enum ReferenceError {
     Record { level: usize, differences: String },
 }
 
-/// Fields of the last level a one-solve replay cannot give as the loop did: the active-set
-/// iteration starts from the set the loop ended with, so it takes fewer iterations.
-pub(crate) const NOT_REPLAYED: &[&str] = &["pdas_iterations"];
-
 /// The adaptive loop of a reference solution: the maximum strategy with `spec.theta`, the
 /// estimator with `spec.contact_term` (otherwise the defaults), as many levels as it takes.
 fn config_of(spec: &ReferenceSpec) -> AdaptConfig {
@@ -145,7 +141,7 @@ pub fn replay(
     if solved.record.ndof != record.ndof {
         return Err(ReferenceError::Replayed { stored: record.ndof, replayed: solved.record.ndof });
     }
-    let rows = crate::study::drift::level_differences(&record.last, &solved.record, tolerances, NOT_REPLAYED);
+    let rows = crate::study::drift::level_differences(&record.last, &solved.record, tolerances, crate::study::drift::NOT_REPLAYED);
     if !rows.is_empty() {
         let differences =
             rows.iter().map(|r| format!("{} stored {}, replayed {} ({})", r.field, r.stored, r.fresh, r.tolerance)).collect::<Vec<_>>();
