@@ -145,16 +145,9 @@ impl<'a> Chords<'a> {
             .max_by(|a, b| a.left().total_cmp(&b.left()))
     }
 
-    /// Whether Gamma_D holds the displacement along the unit vector `d`: both components
-    /// prescribed, or the one prescribed component along `d` (a roller whose free direction
-    /// has a part along `d` lets its edge move that way, and holds nothing).
+    /// Whether Gamma_D holds the displacement along the unit vector `d` ([`holds_along`]).
     fn holds_along(&self, d: [f64; 2]) -> bool {
-        match self.prescribed {
-            [true, true] => true,
-            [true, false] => d[1].abs() <= 1e-12,
-            [false, true] => d[0].abs() <= 1e-12,
-            [false, false] => false,
-        }
+        holds_along(self.prescribed, d)
     }
 
     fn boxes(&self) -> RTree<Boxed> {
@@ -164,6 +157,19 @@ impl<'a> Chords<'a> {
             GeomWithData::new(Rectangle::from_corners(lo, hi), e)
         });
         RTree::bulk_load(boxes.collect())
+    }
+}
+
+/// Whether prescribing the components `fixed` holds the displacement along the unit vector
+/// `d`: both components prescribed, or the one prescribed component along `d` (a roller whose
+/// free direction has a part along `d` lets the point move that way). The one rule for a
+/// chord's held end and for a prescribed node of the contact part's closure.
+pub(super) fn holds_along(fixed: [bool; 2], d: [f64; 2]) -> bool {
+    match fixed {
+        [true, true] => true,
+        [true, false] => d[1].abs() < 1e-12,
+        [false, true] => d[0].abs() < 1e-12,
+        [false, false] => false,
     }
 }
 

@@ -378,17 +378,16 @@ fn check_prescribed(
         // u . n is known where both components are prescribed, or the one n lies along; where n
         // has a part along a free component, u . n would be constrained by nothing (such a node
         // is not a contact node): refused
-        let un = match (fixed(p, 0), fixed(p, 1)) {
-            (true, true) => u[0] * n[0] + u[1] * n[1],
-            (true, false) if n[1].abs() < 1e-12 => u[0] * n[0],
-            (false, true) if n[0].abs() < 1e-12 => u[1] * n[1],
-            (true, false) | (false, true) => {
-                let fixed = if fixed(p, 0) { 0 } else { 1 };
-                let (problem, part) = (problem_name(problem), contact_part(problem));
-                return Err(Box::new(ContactDataError::HalfPrescribed { problem, part, by: by.into(), at: x, fixed, normal: n }));
-            }
-            (false, false) => continue,
-        };
+        let held = [fixed(p, 0), fixed(p, 1)];
+        if held == [false, false] {
+            continue;
+        }
+        if !super::chord::holds_along(held, n) {
+            let fixed = if held[0] { 0 } else { 1 };
+            let (problem, part) = (problem_name(problem), contact_part(problem));
+            return Err(Box::new(ContactDataError::HalfPrescribed { problem, part, by: by.into(), at: x, fixed, normal: n }));
+        }
+        let un: f64 = (0..2).filter(|&i| held[i]).map(|i| u[i] * n[i]).sum();
         if un - chi > PRESCRIBED_PENETRATION * diameter {
             let (problem, part) = (problem_name(problem), contact_part(problem));
             let u = [0, 1].map(|i| if fixed(p, i) { u[i].to_string() } else { "free".to_string() });
