@@ -22,8 +22,22 @@ pub struct Rule<const D: usize> {
 }
 
 /// Gauss–Legendre rule with `n` points on [0, 1] (exact for degree 2n-1).
-/// Nodes by Newton's method on the Legendre polynomial, the textbook way.
+/// Nodes by Newton's method on the Legendre polynomial, the textbook way. Rules of up to
+/// [`CACHED_GAUSS`] points are computed once per process and copied: the boundary checks ask for
+/// one per boundary edge, and the Newton steps cost more than the edge's own work.
 pub fn gauss_legendre(n: usize) -> Rule<1> {
+    static RULES: [std::sync::OnceLock<Rule<1>>; CACHED_GAUSS + 1] = [const { std::sync::OnceLock::new() }; CACHED_GAUSS + 1];
+    match RULES.get(n) {
+        Some(rule) => rule.get_or_init(|| newton_gauss(n)).clone(),
+        None => newton_gauss(n),
+    }
+}
+
+/// The largest Gauss rule [`gauss_legendre`] keeps once computed.
+pub const CACHED_GAUSS: usize = 32;
+
+/// [`gauss_legendre`]'s computation.
+fn newton_gauss(n: usize) -> Rule<1> {
     assert!(n >= 1, "a Gauss rule needs at least one point");
     let mut points = Vec::with_capacity(n);
     let mut weights = Vec::with_capacity(n);

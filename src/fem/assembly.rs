@@ -343,25 +343,35 @@ pub fn assemble(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: &dyn Probl
     System { matrix, rhs, dirichlet }
 }
 
-/// Every point where [`assemble`] evaluates the body force, with its triangle: the load rule's
-/// points, or the piecewise rule's across a load break (`breaks`, the problem's
-/// `load_breaks`). Enumerated by [`element_load`] itself, so the exact solution's consistency
-/// check (`crate::contact::consistent`) sees every value of f the discrete problem sees.
-pub fn load_points(mesh: &Mesh, breaks: &[f64]) -> Vec<(usize, [f64; 2])> {
-    let load_rule = element::triangle_rule(LOAD_DEGREE);
-    let load_basis: Vec<[f64; N_NODES]> = load_rule.points.iter().map(|q| element::p2_values(q[0], q[1])).collect();
-    let mut out = Vec::new();
-    for t in 0..mesh.n_triangles() {
+/// Where [`assemble`] evaluates the body force, triangle by triangle: the load rule's points, or
+/// the piecewise rule's across a load break (the problem's `load_breaks`). Enumerated by
+/// [`element_load`] itself, so the exact solution's consistency check
+/// (`crate::contact::consistent`) sees every value of f the discrete problem sees. One triangle
+/// at a time: a mesh of 1e7 unknowns has about 1e8 load points, too many to hold at once.
+pub struct LoadPoints {
+    breaks: Vec<f64>,
+    rule: element::Rule<2>,
+    basis: Vec<[f64; N_NODES]>,
+}
+
+impl LoadPoints {
+    pub fn new(breaks: Vec<f64>) -> LoadPoints {
+        let rule = element::triangle_rule(LOAD_DEGREE);
+        let basis = rule.points.iter().map(|q| element::p2_values(q[0], q[1])).collect();
+        LoadPoints { breaks, rule, basis }
+    }
+
+    /// The points of triangle `t`, in the order [`element_load`] evaluates f at them.
+    pub fn of(&self, mesh: &Mesh, t: usize) -> Vec<[f64; 2]> {
         let corners = mesh.corners(t);
-        let seen = std::cell::RefCell::new(Vec::new());
+        let seen = std::cell::RefCell::new(Vec::with_capacity(self.rule.points.len()));
         let record = |x: [f64; 2]| {
             seen.borrow_mut().push(x);
             [0.0; 2]
         };
-        element_load(&Affine::new(corners), corners, &record, breaks, &load_rule, &load_basis);
-        out.extend(seen.into_inner().into_iter().map(|x| (t, x)));
+        element_load(&Affine::new(corners), corners, &record, &self.breaks, &self.rule, &self.basis);
+        seen.into_inner()
     }
-    out
 }
 
 /// The points where [`assemble`] evaluates the Neumann traction on the boundary edge from `a`

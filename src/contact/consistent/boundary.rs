@@ -83,23 +83,26 @@ fn parameters(p: [f64; 2], q: [f64; 2], part: Part, spacing: f64) -> Vec<f64> {
 /// solution's contact conditions and the contact data ([`crate::contact::plausible`]) are
 /// checked on it.
 pub(in crate::contact) fn sample(mesh: &Mesh, nodes: &P2Nodes, only: Option<Part>) -> Vec<(Point, f64)> {
+    use rayon::prelude::*;
     let normals = super::super::plausible::outward_normals(mesh, nodes);
     let spacing = super::diameter(mesh) / CONTACT_DENSITY as f64;
-    let mut out = Vec::new();
-    for (b, edge) in mesh.boundary.iter().enumerate().filter(|(_, e)| only.is_none_or(|p| e.part == p)) {
-        let [p, q] = edge.v.map(|v| mesh.vertices[v]);
-        let len = (p[0] - q[0]).hypot(p[1] - q[1]);
-        let chord = normals[b];
-        for t in parameters(p, q, edge.part, spacing) {
-            let x = [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
-            let (at, normal) = match &edge.curve {
-                None => (x, chord),
-                Some(curve) => on_curve(curve, x, chord),
-            };
-            out.push((Point { at, normal, part: edge.part, edge: b, t }, len));
-        }
-    }
-    out
+    // in the edges' order, whatever the number of threads
+    let edges = mesh.boundary.par_iter().enumerate().filter(|(_, e)| only.is_none_or(|p| e.part == p));
+    edges
+        .flat_map_iter(|(b, edge)| {
+            let [p, q] = edge.v.map(|v| mesh.vertices[v]);
+            let len = (p[0] - q[0]).hypot(p[1] - q[1]);
+            let chord = normals[b];
+            parameters(p, q, edge.part, spacing).into_iter().map(move |t| {
+                let x = [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
+                let (at, normal) = match &edge.curve {
+                    None => (x, chord),
+                    Some(curve) => on_curve(curve, x, chord),
+                };
+                (Point { at, normal, part: edge.part, edge: b, t }, len)
+            })
+        })
+        .collect()
 }
 
 /// The boundary points where `exact.grad` is compared with differences of `exact.u`, each with
@@ -130,136 +133,162 @@ fn stress_scale(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, points: &
     let material = problem.material();
     let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
     let stiffness = 2.0 * material.mu + material.zeta.abs();
-    let (mut traction, mut gradient) = (0.0f64, 0.0f64);
-    for p in points {
-        let g = exact.grad(p.at);
-        let t = material.traction(g, p.normal);
-        traction = traction.max(finite(t[0].hypot(t[1])));
-        gradient = gradient.max(finite(g[0][0].abs().max(g[0][1].abs()).max(g[1][0].abs()).max(g[1][1].abs())));
-    }
+    use rayon::prelude::*;
+    let (traction, gradient) = points
+        .par_iter()
+        .map(|p| {
+            let g = exact.grad(p.at);
+            let t = material.traction(g, p.normal);
+            (finite(t[0].hypot(t[1])), finite(g[0][0].abs().max(g[0][1].abs()).max(g[1][0].abs()).max(g[1][1].abs())))
+        })
+        .reduce(|| (0.0f64, 0.0f64), |a, b| (a.0.max(b.0), a.1.max(b.1)));
     traction.max(stiffness * gradient).max(stiffness * scale_u / super::diameter(mesh))
 }
 
-/// One condition at one point: how far it is violated (0 when it holds) and what the error says.
+/// The numbers a violated condition is reported with ([`Detail::text`]): written out only for
+/// the conditions that fail, as a mesh of 1e7 unknowns has 1e5 checked boundary points.
+enum Detail {
+    Dirichlet { i: usize, u: f64, g: f64 },
+    Free { i: usize, s: f64, n: [f64; 2] },
+    Traction { i: usize, s: f64, g: f64, n: [f64; 2] },
+    Contact { un: f64, chi: f64, snn: f64 },
+    Tangential { s: [f64; 2], cn: [f64; 2], tangential: f64 },
+    Point { i: usize, u: f64, v: f64 },
+}
+
+impl Detail {
+    fn text(&self) -> String {
+        match *self {
+            Detail::Dirichlet { i, u, g } => format!("u_{} = {u:.6e}, `dirichlet[{i}]` = {g:.6e}", i + 1),
+            Detail::Free { i, s, n } => {
+                format!("(sigma(u) n)_{} = {s:.6e} where `dirichlet[{i}]` is \"free\" (n = ({:.4}, {:.4}))", i + 1, n[0], n[1])
+            }
+            Detail::Traction { i, s, g, n } => {
+                format!("(sigma(u) n)_{} = {s:.6e}, the traction `traction[{i}]` = {g:.6e} (n = ({:.4}, {:.4}))", i + 1, n[0], n[1])
+            }
+            Detail::Contact { un, chi, snn } => format!("u . n = {un:.6e}, the gap chi = {chi:.6e}, sigma_nn = {snn:.6e}"),
+            Detail::Tangential { s, cn, tangential } => format!(
+                "sigma(u) n = ({:.6e}, {:.6e}), its part across the contact normal ({:.4}, {:.4}) is {tangential:.6e}",
+                s[0], s[1], cn[0], cn[1]
+            ),
+            Detail::Point { i, u, v } => format!("u_{} = {u:.6e}, prescribed {v:.6e}", i + 1),
+        }
+    }
+}
+
+/// One condition at one point: how far it is violated (0 when it holds), the scale that is
+/// measured against, and what the error says.
 struct Violation {
     at: [f64; 2],
     off: f64,
-    what: String,
-    detail: String,
+    scale: f64,
+    what: &'static str,
+    detail: Detail,
+}
+
+impl Violation {
+    /// A contradiction: off by more than [`CONSISTENT`] times its scale.
+    fn holds(&self) -> bool {
+        !(self.off.is_finite() && self.off > CONSISTENT * self.scale)
+    }
+}
+
+/// Scales the conditions are measured against: |u| ([`check_boundary`]'s `scale_u`) and a
+/// traction's ([`stress_scale`]).
+struct Scales {
+    u: f64,
+    stress: f64,
+}
+
+/// The conditions at one boundary point (see the module docs), each with how far it is off.
+fn conditions(problem: &dyn Problem, exact: &dyn Exact, p: &Point, scales: &Scales) -> Vec<Violation> {
+    let material = problem.material();
+    let sigma_n = |x: [f64; 2], n: [f64; 2]| material.traction(exact.grad(x), n);
+    let norm = |v: [f64; 2]| v[0].hypot(v[1]);
+    let (u, n, at) = (exact.u(p.at), p.normal, p.at);
+    let mut out = Vec::new();
+    match p.part {
+        Part::Dirichlet => {
+            let g = problem.dirichlet(at);
+            let prescribed = problem.dirichlet_components();
+            for i in (0..2).filter(|&i| prescribed[i]) {
+                let detail = Detail::Dirichlet { i, u: u[i], g: g[i] };
+                out.push(Violation { at, off: (u[i] - g[i]).abs(), scale: scales.u, what: "the Dirichlet data on Gamma_D", detail });
+            }
+            // a component the data leave free ("free": rollers) carries zero traction
+            let s = sigma_n(at, n);
+            for i in (0..2).filter(|&i| !prescribed[i]) {
+                let what = "zero traction in a free component on Gamma_D (rollers)";
+                out.push(Violation { at, off: s[i].abs(), scale: scales.stress, what, detail: Detail::Free { i, s: s[i], n } });
+            }
+        }
+        Part::Neumann => {
+            let (g, s) = (problem.traction(at, n), sigma_n(at, n));
+            for i in 0..2 {
+                let detail = Detail::Traction { i, s: s[i], g: g[i], n };
+                out.push(Violation { at, off: (s[i] - g[i]).abs(), scale: scales.stress, what: "the traction on Gamma_N", detail });
+            }
+        }
+        Part::Contact => {
+            let cn = problem.contact_normal(at, n);
+            let len = norm(cn);
+            let cn = [cn[0] / len, cn[1] / len];
+            let (un, chi) = (u[0] * cn[0] + u[1] * cn[1], problem.gap(at));
+            let s = sigma_n(at, n);
+            let snn = s[0] * cn[0] + s[1] * cn[1];
+            let contact =
+                |what: &'static str, off: f64, scale: f64| Violation { at, off, scale, what, detail: Detail::Contact { un, chi, snn } };
+            out.push(contact("the contact condition u . n <= chi on Gamma_C", (un - chi).max(0.0), scales.u));
+            out.push(contact("the contact condition sigma_nn <= 0 on Gamma_C (no tension)", snn.max(0.0), scales.stress));
+            // frictionless: the traction acts along the contact normal only
+            let tangential = norm([s[0] - snn * cn[0], s[1] - snn * cn[1]]);
+            let what = "no tangential traction on Gamma_C (frictionless contact)";
+            out.push(Violation { at, off: tangential, scale: scales.stress, what, detail: Detail::Tangential { s, cn, tangential } });
+            // open (chi - u . n > 0) and pressed (sigma_nn < 0) at once: the smaller of the two
+            // relative violations
+            let open = ((chi - un).max(0.0) / scales.u.max(f64::MIN_POSITIVE)).min((-snn).max(0.0) / scales.stress.max(f64::MIN_POSITIVE));
+            out.push(contact("complementarity on Gamma_C ((chi - u . n) sigma_nn = 0: pressed where the gap is open)", open, 1.0));
+        }
+    }
+    out
 }
 
 /// Check the exact solution against the boundary and contact conditions on `mesh`.
 pub fn check_boundary(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, nodes: &P2Nodes, name: &str) -> Result<(), ExactError> {
+    use rayon::prelude::*;
     let points: Vec<Point> = sample(mesh, nodes, None).into_iter().map(|(p, _)| p).collect();
-    let material = problem.material();
-    let sigma_n = |x: [f64; 2], n: [f64; 2]| material.traction(exact.grad(x), n);
-    let norm = |v: [f64; 2]| v[0].hypot(v[1]);
     let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
-    let scale_u = points.iter().map(|p| finite(norm(exact.u(p.at)))).fold(0.0, f64::max);
-    let scale_s = stress_scale(problem, exact, mesh, &points, scale_u);
-    let mut found: Vec<(Violation, f64)> = Vec::new();
-    for p in &points {
-        let (u, n) = (exact.u(p.at), p.normal);
-        match p.part {
-            Part::Dirichlet => {
-                let g = problem.dirichlet(p.at);
-                let prescribed = problem.dirichlet_components();
-                for i in (0..2).filter(|&i| prescribed[i]) {
-                    let detail = format!("u_{} = {:.6e}, `dirichlet[{i}]` = {:.6e}", i + 1, u[i], g[i]);
-                    found.push((
-                        Violation { at: p.at, off: (u[i] - g[i]).abs(), what: "the Dirichlet data on Gamma_D".into(), detail },
-                        scale_u,
-                    ));
-                }
-                // a component the data leave free ("free": rollers) carries zero traction
-                let s = sigma_n(p.at, n);
-                for i in (0..2).filter(|&i| !prescribed[i]) {
-                    let detail = format!(
-                        "(sigma(u) n)_{} = {:.6e} where `dirichlet[{i}]` is \"free\" (n = ({:.4}, {:.4}))",
-                        i + 1,
-                        s[i],
-                        n[0],
-                        n[1]
-                    );
-                    found.push((
-                        Violation {
-                            at: p.at,
-                            off: s[i].abs(),
-                            what: "zero traction in a free component on Gamma_D (rollers)".into(),
-                            detail,
-                        },
-                        scale_s,
-                    ));
-                }
-            }
-            Part::Neumann => {
-                let (g, s) = (problem.traction(p.at, n), sigma_n(p.at, n));
-                for i in 0..2 {
-                    let detail = format!(
-                        "(sigma(u) n)_{} = {:.6e}, the traction `traction[{i}]` = {:.6e} (n = ({:.4}, {:.4}))",
-                        i + 1,
-                        s[i],
-                        g[i],
-                        n[0],
-                        n[1]
-                    );
-                    found.push((Violation { at: p.at, off: (s[i] - g[i]).abs(), what: "the traction on Gamma_N".into(), detail }, scale_s));
-                }
-            }
-            Part::Contact => {
-                let cn = problem.contact_normal(p.at, p.normal);
-                let len = norm(cn);
-                let cn = [cn[0] / len, cn[1] / len];
-                let (un, chi) = (u[0] * cn[0] + u[1] * cn[1], problem.gap(p.at));
-                let s = sigma_n(p.at, n);
-                let snn = s[0] * cn[0] + s[1] * cn[1];
-                let state = format!("u . n = {un:.6e}, the gap chi = {chi:.6e}, sigma_nn = {snn:.6e}");
-                let contact =
-                    |what: &str, off: f64, scale: f64| (Violation { at: p.at, off, what: what.into(), detail: state.clone() }, scale);
-                found.push(contact("the contact condition u . n <= chi on Gamma_C", (un - chi).max(0.0), scale_u));
-                found.push(contact("the contact condition sigma_nn <= 0 on Gamma_C (no tension)", snn.max(0.0), scale_s));
-                // frictionless: the traction acts along the contact normal only
-                let tangential = norm([s[0] - snn * cn[0], s[1] - snn * cn[1]]);
-                let detail = format!(
-                    "sigma(u) n = ({:.6e}, {:.6e}), its part across the contact normal ({:.4}, {:.4}) is {tangential:.6e}",
-                    s[0], s[1], cn[0], cn[1]
-                );
-                found.push((
-                    Violation {
-                        at: p.at,
-                        off: tangential,
-                        what: "no tangential traction on Gamma_C (frictionless contact)".into(),
-                        detail,
-                    },
-                    scale_s,
-                ));
-                // open (chi - u . n > 0) and pressed (sigma_nn < 0) at once: the smaller of the two
-                // relative violations
-                let open = ((chi - un).max(0.0) / scale_u.max(f64::MIN_POSITIVE)).min((-snn).max(0.0) / scale_s.max(f64::MIN_POSITIVE));
-                found.push(contact("complementarity on Gamma_C ((chi - u . n) sigma_nn = 0: pressed where the gap is open)", open, 1.0));
-            }
-        }
-    }
+    let scale_u = points
+        .par_iter()
+        .map(|p| {
+            let u = exact.u(p.at);
+            finite(u[0].hypot(u[1]))
+        })
+        .reduce(|| 0.0, f64::max);
+    let scales = Scales { u: scale_u, stress: stress_scale(problem, exact, mesh, &points, scale_u) };
+    // in the points' order, whatever the number of threads
+    let mut bad: Vec<Violation> =
+        points.par_iter().flat_map_iter(|p| conditions(problem, exact, p, &scales).into_iter().filter(|v| !v.holds())).collect();
     for c in problem.point_constraints() {
         let u = exact.u(c.at);
         for (i, v) in c.u.iter().enumerate() {
-            if let Some(v) = v {
-                let detail = format!("u_{} = {:.6e}, prescribed {v:.6e}", i + 1, u[i]);
-                found.push((
-                    Violation { at: c.at, off: (u[i] - v).abs(), what: "a point constraint (`point_constraints`)".into(), detail },
-                    scale_u,
-                ));
+            if let Some(v) = *v {
+                let detail = Detail::Point { i, u: u[i], v };
+                let what = "a point constraint (`point_constraints`)";
+                let violation = Violation { at: c.at, off: (u[i] - v).abs(), scale: scale_u, what, detail };
+                if !violation.holds() {
+                    bad.push(violation);
+                }
             }
         }
     }
-    let bad: Vec<&Violation> = found.iter().filter(|(v, scale)| v.off.is_finite() && v.off > CONSISTENT * scale).map(|(v, _)| v).collect();
     match bad.first() {
         None => Ok(()),
         Some(v) => Err(ExactError::Boundary {
             problem: name.to_string(),
-            what: v.what.clone(),
+            what: v.what.to_string(),
             at: v.at,
-            detail: v.detail.clone(),
+            detail: v.detail.text(),
             count: bad.iter().filter(|b| b.what == v.what).count(),
             sampled: points.len(),
         }),

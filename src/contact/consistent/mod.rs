@@ -176,11 +176,10 @@ pub(in crate::contact) fn diameter(mesh: &Mesh) -> f64 {
     (hi[0] - lo[0]).hypot(hi[1] - lo[1])
 }
 
-/// The centroid of every sampled triangle and its step ([`steps`]).
-fn points(mesh: &Mesh) -> Vec<([f64; 2], f64)> {
+/// The centroid of every sampled triangle and its step (`steps`, per triangle: [`steps`]).
+fn points(mesh: &Mesh, steps: &[f64]) -> Vec<([f64; 2], f64)> {
     let n = mesh.n_triangles();
     let picks = SAMPLES.min(n);
-    let steps = steps(mesh);
     (0..picks)
         .map(|k| {
             let t = mesh.triangles[k * n / picks].map(|v| mesh.vertices[v]);
@@ -255,15 +254,85 @@ fn minus_div(material: &Material, exact: &dyn Exact, x: [f64; 2], s: f64) -> [Qu
     minus
 }
 
-/// The points where the body force is compared: the sampled centroids, and every point where
-/// the assembly evaluates f on this mesh ([`crate::fem::assembly::load_points`]), each with the
-/// step of its triangle. Whatever value of f the discrete problem sees is checked, so a file is
-/// not accepted on one mesh and refused on another for a mismatch between samples (battery 6).
-fn load_points(mesh: &Mesh, problem: &dyn Problem, centroids: &[([f64; 2], f64)]) -> Vec<([f64; 2], f64)> {
-    let steps = steps(mesh);
-    let mut pts = centroids.to_vec();
-    pts.extend(crate::fem::assembly::load_points(mesh, &problem.load_breaks()).into_iter().map(|(t, x)| (x, steps[t])));
-    pts
+/// Triangles whose load points [`body_force_mismatch`] compares at once.
+const CHUNK: usize = 4096;
+
+/// The body force `f` at a point and -div sigma(u) there with the finer step (half `step`).
+struct Evaluated {
+    at: [f64; 2],
+    step: f64,
+    f: [f64; 2],
+    fine: [Quotient; 2],
+}
+
+/// A point whose finer quotient is off ([`judge`]'s first test against the scale so far), kept
+/// for the final test against the scale over every point.
+struct Kept {
+    at: [f64; 2],
+    step: f64,
+    declared: f64,
+    fine: Quotient,
+}
+
+/// The body force against -div sigma(u) (each component, as [`judge`] does for one): at the
+/// sampled centroids, and at every point where the assembly evaluates f on this mesh
+/// ([`crate::fem::assembly::LoadPoints`]), each with the step of its triangle. Whatever value of f
+/// the discrete problem sees is checked, so a file is not accepted on one mesh and refused on
+/// another for a mismatch between samples (battery 6). Returns the first mismatch with its
+/// component, and the number of points compared.
+///
+/// The points (about 36 a triangle) are streamed, [`CHUNK`] triangles at a time, and only those
+/// off by more than [`CONSISTENT`] times the scale so far are kept: the scale over every point is
+/// no smaller, so the points it finds off are among them, and the answer is [`judge`]'s over
+/// all the points at once, in the same order, without holding them.
+fn body_force_mismatch(
+    problem: &dyn Problem,
+    exact: &dyn Exact,
+    mesh: &Mesh,
+    centroids: &[([f64; 2], f64)],
+    steps: &[f64],
+    floor: f64,
+) -> (Option<(usize, Mismatch)>, usize) {
+    use rayon::prelude::*;
+    let material = problem.material();
+    let loads = crate::fem::assembly::LoadPoints::new(problem.load_breaks());
+    let evaluate = |&(at, step): &([f64; 2], f64)| Evaluated {
+        at,
+        step,
+        f: problem.body_force(at),
+        fine: minus_div(&material, exact, at, step / 2.0),
+    };
+    let mut scale = [floor; 2];
+    let mut kept: [Vec<Kept>; 2] = [Vec::new(), Vec::new()];
+    let mut count = 0;
+    let mut take = |values: Vec<Evaluated>| {
+        for i in 0..2 {
+            let finite = values.par_iter().flat_map_iter(|v| [v.f[i].abs(), v.fine[i].value.abs()]).filter(|v| v.is_finite());
+            let so_far = scale[i];
+            scale[i] = finite.reduce(|| so_far, f64::max);
+            let so_far = scale[i];
+            let off = values.par_iter().filter(|v| (v.fine[i].value - v.f[i]).abs() > CONSISTENT * so_far);
+            let off: Vec<Kept> = off.map(|v| Kept { at: v.at, step: v.step, declared: v.f[i], fine: v.fine[i] }).collect();
+            kept[i].extend(off);
+        }
+        count += values.len();
+    };
+    take(centroids.par_iter().map(evaluate).collect());
+    for start in (0..mesh.n_triangles()).step_by(CHUNK) {
+        let end = (start + CHUNK).min(mesh.n_triangles());
+        let points = (start..end).into_par_iter().flat_map_iter(|t| loads.of(mesh, t).into_iter().map(move |x| (x, steps[t])));
+        take(points.map(|p| evaluate(&p)).collect());
+    }
+    for (i, kept) in kept.iter().enumerate() {
+        let pts: Vec<([f64; 2], f64)> = kept.iter().map(|k| (k.at, k.step)).collect();
+        let first: Vec<(f64, Quotient)> = kept.iter().map(|k| (k.declared, k.fine)).collect();
+        let differenced = |at, s| minus_div(&material, exact, at, s)[i];
+        // the scale over every point, fixed: judge's own fold over the kept ones cannot exceed it
+        if let Some(m) = judge(&pts, &first, &differenced, scale[i]) {
+            return (Some((i, m)), count);
+        }
+    }
+    (None, count)
 }
 
 /// Check `problem`'s exact solution, if it has one, on `mesh` (see the module docs).
@@ -273,7 +342,8 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Resul
         Some(file) => format!("problem file {}", file.display()),
         None => format!("problem {}", problem.name()),
     };
-    let pts = points(mesh);
+    let steps = steps(mesh);
+    let pts = points(mesh, &steps);
     // the gradient also where it enters: the traction "exact" = sigma(grad) n (battery 7)
     let mut grad_pts = pts.clone();
     grad_pts.extend(boundary::gradient_points(mesh, nodes));
@@ -300,11 +370,6 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Resul
         }
     }
     let material = problem.material();
-    let loads = load_points(mesh, problem, &pts);
-    let first: Vec<([f64; 2], [Quotient; 2])> = {
-        use rayon::prelude::*;
-        loads.par_iter().map(|&(at, s)| (problem.body_force(at), minus_div(&material, exact, at, s / 2.0))).collect()
-    };
     // a body force's scale is no less than the stress the gradient implies over the body's size:
     // for a stress-free exact solution (a rigid motion written as cosh(3 x)^2 - sinh(3 x)^2 - 0.001 y)
     // the largest |f| and |div sigma| are the round-off of the symbolic gradient (battery 10, F4)
@@ -314,13 +379,9 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Resul
         .filter(|v| v.is_finite())
         .fold(0.0f64, |a, v| a.max(v.abs()));
     let floor = (2.0 * material.mu + material.zeta.abs()) * gradient / diameter(mesh);
-    for i in 0..2 {
-        let first_i: Vec<(f64, Quotient)> = first.iter().map(|(f, d)| (f[i], d[i])).collect();
-        if let Some(m) = judge(&loads, &first_i, &|at, s| minus_div(&material, exact, at, s)[i], floor) {
-            let Mismatch { at, declared, differenced, step, spread, count } = m;
-            let sampled = loads.len();
-            return Err(ExactError::BodyForce { problem: problem_name(), at, i, declared, differenced, step, spread, count, sampled });
-        }
+    if let (Some((i, m)), sampled) = body_force_mismatch(problem, exact, mesh, &pts, &steps, floor) {
+        let Mismatch { at, declared, differenced, step, spread, count } = m;
+        return Err(ExactError::BodyForce { problem: problem_name(), at, i, declared, differenced, step, spread, count, sampled });
     }
     boundary::check_boundary(problem, exact, mesh, nodes, &problem_name())
 }
