@@ -1149,7 +1149,7 @@ fn run_report(
     if experiments != std::path::Path::new("experiments") {
         advice += &format!(" --experiments {}", experiments.display());
     }
-    let drift = signorini::page::DriftReports::read(&files, &advice)?;
+    let drift = signorini::page::DriftReports::read(&files, drift_report.is_some(), &advice)?;
     let shelf = study::store::Shelf::open_folder(&results, &study::manifest::declared(experiments, &[])?)?;
     for page in signorini::page::write_pages(&shelf, &figures, &out, studies, &drift, &roles)? {
         wrote(&page, format_args!("wrote {}", page.display()));
@@ -1197,6 +1197,29 @@ fn install_interrupt_handler() {
     }
 }
 
+/// The command line, or the exit status of what parsing printed instead: help and version go
+/// through [`stdout_write`], so that a standard output that fails is an error there too (clap's
+/// own printing ignores the failure: `--help > /dev/full` exited 0, battery 18, F3); a usage
+/// error goes to standard error with clap's status.
+fn parse() -> std::result::Result<Cli, ExitCode> {
+    let e = match Cli::try_parse() {
+        Ok(cli) => return Ok(cli),
+        Err(e) => e,
+    };
+    if e.use_stderr() {
+        let _ = e.print();
+        return Err(ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2)));
+    }
+    print!("{}", e.render());
+    match stdout_result() {
+        Ok(()) => Err(ExitCode::SUCCESS),
+        Err(msg) => {
+            say!("error: writing standard output: {msg}");
+            Err(ExitCode::FAILURE)
+        }
+    }
+}
+
 fn main() -> ExitCode {
     // A closed stdout (`signorini drift | head -5`) ends the process quietly, as command-line
     // tools do: Rust ignores SIGPIPE, and `println!` then panics on the broken pipe. Results stay
@@ -1208,7 +1231,10 @@ fn main() -> ExitCode {
         // killing the process, so the store can clean up and say which file it was writing.
         libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
-    let cli = Cli::parse();
+    let cli = match parse() {
+        Ok(cli) => cli,
+        Err(code) => return code,
+    };
     if let Err(e) = signorini::ordering::forced() {
         say!("error: {e}");
         return ExitCode::from(2);

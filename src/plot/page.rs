@@ -65,9 +65,11 @@ pub struct DriftReports {
 }
 
 impl DriftReports {
-    /// Read `files` (those that do not exist are skipped; one that cannot be read or parsed is
-    /// an error naming it); `advice` is the command a page advises, `STUDY` in place of the study.
-    pub fn read(files: &[PathBuf], advice: &str) -> anyhow::Result<DriftReports> {
+    /// Read `files` (one that cannot be read or parsed is an error naming it; one that does not
+    /// exist is skipped, unless `named`: a file the user named is an error when it is missing,
+    /// as a typo would otherwise read as "no drift report" (battery 18, F2)); `advice` is the
+    /// command a page advises, `STUDY` in place of the study.
+    pub fn read(files: &[PathBuf], named: bool, advice: &str) -> anyhow::Result<DriftReports> {
         use anyhow::Context;
         let mut reports = Vec::new();
         for file in files {
@@ -78,7 +80,10 @@ impl DriftReports {
                         file.display()
                     )
                 })?),
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound && !named => {}
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                    anyhow::bail!("the drift report {} (--drift-report) does not exist: give the file `signorini drift` wrote (by default target/drift/report.json), or leave --drift-report out", file.display())
+                }
                 Err(e) => return Err(e).with_context(|| format!("reading the drift report {}", file.display())),
             }
         }
@@ -328,7 +333,11 @@ fn provenance_html(text: Option<&str>) -> String {
     let Ok(serde_json::Value::Object(map)) = serde_json::from_str::<serde_json::Value>(text) else {
         return "<p>provenance.json is not a JSON object.</p>\n".into();
     };
-    let mut s = String::from("<table class=\"provenance\">\n");
+    // what a reader can trust of it (battery 18, F4): the store checks three fields against the
+    // records; the others are a note that nothing can check
+    let mut s = String::from(
+        "<p>As recorded when the study was written. <code>study</code>, <code>runs</code> and the input files' hashes are checked against the records by every command that reads the folder; the other fields (the commit, <code>quick</code>, the machine, the date, ...) are a note of how the study was made, and nothing checks them: a hand edit of them goes unnoticed.</p>\n<table class=\"provenance\">\n",
+    );
     for (k, v) in map {
         let v = match v {
             serde_json::Value::String(t) => t,

@@ -373,7 +373,7 @@ fn report_refuses_an_image_that_is_not_a_png() {
         &figs,
         &out,
         &[study.into()],
-        &signorini::page::DriftReports::read(&[figs.join("none.json")], "signorini drift --study STUDY").unwrap(),
+        &signorini::page::DriftReports::read(&[figs.join("none.json")], false, "signorini drift --study STUDY").unwrap(),
         crate::common::roles(),
     )
     .unwrap_err();
@@ -731,7 +731,7 @@ fn report_of_one_study_refuses_another_at_fault_that_its_claims_read() {
     for study in ["c0_sweep", "hertz"] {
         copy_tree(&repo.join("results").join(study), &d.join("results").join(study));
     }
-    let report = ["report", "--results", "results", "--study", "c0_sweep", "--figures", "figs", "--drift-report", "none.json"];
+    let report = ["report", "--results", "results", "--study", "c0_sweep", "--figures", "figs"];
     let (code, out) = signorini(&d, &report);
     assert_eq!(code, 0, "the sound copy is reported: {out}");
     std::fs::remove_file(d.join("results/hertz/meshes/adaptive_level19.json")).unwrap();

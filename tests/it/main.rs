@@ -21,6 +21,7 @@ mod bad_battery14b;
 mod bad_battery15;
 mod bad_battery16;
 mod bad_battery17;
+mod bad_battery18;
 mod bad_battery7;
 mod bad_battery8_contact;
 mod bad_battery8_files;

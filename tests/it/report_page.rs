@@ -20,7 +20,8 @@ fn study_pages_load_in_chromium_with_every_image_and_claim() {
         Path::new("figures"),
         &out,
         &[],
-        &signorini::page::DriftReports::read(&[Path::new("target/drift/report.json").into()], "signorini drift --study STUDY").unwrap(),
+        &signorini::page::DriftReports::read(&[Path::new("target/drift/report.json").into()], false, "signorini drift --study STUDY")
+            .unwrap(),
         crate::common::roles(),
     )
     .unwrap();
