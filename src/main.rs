@@ -248,6 +248,19 @@ enum Command {
     },
 }
 
+impl Command {
+    /// Whether the command writes files (results, figures, pages, a report, a VTU): a closed
+    /// standard output must not stop it before they are written ([`main`]).
+    fn writes_files(&self) -> bool {
+        match self {
+            Command::Solve { .. } => false,
+            Command::Adapt(args) => args.save.is_some(),
+            Command::Run { plan, .. } => !plan,
+            Command::Drift { .. } | Command::Figures { .. } | Command::Export { .. } | Command::Report { .. } => true,
+        }
+    }
+}
+
 /// The estimator's flags. Each argument's id is the setting's key (`estimator.c0`, as
 /// [`estimate::ConfigError`] names it), its default the library's ([`EstimatorConfig::default`]),
 /// its values the library's enums ([`clap::ValueEnum`]).
@@ -1221,20 +1234,27 @@ fn parse() -> std::result::Result<Cli, ExitCode> {
 }
 
 fn main() -> ExitCode {
-    // A closed stdout (`signorini drift | head -5`) ends the process quietly, as command-line
-    // tools do: Rust ignores SIGPIPE, and `println!` then panics on the broken pipe. Results stay
-    // consistent: every file is written to a temporary name and renamed.
-    // SAFETY: setting a signal's disposition to the default, before any thread is started.
+    // A file-size limit (`ulimit -f`, a quota) makes a write fail with EFBIG instead of killing
+    // the process, so the store can clean up and say which file it was writing.
+    // SAFETY: setting a signal's disposition, before any thread is started.
     unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
-        // A file-size limit (`ulimit -f`, a quota) makes a write fail with EFBIG instead of
-        // killing the process, so the store can clean up and say which file it was writing.
         libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
     let cli = match parse() {
         Ok(cli) => cli,
         Err(code) => return code,
     };
+    if !cli.command.writes_files() {
+        // A closed stdout (`signorini solve ... | head -5`) ends a command that only prints
+        // quietly, as command-line tools do (Rust ignores SIGPIPE, and the write would fail).
+        // A command that writes files goes on: the broken pipe is a failed standard output like
+        // `> /dev/full`, the files are written and the error names them (`adapt --save x.vtu |
+        // head` lost the VTU).
+        // SAFETY: setting a signal's disposition to the default, before any thread is started.
+        unsafe {
+            libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+        }
+    }
     if let Err(e) = signorini::ordering::forced() {
         say!("error: {e}");
         return ExitCode::from(2);

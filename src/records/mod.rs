@@ -61,6 +61,24 @@ fn replaceable(path: &Path) -> std::io::Result<()> {
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, format!("{}: {e}", path.display())))
 }
 
+/// What a write that failed with EFBIG ran into: the process's file-size limit (RLIMIT_FSIZE,
+/// `ulimit -f`), with the size of the file, so that the message says what to raise (battery 16:
+/// it named the file only). Empty for any other error.
+fn size_limit_note(e: &std::io::Error, len: usize) -> String {
+    if e.raw_os_error() != Some(libc::EFBIG) {
+        return String::new();
+    }
+    let mut lim = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+    // SAFETY: getrlimit writes the struct it is given, nothing else
+    if unsafe { libc::getrlimit(libc::RLIMIT_FSIZE, &mut lim) } != 0 || lim.rlim_cur == libc::RLIM_INFINITY {
+        return format!(" (the file is {len} bytes)");
+    }
+    format!(
+        " (the file is {len} bytes; this process may write files of at most {} bytes, its file-size limit `ulimit -f`: raise it, or write elsewhere)",
+        lim.rlim_cur
+    )
+}
+
 /// Files written in full to temporary files, then renamed into place together by
 /// [`Batch::commit`], in the order they were added. Dropped without a commit (an error, an
 /// interrupt), it removes its temporary files: nothing of it reaches the folder.
@@ -90,7 +108,7 @@ impl Batch {
                 path.display(),
                 tmp.file_name().unwrap_or_default().to_string_lossy()
             );
-            return Err(std::io::Error::new(e.kind(), format!("writing {what}: {e}")));
+            return Err(std::io::Error::new(e.kind(), format!("writing {what}: {e}{}", size_limit_note(&e, bytes.len()))));
         }
         self.staged.push((tmp, path.to_path_buf(), crate::base::digest::sha256_hex(bytes)));
         Ok(())

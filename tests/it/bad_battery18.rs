@@ -68,3 +68,43 @@ fn help_and_version_to_a_full_device_are_an_error() {
     assert!(out.starts_with("signorini "), "{out}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Battery 16's note: `adapt --save x.vtu | head` died by SIGPIPE before the VTU was written. A
+/// command that writes files goes on past a closed standard output, writes them and names them;
+/// one that only prints still ends quietly by SIGPIPE.
+#[test]
+fn a_closed_stdout_does_not_stop_a_command_before_its_files_are_written() {
+    let dir = scratch("b18-pipe");
+    let sig = env!("CARGO_BIN_EXE_signorini");
+    let sh = |cmd: &str| {
+        let out = std::process::Command::new("bash")
+            .args(["-c", &format!("set -o pipefail; {cmd} | head -c 1 > /dev/null")])
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).to_string())
+    };
+    let (code, err) = sh(&format!("{sig} adapt --problem ex72 --levels 14 --save x.vtu"));
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("Broken pipe") && err.contains("x.vtu"), "{err}");
+    let vtu = std::fs::read_to_string(dir.join("x.vtu")).unwrap();
+    assert!(vtu.trim_end().ends_with("</VTKFile>"), "the VTU is whole");
+    let (code, err) = sh(&format!("{sig} adapt --problem ex72 --levels 14"));
+    assert_eq!(code, Some(141), "{err}");
+    assert!(err.is_empty(), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Battery 16's note: a write stopped by the file-size limit named the file, not the limit.
+#[test]
+fn a_file_beyond_the_size_limit_names_the_limit() {
+    let dir = scratch("b18-fsize");
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"));
+    cmd.args(["export", "--problem", "ex72", "--mesh", "structured:8", "--out", "z"]).current_dir(&dir);
+    super::common::limit(&mut cmd, libc::RLIMIT_FSIZE, 4000);
+    let out = cmd.output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("z/mesh.vtu") && err.contains("at most 4000 bytes") && err.contains("file-size limit"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
