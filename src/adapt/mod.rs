@@ -50,6 +50,11 @@ pub enum AdaptError {
     Config(#[from] ConfigError),
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// The solve of level `level` (its mesh with `ndof` unknowns) failed: a refusal of the data
+    /// or a solver that did not converge, named with the level it happened at (battery 19: a
+    /// body force refused at level 1 of `solve --adapt-levels 3` named no level).
+    #[error("level {level} ({ndof} unknowns): {error}")]
+    SolveAt { level: usize, ndof: usize, error: Box<SolveError> },
     /// The estimate of level `level` is not a finite number (nothing of that level is kept).
     #[error("level {level}: {error}")]
     Estimate { level: usize, error: estimate::NotFinite },
@@ -346,7 +351,7 @@ pub fn solve_level(
         options.initial_active = initial_active;
     }
     let t0 = Instant::now();
-    let sol = solve::solve(mesh, problem, &options, &mut |_| {})?;
+    let sol = solve::solve(mesh, problem, &options, &mut |_| {}).map_err(|error| AdaptError::SolveAt { level, ndof, error: Box::new(error) })?;
     let t_solve = t0.elapsed().as_secs_f64();
     let t0 = Instant::now();
     let est = estimate::estimate(mesh, problem, &sol, &config.estimator);

@@ -240,12 +240,14 @@ fn set_up(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &RunOpt
     }
     let checked = writer.check()?;
     let mut runs = checked.runs;
-    writer.remove_orphans(&runs)?;
     let mut stale = store::stale::damaged(&checked.faults);
     stale.extend(store::stale::stale_runs(manifest, &runs, planned));
+    // a refusal changes nothing: it comes before any file is removed (battery 19: the snapshots
+    // and reference of a run whose record was damaged went as orphans, then run refused)
     if !stale.is_empty() && !opts.replace && !opts.fresh {
         return Err(store::stale::refusal(manifest, store.dir(), &stale));
     }
+    writer.remove_orphans(&runs)?;
     for s in &stale {
         let (id, why) = match s {
             store::Stale::Undeclared { id } => (id, format!("not declared in {}", manifest.file.display())),

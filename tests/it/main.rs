@@ -22,6 +22,7 @@ mod bad_battery15;
 mod bad_battery16;
 mod bad_battery17;
 mod bad_battery18;
+mod bad_battery19;
 mod bad_battery7;
 mod bad_battery8_contact;
 mod bad_battery8_files;

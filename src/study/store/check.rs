@@ -78,11 +78,25 @@ pub(super) fn orphans(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<PathBuf>
     let runs_dir = dir.root.join("runs");
     let references = dir.root.join("references");
     let keys: Vec<String> = runs.iter().filter_map(|r| records::ReferenceRecord::key_of(&r.run)).collect();
+    // runs whose record is there but could not be read (a damaged record, a fault of its run):
+    // what they saved and what they are measured against is not known, so none of it is an
+    // orphan (battery 19: removed as such, a truncated record's snapshots and reference were lost)
+    let unread: Vec<String> = files_in(&runs_dir)?
+        .into_iter()
+        .filter_map(|(name, _)| {
+            name.strip_suffix(".json")
+                .filter(|id| !records::is_temporary(&name) && !runs.iter().any(|r| r.run.id == *id))
+                .map(str::to_string)
+        })
+        .collect();
     for sub in [dir.root.clone(), runs_dir.clone(), meshes.clone(), references.clone()] {
         for (name, path) in files_in(&sub)? {
-            let stray_mesh = sub == meshes && StudyDir::parse_mesh_name(&name).is_some_and(|(run, level)| !saved(runs, run, level));
+            let stray_mesh = sub == meshes
+                && StudyDir::parse_mesh_name(&name)
+                    .is_some_and(|(run, level)| !saved(runs, run, level) && !unread.iter().any(|u| u == run));
             // a reference no stored run is measured against (its runs replaced or removed)
-            let stray_reference = sub == references && name.strip_suffix(".json").is_some_and(|k| !keys.iter().any(|key| key == k));
+            let stray_reference =
+                sub == references && unread.is_empty() && name.strip_suffix(".json").is_some_and(|k| !keys.iter().any(|key| key == k));
             let temporary = records::is_temporary(&name);
             // a temporary file of a run another process computes now is not an orphan
             let of_run = name.strip_prefix('.').and_then(|n| n.rsplit_once(".tmp")).and_then(|(target, _)| {

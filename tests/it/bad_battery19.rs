@@ -1,0 +1,89 @@
+//! Battery 19's findings:
+//! - F1 [lost]: a record made unreadable (truncated) made `run` (no --replace) remove the run's
+//!   mesh snapshots and the study's reference solution as "files of an unfinished run", then
+//!   refuse with "Nothing was run or changed". A refusal now comes before any file is removed,
+//!   and the files of a run whose record is there but cannot be read are no orphans.
+//! - F2 [message]: a refusal of the data found at a later level of the adaptive loop (`adapt`,
+//!   `solve --adapt-levels`) named no level; it names the level and its unknowns now.
+
+use super::common::{scratch, signorini_in};
+
+const STUDY: &str = "description = \"repro\"\n[defaults]\nproblem = \"ex72\"\nmesh = \"structured:4\"\ntheta = 0.5\nquick_levels = 2\nsave_levels = [2]\n[defaults.reference]\ntheta = 0.5\nmin_ndof = 3000\n[[run]]\nid = \"adaptive\"\nrefine = \"adaptive\"\nlevels = 4\n";
+
+/// Every file under `dir` with its bytes, sorted by path (lock files aside: each process that
+/// takes a lock writes its own pid into it).
+fn files(dir: &std::path::Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        if e.file_name().to_string_lossy().contains(".lock") {
+            continue;
+        } else if e.path().is_dir() {
+            out.extend(files(&e.path()));
+        } else {
+            out.push((e.path(), std::fs::read(e.path()).unwrap()));
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn a_run_refused_for_a_damaged_record_removes_nothing() {
+    let dir = scratch("b19-damaged");
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    std::fs::write(dir.join("experiments/r.toml"), STUDY).unwrap();
+    let run = ["run", "--results", "res", "experiments/r.toml"];
+    let (code, out, err) = signorini_in(&dir, &run);
+    assert_eq!(code, 0, "{out}{err}");
+    let record = dir.join("res/r/runs/adaptive.json");
+    let good = std::fs::read(&record).unwrap();
+    std::fs::write(&record, &good[..good.len() - 20]).unwrap();
+    let before = files(&dir.join("res"));
+    assert!(before.iter().any(|(p, _)| p.to_string_lossy().contains("meshes/adaptive_level2")), "a snapshot");
+    assert!(before.iter().any(|(p, _)| p.to_string_lossy().contains("references/")), "a reference");
+    let (code, out, err) = signorini_in(&dir, &run);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(err.contains("runs/adaptive.json") && !err.contains("removed"), "{err}");
+    assert_eq!(files(&dir.join("res")), before, "the refusal changed the folder");
+    // the record restored, the folder is whole again
+    std::fs::write(&record, &good).unwrap();
+    let (code, out, err) = signorini_in(&dir, &run);
+    assert_eq!(code, 0, "{out}{err}");
+    let said = format!("{out}{err}");
+    assert!(said.contains("finished earlier") && !said.contains("removing"), "{said}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+const BF_LOW: &str = r#"description = "Ex. 7.1 with f_1 off by 1e-3 in a disc of radius 0.002 at (0.503, 0.013)"
+body_force = ["(2*exp(y)*(y^2 + y - 1) - 6*y + 2)*(1 + 1e-3*(1+signum(0.000004-(x-0.503)^2-(y-0.013)^2))/2)", "3*y*(x - 2)*(y + 3)*exp(y)"]
+traction = "exact"
+dirichlet = "exact"
+[material]
+mu = 1
+lambda = 1
+[parts]
+contact = "y < 1e-12"
+dirichlet = "y > 1 - 1e-12"
+[contact]
+normal = "outward"
+chi = 0
+[exact]
+u = ["y^2*(y - 1)", "exp(y)*(1 - y)*y*(x - 2)"]
+"#;
+
+#[test]
+fn a_refusal_at_a_later_level_names_the_level() {
+    let dir = scratch("b19-level");
+    std::fs::write(dir.join("bf_low.toml"), BF_LOW).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["solve", "--problem", "bf_low.toml", "--mesh", "structured:4"]);
+    assert_eq!(code, 0, "no load point of structured:4 is in the disc: {out}{err}");
+    for args in [
+        &["adapt", "--problem", "bf_low.toml", "--levels", "4"][..],
+        &["solve", "--problem", "bf_low.toml", "--mesh", "structured:4", "--adapt-levels", "3"],
+    ] {
+        let (code, out, err) = signorini_in(&dir, args);
+        assert_eq!(code, 1, "{args:?}: {out}{err}");
+        assert!(err.contains("level 1 (282 unknowns): problem file bf_low.toml: the body force is not -div sigma(u)"), "{args:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
