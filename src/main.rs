@@ -138,7 +138,8 @@ enum Command {
         #[arg(long)]
         wait: bool,
         /// Check the manifests (and the shard) and the results folder as a run does, print its
-        /// runs, one STUDY/RUN a line (those it would keep or replace say so), and run nothing
+        /// runs, one STUDY/RUN a line (those it would keep, replace or remove say so, and the
+        /// leftover files of unfinished runs it would remove first), and run nothing
         /// (scripts/slurm/submit.sh checks --tasks with it).
         #[arg(long)]
         plan: bool,
@@ -653,12 +654,18 @@ fn run_studies(manifests: &[std::path::PathBuf], shard: Option<&str>, results: O
         // stores each run once: each listed once
         let mut listed = std::collections::BTreeSet::new();
         for m in &parsed {
-            for (spec, doing) in study::plan(m, &options)? {
-                if listed.insert((m.study.clone(), spec.id.clone())) {
+            let plan = study::plan(m, &options)?;
+            if !plan.leftovers.is_empty() && listed.insert((m.study.clone(), String::new())) {
+                let files: Vec<String> = plan.leftovers.iter().map(|f| f.display().to_string()).collect();
+                println!("{} (first removes {} leftover file(s) of an unfinished run: {})", m.study, files.len(), files.join(", "));
+            }
+            for (id, doing) in plan.runs {
+                if listed.insert((m.study.clone(), id.clone())) {
                     match doing {
-                        study::Planned::Compute => println!("{}/{}", m.study, spec.id),
-                        study::Planned::Keep => println!("{}/{} (kept: stored with this spec, nothing computed)", m.study, spec.id),
-                        study::Planned::Replace(why) => println!("{}/{} (replaces the stored run: {})", m.study, spec.id, why.join("; ")),
+                        study::Planned::Compute => println!("{}/{id}", m.study),
+                        study::Planned::Keep => println!("{}/{id} (kept: stored with this spec, nothing computed)", m.study),
+                        study::Planned::Replace(why) => println!("{}/{id} (replaces the stored run: {})", m.study, why.join("; ")),
+                        study::Planned::Remove(why) => println!("{}/{id} (removes the stored run and its snapshots: {why})", m.study),
                     }
                 }
             }

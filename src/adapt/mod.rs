@@ -351,7 +351,8 @@ pub fn solve_level(
         options.initial_active = initial_active;
     }
     let t0 = Instant::now();
-    let sol = solve::solve(mesh, problem, &options, &mut |_| {}).map_err(|error| AdaptError::SolveAt { level, ndof, error: Box::new(error) })?;
+    let sol =
+        solve::solve(mesh, problem, &options, &mut |_| {}).map_err(|error| AdaptError::SolveAt { level, ndof, error: Box::new(error) })?;
     let t_solve = t0.elapsed().as_secs_f64();
     let t0 = Instant::now();
     let est = estimate::estimate(mesh, problem, &sol, &config.estimator);

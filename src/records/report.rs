@@ -27,7 +27,7 @@ pub struct Probe {
 pub enum ProbeError {
     #[error("malformed --probe '{0}': expected X,Y with two finite numbers, e.g. 0.5,0.25")]
     Malformed(String),
-    #[error("--probe {},{}: the point is outside the domain (no triangle of the mesh contains it)", crate::base::number::shown(*x), crate::base::number::shown(*y))]
+    #[error("--probe {},{}: the point is outside the mesh (no triangle of the mesh contains it; u_h is defined on the triangles only, and where the boundary is curved the straight-sided triangles leave out the thin part between each boundary edge and the curve)", crate::base::number::shown(*x), crate::base::number::shown(*y))]
     Outside { x: f64, y: f64 },
 }
 

@@ -174,6 +174,16 @@ pub enum Planned {
     Keep,
     /// Stored with another spec: replaced (`--replace`), with what differs.
     Replace(Vec<String>),
+    /// Stored but no longer declared: removed with its snapshots (`--replace`), and why.
+    Remove(String),
+}
+
+/// What `run` would do ([`plan`]): each run, by id, and the leftover files of unfinished runs it
+/// removes first (battery 20: the plan named neither the runs `--replace` removes nor these).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Plan {
+    pub runs: Vec<(String, Planned)>,
+    pub leftovers: Vec<PathBuf>,
 }
 
 /// What `run --plan` prints: each run of `manifest` in `opts`' shard and what `run` would do
@@ -181,20 +191,22 @@ pub enum Planned {
 /// set-up (a folder `run` refuses, damaged or with runs stored with another spec, is refused
 /// here too; battery 13: the plan listed three runs and exited 0 where `run` refused). Changes
 /// nothing. A folder another process writes now is read as it is, with a note that says so.
-pub fn plan(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<(RunSpec, Planned)>> {
+pub fn plan(manifest: &Manifest, opts: &RunOptions) -> Result<Plan> {
     let store = Store::of(&opts.results, manifest);
     let in_shard = |i: usize| opts.shard.is_none_or(|(k, n)| i % n == k - 1);
     let planned: Vec<RunSpec> =
         manifest.runs.iter().enumerate().filter(|(i, _)| in_shard(*i)).map(|(_, p)| effective_spec(p, opts.quick)).collect();
+    let computed =
+        |planned: Vec<RunSpec>| Plan { runs: planned.into_iter().map(|s| (s.id, Planned::Compute)).collect(), leftovers: Vec::new() };
     if opts.fresh || !store.dir().root.exists() {
-        return Ok(planned.into_iter().map(|s| (s, Planned::Compute)).collect());
+        return Ok(computed(planned));
     }
     let checked = match store.check() {
         Ok(checked) => checked,
         Err(e) => match e.downcast_ref::<store::BeingWritten>() {
             Some(w) => {
                 crate::base::note::line(format_args!("{}: {w}", manifest.study));
-                return Ok(planned.into_iter().map(|s| (s, Planned::Compute)).collect());
+                return Ok(computed(planned));
             }
             None => return Err(e),
         },
@@ -204,19 +216,32 @@ pub fn plan(manifest: &Manifest, opts: &RunOptions) -> Result<Vec<(RunSpec, Plan
     if !stale.is_empty() && !opts.replace {
         return Err(store::stale::refusal(manifest, store.dir(), &stale));
     }
-    Ok(planned
+    let damaged = |id: &str| stale.iter().any(|s| matches!(s, store::Stale::Damaged { file, .. } if file == id));
+    let mut runs: Vec<(String, Planned)> = planned
         .into_iter()
         .map(|spec| {
-            let damaged = stale.iter().any(|s| matches!(s, store::Stale::Damaged { file, .. } if *file == spec.id));
             let doing = match checked.runs.iter().find(|r| r.run.id == spec.id) {
+                // a record that cannot be read is not among the runs, and is replaced all the same
+                _ if damaged(&spec.id) => Planned::Replace(vec!["its record does not hold together".to_string()]),
                 None => Planned::Compute,
-                Some(_) if damaged => Planned::Replace(vec!["its record does not hold together".to_string()]),
                 Some(r) if r.run == spec => Planned::Keep,
                 Some(r) => Planned::Replace(store::stale::spec_differences(&r.run, &spec)),
             };
-            (spec, doing)
+            (spec.id, doing)
         })
-        .collect())
+        .collect();
+    // what --replace removes besides: the runs stored but not declared, readable or not
+    for s in &stale {
+        let (id, why) = match s {
+            store::Stale::Undeclared { id } => (id, format!("not declared in {}", manifest.file.display())),
+            store::Stale::Damaged { file, .. } if !runs.iter().any(|(id, _)| id == file) => {
+                (file, format!("a damaged record, not declared in {}", manifest.file.display()))
+            }
+            _ => continue,
+        };
+        runs.push((id.clone(), Planned::Remove(why)));
+    }
+    Ok(Plan { runs, leftovers: checked.leftovers })
 }
 
 /// Under the study lock: `--fresh`, the orphans of unfinished runs removed, stored runs whose

@@ -87,3 +87,38 @@ fn a_refusal_at_a_later_level_names_the_level() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Battery 20, F1 [message]: `run --plan --replace` did not say which stored runs `run --replace`
+/// removes (a run no longer declared was left out of the plan, a run whose record cannot be read
+/// was listed as a new run) nor the leftover files `run` removes first.
+#[test]
+fn the_plan_names_every_removal() {
+    let dir = scratch("b20-plan");
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    let two = "description = \"plan\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\nlevels = 3\nsave_levels = [1]\n[[run]]\nid = \"adaptive\"\n[[run]]\nid = \"uniform\"\nrefine = \"uniform\"\n";
+    std::fs::write(dir.join("experiments/s.toml"), two).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "res"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let plan = ["run", "experiments/s.toml", "--results", "res", "--plan", "--replace"];
+    // a leftover of a killed process: named as what run removes first
+    std::fs::write(dir.join("res/s/meshes/gone_level1.json"), "{}").unwrap();
+    let (code, out, err) = signorini_in(&dir, &plan);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("s (first removes 1 leftover file(s) of an unfinished run:") && out.contains("gone_level1.json"), "{out}");
+    std::fs::remove_file(dir.join("res/s/meshes/gone_level1.json")).unwrap();
+    // a record that cannot be read: replaced
+    let record = dir.join("res/s/runs/uniform.json");
+    let good = std::fs::read(&record).unwrap();
+    std::fs::write(&record, &good[..500]).unwrap();
+    let (code, out, err) = signorini_in(&dir, &plan);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("s/uniform (replaces the stored run: its record does not hold together)"), "{out}");
+    // a run no longer declared: removed
+    std::fs::write(&record, &good).unwrap();
+    std::fs::write(dir.join("experiments/s.toml"), &two[..two.find("[[run]]\nid = \"uniform\"").unwrap()]).unwrap();
+    let (code, out, err) = signorini_in(&dir, &plan);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("s/uniform (removes the stored run and its snapshots: not declared in experiments/s.toml)"), "{out}");
+    assert!(out.contains("s/adaptive (kept"), "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -155,7 +155,7 @@ fn bad_probe_outside_the_domain_or_not_finite_is_an_error() {
     for p in ["2,0.5", "0.5,-0.1", "1.0000001,0.5", "-0.1,0.5"] {
         let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", p]);
         assert_eq!(code, 1, "{p}: {err}");
-        assert!(err.contains("outside the domain") && err.contains(p), "{p}: {err}");
+        assert!(err.contains("outside the mesh") && err.contains(p), "{p}: {err}");
     }
     for p in ["nan,0.5", "0.5,NaN", "inf,0.5", "0.5,-inf", "1e999,0"] {
         let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", p]);
@@ -169,7 +169,7 @@ fn probe_accepts_negative_numbers_and_corners() {
     // a negative coordinate is a value, not a flag: read as such and then found outside
     let (code, err) = run(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", "-0.1,0.5"]);
     assert_eq!(code, 1);
-    assert!(!err.contains("unexpected argument") && err.contains("outside the domain"), "{err}");
+    assert!(!err.contains("unexpected argument") && err.contains("outside the mesh"), "{err}");
     let (code, out, err) =
         run_out(&["solve", "--problem", "ex71", "--mesh", "structured:4", "--probe", "-0,0", "--probe", "1,1", "--json"]);
     assert_eq!(code, 0, "{err}");

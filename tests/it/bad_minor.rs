@@ -244,7 +244,7 @@ fn bad_probe_far_outside_is_shown_in_a_few_characters() {
     let args = [SOLVE, &["--probe", "1e308,0.5"]].concat();
     let (code, _, err) = run("probe-far", SQUARE, &[], &args);
     assert_eq!(code, 1, "{err}");
-    assert!(err.contains("--probe 1e308,0.5: the point is outside the domain"), "{err}");
+    assert!(err.contains("--probe 1e308,0.5: the point is outside the mesh"), "{err}");
     assert!(!err.contains("0000000000"), "{err}");
 }
 
