@@ -485,6 +485,10 @@ pub fn run_from(
             termination = AdaptTermination::MaxNdofReached;
             break;
         }
+        // the level before is not needed while this one solves (the loop returns it only when
+        // this level is not solved): its mesh, u_h and estimate added to the peak memory (fb
+        // adaptive to 2.6e6 unknowns: peak resident 4.09 -> 3.91 GB without them)
+        drop(state.take());
         let t_level = Instant::now();
         let previous = records.last().and_then(LevelRecord::measured_peak);
         let measured = crate::base::memory::reset_peak_resident();
