@@ -216,10 +216,10 @@ pub struct ContactSolver {
     l_values: Vec<f64>,
     /// ... and zero until the first factorisation.
     l_zeroed: bool,
-    /// Whether L is the factor of the stiffness K itself (not of a matrix with an active set
-    /// imposed): [`Self::refactor`] makes it so; the Refactor strategy's `new` does not, and
-    /// factorises K only where it is used ([`Self::factor_k`]).
-    holds_k: bool,
+    /// The active set imposed on the matrix L is the factor of (all false: the stiffness K
+    /// itself; None: no factor yet). [`Self::refactor`] factorises K; the Refactor strategy's
+    /// `new` does not, and factorises only where a factor is used ([`Self::impose`]).
+    factor_of: Option<Vec<bool>>,
     /// S = L_CC L_CC^T (m x m), Schur strategy only.
     schur: Mat<f64>,
     /// Refactor strategy: per contact node, the (column, position) of the off-diagonal entries
@@ -270,7 +270,7 @@ impl ContactSolver {
             // not touched here: loading the values writes every one
             l_values: cholesky::zeros(symbolic.len_val(), "the Cholesky factor L").map_err(|e| ContactError::OutOfMemory(e.to_string()))?,
             l_zeroed: true,
-            holds_k: false,
+            factor_of: None,
             symbolic,
             placement: Some(placement),
             matrix: None,
@@ -295,11 +295,52 @@ impl ContactSolver {
     /// Make L the factor of K (`matrix`, the Refactor strategy's), unless it is: what the
     /// unconstrained solution needs.
     fn factor_k(&mut self, matrix: &SymCsc) -> Result<(), ContactError> {
-        if !self.holds_k {
-            self.load(matrix.values());
-            self.factorize()?;
-            self.holds_k = true;
+        self.impose(matrix, &vec![false; self.n_contact()])
+    }
+
+    /// Make L the factor of `matrix` (the Refactor strategy's K) with the constraints of the
+    /// contact nodes in `active` imposed by values on its pattern: the row and column of an
+    /// active normal unknown are zero but for the diagonal (explicit zeros kept). If L holds the
+    /// factor for another active set, only the supernodes that the changed nodes' rows and
+    /// columns reach are computed again ([`cholesky::refactorize`], bit for bit a whole
+    /// factorisation): an active-set step that moves a few nodes refactorises the paths from them
+    /// to the root of the elimination tree, not the whole tree.
+    fn impose(&mut self, matrix: &SymCsc, active: &[bool]) -> Result<(), ContactError> {
+        if self.factor_of.as_deref() == Some(active) {
+            return Ok(());
         }
+        let (ni, m) = (self.n_interior, self.n_contact());
+        let (col_ptr, row_idx) = (matrix.col_ptr(), matrix.row_idx());
+        // the off-diagonal entries of node k's normal unknown: its column below the diagonal,
+        // its row left of it
+        let entries = |k: usize| {
+            let col = ni + k;
+            (col_ptr[col] + 1..col_ptr[col + 1]).map(move |pos| (row_idx[pos], pos)).chain(self.row_entries[k].iter().copied())
+        };
+        let mut values = matrix.values().to_vec();
+        for k in (0..m).filter(|&k| active[k]) {
+            entries(k).for_each(|(_, pos)| values[pos] = 0.0);
+        }
+        let t0 = Instant::now();
+        match self.factor_of.take() {
+            None => {
+                let placement = self.placement.as_ref().expect("the Refactor strategy keeps the placement");
+                cholesky::load(&self.symbolic, placement, &values, &mut self.l_values, self.l_zeroed);
+                self.l_zeroed = false;
+                self.factorize()?;
+            }
+            Some(before) => {
+                // an entry (i, j) of the permuted matrix lies in column min(i, j) of L
+                let inv = self.symbolic.inv();
+                let columns =
+                    (0..m).filter(|&k| before[k] != active[k]).flat_map(|k| entries(k).map(move |(other, _)| inv[other].min(inv[ni + k])));
+                let which = self.plan.changed(&self.symbolic, columns);
+                let placement = self.placement.as_ref().expect("the Refactor strategy keeps the placement");
+                cholesky::refactorize(&self.symbolic, &self.plan, placement, &values, &mut self.l_values, &which).map_err(factor_error)?;
+            }
+        }
+        self.timings.numeric += t0.elapsed().as_secs_f64();
+        self.factor_of = Some(active.to_vec());
         Ok(())
     }
 
@@ -327,7 +368,7 @@ impl ContactSolver {
             }
         }
         self.factorize()?;
-        self.holds_k = true;
+        self.factor_of = Some(vec![false; self.n_contact()]);
         if self.strategy == Strategy::Schur {
             let t0 = Instant::now();
             let lcc = self.trailing_factor_block()?;
@@ -350,10 +391,7 @@ impl ContactSolver {
     /// Numeric factorisation of the loaded values in place ([`cholesky::factorize`]).
     fn factorize(&mut self) -> Result<(), ContactError> {
         let t0 = Instant::now();
-        cholesky::factorize(&self.symbolic, &self.plan, &mut self.l_values).map_err(|e| match e {
-            cholesky::FactorError::NotPositiveDefinite(e) => ContactError::NotPositiveDefinite(e.to_string()),
-            cholesky::FactorError::OutOfMemory(e) => ContactError::OutOfMemory(e.to_string()),
-        })?;
+        cholesky::factorize(&self.symbolic, &self.plan, &mut self.l_values).map_err(factor_error)?;
         self.timings.numeric += t0.elapsed().as_secs_f64();
         Ok(())
     }
@@ -590,27 +628,21 @@ impl ContactSolver {
         };
         let mut last_u = Vec::new();
         let mut step = |active: &[bool]| -> Result<(Vec<f64>, Vec<f64>), ContactError> {
-            let mut values = matrix.values().to_vec();
+            // the known values of the active normals move to the right-hand side
             let mut b = rhs.to_vec();
             for k in (0..m).filter(|&k| active[k]) {
                 let col = ni + k;
-                // column entries below the diagonal, then row entries left of it: move the known
-                // value to the right-hand side and keep an explicit zero in the pattern
                 for pos in matrix.col_ptr()[col] + 1..matrix.col_ptr()[col + 1] {
                     b[matrix.row_idx()[pos]] -= matrix.values()[pos] * gap[k];
-                    values[pos] = 0.0;
                 }
                 for &(j, pos) in &self.row_entries[k] {
                     b[j] -= matrix.values()[pos] * gap[k];
-                    values[pos] = 0.0;
                 }
             }
             for k in (0..m).filter(|&k| active[k]) {
                 b[ni + k] = diag(k) * gap[k];
             }
-            self.load(&values);
-            self.holds_k = false;
-            self.factorize()?;
+            self.impose(matrix, active)?;
             let u = self.solve(&b);
             let ku = matrix.mul(&u);
             let lambda: Vec<f64> = (0..m).map(|k| if active[k] { rhs[ni + k] - ku[ni + k] } else { 0.0 }).collect();
@@ -625,6 +657,14 @@ impl ContactSolver {
             last_u = self.solve(rhs);
         }
         Ok((last_u, outcome, c))
+    }
+}
+
+/// The contact solver's error for a failed numeric factorisation.
+fn factor_error(e: cholesky::FactorError) -> ContactError {
+    match e {
+        cholesky::FactorError::NotPositiveDefinite(e) => ContactError::NotPositiveDefinite(e.to_string()),
+        cholesky::FactorError::OutOfMemory(e) => ContactError::OutOfMemory(e.to_string()),
     }
 }
 

@@ -57,6 +57,8 @@ pub struct Plan {
     kid_ptr: Vec<usize>,
     kids: Vec<u32>,
     roots: Vec<u32>,
+    /// The parent of each supernode (`u32::MAX` for a root).
+    parent: Vec<u32>,
     /// Multiply-add pairs of the task of each supernode (`own`) and of its subtree (`work`).
     own: Vec<f64>,
     work: Vec<f64>,
@@ -225,50 +227,93 @@ impl Plan {
             let w: f64 = kids[kid_ptr[s]..kid_ptr[s + 1]].iter().map(|&k| work[k as usize]).sum();
             work[s] += w;
         }
+        let mut parent = vec![u32::MAX; ns];
+        for s in 0..ns {
+            for &k in &kids[kid_ptr[s]..kid_ptr[s + 1]] {
+                parent[k as usize] = s as u32;
+            }
+        }
         let total: f64 = roots.iter().map(|&r| work[r as usize]).sum();
         let max_cols = (0..ns).map(|s| begin[s + 1] - begin[s]).max().unwrap_or(0);
         let max_pattern = (0..ns).map(|s| sn.pattern(s).len()).max().unwrap_or(0);
-        Plan { upd_ptr, upd, kid_ptr, kids, roots, own, work, task_work: total * TASK_SHARE, max_update, max_cols, max_pattern }
+        Plan { upd_ptr, upd, kid_ptr, kids, roots, parent, own, work, task_work: total * TASK_SHARE, max_update, max_cols, max_pattern }
     }
 
-    /// Run `kernel(s, alone)` for every supernode, each after all its descendants (for the
+    /// Run `kernel(s, alone)` for every supernode of `which` (all if None; a set closed under
+    /// ancestors, as [`Plan::changed`] gives), each after all its descendants (for the
     /// factorisation and the forward substitution): the children's subtrees in parallel, then
     /// the supernode; subtrees with less work than [`TASK_SHARE`] of the whole in one task. A
     /// chain of supernodes with one large child each is walked without recursion (its small side
     /// subtrees run just before their parent), so the depth of recursion is bounded by the number
     /// of tasks, not by the height of the tree. `alone`: nothing else runs meanwhile (the top of
-    /// the tree), so the kernel may use every thread.
-    fn upward<E: Send>(&self, kernel: &(dyn Fn(usize, bool) -> Result<(), E> + Sync)) -> Result<(), E> {
-        let alone = self.roots.len() == 1;
-        self.roots.par_iter().try_for_each(|&r| self.up(r as usize, alone, kernel))
+    /// the tree), so the kernel may use every thread. A subtree outside `which` is skipped
+    /// whole (its root is not in the set, so none of its supernodes is).
+    fn upward<E: Send>(&self, which: Option<&[bool]>, kernel: &(dyn Fn(usize, bool) -> Result<(), E> + Sync)) -> Result<(), E> {
+        let roots: Vec<usize> = self.roots.iter().map(|&r| r as usize).filter(|&r| which.is_none_or(|w| w[r])).collect();
+        let alone = roots.len() == 1;
+        roots.into_par_iter().try_for_each(|r| self.up(r, alone, which, kernel))
     }
 
-    fn up<E: Send>(&self, s: usize, alone: bool, kernel: &(dyn Fn(usize, bool) -> Result<(), E> + Sync)) -> Result<(), E> {
+    fn up<E: Send>(
+        &self,
+        s: usize,
+        alone: bool,
+        which: Option<&[bool]>,
+        kernel: &(dyn Fn(usize, bool) -> Result<(), E> + Sync),
+    ) -> Result<(), E> {
+        let kept = |x: &usize| which.is_none_or(|w| w[*x]);
         if self.work[s] < self.task_work {
-            return self.subtree(s).into_iter().try_for_each(|x| kernel(x, alone));
+            return self.subtree(s).into_iter().filter(kept).try_for_each(|x| kernel(x, alone));
         }
         let mut chain = vec![s];
         loop {
             let top = *chain.last().unwrap();
-            let large: Vec<usize> = self.kids(top).filter(|&k| self.work[k] >= self.task_work).collect();
+            let large: Vec<usize> = self.kids(top).filter(kept).filter(|&k| self.work[k] >= self.task_work).collect();
             if large.len() != 1 {
                 break;
             }
             chain.push(large[0]);
         }
         let bottom = *chain.last().unwrap();
-        let kids: Vec<usize> = self.kids(bottom).collect();
+        let kids: Vec<usize> = self.kids(bottom).filter(kept).collect();
         let kids_alone = alone && kids.len() == 1;
-        kids.into_par_iter().try_for_each(|k| self.up(k, kids_alone, kernel))?;
+        kids.into_par_iter().try_for_each(|k| self.up(k, kids_alone, which, kernel))?;
         kernel(bottom, alone)?;
         for w in chain.windows(2).rev() {
             let (x, large) = (w[0], w[1]);
-            for k in self.kids(x).filter(|&k| k != large) {
-                self.up(k, alone, kernel)?;
+            for k in self.kids(x).filter(kept).filter(|&k| k != large) {
+                self.up(k, alone, which, kernel)?;
             }
             kernel(x, alone)?;
         }
         Ok(())
+    }
+
+    /// The supernodes whose blocks of L change when the matrix's values change in the columns
+    /// `columns` of L (the permuted numbering; an entry (i, j) of the permuted matrix lies in
+    /// column min(i, j)): the supernodes holding those columns and all their ancestors. Every
+    /// other supernode is computed from the same values and the same (unchanged) descendants,
+    /// so a refactorisation of only these ([`refactorize`]) gives L bit for bit.
+    pub fn changed(&self, sn: &Symbolic, columns: impl IntoIterator<Item = usize>) -> Vec<bool> {
+        let begin = sn.supernode_begin();
+        let mut which = vec![false; self.own.len()];
+        for j in columns {
+            let mut s = begin.partition_point(|&b| b <= j) - 1;
+            while !which[s] {
+                which[s] = true;
+                match self.parent[s] {
+                    u32::MAX => break,
+                    p => s = p as usize,
+                }
+            }
+        }
+        which
+    }
+
+    /// The share of the factorisation's multiply-adds in the supernodes of `which`.
+    pub fn share(&self, which: &[bool]) -> f64 {
+        let part: f64 = self.own.iter().zip(which).filter(|(_, w)| **w).map(|(o, _)| o).sum();
+        part / self.multiply_adds().max(f64::MIN_POSITIVE)
     }
 
     /// Run `kernel(s)` for every supernode, each after all its ancestors (for the backward
@@ -397,29 +442,64 @@ pub fn load(sn: &Symbolic, placement: &Placement, values: &[f64], l: &mut [f64],
             let base = val_ptr[first];
             for s in first..last {
                 let node = supernode(sn, s);
-                let (ncols, nrows) = (node.ncols, node.nrows());
-                let block = &mut run[node.offset - base..][..nrows * ncols];
-                if !zeroed {
-                    block.fill(0.0);
-                }
-                for (i, &r) in node.pattern.iter().enumerate() {
-                    local[r as usize] = (ncols + i) as u32;
-                }
-                let end = node.begin + ncols;
-                for j in node.begin..end {
-                    let column = &mut block[(j - node.begin) * nrows..][..nrows];
-                    for &(r, pos) in placement.entries(j) {
-                        let r = r as usize;
-                        // a store, not `+=`: no other entry shares the slot, which holds zero, so
-                        // the bits are those of adding the value to zero; and a first access that
-                        // writes is one page fault on a fresh L (a read first maps the zero page,
-                        // and the write then faults again: 2.0 s instead of 0.44 s at structured:512)
-                        column[if r < end { r - node.begin } else { local[r] as usize }] = 0.0 + values[pos as usize];
-                    }
-                }
+                let block = &mut run[node.offset - base..][..node.nrows() * node.ncols];
+                load_supernode(&node, placement, values, block, zeroed, local);
             }
         })
     });
+}
+
+/// Supernode `node`'s part of [`load`] into its `block`, with this thread's row map `local`.
+fn load_supernode(node: &Supernode, placement: &Placement, values: &[f64], block: &mut [f64], zeroed: bool, local: &mut [u32]) {
+    let (ncols, nrows) = (node.ncols, node.nrows());
+    if !zeroed {
+        block.fill(0.0);
+    }
+    for (i, &r) in node.pattern.iter().enumerate() {
+        local[r as usize] = (ncols + i) as u32;
+    }
+    let end = node.begin + ncols;
+    for j in node.begin..end {
+        let column = &mut block[(j - node.begin) * nrows..][..nrows];
+        for &(r, pos) in placement.entries(j) {
+            let r = r as usize;
+            // a store, not `+=`: no other entry shares the slot, which holds zero, so the bits
+            // are those of adding the value to zero; and a first access that writes is one page
+            // fault on a fresh L (a read first maps the zero page, and the write then faults
+            // again: 2.0 s instead of 0.44 s at structured:512)
+            column[if r < end { r - node.begin } else { local[r] as usize }] = 0.0 + values[pos as usize];
+        }
+    }
+}
+
+/// Refactorise `l`, the factor of a matrix with the pattern `placement` was made for, for new
+/// `values` that differ from that matrix's only in the columns of L whose supernodes
+/// [`Plan::changed`] marked in `which`: only those supernodes are loaded and computed again,
+/// in the factorisation's own schedule. The result is bit for bit [`load`] and [`factorize`]
+/// of `values`: every other supernode holds what they would compute (the same values, the same
+/// descendants). Where an active-set step changes a few contact nodes, that is the path from
+/// them to the root of the elimination tree instead of the whole tree.
+pub fn refactorize(
+    sn: &Symbolic,
+    plan: &Plan,
+    placement: &Placement,
+    values: &[f64],
+    l: &mut [f64],
+    which: &[bool],
+) -> Result<(), FactorError> {
+    assert_eq!((l.len(), which.len()), (sn.len_val(), sn.n_supernodes()));
+    let shared = Shared::new(l);
+    let marked: Vec<usize> = (0..which.len()).filter(|&s| which[s]).collect();
+    marked.par_iter().for_each(|&s| {
+        with_local_map(sn.n(), |local| {
+            let node = supernode(sn, s);
+            // SAFETY: each marked supernode's block is written by this one task only
+            let block = unsafe { shared.slice(node.offset, node.nrows() * node.ncols) };
+            load_supernode(&node, placement, values, block, false, local);
+        })
+    });
+    let ctx = Context { sn, plan, l: shared };
+    plan.upward(Some(which), &|s, alone| ctx.supernode(s, alone))
 }
 
 /// Overwrite `l` (the layout of `sn`, holding a matrix's values from [`load`]) with the
@@ -428,7 +508,7 @@ pub fn factorize(sn: &Symbolic, plan: &Plan, l: &mut [f64]) -> Result<(), Factor
     assert_eq!(l.len(), sn.len_val());
     let shared = Shared::new(l);
     let ctx = Context { sn, plan, l: shared };
-    plan.upward(&|s, alone| ctx.supernode(s, alone))
+    plan.upward(None, &|s, alone| ctx.supernode(s, alone))
 }
 
 struct Context<'a> {
@@ -586,7 +666,7 @@ pub fn forward_in_place(sn: &Symbolic, plan: &Plan, l: &[f64], x: &mut [f64]) {
     let x = Shared::new(x);
     // SAFETY: a task writes only its supernode's rows of x, and reads rows of descendants, which
     // the schedule has finished
-    let _ = plan.upward(&|s, _| -> Result<(), std::convert::Infallible> {
+    let _ = plan.upward(None, &|s, _| -> Result<(), std::convert::Infallible> {
         unsafe { forward_supernode(sn, plan, l, x, s) };
         Ok(())
     });

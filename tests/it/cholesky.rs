@@ -153,6 +153,44 @@ fn the_factor_is_faers_and_the_same_on_any_number_of_threads() {
 }
 
 #[test]
+fn a_refactorisation_of_the_changed_supernodes_is_the_whole_one_bit_for_bit() {
+    // a few contact normals constrained as the Refactor strategy does (the off-diagonal entries
+    // of their rows and columns zero), then released again: each time only the supernodes the
+    // changed entries reach are computed, and L is the whole factorisation's to the bit
+    for (name, m) in meshes() {
+        let (matrix, coords, n_interior) = stiffness_and_contact(&m);
+        let symbolic = symbolic(&matrix, matrix.n(), &coords);
+        let (plan, placement) = (Plan::new(&symbolic), placement(&matrix, &symbolic));
+        let picked: Vec<usize> = (n_interior..matrix.n()).step_by(7).take(4).collect();
+        let (col_ptr, row_idx, inv) = (matrix.col_ptr(), matrix.row_idx(), symbolic.inv());
+        let mut constrained = matrix.values().to_vec();
+        let mut columns = Vec::new();
+        for j in 0..matrix.n() {
+            for pos in col_ptr[j]..col_ptr[j + 1] {
+                let i = row_idx[pos];
+                if i != j && (picked.contains(&i) || picked.contains(&j)) {
+                    constrained[pos] = 0.0;
+                    columns.push(inv[i].min(inv[j]));
+                }
+            }
+        }
+        let which = plan.changed(&symbolic, columns);
+        let share = plan.share(&which);
+        assert!(share > 0.0 && share < 0.9, "{name}: the changed supernodes hold {share:.2} of the work");
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let free = ours(&matrix, &symbolic, matrix.values(), threads).unwrap();
+            let whole = ours(&matrix, &symbolic, &constrained, threads).unwrap();
+            let mut l = free.clone();
+            pool.install(|| cholesky::refactorize(&symbolic, &plan, &placement, &constrained, &mut l, &which)).unwrap();
+            assert!(l.iter().zip(&whole).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}, {threads} threads: constrained");
+            pool.install(|| cholesky::refactorize(&symbolic, &plan, &placement, matrix.values(), &mut l, &which)).unwrap();
+            assert!(l.iter().zip(&free).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}, {threads} threads: released");
+        }
+    }
+}
+
+#[test]
 fn a_matrix_that_is_not_positive_definite_is_an_error_naming_its_column() {
     let (matrix, coords) = stiffness(&mesh(&problems::Ex72, "structured:8"));
     let symbolic = symbolic(&matrix, matrix.n(), &coords);
