@@ -830,7 +830,7 @@ fn factor_rate(n: usize, repeats: usize) -> Result<FactorRate> {
     let mut l = vec![0.0; sn.len_val()];
     let mut times = Vec::new();
     for r in 0..=repeats.max(1) {
-        cholesky::load(&sn, &placement, sys.matrix.values(), &mut l, r == 0);
+        cholesky::load(&sn, &placement, sys.matrix.values(), None, &mut l, r == 0);
         let t0 = Instant::now();
         cholesky::factorize(&sn, &plan, &mut l)?;
         times.push(t0.elapsed().as_secs_f64());

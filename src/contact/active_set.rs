@@ -317,26 +317,28 @@ impl ContactSolver {
             let col = ni + k;
             (col_ptr[col] + 1..col_ptr[col + 1]).map(move |pos| (row_idx[pos], pos)).chain(self.row_entries[k].iter().copied())
         };
-        let mut values = matrix.values().to_vec();
+        let inv = self.symbolic.inv();
+        let mut fixed = vec![false; self.n];
         for k in (0..m).filter(|&k| active[k]) {
-            entries(k).for_each(|(_, pos)| values[pos] = 0.0);
+            fixed[inv[ni + k]] = true;
         }
+        let (values, fixed) = (matrix.values(), Some(&fixed[..]));
         let t0 = Instant::now();
         match self.factor_of.take() {
             None => {
                 let placement = self.placement.as_ref().expect("the Refactor strategy keeps the placement");
-                cholesky::load(&self.symbolic, placement, &values, &mut self.l_values, self.l_zeroed);
+                cholesky::load(&self.symbolic, placement, values, fixed, &mut self.l_values, self.l_zeroed);
                 self.l_zeroed = false;
                 self.factorize()?;
             }
             Some(before) => {
                 // an entry (i, j) of the permuted matrix lies in column min(i, j) of L
-                let inv = self.symbolic.inv();
                 let columns =
                     (0..m).filter(|&k| before[k] != active[k]).flat_map(|k| entries(k).map(move |(other, _)| inv[other].min(inv[ni + k])));
                 let which = self.plan.changed(&self.symbolic, columns);
                 let placement = self.placement.as_ref().expect("the Refactor strategy keeps the placement");
-                cholesky::refactorize(&self.symbolic, &self.plan, placement, &values, &mut self.l_values, &which).map_err(factor_error)?;
+                cholesky::refactorize(&self.symbolic, &self.plan, placement, values, fixed, &mut self.l_values, &which)
+                    .map_err(factor_error)?;
             }
         }
         self.timings.numeric += t0.elapsed().as_secs_f64();
@@ -383,7 +385,7 @@ impl ContactSolver {
     fn load(&mut self, values: &[f64]) {
         let t0 = Instant::now();
         let placement = self.placement.as_ref().expect("the placement is kept while the matrix can change");
-        cholesky::load(&self.symbolic, placement, values, &mut self.l_values, self.l_zeroed);
+        cholesky::load(&self.symbolic, placement, values, None, &mut self.l_values, self.l_zeroed);
         self.l_zeroed = false;
         self.timings.numeric += t0.elapsed().as_secs_f64();
     }

@@ -419,7 +419,9 @@ const LOAD_RUNS: usize = 64;
 /// other entry shares: the same bits as a copy. In parallel over runs of supernodes of about
 /// equal size. On a fresh allocation (`zeroed`) only the pages with entries are touched here; the
 /// rest of L is first touched by the factorisation, after the caller could release the matrix.
-pub fn load(sn: &Symbolic, placement: &Placement, values: &[f64], l: &mut [f64], zeroed: bool) {
+/// `fixed` (permuted numbering) marks unknowns whose rows and columns are taken as zero but for
+/// the diagonal: the constraints of the Refactor strategy, imposed without a copy of the values.
+pub fn load(sn: &Symbolic, placement: &Placement, values: &[f64], fixed: Option<&[bool]>, l: &mut [f64], zeroed: bool) {
     assert_eq!(l.len(), sn.len_val());
     let (ns, val_ptr) = (sn.n_supernodes(), sn.val_ptr());
     let total = sn.len_val();
@@ -443,14 +445,22 @@ pub fn load(sn: &Symbolic, placement: &Placement, values: &[f64], l: &mut [f64],
             for s in first..last {
                 let node = supernode(sn, s);
                 let block = &mut run[node.offset - base..][..node.nrows() * node.ncols];
-                load_supernode(&node, placement, values, block, zeroed, local);
+                load_supernode(&node, placement, values, fixed, block, zeroed, local);
             }
         })
     });
 }
 
 /// Supernode `node`'s part of [`load`] into its `block`, with this thread's row map `local`.
-fn load_supernode(node: &Supernode, placement: &Placement, values: &[f64], block: &mut [f64], zeroed: bool, local: &mut [u32]) {
+fn load_supernode(
+    node: &Supernode,
+    placement: &Placement,
+    values: &[f64],
+    fixed: Option<&[bool]>,
+    block: &mut [f64],
+    zeroed: bool,
+    local: &mut [u32],
+) {
     let (ncols, nrows) = (node.ncols, node.nrows());
     if !zeroed {
         block.fill(0.0);
@@ -467,14 +477,18 @@ fn load_supernode(node: &Supernode, placement: &Placement, values: &[f64], block
             // are those of adding the value to zero; and a first access that writes is one page
             // fault on a fresh L (a read first maps the zero page, and the write then faults
             // again: 2.0 s instead of 0.44 s at structured:512)
-            column[if r < end { r - node.begin } else { local[r] as usize }] = 0.0 + values[pos as usize];
+            let value = match fixed {
+                Some(fixed) if r != j && (fixed[r] || fixed[j]) => 0.0,
+                _ => 0.0 + values[pos as usize],
+            };
+            column[if r < end { r - node.begin } else { local[r] as usize }] = value;
         }
     }
 }
 
 /// Refactorise `l`, the factor of a matrix with the pattern `placement` was made for, for new
-/// `values` that differ from that matrix's only in the columns of L whose supernodes
-/// [`Plan::changed`] marked in `which`: only those supernodes are loaded and computed again,
+/// `values` (with `fixed`, as [`load`] takes them) that differ from that matrix's only in the
+/// columns of L whose supernodes [`Plan::changed`] marked in `which`: only those supernodes are loaded and computed again,
 /// in the factorisation's own schedule. The result is bit for bit [`load`] and [`factorize`]
 /// of `values`: every other supernode holds what they would compute (the same values, the same
 /// descendants). Where an active-set step changes a few contact nodes, that is the path from
@@ -484,6 +498,7 @@ pub fn refactorize(
     plan: &Plan,
     placement: &Placement,
     values: &[f64],
+    fixed: Option<&[bool]>,
     l: &mut [f64],
     which: &[bool],
 ) -> Result<(), FactorError> {
@@ -495,7 +510,7 @@ pub fn refactorize(
             let node = supernode(sn, s);
             // SAFETY: each marked supernode's block is written by this one task only
             let block = unsafe { shared.slice(node.offset, node.nrows() * node.ncols) };
-            load_supernode(&node, placement, values, block, false, local);
+            load_supernode(&node, placement, values, fixed, block, false, local);
         })
     });
     let ctx = Context { sn, plan, l: shared };

@@ -81,7 +81,7 @@ fn ours(matrix: &SymCsc, symbolic: &Symbolic, values: &[f64], threads: usize) ->
     let mut l = vec![f64::NAN; symbolic.len_val()];
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     pool.install(|| {
-        cholesky::load(symbolic, &placement(matrix, symbolic), values, &mut l, false);
+        cholesky::load(symbolic, &placement(matrix, symbolic), values, None, &mut l, false);
         cholesky::factorize(symbolic, &plan, &mut l)
     })?;
     Ok(l)
@@ -146,7 +146,7 @@ fn the_factor_is_faers_and_the_same_on_any_number_of_threads() {
         assert!(worst <= 1e-13 * scale, "{name}: largest difference from faer's factor {worst:.2e} (largest entry {scale:.2e})");
         // a refactorisation in place (loading over the finished factor) gives the same again
         let mut again = two.clone();
-        cholesky::load(&symbolic, &placement(&matrix, &symbolic), matrix.values(), &mut again, false);
+        cholesky::load(&symbolic, &placement(&matrix, &symbolic), matrix.values(), None, &mut again, false);
         cholesky::factorize(&symbolic, &Plan::new(&symbolic), &mut again).unwrap();
         assert!(again.iter().zip(&two).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}: refactorisation differs");
     }
@@ -155,8 +155,9 @@ fn the_factor_is_faers_and_the_same_on_any_number_of_threads() {
 #[test]
 fn a_refactorisation_of_the_changed_supernodes_is_the_whole_one_bit_for_bit() {
     // a few contact normals constrained as the Refactor strategy does (the off-diagonal entries
-    // of their rows and columns zero), then released again: each time only the supernodes the
-    // changed entries reach are computed, and L is the whole factorisation's to the bit
+    // of their rows and columns zero), released again, and constrained by marking them fixed:
+    // each time only the supernodes the changed entries reach are computed, and L is the whole
+    // factorisation's to the bit
     for (name, m) in meshes() {
         let (matrix, coords, n_interior) = stiffness_and_contact(&m);
         let symbolic = symbolic(&matrix, matrix.n(), &coords);
@@ -182,10 +183,15 @@ fn a_refactorisation_of_the_changed_supernodes_is_the_whole_one_bit_for_bit() {
             let free = ours(&matrix, &symbolic, matrix.values(), threads).unwrap();
             let whole = ours(&matrix, &symbolic, &constrained, threads).unwrap();
             let mut l = free.clone();
-            pool.install(|| cholesky::refactorize(&symbolic, &plan, &placement, &constrained, &mut l, &which)).unwrap();
+            pool.install(|| cholesky::refactorize(&symbolic, &plan, &placement, &constrained, None, &mut l, &which)).unwrap();
             assert!(l.iter().zip(&whole).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}, {threads} threads: constrained");
-            pool.install(|| cholesky::refactorize(&symbolic, &plan, &placement, matrix.values(), &mut l, &which)).unwrap();
+            pool.install(|| cholesky::refactorize(&symbolic, &plan, &placement, matrix.values(), None, &mut l, &which)).unwrap();
             assert!(l.iter().zip(&free).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}, {threads} threads: released");
+            // the same constraints marked as fixed unknowns (permuted numbering) on K's own values
+            let mut fixed = vec![false; matrix.n()];
+            picked.iter().for_each(|&i| fixed[inv[i]] = true);
+            pool.install(|| cholesky::refactorize(&symbolic, &plan, &placement, matrix.values(), Some(&fixed), &mut l, &which)).unwrap();
+            assert!(l.iter().zip(&whole).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}, {threads} threads: fixed");
         }
     }
 }

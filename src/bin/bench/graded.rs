@@ -303,7 +303,7 @@ fn solver_phases(matrix: &signorini::sparse::csc::SymCsc, n_order: usize, coords
     let plan_s = t0.elapsed().as_secs_f64();
     let mut l = cholesky::zeros(sn.len_val(), "L")?;
     let t0 = Instant::now();
-    cholesky::load(&sn, &placement, matrix.values(), &mut l, true);
+    cholesky::load(&sn, &placement, matrix.values(), None, &mut l, true);
     let load_s = t0.elapsed().as_secs_f64();
     let factor = |l: &mut [f64]| -> Result<f64> {
         let t0 = Instant::now();
@@ -313,7 +313,7 @@ fn solver_phases(matrix: &signorini::sparse::csc::SymCsc, n_order: usize, coords
     let numeric_first_s = factor(&mut l)?;
     let mut numeric_warm_s = f64::INFINITY;
     for _ in 0..2 {
-        cholesky::load(&sn, &placement, matrix.values(), &mut l, false);
+        cholesky::load(&sn, &placement, matrix.values(), None, &mut l, false);
         numeric_warm_s = numeric_warm_s.min(factor(&mut l)?);
     }
     // the ordering counts the leading block; a trailing contact block is dense: m^3 / 6 more
