@@ -32,7 +32,9 @@
 //! The solver takes the matrix. The Schur strategy needs neither the matrix nor where its entries
 //! go in L once L holds its values: both are released before the numeric factorisation, so that
 //! L never shares the memory with them (at `structured:512` they take 0.6 GB, L 2.2 GB). The
-//! Refactor strategy keeps both: it changes the matrix's values in every iteration.
+//! Refactor strategy keeps the matrix (it imposes each iteration's constraints on its values
+//! while loading them, without a copy) and computes where its entries go again for each load,
+//! released before the factorisation as well.
 
 use crate::sparse::cholesky;
 use crate::sparse::csc::SymCsc;
@@ -204,8 +206,9 @@ pub struct ContactSolver {
     n_interior: usize,
     strategy: Strategy,
     symbolic: Symbolic,
-    /// Where the matrix's entries go in L: kept by the Refactor strategy, released by Schur once L
-    /// holds the values ([`ContactSolver::refactor`] computes it again if needed).
+    /// Where the matrix's entries go in L, from the symbolic analysis until the first load;
+    /// released once L holds the values and computed again for the next load
+    /// ([`ContactSolver::placement`]).
     placement: Option<Placement>,
     /// The matrix, kept by the Refactor strategy (it imposes the constraints on its values in
     /// every iteration).
@@ -309,6 +312,7 @@ impl ContactSolver {
         if self.factor_of.as_deref() == Some(active) {
             return Ok(());
         }
+        let placement = self.placement(matrix);
         let (ni, m) = (self.n_interior, self.n_contact());
         let (col_ptr, row_idx) = (matrix.col_ptr(), matrix.row_idx());
         // the off-diagonal entries of node k's normal unknown: its column below the diagonal,
@@ -326,9 +330,9 @@ impl ContactSolver {
         let t0 = Instant::now();
         match self.factor_of.take() {
             None => {
-                let placement = self.placement.as_ref().expect("the Refactor strategy keeps the placement");
-                cholesky::load(&self.symbolic, placement, values, fixed, &mut self.l_values, self.l_zeroed);
+                cholesky::load(&self.symbolic, &placement, values, fixed, &mut self.l_values, self.l_zeroed);
                 self.l_zeroed = false;
+                drop(placement);
                 self.factorize()?;
             }
             Some(before) => {
@@ -336,9 +340,9 @@ impl ContactSolver {
                 let columns =
                     (0..m).filter(|&k| before[k] != active[k]).flat_map(|k| entries(k).map(move |(other, _)| inv[other].min(inv[ni + k])));
                 let which = self.plan.changed(&self.symbolic, columns);
-                let placement = self.placement.as_ref().expect("the Refactor strategy keeps the placement");
-                cholesky::refactorize(&self.symbolic, &self.plan, placement, values, fixed, &mut self.l_values, &which)
-                    .map_err(factor_error)?;
+                cholesky::load_changed(&self.symbolic, &placement, values, fixed, &mut self.l_values, &which);
+                drop(placement);
+                cholesky::refactorize(&self.symbolic, &self.plan, &mut self.l_values, &which).map_err(factor_error)?;
             }
         }
         self.timings.numeric += t0.elapsed().as_secs_f64();
@@ -350,24 +354,32 @@ impl ContactSolver {
         self.strategy
     }
 
+    /// Where the entries of `matrix` go in L: the placement the symbolic analysis computed, taken,
+    /// or computed again (counted as symbolic time). Released once L holds the values, before the
+    /// numeric factorisation (see the module docs).
+    fn placement(&mut self, matrix: &SymCsc) -> Placement {
+        self.placement.take().unwrap_or_else(|| {
+            let t0 = Instant::now();
+            let placement = Placement::new(matrix, self.symbolic.inv());
+            self.timings.symbolic += t0.elapsed().as_secs_f64();
+            placement
+        })
+    }
+
     /// Numeric factorisation of a matrix with the same pattern (and, for the Schur strategy, its
-    /// Schur complement). The Schur strategy releases the matrix and the placement of its
-    /// entries before factorising (see the module docs); the placement is computed again here
-    /// if it was released (counted as symbolic time).
+    /// Schur complement). The Schur strategy releases the matrix before factorising (see the
+    /// module docs); the Refactor strategy keeps it.
     pub fn refactor(&mut self, matrix: SymCsc) -> Result<(), ContactError> {
         self.timings.numeric = 0.0;
-        if self.placement.is_none() {
-            let t0 = Instant::now();
-            self.placement = Some(Placement::new(&matrix, self.symbolic.inv()));
-            self.timings.symbolic += t0.elapsed().as_secs_f64();
-        }
-        self.load(matrix.values());
+        let placement = self.placement(&matrix);
+        let t0 = Instant::now();
+        cholesky::load(&self.symbolic, &placement, matrix.values(), None, &mut self.l_values, self.l_zeroed);
+        self.l_zeroed = false;
+        self.timings.numeric += t0.elapsed().as_secs_f64();
+        drop(placement);
         match self.strategy {
             Strategy::Refactor => self.matrix = Some(matrix),
-            Strategy::Schur => {
-                drop(matrix);
-                self.placement = None;
-            }
+            Strategy::Schur => drop(matrix),
         }
         self.factorize()?;
         self.factor_of = Some(vec![false; self.n_contact()]);
@@ -378,16 +390,6 @@ impl ContactSolver {
             self.timings.schur = t0.elapsed().as_secs_f64();
         }
         Ok(())
-    }
-
-    /// The values of a matrix with the solver's pattern into L's layout ([`cholesky::load`]);
-    /// numeric time, as the factorisation.
-    fn load(&mut self, values: &[f64]) {
-        let t0 = Instant::now();
-        let placement = self.placement.as_ref().expect("the placement is kept while the matrix can change");
-        cholesky::load(&self.symbolic, placement, values, None, &mut self.l_values, self.l_zeroed);
-        self.l_zeroed = false;
-        self.timings.numeric += t0.elapsed().as_secs_f64();
     }
 
     /// Numeric factorisation of the loaded values in place ([`cholesky::factorize`]).

@@ -486,22 +486,11 @@ fn load_supernode(
     }
 }
 
-/// Refactorise `l`, the factor of a matrix with the pattern `placement` was made for, for new
+/// Load into `l`, the factor of a matrix with the pattern `placement` was made for, new
 /// `values` (with `fixed`, as [`load`] takes them) that differ from that matrix's only in the
-/// columns of L whose supernodes [`Plan::changed`] marked in `which`: only those supernodes are loaded and computed again,
-/// in the factorisation's own schedule. The result is bit for bit [`load`] and [`factorize`]
-/// of `values`: every other supernode holds what they would compute (the same values, the same
-/// descendants). Where an active-set step changes a few contact nodes, that is the path from
-/// them to the root of the elimination tree instead of the whole tree.
-pub fn refactorize(
-    sn: &Symbolic,
-    plan: &Plan,
-    placement: &Placement,
-    values: &[f64],
-    fixed: Option<&[bool]>,
-    l: &mut [f64],
-    which: &[bool],
-) -> Result<(), FactorError> {
+/// columns of L whose supernodes [`Plan::changed`] marked in `which`: only those supernodes'
+/// blocks are loaded, for [`refactorize`].
+pub fn load_changed(sn: &Symbolic, placement: &Placement, values: &[f64], fixed: Option<&[bool]>, l: &mut [f64], which: &[bool]) {
     assert_eq!((l.len(), which.len()), (sn.len_val(), sn.n_supernodes()));
     let shared = Shared::new(l);
     let marked: Vec<usize> = (0..which.len()).filter(|&s| which[s]).collect();
@@ -513,7 +502,16 @@ pub fn refactorize(
             load_supernode(&node, placement, values, fixed, block, false, local);
         })
     });
-    let ctx = Context { sn, plan, l: shared };
+}
+
+/// Factorise again only the supernodes marked in `which` ([`load_changed`] loaded them), in the
+/// factorisation's own schedule. The result is bit for bit [`load`] and [`factorize`] of the
+/// new values: every other supernode holds what they would compute (the same values, the same
+/// descendants). Where an active-set step changes a few contact nodes, that is the path from
+/// them to the root of the elimination tree instead of the whole tree.
+pub fn refactorize(sn: &Symbolic, plan: &Plan, l: &mut [f64], which: &[bool]) -> Result<(), FactorError> {
+    assert_eq!((l.len(), which.len()), (sn.len_val(), sn.n_supernodes()));
+    let ctx = Context { sn, plan, l: Shared::new(l) };
     plan.upward(Some(which), &|s, alone| ctx.supernode(s, alone))
 }
 

@@ -183,14 +183,26 @@ fn a_refactorisation_of_the_changed_supernodes_is_the_whole_one_bit_for_bit() {
             let free = ours(&matrix, &symbolic, matrix.values(), threads).unwrap();
             let whole = ours(&matrix, &symbolic, &constrained, threads).unwrap();
             let mut l = free.clone();
-            pool.install(|| cholesky::refactorize(&symbolic, &plan, &placement, &constrained, None, &mut l, &which)).unwrap();
+            pool.install(|| {
+                cholesky::load_changed(&symbolic, &placement, &constrained, None, &mut l, &which);
+                cholesky::refactorize(&symbolic, &plan, &mut l, &which)
+            })
+            .unwrap();
             assert!(l.iter().zip(&whole).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}, {threads} threads: constrained");
-            pool.install(|| cholesky::refactorize(&symbolic, &plan, &placement, matrix.values(), None, &mut l, &which)).unwrap();
+            pool.install(|| {
+                cholesky::load_changed(&symbolic, &placement, matrix.values(), None, &mut l, &which);
+                cholesky::refactorize(&symbolic, &plan, &mut l, &which)
+            })
+            .unwrap();
             assert!(l.iter().zip(&free).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}, {threads} threads: released");
             // the same constraints marked as fixed unknowns (permuted numbering) on K's own values
             let mut fixed = vec![false; matrix.n()];
             picked.iter().for_each(|&i| fixed[inv[i]] = true);
-            pool.install(|| cholesky::refactorize(&symbolic, &plan, &placement, matrix.values(), Some(&fixed), &mut l, &which)).unwrap();
+            pool.install(|| {
+                cholesky::load_changed(&symbolic, &placement, matrix.values(), Some(&fixed), &mut l, &which);
+                cholesky::refactorize(&symbolic, &plan, &mut l, &which)
+            })
+            .unwrap();
             assert!(l.iter().zip(&whole).all(|(a, b)| a.to_bits() == b.to_bits()), "{name}, {threads} threads: fixed");
         }
     }
