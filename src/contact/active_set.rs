@@ -327,12 +327,14 @@ impl ContactSolver {
             fixed[inv[ni + k]] = true;
         }
         let (values, fixed) = (matrix.values(), Some(&fixed[..]));
+        // numeric time: the load here, the factorisation in `factorize` (which times itself)
         let t0 = Instant::now();
         match self.factor_of.take() {
             None => {
                 cholesky::load(&self.symbolic, &placement, values, fixed, &mut self.l_values, self.l_zeroed);
                 self.l_zeroed = false;
                 drop(placement);
+                self.timings.numeric += t0.elapsed().as_secs_f64();
                 self.factorize()?;
             }
             Some(before) => {
@@ -342,10 +344,11 @@ impl ContactSolver {
                 let which = self.plan.changed(&self.symbolic, columns);
                 cholesky::load_changed(&self.symbolic, &placement, values, fixed, &mut self.l_values, &which);
                 drop(placement);
-                cholesky::refactorize(&self.symbolic, &self.plan, &mut self.l_values, &which).map_err(factor_error)?;
+                let refactorized = cholesky::refactorize(&self.symbolic, &self.plan, &mut self.l_values, &which);
+                self.timings.numeric += t0.elapsed().as_secs_f64();
+                refactorized.map_err(factor_error)?;
             }
         }
-        self.timings.numeric += t0.elapsed().as_secs_f64();
         self.factor_of = Some(active.to_vec());
         Ok(())
     }
