@@ -314,13 +314,6 @@ impl ContactSolver {
         }
         let placement = self.placement(matrix);
         let (ni, m) = (self.n_interior, self.n_contact());
-        let (col_ptr, row_idx) = (matrix.col_ptr(), matrix.row_idx());
-        // the off-diagonal entries of node k's normal unknown: its column below the diagonal,
-        // its row left of it
-        let entries = |k: usize| {
-            let col = ni + k;
-            (col_ptr[col] + 1..col_ptr[col + 1]).map(move |pos| (row_idx[pos], pos)).chain(self.row_entries[k].iter().copied())
-        };
         let inv = self.symbolic.inv();
         let mut fixed = vec![false; self.n];
         for k in (0..m).filter(|&k| active[k]) {
@@ -339,8 +332,9 @@ impl ContactSolver {
             }
             Some(before) => {
                 // an entry (i, j) of the permuted matrix lies in column min(i, j) of L
-                let columns =
-                    (0..m).filter(|&k| before[k] != active[k]).flat_map(|k| entries(k).map(move |(other, _)| inv[other].min(inv[ni + k])));
+                let columns = (0..m)
+                    .filter(|&k| before[k] != active[k])
+                    .flat_map(|k| self.normal_entries(matrix, k).map(move |(other, _)| inv[other].min(inv[ni + k])));
                 let which = self.plan.changed(&self.symbolic, columns);
                 cholesky::load_changed(&self.symbolic, &placement, values, fixed, &mut self.l_values, &which);
                 drop(placement);
@@ -355,6 +349,14 @@ impl ContactSolver {
 
     pub fn strategy(&self) -> Strategy {
         self.strategy
+    }
+
+    /// The off-diagonal entries of contact node k's normal unknown in `matrix` (the Refactor
+    /// strategy's): its column below the diagonal, then its row left of it, each as (the other
+    /// unknown, position in the matrix's values).
+    fn normal_entries<'a>(&'a self, matrix: &'a SymCsc, k: usize) -> impl Iterator<Item = (usize, usize)> + 'a {
+        let (col, col_ptr, row_idx) = (self.n_interior + k, matrix.col_ptr(), matrix.row_idx());
+        (col_ptr[col] + 1..col_ptr[col + 1]).map(move |pos| (row_idx[pos], pos)).chain(self.row_entries[k].iter().copied())
     }
 
     /// Where the entries of `matrix` go in L: the placement the symbolic analysis computed, taken,
@@ -638,12 +640,8 @@ impl ContactSolver {
             // the known values of the active normals move to the right-hand side
             let mut b = rhs.to_vec();
             for k in (0..m).filter(|&k| active[k]) {
-                let col = ni + k;
-                for pos in matrix.col_ptr()[col] + 1..matrix.col_ptr()[col + 1] {
-                    b[matrix.row_idx()[pos]] -= matrix.values()[pos] * gap[k];
-                }
-                for &(j, pos) in &self.row_entries[k] {
-                    b[j] -= matrix.values()[pos] * gap[k];
+                for (other, pos) in self.normal_entries(matrix, k) {
+                    b[other] -= matrix.values()[pos] * gap[k];
                 }
             }
             for k in (0..m).filter(|&k| active[k]) {
