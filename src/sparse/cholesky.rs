@@ -510,18 +510,21 @@ pub fn load_changed(sn: &Symbolic, placement: &Placement, values: &[f64], fixed:
 /// descendants). Where an active-set step changes a few contact nodes, that is the path from
 /// them to the root of the elimination tree instead of the whole tree.
 pub fn refactorize(sn: &Symbolic, plan: &Plan, l: &mut [f64], which: &[bool]) -> Result<(), FactorError> {
-    assert_eq!((l.len(), which.len()), (sn.len_val(), sn.n_supernodes()));
-    let ctx = Context { sn, plan, l: Shared::new(l) };
-    plan.upward(Some(which), &|s, alone| ctx.supernode(s, alone))
+    assert_eq!(which.len(), sn.n_supernodes());
+    factorize_some(sn, plan, l, Some(which))
 }
 
 /// Overwrite `l` (the layout of `sn`, holding a matrix's values from [`load`]) with the
 /// Cholesky factor of that matrix, permuted as planned.
 pub fn factorize(sn: &Symbolic, plan: &Plan, l: &mut [f64]) -> Result<(), FactorError> {
+    factorize_some(sn, plan, l, None)
+}
+
+/// [`factorize`] of the supernodes in `which` (all if None).
+fn factorize_some(sn: &Symbolic, plan: &Plan, l: &mut [f64], which: Option<&[bool]>) -> Result<(), FactorError> {
     assert_eq!(l.len(), sn.len_val());
-    let shared = Shared::new(l);
-    let ctx = Context { sn, plan, l: shared };
-    plan.upward(None, &|s, alone| ctx.supernode(s, alone))
+    let ctx = Context { sn, plan, l: Shared::new(l) };
+    plan.upward(which, &|s, alone| ctx.supernode(s, alone))
 }
 
 struct Context<'a> {
