@@ -18,7 +18,35 @@ pub struct LinfError {
 
 /// max over the sampling points of |u - u_h| (componentwise maximum).
 /// The displacement the error is measured against: an exact solution or a reference solution.
-pub type Reference<'a> = &'a (dyn Fn([f64; 2]) -> [f64; 2] + Sync);
+pub type Reference<'a> = &'a dyn Displacement;
+
+/// A displacement field given everywhere: any closure `Fn([f64; 2]) -> [f64; 2]` (an exact
+/// solution), or a discrete solution on another mesh (a study's reference solution).
+pub trait Displacement: Sync {
+    /// The displacement at `x`.
+    fn at(&self, x: [f64; 2]) -> [f64; 2];
+
+    /// The displacement at each point of `xs`, points close together (the sampling points of one
+    /// triangle): what [`Displacement::at`] gives point by point. A field on another mesh finds
+    /// the triangles that hold them together.
+    fn at_each(&self, xs: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        xs.iter().map(|&x| self.at(x)).collect()
+    }
+}
+
+impl<F: Fn([f64; 2]) -> [f64; 2] + Sync> Displacement for F {
+    fn at(&self, x: [f64; 2]) -> [f64; 2] {
+        self(x)
+    }
+}
+
+/// The largest of |u - u_h| (componentwise maximum) at the points `at` (with u_h there), u
+/// taken from `exact` for all of them at once.
+fn largest_error(exact: Reference, at: &[([f64; 2], [f64; 2])]) -> Option<f64> {
+    let xs: Vec<[f64; 2]> = at.iter().map(|(x, _)| *x).collect();
+    let u = exact.at_each(&xs);
+    u.iter().zip(at).map(|(u, (_, uh))| (u[0] - uh[0]).abs().max((u[1] - uh[1]).abs())).reduce(f64::max)
+}
 
 pub fn linf_error_on(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference, sampling: Sampling) -> f64 {
     linf_error_where(mesh, sol, exact, sampling, &|_| true).unwrap_or(0.0)
@@ -36,14 +64,9 @@ pub fn linf_error_where(
     (0..mesh.n_triangles())
         .into_par_iter()
         .map(|t| {
-            sol.eval_element(mesh, t, &refs)
-                .iter()
-                .filter(|(x, _)| keep(*x))
-                .map(|(x, uh)| {
-                    let u = exact(*x);
-                    (u[0] - uh[0]).abs().max((u[1] - uh[1]).abs())
-                })
-                .reduce(f64::max)
+            let mut at = sol.eval_element(mesh, t, &refs);
+            at.retain(|(x, _)| keep(*x));
+            largest_error(exact, &at)
         })
         .reduce(
             || None,
@@ -77,13 +100,7 @@ pub fn linf_error_contact(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference)
                     refs.push([(1.0 - s) * reference[i][0] + s * reference[j][0], (1.0 - s) * reference[i][1] + s * reference[j][1]]);
                 }
             }
-            sol.eval_element(mesh, t, &refs)
-                .iter()
-                .map(|(x, uh)| {
-                    let u = exact(*x);
-                    (u[0] - uh[0]).abs().max((u[1] - uh[1]).abs())
-                })
-                .reduce(f64::max)
+            largest_error(exact, &sol.eval_element(mesh, t, &refs))
         })
         .reduce_with(f64::max)
 }
@@ -95,7 +112,7 @@ pub fn linf_error(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference) -> Linf
         .iter()
         .zip(&sol.u)
         .map(|(x, uh)| {
-            let u = exact(*x);
+            let u = exact.at(*x);
             (u[0] - uh[0]).abs().max((u[1] - uh[1]).abs())
         })
         .fold(0.0, f64::max);

@@ -164,6 +164,9 @@ pub struct DiscreteSolution {
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct SolveTimings {
     pub assembly: f64,
+    /// The checks of the data before the assembly (part of `assembly`): the Dirichlet parts,
+    /// the contact data, and an exact solution against the equations and boundary conditions.
+    pub checks: f64,
     #[serde(flatten)]
     pub contact: Timings,
     /// The refinement step that measures [`DiscreteSolution::roundoff`].
@@ -218,6 +221,7 @@ pub fn solve(
     let t0 = Instant::now();
     let nodes = P2Nodes::new(mesh);
     let dofs = DofMap::new(&nodes, problem);
+    let t_checks = Instant::now();
     super::point::check_on_dirichlet(&nodes, &dofs, problem)?;
     certify::check_held(mesh, &nodes, &dofs, problem)?;
     super::plausible::check_contact_data(mesh, &nodes, &dofs, problem)?;
@@ -226,6 +230,7 @@ pub fn solve(
         return Err(SolveError::NoContact { declared: problem.declared_parts() });
     }
     unused_traction(mesh, &nodes, problem)?;
+    let checks_time = t_checks.elapsed().as_secs_f64();
     let system = assembly::assemble(mesh, &nodes, &dofs, problem);
     // the data were evaluated where they are used (gap and normal in the DofMap, load and
     // Dirichlet data in the assembly): any that was not a finite number stops here
@@ -294,6 +299,7 @@ pub fn solve(
     let reactions = reactions.residual;
     let timings = SolveTimings {
         assembly: assembly_time,
+        checks: checks_time,
         contact: contact_timings,
         roundoff: t_roundoff.elapsed().as_secs_f64(),
         total: t_all.elapsed().as_secs_f64(),

@@ -492,10 +492,9 @@ impl Prepared {
     pub fn with_error_against<R>(&self, f: impl FnOnce(Option<crate::contact::norms::Reference>) -> R) -> R {
         let exact = self.problem.exact();
         let exact_fn = exact.map(|e| move |x: [f64; 2]| e.u(x));
-        let reference_fn = self.reference.as_ref().map(|r| move |x: [f64; 2]| r.eval(x));
-        match (&exact_fn, &reference_fn) {
+        match (&exact_fn, &self.reference) {
             (Some(e), _) => f(Some(e)),
-            (None, Some(r)) => f(Some(r)),
+            (None, Some(r)) => f(Some(r.as_ref())),
             (None, None) => f(None),
         }
     }

@@ -5,7 +5,11 @@
 
 use crate::adapt::{self, AdaptConfig};
 use crate::base::element::{self, N_NODES};
-use crate::mesh::{Mesh, MeshSpec, locate::Locator};
+use crate::contact::norms::Displacement;
+use crate::mesh::{
+    Mesh, MeshSpec,
+    locate::{Hit, Locator},
+};
 use crate::problems::Problem;
 use crate::records::{Flags, Rebuild, ReferenceSpec, Refine};
 
@@ -33,7 +37,11 @@ impl ReferenceField {
     /// edge), or the P2 polynomial of the triangle x is least outside of if x is a hair outside
     /// every triangle (a point of a coarser mesh whose boundary approximates a curve differently).
     pub fn eval(&self, x: [f64; 2]) -> [f64; 2] {
-        let hit = self.locator.nearest(&self.mesh, x).expect("a reference mesh has triangles");
+        self.value(&self.locator.nearest(&self.mesh, x).expect("a reference mesh has triangles"))
+    }
+
+    /// The field's P2 polynomial on the triangle of `hit`, at its point.
+    fn value(&self, hit: &Hit) -> [f64; 2] {
         let phi = element::p2_values(hit.reference[0], hit.reference[1]);
         let el = &self.elements[hit.triangle];
         let mut v = [0.0; 2];
@@ -42,6 +50,18 @@ impl ReferenceField {
             v[1] += phi[a] * self.values[el[a]][1];
         }
         v
+    }
+}
+
+/// What the errors of a study's runs are measured against; the points of one triangle of a run's
+/// mesh are located together ([`Locator::nearest_each`]: the same triangles as one by one).
+impl Displacement for ReferenceField {
+    fn at(&self, x: [f64; 2]) -> [f64; 2] {
+        self.eval(x)
+    }
+
+    fn at_each(&self, xs: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        self.locator.nearest_each(&self.mesh, xs).iter().map(|hit| self.value(hit)).collect()
     }
 }
 
