@@ -257,12 +257,16 @@ pub const GRADED: f64 = 3.0;
 /// dissection wins (0.46-0.63 on half of the uniform refinements of Example 7.1's and 7.2's
 /// meshes above 8k nodes, 0.50 on `structured:256` and `structured:512`) or loses by little
 /// (1.25-1.5 on the other half, all below 66k nodes, where both are computed anyway); on every
-/// graded mesh above 2.3k nodes AMD wins, by a lot on most (Example 7.1 graded towards
-/// Gamma_C: 10-67 from 18k nodes up; Example 7.2's adaptive meshes: 1.7-27, 25 at 1.1M
+/// graded mesh of those studies above 2.3k nodes AMD wins, by a lot on most (Example 7.1 graded
+/// towards Gamma_C: 10-67 from 18k nodes up; Example 7.2's adaptive meshes: 1.7-27, 25 at 1.1M
 /// unknowns; Hertz: 2-7). There the flops of nested dissection per n^1.5 for n unknowns
 /// overlap those of `structured:N` (27 on `structured:N`, 35-65 on `ex72_large`), so the flop
 /// count of nested dissection alone cannot tell the two kinds of mesh apart: the
-/// grading does. The rule is a function of the mesh only (never of timing or threads).
+/// grading does. On the deep study's graded meshes either can win, so neither is skipped there
+/// (nested dissection / AMD above 100k nodes: 22-41 on Example 7.1 as written, graded
+/// 512-2048; 0.87-2.0 on fb as written, graded 128-512; 0.68-0.96 from 257k nodes up on fb
+/// without full-contact nodes and repaired, graded 16; 0.80-1.16 on those runs of Example 7.1).
+/// The rule is a function of the mesh only (never of timing or threads).
 /// [`FORCE_ENV`] overrides it: a forced AMD is computed whatever the mesh.
 pub fn fill_reducing(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (Vec<usize>, OrderingChoice) {
     fill_reducing_then(matrix, n_order, coords, |graph, node_order| {
