@@ -17,3 +17,15 @@ pub const HERTZ: &str = "hertz";
 
 /// Every problem name above.
 pub const ALL: [&str; 5] = [EX71, EX72, FB, EX72_ROLLERS, HERTZ];
+
+/// How the rows name a problem: "Ex. 7.1", "Ex. 7.2", "fb", "Ex. 7.2 on rollers", "Hertz"; any
+/// other name as it is.
+pub fn label(problem: &str) -> &str {
+    match problem {
+        EX71 => "Ex. 7.1",
+        EX72 => "Ex. 7.2",
+        EX72_ROLLERS => "Ex. 7.2 on rollers",
+        HERTZ => "Hertz",
+        other => other,
+    }
+}

@@ -28,17 +28,22 @@ pub fn claim_studies(id: &str) -> &'static [Study] {
     match id {
         // every stored run with an error (claims::c0_claim; battery 16, F3: the pages said
         // "No CLAIMS row rests on this study" of studies whose runs it reads)
-        "c0" => ALL,
+        _ if id.starts_with("c0") => ALL,
+        // every row recomputed: every study a row reads
+        "parity" => ALL,
         "sampling" => &[EX71, EX72, CONTACT_TERM_ABLATION],
+        _ if id.starts_with("efficiency-up-to-l_h") => {
+            &[DEEP, EX71, EX72, EX72_LARGE, EX72_ROLLERS, FB, HERTZ, CONTACT_TERM_ABLATION, ESTIMATOR_REPAIR]
+        }
         // the row named after the study it judges
         HERTZ => &[HERTZ],
         "efficiency-size" => &[DEEP, EX72_LARGE, EX72_ROLLERS, HERTZ],
         _ if id.starts_with("theta") => &[THETA_ABLATION],
-        _ if id.starts_with("7.1-") => &[DEEP, EX71, CONTACT_TERM_ABLATION],
-        _ if id.starts_with("7.2-") => &[EX72, EX72_LARGE],
+        _ if id.starts_with("7.1-") => &[DEEP, EX71, CONTACT_TERM_ABLATION, ESTIMATOR_REPAIR],
+        _ if id.starts_with("7.2-") => &[EX72, EX72_LARGE, CONTACT_TERM_ABLATION, ESTIMATOR_REPAIR],
         _ if id.starts_with("7.2r-") => &[EX72_ROLLERS],
         _ if id.starts_with("log-factor") => &[LOG_ABLATION],
-        _ if id.starts_with("fb-") => &[DEEP, FB],
+        _ if id.starts_with("fb-") => &[DEEP, FB, ESTIMATOR_REPAIR],
         _ if id.starts_with("estimator-repair") => &[DEEP, ESTIMATOR_REPAIR, HERTZ],
         _ => &[],
     }
@@ -48,7 +53,7 @@ pub fn claim_studies(id: &str) -> &'static [Study] {
 /// stored run with an error, of any study, declared here or not: `claims::c0_claim`), the
 /// others on their [`claim_studies`].
 pub fn rests_on(id: &str, study: &str) -> bool {
-    id == "c0" || claim_studies(id).contains(&study)
+    id.starts_with("c0") || claim_studies(id).contains(&study)
 }
 
 /// The drift reports the pages may quote, and the command a page advises where none covers its
@@ -239,14 +244,14 @@ fn claims_table(claims: &[&Claim]) -> String {
         let _ = writeln!(
             s,
             "<tr class=\"claim\" id=\"claim-{id}\"><td><b>{id}</b>: {}<details><summary>the claim in full</summary>{}</details><details><summary>what would fail it</summary>{}</details></td><td>{}</td><td>{}<details><summary>evidence</summary>{}</details></td><td>{}</td></tr>",
-            escape(c.summary.topic),
+            escape(&c.summary.topic),
             escape(&c.claim),
             escape(&crate::analysis::claims::capitalised(&c.criterion.fails_if())),
             escape(c.summary.paper),
             escape(&c.summary.headline),
             escape(&c.measured),
             verdict_html(c),
-            id = escape(c.id)
+            id = escape(&c.id)
         );
     }
     s + "</table>\n"
@@ -271,14 +276,14 @@ pub fn index_page(results: &Path, studies: &[String], claims: &[Claim]) -> Strin
     for c in claims {
         let links: Vec<String> = studies
             .iter()
-            .filter(|st| rests_on(c.id, st))
-            .map(|st| format!("<a href=\"{st}.html#claim-{id}\">{st}</a>", id = escape(c.id)))
+            .filter(|st| rests_on(&c.id, st))
+            .map(|st| format!("<a href=\"{st}.html#claim-{id}\">{st}</a>", id = escape(&c.id)))
             .collect();
         let _ = writeln!(
             s,
             "<tr><td><b>{}</b>: {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-            escape(c.id),
-            escape(c.summary.topic),
+            escape(&c.id),
+            escape(&c.summary.topic),
             escape(c.summary.paper),
             escape(&c.summary.headline),
             verdict_html(c),
@@ -357,7 +362,7 @@ details{margin-top:4px;color:#444}summary{cursor:pointer;color:#06c}";
 /// row (those of the study are shown), `drift` the drift report if one was found.
 pub fn study_page(shelf: &Shelf, figures: &Path, study: &str, claims: &[Claim], drift: &DriftReports) -> std::io::Result<String> {
     let runs = shelf.runs(study)?;
-    let rows: Vec<&Claim> = claims.iter().filter(|c| rests_on(c.id, study)).collect();
+    let rows: Vec<&Claim> = claims.iter().filter(|c| rests_on(&c.id, study)).collect();
     let mut s = String::new();
     let _ = write!(
         s,

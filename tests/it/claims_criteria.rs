@@ -1,39 +1,21 @@
 //! Every CLAIMS row states what would fail it, from the criterion its verdict applies
-//! (`claims::criterion`): the rendered CLAIMS.md carries the condition in every evidence section,
-//! the stored CLAIMS.md is what the records render, and for several rows evidence built to
-//! violate the condition as stated (its numbers read back from the text) fails the row, while
-//! evidence inside it passes.
+//! (`claims::criterion`); rows of one kind are judged by one rule, whatever the problem or the
+//! contact term; and every kind of row can fail: the stored records altered in memory (a rate
+//! moved, an efficiency made to grow or fall, errors made larger, the free-boundary edge made to
+//! stall, a contact term made to appear, a reference made coarse) flip the verdicts of its rows.
 
-use signorini::base::stats::LineFit;
-use signorini::claims::{self, Claim, Criterion, Evidence, Verdict};
-use signorini::verdict::{Abscissa, RateFit};
+use signorini::claims::{self, Claim, Criterion, RowKind, Verdict, terms};
+use signorini::records::RunRecord;
+use signorini::study::store::Shelf;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
-fn stored() -> Vec<Claim> {
-    claims::claims(&crate::common::shelf(Path::new("results")), crate::common::roles()).unwrap()
+fn stored_shelf() -> Shelf {
+    crate::common::shelf(Path::new("results"))
 }
 
-fn row<'a>(c: &'a [Claim], id: &str) -> &'a Claim {
-    c.iter().find(|c| c.id == id).unwrap_or_else(|| panic!("no row {id}"))
-}
-
-/// The number right after `after` in `text` ("lies below 1.400 (slower)" -> 1.4).
-fn number_after(text: &str, after: &str) -> f64 {
-    let rest = &text[text.find(after).unwrap_or_else(|| panic!("'{after}' not in: {text}")) + after.len()..];
-    let end = rest.find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == 'e')).unwrap_or(rest.len());
-    rest[..end].trim_end_matches('.').parse().unwrap_or_else(|e| panic!("no number after '{after}' in {text}: {e}"))
-}
-
-/// A fit of `slope` ± `half_width` over 2.5 decades of NDF.
-fn fit(slope: f64, half_width: f64, abscissa: Abscissa) -> Evidence {
-    Evidence::Fit(RateFit {
-        rate: LineFit { slope, half_width, points: 8 },
-        abscissa,
-        first_level: 10,
-        last_level: 24,
-        first_ndof: 10_000,
-        last_ndof: 3_162_278,
-    })
+fn verdicts(shelf: &Shelf) -> Vec<Claim> {
+    claims::claims(shelf, crate::common::roles()).unwrap()
 }
 
 fn fails(v: Verdict) -> bool {
@@ -44,9 +26,46 @@ fn passes(v: Verdict) -> bool {
     matches!(v, Verdict::Reproduced | Verdict::Holds)
 }
 
+/// Whether a row's criterion is one check with a reference part (a row over several runs, some
+/// without a reference, is judged run by run: its other runs may still fail it).
+fn has_reference_part(c: &Criterion) -> bool {
+    matches!(c, Criterion::All(parts) if parts.iter().any(|p| matches!(p, Criterion::Reference { .. })))
+}
+
+/// Multiply `f`'s value at every level of `r` by (NDF / NDF_0)^power: its rate in NDF moves by
+/// -power (its trend by +power).
+fn scale_by_ndof(r: &mut RunRecord, power: f64, f: impl Fn(&mut signorini::records::LevelRecord) -> Vec<&mut f64>) {
+    let n0 = r.levels.first().map_or(1.0, |l| l.ndof as f64);
+    for l in &mut r.levels {
+        let factor = (l.ndof as f64 / n0).powf(power);
+        for v in f(l) {
+            *v *= factor;
+        }
+    }
+}
+
+/// Every error and estimator quantity a rate row fits.
+fn rated(l: &mut signorini::records::LevelRecord) -> Vec<&mut f64> {
+    let t = &mut l.terms;
+    let mut out: Vec<&mut f64> = vec![
+        &mut t.eta1,
+        &mut t.eta2,
+        &mut t.eta3,
+        &mut t.eta4,
+        &mut t.eta5,
+        &mut t.eta6,
+        &mut t.eta7,
+        &mut t.psi,
+        &mut t.eta_h,
+        &mut t.estimate,
+    ];
+    out.extend([&mut l.err_quadrature, &mut l.err_dense, &mut l.err_contact, &mut l.err_right_half].into_iter().flatten());
+    out
+}
+
 #[test]
 fn every_row_states_what_would_fail_it_and_claims_md_is_what_the_records_render() {
-    let c = stored();
+    let c = verdicts(&stored_shelf());
     assert!(c.len() >= 20, "{} rows", c.len());
     let md = claims::markdown_for(&c, Path::new("results"));
     for r in &c {
@@ -67,109 +86,191 @@ fn every_row_states_what_would_fail_it_and_claims_md_is_what_the_records_render(
 }
 
 #[test]
-fn a_rate_outside_the_stated_band_fails_the_rate_rows() {
-    let c = stored();
-    for (id, abscissa) in [
-        ("7.1-error-rate", Abscissa::Ndof),
-        ("fb-error-rate", Abscissa::Ndof),
-        ("7.2-corners (beyond the paper)", Abscissa::InverseHMin),
-        ("7.2r-error-rate (as written)", Abscissa::Ndof),
-        ("7.2r-error-rate (without full-contact nodes)", Abscissa::Ndof),
-        ("7.2r-error-rate (repaired)", Abscissa::Ndof),
-    ] {
-        let r = row(&c, id);
-        let f = r.criterion.fails_if();
-        let (lo, hi) = (number_after(&f, "lies below "), number_after(&f, "or above "));
-        assert!(lo < hi, "{id}: {f}");
-        let v = |e: Evidence| r.criterion.verdict(r.kind(), Some(&e));
-        assert!(fails(v(fit(lo - 0.05, 0.02, abscissa))), "{id}: a rate below {lo} must fail: {f}");
-        assert!(fails(v(fit(hi + 0.05, 0.02, abscissa))), "{id}: a rate above {hi} must fail: {f}");
-        assert!(passes(v(fit((lo + hi) / 2.0, 0.02, abscissa))), "{id}: a rate in the middle of [{lo}, {hi}] passes");
-        assert!(!fails(v(fit(lo + 0.01, 0.02, abscissa))), "{id}: an interval straddling {lo} is not decided");
-    }
-}
-
-#[test]
-fn a_growing_efficiency_and_a_c0_beyond_its_limit_fail_their_rows() {
-    let c = stored();
-    for id in ["7.1-efficiency", "fb-efficiency"] {
-        let r = row(&c, id);
-        assert!(r.criterion.fails_if().contains("excludes 0"), "{id}: {}", r.criterion.fails_if());
-        assert!(fails(r.criterion.verdict(r.kind(), Some(&fit(0.2, 0.04, Abscissa::Ndof)))), "{id}");
-        assert!(passes(r.criterion.verdict(r.kind(), Some(&fit(0.0, 0.04, Abscissa::Ndof)))), "{id}");
-    }
-    for id in ["c0", "fb-reliability"] {
-        let r = row(&c, id);
-        let limit = number_after(&r.criterion.fails_if(), "exceeds ");
-        assert_eq!(limit, 0.45, "{id}: {}", r.criterion.fails_if());
-        assert!(fails(r.criterion.verdict(r.kind(), Some(&Evidence::Value(limit * 1.01)))), "{id}");
-        assert!(passes(r.criterion.verdict(r.kind(), Some(&Evidence::Value(limit)))), "{id}");
-    }
-    let s = row(&c, "sampling");
-    assert!(fails(s.criterion.verdict(s.kind(), Some(&Evidence::Value(1.0)))));
-    assert_eq!(s.criterion.verdict(s.kind(), Some(&Evidence::Value(0.0))), Verdict::Holds);
-}
-
-/// The rows of Example 7.2 on rollers that judge a rate against a limit (the uniform rate against
-/// the clamped corners' h^0.711, h_fb against uniform refinement's NDF^-1/2): a rate below the
-/// stated limit fails, one above it passes, one whose interval contains it is not decided; and
-/// the efficiency rows fail on a growing estimate / error / l_h, pass on a bounded or falling one.
-#[test]
-fn the_rollers_rows_fail_below_their_stated_limits() {
-    let c = stored();
-    for (id, abscissa, limit) in [
-        ("7.2r-uniform (beyond the paper)", Abscissa::InverseHMin, 0.711),
-        ("7.2r-refinement (as written)", Abscissa::Ndof, 0.5),
-        ("7.2r-refinement (without full-contact nodes)", Abscissa::Ndof, 0.5),
-        ("7.2r-refinement (repaired)", Abscissa::Ndof, 0.5),
-    ] {
-        let r = row(&c, id);
-        let f = r.criterion.fails_if();
-        let stated = number_after(&f, "lies below ");
-        assert!((stated - limit).abs() < 1e-3, "{id}: {f}");
-        let v = |slope: f64| r.criterion.verdict(r.kind(), Some(&fit(slope, 0.02, abscissa)));
-        assert!(fails(v(stated - 0.05)), "{id}: a rate below {stated} must fail: {f}");
-        assert!(passes(v(stated + 0.05)), "{id}: a rate above {stated} passes");
-        assert!(!fails(v(stated)) && !passes(v(stated)), "{id}: an interval containing {stated} is not decided");
-        if abscissa == Abscissa::InverseHMin {
-            let other = r.criterion.verdict(r.kind(), Some(&fit(stated + 0.05, 0.02, Abscissa::Ndof)));
-            assert!(!passes(other) && !fails(other), "{id}: a fit against NDF decides nothing");
+fn rows_of_one_kind_are_judged_by_one_rule_on_every_problem_and_contact_term() {
+    let c = verdicts(&stored_shelf());
+    let mut rules: BTreeMap<RowKind, BTreeSet<String>> = BTreeMap::new();
+    for r in &c {
+        match r.row {
+            RowKind::Finding => {}
+            RowKind::Measured => {
+                assert!(matches!(r.criterion, Criterion::Reported { .. }), "{}: a measurement with a criterion", r.id);
+                assert_eq!(r.verdict, Verdict::NoClaim, "{}", r.id);
+            }
+            kind => {
+                rules.entry(kind).or_default().insert(r.criterion.rule());
+            }
         }
     }
-    for id in ["7.2r-efficiency (as written)", "7.2r-efficiency (without full-contact nodes)", "7.2r-efficiency (repaired)"] {
-        let r = row(&c, id);
-        assert!(r.criterion.fails_if().contains("lies above 0 (growing)"), "{id}: {}", r.criterion.fails_if());
-        let v = |slope: f64| r.criterion.verdict(r.kind(), Some(&fit(slope, 0.04, Abscissa::Ndof)));
-        assert!(fails(v(0.2)), "{id}: growing");
-        assert!(passes(v(0.0)) && passes(v(-0.2)), "{id}: bounded or falling");
+    for kind in [RowKind::Rate, RowKind::Efficiency, RowKind::EfficiencyUpToLh, RowKind::Reliability, RowKind::Refinement] {
+        let r = rules.get(&kind).unwrap_or_else(|| panic!("no row of kind {kind:?}"));
+        assert_eq!(r.len(), 1, "rows of kind {kind:?} are judged by different rules: {r:#?}");
+    }
+    // every claim of the paper is judged for every contact term
+    let mut per_claim: BTreeMap<&str, BTreeSet<_>> = BTreeMap::new();
+    for r in c.iter().filter(|r| r.kind() == claims::Kind::Paper) {
+        assert!(!r.terms.is_empty(), "{}: a claim of the paper judged for no contact term", r.id);
+        per_claim.entry(r.id.split(" (").next().unwrap()).or_default().extend(r.terms.iter().map(|t| terms::name(*t)));
+    }
+    for (id, t) in &per_claim {
+        assert_eq!(t.len(), terms::ALL.len(), "{id} is not judged for every contact term: {t:?}");
     }
 }
 
-/// The repair row: passes on evidence where every criterion of every problem holds and one
-/// separates; one problem's reliability beyond 0.45 fails it; no separating criterion leaves it
-/// undecided.
 #[test]
-fn one_failing_criterion_fails_the_repair_row() {
-    let c = stored();
-    let r = row(&c, "estimator-repair (beyond the paper)");
-    let Criterion::All(parts) = &r.criterion else { panic!("{:?}", r.criterion) };
-    let Criterion::Each { of, .. } = &parts[0] else { panic!("{:?}", parts[0]) };
-    assert_eq!(of, &["ex71", "fb", "ex72", "hertz"], "the problems judged (Hertz's errors against its reference)");
-    let f = r.criterion.fails_if();
-    assert!(f.contains("exceeds 0.45") && f.contains("not decided unless"), "{f}");
-    let problem = |c0: f64| {
-        Some(Evidence::All(vec![
-            Some(fit(1.5, 0.02, Abscissa::Ndof)),
-            Some(fit(0.0, 0.05, Abscissa::Ndof)),
-            Some(Evidence::Value(c0)),
-            Some(Evidence::Unknowns { uniform_rate_hi: 1.499, lines: None }),
-        ]))
-    };
-    let evidence = |c0s: [f64; 4], separates: bool| {
-        Evidence::All(vec![Some(Evidence::All(c0s.iter().map(|c| problem(*c)).collect())), Some(Evidence::Bool(separates))])
-    };
-    assert_eq!(r.criterion.verdict(r.kind(), Some(&evidence([4e-4, 4e-4, 4e-6, 9e-7], true))), Verdict::Holds);
-    assert_eq!(r.criterion.verdict(r.kind(), Some(&evidence([4e-4, 0.5, 4e-6, 9e-7], true))), Verdict::Fails);
-    assert_eq!(r.criterion.verdict(r.kind(), Some(&evidence([4e-4, 4e-4, 4e-6, 0.5], true))), Verdict::Fails, "Hertz's reliability counts");
-    assert_eq!(r.criterion.verdict(r.kind(), Some(&evidence([4e-4, 4e-4, 4e-6, 9e-7], false))), Verdict::Inconclusive);
+fn the_headline_counts_the_papers_claims_per_contact_term_and_a_fragile_pass_as_undecided() {
+    let c = verdicts(&stored_shelf());
+    let md = claims::markdown_for(&c, Path::new("results"));
+    let head = md.split("## Headline\n\n").nth(1).unwrap().split("\n## ").next().unwrap();
+    assert!(head.lines().filter(|l| !l.is_empty()).count() <= 10, "the headline is at most ten lines: {head}");
+    for t in terms::ALL {
+        let rows: Vec<&Claim> = c.iter().filter(|r| r.kind() == claims::Kind::Paper && r.terms.contains(&t)).collect();
+        let robust = rows.iter().filter(|r| passes(r.verdict) && r.fragile.is_none()).count();
+        let line = head
+            .lines()
+            .find(|l| l.starts_with(&format!("- **{}**", terms::name(t))))
+            .unwrap_or_else(|| panic!("no line for {t:?}: {head}"));
+        assert!(line.contains(&format!("of the paper's {} Section 7 claims, {robust} reproduce", rows.len())), "{line}");
+    }
+}
+
+/// A change to every stored record, made in memory.
+type Alteration = Box<dyn Fn(&mut RunRecord)>;
+
+/// Each kind of row, by an alteration of the stored records that its criterion must see.
+#[test]
+fn every_kind_of_row_fails_when_the_records_are_altered_against_it() {
+    let before = verdicts(&stored_shelf());
+    let kinds: BTreeSet<RowKind> = before.iter().map(|c| c.row).collect();
+    // (kind, alteration, what the rows of that kind must become)
+    let far_reference = |r: &mut RunRecord| r.reference_ndof = r.reference_ndof.map(|n| n * 1000);
+    let checks: Vec<(RowKind, &str, Alteration)> = vec![
+        (
+            RowKind::Rate,
+            "every rate 0.6 slower",
+            Box::new(move |r| {
+                scale_by_ndof(r, 0.6, rated);
+                far_reference(r);
+            }),
+        ),
+        (
+            RowKind::Efficiency,
+            "the estimate growing at 0.6 against the error",
+            Box::new(move |r| {
+                scale_by_ndof(r, 0.6, |l| vec![&mut l.terms.estimate]);
+                far_reference(r);
+            }),
+        ),
+        (
+            RowKind::Efficiency,
+            "the estimate falling at 0.6 against the error",
+            Box::new(move |r| {
+                scale_by_ndof(r, -0.6, |l| vec![&mut l.terms.estimate]);
+                far_reference(r);
+            }),
+        ),
+        (
+            RowKind::EfficiencyUpToLh,
+            "the estimate growing at 0.6 against the error",
+            Box::new(move |r| {
+                scale_by_ndof(r, 0.6, |l| vec![&mut l.terms.estimate]);
+                far_reference(r);
+            }),
+        ),
+        (
+            RowKind::Reliability,
+            "every error 1e4 times larger",
+            Box::new(|r| {
+                for l in &mut r.levels {
+                    for e in [&mut l.err_quadrature, &mut l.err_dense].into_iter().flatten() {
+                        *e *= 1e4;
+                    }
+                }
+            }),
+        ),
+        (
+            RowKind::Refinement,
+            "the free-boundary edge shrinking 0.8 slower",
+            Box::new(|r| {
+                scale_by_ndof(r, 0.8, |l| l.h_free_boundary.as_mut().into_iter().collect());
+            }),
+        ),
+        (
+            RowKind::Vanishing,
+            "eta_6 of 1e-3 at the last level",
+            Box::new(|r| {
+                if let Some(l) = r.levels.last_mut() {
+                    l.terms.eta6 = 1e-3;
+                }
+            }),
+        ),
+    ];
+    for kind in &kinds {
+        let covered = checks.iter().any(|(k, ..)| k == kind) || matches!(kind, RowKind::Finding | RowKind::Measured);
+        assert!(covered, "no alteration shows that rows of kind {kind:?} can fail");
+    }
+    for (kind, what, alter) in &checks {
+        let after = verdicts(&stored_shelf().alter(alter));
+        let rows: Vec<(&Claim, &Claim)> = before
+            .iter()
+            .filter(|c| c.row == *kind && c.verdict != Verdict::NoData)
+            .map(|b| (b, after.iter().find(|a| a.id == b.id).unwrap_or_else(|| panic!("{} gone after: {what}", b.id))))
+            .collect();
+        assert!(!rows.is_empty(), "no row of kind {kind:?}");
+        for (b, a) in rows {
+            assert!(
+                fails(a.verdict),
+                "{} ({kind:?}, {:?} before) does not fail with {what}: {:?}, {}",
+                b.id,
+                b.verdict,
+                a.verdict,
+                a.summary.headline
+            );
+        }
+    }
+}
+
+#[test]
+fn a_coarse_reference_leaves_every_row_that_measures_against_it_undecided() {
+    let before = verdicts(&stored_shelf());
+    // a reference as coarse as each run's middle level: its own error is as large as the errors
+    let after = verdicts(&stored_shelf().alter(|r| {
+        let middle = r.levels.get(r.levels.len() / 2).map(|l| l.ndof);
+        if let (Some(n), Some(m)) = (r.reference_ndof.as_mut(), middle) {
+            *n = m;
+        }
+    }));
+    let with_reference: Vec<&Claim> = before.iter().filter(|c| has_reference_part(&c.criterion)).collect();
+    assert!(with_reference.len() >= 5, "{} rows measure against a reference", with_reference.len());
+    for b in with_reference {
+        let a = after.iter().find(|a| a.id == b.id).unwrap();
+        assert!(
+            !passes(a.verdict) && !fails(a.verdict),
+            "{}: {:?} with a reference as coarse as the run's middle level ({:?} before): {}",
+            b.id,
+            a.verdict,
+            b.verdict,
+            a.measured
+        );
+    }
+}
+
+/// A verdict that the other parity of levels changes is fragile, and the row `parity` counts it.
+#[test]
+fn a_verdict_that_depends_on_the_parity_of_levels_is_fragile() {
+    let shelf = stored_shelf();
+    let roles = crate::common::roles();
+    let c = verdicts(&shelf);
+    let last = claims::claims_with(&shelf, roles, claims::ErrorSampling::Quadrature, claims::Parity::Last).unwrap();
+    let other = claims::claims_with(&shelf, roles, claims::ErrorSampling::Quadrature, claims::Parity::Other).unwrap();
+    let mut flips = 0;
+    for (l, o) in last.iter().zip(&other) {
+        assert_eq!(l.id, o.id, "both parities give the same rows");
+        if l.verdict != o.verdict {
+            flips += 1;
+            let r = c.iter().find(|r| r.id == l.id).unwrap();
+            assert!(r.fragile.as_deref().is_some_and(|f| f.contains("other parity")), "{}: {:?}", r.id, r.fragile);
+        }
+    }
+    let parity = c.iter().find(|r| r.id == "parity").expect("the row parity");
+    assert!(parity.summary.headline.starts_with(&format!("{flips} of ")), "{}", parity.summary.headline);
 }

@@ -8,7 +8,7 @@ use std::path::Path;
 #[test]
 fn every_claims_row_belongs_to_a_study() {
     for c in signorini::claims::claims(&common::shelf(Path::new("results")), crate::common::roles()).unwrap() {
-        assert!(!signorini::page::claim_studies(c.id).is_empty(), "CLAIMS row {} maps to no study (page::claim_studies)", c.id);
+        assert!(!signorini::page::claim_studies(&c.id).is_empty(), "CLAIMS row {} maps to no study (page::claim_studies)", c.id);
     }
 }
 
@@ -50,7 +50,7 @@ fn study_pages_load_in_chromium_with_every_image_and_claim() {
         for (name, loaded) in &seen.images {
             assert!(loaded, "{study}: image {name} did not load");
         }
-        for c in claims.iter().filter(|c| signorini::page::claim_studies(c.id).contains(&study.as_str())) {
+        for c in claims.iter().filter(|c| signorini::page::claim_studies(&c.id).contains(&study.as_str())) {
             assert!(seen.text.contains(&format!("{}:", c.id)), "{study}: CLAIMS row {} missing from the page", c.id);
         }
         assert!(seen.text.contains(&format!("Study {study}")) && seen.text.contains("Provenance"), "{study}: {}", seen.text);

@@ -170,7 +170,7 @@ fn every_role_figure_and_row_table_reads_a_defined_study() {
     }
     let shelf = crate::common::shelf(Path::new("results"));
     for c in signorini::analysis::claims::claims(&shelf, crate::common::roles()).unwrap() {
-        for study in signorini::plot::page::claim_studies(c.id) {
+        for study in signorini::plot::page::claim_studies(&c.id) {
             assert!(studies::ALL.contains(study), "CLAIMS row {} reads study {study}: not in studies::ALL", c.id);
         }
     }

@@ -104,6 +104,10 @@ pub enum Criterion {
     /// Fewer unknowns than uniform refinement for the same error, where uniform refinement is
     /// slower than `claim` beyond its band (see `claims::repair::unknowns`).
     FewerUnknowns { claim: f64 },
+    /// The reference solution a row's errors are measured against is fine enough: its own error
+    /// (estimated) at most `share` of the smallest error the row judges (evidence: that ratio).
+    /// A coarser reference leaves the row undecided; it does not fail the claim.
+    Reference { share: f64 },
     /// The same criterion for each of `of` (evidence: one per item).
     Each { of: Vec<String>, each: Box<Criterion> },
     /// Every part (evidence: one per part).
@@ -229,15 +233,49 @@ impl Criterion {
                     }
                 }
             }
+            (Criterion::Reference { share }, Evidence::Value(v)) => {
+                if *v <= *share {
+                    Outcome::Pass
+                } else {
+                    Outcome::Open
+                }
+            }
             (Criterion::Each { of, each }, Evidence::All(es)) if es.len() == of.len() => {
                 combine(&es.iter().map(|e| each.judge(e.as_ref())).collect::<Vec<_>>())
             }
             (Criterion::All(parts), Evidence::All(es)) if es.len() == parts.len() => {
-                combine(&parts.iter().zip(es).map(|(p, e)| p.judge(e.as_ref())).collect::<Vec<_>>())
+                let outs: Vec<Outcome> = parts.iter().zip(es).map(|(p, e)| p.judge(e.as_ref())).collect();
+                // errors against a reference too coarse decide nothing, a failure included
+                let coarse = parts.iter().zip(&outs).any(|(p, o)| matches!(p, Criterion::Reference { .. }) && *o != Outcome::Pass);
+                if coarse { Outcome::Open } else { combine(&outs) }
             }
             (Criterion::Reported { .. }, _) => Outcome::Reported,
             // evidence of another kind than the criterion judges: decides nothing
             _ => Outcome::Open,
+        }
+    }
+
+    /// The rule a row of some kind applies, without the runs it names: "rate 1.5 in NDF of the
+    /// adaptive error", "bounded estimate / error". A reference check and the items of
+    /// [`Criterion::Each`] are the rule of their principal part.
+    pub fn rule(&self) -> String {
+        // `what` names the runs last, in parentheses: "estimate / error (deep/ex71_as_written)"
+        let bare = |w: &str| w.rsplit_once(" (").map_or(w, |(head, _)| head).to_string();
+        match self {
+            Criterion::Rate { claim, abscissa, .. } => format!("rate {claim} against {abscissa:?}"),
+            Criterion::Bounded { what } => format!("bounded {}", bare(what)),
+            Criterion::NotGrowing { what } => format!("not growing {}", bare(what)),
+            Criterion::FasterThan { what, than, abscissa } => format!("{} faster than {than} against {abscissa:?}", bare(what)),
+            Criterion::Decays { what } => format!("decays {}", bare(what)),
+            Criterion::AtMost { what, limit, .. } => format!("{} at most {limit}", bare(what)),
+            Criterion::Test { passes_if, .. } => format!("test: {passes_if}"),
+            Criterion::FewerUnknowns { claim } => format!("fewer unknowns than uniform, claim {claim}"),
+            Criterion::Reference { share } => format!("reference within {share}"),
+            Criterion::Each { each, .. } => each.rule(),
+            Criterion::All(parts) => {
+                parts.iter().filter(|p| !matches!(p, Criterion::Reference { .. })).map(Criterion::rule).collect::<Vec<_>>().join(" and ")
+            }
+            Criterion::Reported { .. } => "reported".into(),
         }
     }
 
@@ -304,6 +342,10 @@ impl Criterion {
             Criterion::FewerUnknowns { claim } => format!(
                 "not applicable where the 95% interval of uniform refinement's error rate in NDF reaches {:.1} (uniform attains the claimed rate's band); elsewhere fails if, at the end of the common window of both fitted error lines (a decade of NDF at least, no extrapolation), the 95% interval of the adaptive line's error lies above the uniform line's (adaptive needs more unknowns); not decided if they overlap",
                 claim - verdict::RATE_BAND
+            ),
+            Criterion::Reference { share } => format!(
+                "not decided while the reference solution's own error (estimated by extrapolating the fitted error rate of the run marked as the reference is to the reference's NDF) exceeds {:.0}% of the smallest error judged",
+                100.0 * share
             ),
             Criterion::Each { of, each } => format!("for each of {}: {}", of.join(", "), each.fails_if()),
             Criterion::All(parts) => parts.iter().map(|p| p.fails_if()).collect::<Vec<_>>().join("; "),

@@ -161,6 +161,15 @@ impl Shelf {
         Ok(self.shelved(study)?.map(|s| s.runs.clone()).unwrap_or_default())
     }
 
+    /// The shelf with every record altered by `f` in memory (nothing on disk changes): what a
+    /// test of the verdicts uses to show that each kind of row can fail.
+    pub fn alter(mut self, mut f: impl FnMut(&mut RunRecord)) -> Shelf {
+        for s in self.studies.values_mut() {
+            s.runs.iter_mut().for_each(&mut f);
+        }
+        self
+    }
+
     /// The folder of `study`'s records (for messages).
     pub fn runs_folder(&self, study: &str) -> Result<PathBuf, ShelfError> {
         self.shelved(study)?;
