@@ -33,6 +33,8 @@
 //! | `ex72_rollers_error` | `ex72_rollers` | the same for Example 7.2 on rollers (`plot/ex72_large.rs`) |
 //! | `estimator_repair` | the runs the CLAIMS row `estimator-repair` reads (`claims::repair::Stored::fitted`: `deep`, `ex72_large`, `estimator_repair`), a 2 x 2 grid, a panel per problem | `err_quadrature` (solid, filled) and `estimate` (dashed, hollow) vs NDF for the repaired run, the run without full-contact nodes, eta_5 as written, uniform refinement and the repaired run with l_h = 1 |
 //!
+//! [`SHOWN`] gives each figure's study and the caption its study page shows under it.
+//!
 //! Coinciding series: in every panel of every line figure, a series with the same values as a
 //! later one at every level (e.g. `uniform` and `uniform_cartesian` of ex71, `repaired` and
 //! `without_full_contact` of ex72_large), or values within [`DRAWS_OVER_REL`] of them, would
@@ -87,48 +89,148 @@ use render::{Figure, HLine, LineFigure, Marker, MeshFigure, PALETTE, Panel, Seri
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
-/// Every figure, in the order drawn. A figure that draws a whole ablation study (`c0_sweep`,
-/// `log_ablation`, ...) is named after it: its name is the study's ([`studies`]).
-pub const FIGURES: [&str; 20] = [
-    "fig2a",
-    "fig2b",
-    "fig3a",
-    "fig3b",
-    "fig3b_variant",
-    "fig4a",
-    "fig4b",
-    studies::C0_SWEEP,
-    studies::LOG_ABLATION,
-    studies::CONTACT_TERM_ABLATION,
-    studies::THETA_ABLATION,
-    "fb_error",
-    "fb_mesh",
-    "hertz_pressure",
-    "hertz_mesh",
-    studies::ESTIMATOR_REPAIR,
-    "deep_error",
-    "deep_floor",
-    "ex72_large_error",
-    "ex72_rollers_error",
+/// A figure: its name (the file stem under `figures/`), the study it is drawn from, and its
+/// caption on the study page (what it shows: the quantities, the runs, the axes).
+#[derive(Clone, Copy, Debug)]
+pub struct Shown {
+    pub name: &'static str,
+    pub study: Study,
+    pub caption: &'static str,
+}
+
+/// Every figure, in the order drawn, with its study and caption (the table above says how each
+/// is drawn). A figure that draws a whole ablation study (`c0_sweep`, `log_ablation`, ...) is
+/// named after it: its name is the study's ([`studies`]).
+pub const SHOWN: [Shown; 20] = [
+    Shown {
+        name: "fig2a",
+        study: studies::EX71,
+        caption: "Example 7.1 (Fig. 2a): the error ‖u − uₕ‖∞ and the estimate C₀ηₕ against the number of unknowns NDF, log-log, for every run of ex71 (the adaptive run solid, the others dashed), with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "fig2b",
+        study: studies::EX71,
+        caption: "Example 7.1 (Fig. 2b): the efficiency index C₀ηₕ / ‖u − uₕ‖∞ (left) and the efficiency index divided by the log factor lₕ (right) against NDF, for every run of ex71, with the line efficiency = 1.",
+    },
+    Shown {
+        name: "fig3a",
+        study: studies::EX72,
+        caption: "Example 7.2 (Fig. 3a): the estimate C₀ηₕ and, where a reference solution was computed, the error ‖u − uₕ‖∞ against it, against NDF, log-log, for every run of ex72, with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "fig3b",
+        study: studies::EX72,
+        caption: "Example 7.2 (Fig. 3b): the adaptive mesh of the run with η₅ as written at level 20 (or its finest saved level, which the title names), active contact nodes red, inactive blue, the obstacle's kink a black diamond.",
+    },
+    Shown {
+        name: "fig3b_variant",
+        study: studies::CONTACT_TERM_ABLATION,
+        caption: "Example 7.2: the adaptive mesh at level 20 of the run that marks with η₅ without full-contact nodes (contact_term_ablation), drawn as Fig. 3b, to set beside the paper's mesh.",
+    },
+    Shown {
+        name: "fig4a",
+        study: studies::EX71,
+        caption: "Example 7.1 (Fig. 4a): the estimator contributions η₁ … η₅ of the run with η₅ as written against NDF, log-log, with the reference rate NDF^−3/2; the legend says what η₆ and η₇ are.",
+    },
+    Shown {
+        name: "fig4b",
+        study: studies::EX72,
+        caption: "Example 7.2 (Fig. 4b): the estimator contributions η₁ … η₇ of the run with η₅ as written against NDF, log-log, with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: studies::C0_SWEEP,
+        study: studies::C0_SWEEP,
+        caption: concat!(
+            "The efficiency C₀ηₕ / ‖u − uₕ‖∞ against NDF, a panel per problem, for every run of c0_sweep with the paper's C₀ = ",
+            c0_paper!(),
+            " (solid) and with the smallest C₀ that bounds the error at every level of the run (dashed), with the line efficiency = 1."
+        ),
+    },
+    Shown {
+        name: studies::LOG_ABLATION,
+        study: studies::LOG_ABLATION,
+        caption: "The efficiency index C₀ηₕ / ‖u − uₕ‖∞ against NDF, a panel per problem, for each log factor lₕ of the estimator in log_ablation (1 + |log h_min|², 1 + |log h_min|, 1), with the line efficiency = 1.",
+    },
+    Shown {
+        name: studies::CONTACT_TERM_ABLATION,
+        study: studies::CONTACT_TERM_ABLATION,
+        caption: "The estimate C₀ηₕ (solid) and its contact term η₅ (dashed) against NDF, log-log, a panel per problem, for each form of η₅ in contact_term_ablation (as written, without full-contact nodes, repaired).",
+    },
+    Shown {
+        name: studies::THETA_ABLATION,
+        study: studies::THETA_ABLATION,
+        caption: "The error ‖u − uₕ‖∞ against NDF, log-log, a panel per problem, for each marking parameter θ of theta_ablation and for uniform refinement (the estimate C₀ηₕ instead where a run has fewer than two errors, as the y label says), with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "fb_error",
+        study: studies::FB,
+        caption: "The free-boundary problem with an exact solution: the error ‖u − uₕ‖∞ (solid) and the estimate C₀ηₕ (dashed) against NDF, log-log, for every run of fb, with the reference rate NDF^−3/2; the legend gives each run's last contact zone against the exact one, [a, 1].",
+    },
+    Shown {
+        name: "fb_mesh",
+        study: studies::FB,
+        caption: "The free-boundary problem: the finest saved adaptive mesh of the run without full-contact nodes (else of the run with η₅ as written), active contact nodes red, inactive blue, the free boundary x = a dashed.",
+    },
+    Shown {
+        name: "hertz_pressure",
+        study: studies::HERTZ,
+        caption: "An elastic cylinder on a rigid flat: the contact pressure at the contact nodes of each run's finest saved mesh against Hertz's, in the units x / a and p / p₀ (left), and its deviation from Hertz's at the vertices (solid) and the edge midpoints (dashed) (right).",
+    },
+    Shown {
+        name: "hertz_mesh",
+        study: studies::HERTZ,
+        caption: "An elastic cylinder on a rigid flat: the finest saved mesh of the adaptive run near the contact (|x| ≤ 1.5a), active contact nodes red, inactive blue, Hertz's half-width a dashed.",
+    },
+    Shown {
+        name: studies::ESTIMATOR_REPAIR,
+        study: studies::ESTIMATOR_REPAIR,
+        caption: "The runs the CLAIMS row estimator-repair reads, a panel per problem: the error ‖u − uₕ‖∞ (solid) and the estimate C₀ηₕ (dashed) against NDF, log-log, for the repaired estimator, η₅ without full-contact nodes, η₅ as written, uniform refinement and the repaired estimator with lₕ = 1, with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "deep_error",
+        study: studies::DEEP,
+        caption: "The deep runs to 10⁷ unknowns: the error ‖u − uₕ‖∞ against NDF, log-log, a panel per problem (Example 7.1, the free-boundary problem), for η₅ as written, without full-contact nodes, repaired and uniform refinement, with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "deep_floor",
+        study: studies::DEEP,
+        caption: "The deep runs with η₅ as written and uniform refinement, a panel per problem: the error ‖u − uₕ‖∞, the estimate C₀ηₕ and a margin times the round-off floor of uₕ (dashed, the margin in the legend; CLAIMS fits no error below it) against NDF, log-log.",
+    },
+    Shown {
+        name: "ex72_large_error",
+        study: studies::EX72_LARGE,
+        caption: "Example 7.2 to about 10⁶ unknowns: the error ‖u − uₕ‖∞ against a reference solution of 4.5 × 10⁶ unknowns, on the whole square (left) and on Γ_C away from the corners (right), against NDF, log-log, for every run of ex72_large (η₅ as written, without full-contact nodes, repaired, uniform refinement), with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "ex72_rollers_error",
+        study: studies::EX72_ROLLERS,
+        caption: "Example 7.2 with the left side on rollers: the error ‖u − uₕ‖∞ against a reference solution of 1.4 × 10⁶ unknowns, on the whole square (left) and on Γ_C (right), against NDF, log-log, for every run of ex72_rollers (η₅ as written, without full-contact nodes, repaired, uniform refinement), with the reference rate NDF^−3/2.",
+    },
 ];
 
-/// The study a figure is drawn from (the table above).
+/// Every figure's name, in the order drawn ([`SHOWN`]).
+pub const FIGURES: [&str; SHOWN.len()] = {
+    let mut names = [""; SHOWN.len()];
+    let mut i = 0;
+    while i < SHOWN.len() {
+        names[i] = SHOWN[i].name;
+        i += 1;
+    }
+    names
+};
+
+fn shown(figure: &str) -> Option<&'static Shown> {
+    SHOWN.iter().find(|s| s.name == figure)
+}
+
+/// The study a figure is drawn from ([`SHOWN`]).
 pub fn study_of(figure: &str) -> Option<Study> {
-    Some(match figure {
-        "fig2a" | "fig2b" | "fig4a" => studies::EX71,
-        "fig3a" | "fig3b" | "fig4b" => studies::EX72,
-        "fig3b_variant" | studies::CONTACT_TERM_ABLATION => studies::CONTACT_TERM_ABLATION,
-        studies::C0_SWEEP => studies::C0_SWEEP,
-        studies::LOG_ABLATION => studies::LOG_ABLATION,
-        studies::THETA_ABLATION => studies::THETA_ABLATION,
-        "fb_error" | "fb_mesh" => studies::FB,
-        "hertz_pressure" | "hertz_mesh" => studies::HERTZ,
-        studies::ESTIMATOR_REPAIR => studies::ESTIMATOR_REPAIR,
-        "deep_error" | "deep_floor" => studies::DEEP,
-        "ex72_large_error" => studies::EX72_LARGE,
-        "ex72_rollers_error" => studies::EX72_ROLLERS,
-        _ => return None,
-    })
+    shown(figure).map(|s| s.study)
+}
+
+/// What a figure shows, one sentence for its caption on the study page ([`SHOWN`]).
+pub fn caption(figure: &str) -> Option<&'static str> {
+    shown(figure).map(|s| s.caption)
 }
 
 /// An estimator term below `ROUNDOFF` times the largest term of its level is round-off: drawn
@@ -875,6 +977,16 @@ mod tests {
         assert_eq!(told_apart("error ‖u‖, uniform", "error ‖u‖, uniform_cartesian"), "uniform");
         assert_eq!(told_apart("repaired", "without full contact"), "repaired");
         assert_eq!(told_apart("a, b", "a, b"), "a, b");
+    }
+
+    #[test]
+    fn every_figure_has_its_study_and_a_caption_that_says_what_it_shows() {
+        for f in FIGURES {
+            assert!(study_of(f).is_some(), "figure {f}: no study");
+            let c = caption(f).unwrap_or_else(|| panic!("figure {f}: no caption"));
+            assert!(c.len() > 80 && c.ends_with('.'), "figure {f}: caption {c:?}");
+            assert!(c.contains(" against ") || c.contains(" mesh "), "figure {f}: the caption names no axes: {c:?}");
+        }
     }
 
     #[test]

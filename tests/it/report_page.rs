@@ -1,6 +1,7 @@
 //! The study pages a reviewer opens in a browser (`signorini report`): built from the stored
 //! results and figures, loaded in headless Chromium, every image must load, every CLAIMS row of
-//! the study must be on the page, and no console error may appear.
+//! the study must be on the page, and no console error may appear. Read as HTML, every
+//! figure's caption says what it shows.
 
 use crate::common;
 use std::path::Path;
@@ -77,4 +78,37 @@ fn report_command_writes_the_pages_asked_for() {
     assert_eq!(bad.status.code(), Some(1), "{err}");
     assert!(err.contains("study nope has no records") && err.contains("hertz"), "{err}");
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// The study pages and the index written from the stored results and figures into the scratch
+/// folder `name`: (file name, HTML) per page, the index last.
+fn stored_pages(name: &str) -> Vec<(String, String)> {
+    let out = common::scratch(name);
+    let pages = signorini::page::write_pages(
+        &common::shelf(Path::new("results")),
+        Path::new("figures"),
+        &out,
+        &[],
+        &signorini::page::DriftReports::read(&[], false, "signorini drift --study STUDY").unwrap(),
+        crate::common::roles(),
+    )
+    .unwrap();
+    let read = pages.iter().map(|p| (p.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read_to_string(p).unwrap())).collect();
+    std::fs::remove_dir_all(&out).unwrap();
+    read
+}
+
+#[test]
+fn every_figure_caption_says_what_it_shows() {
+    for (file, html) in stored_pages("page-captions").iter().filter(|(f, _)| f != "index.html") {
+        let study = file.trim_end_matches(".html");
+        let captions: Vec<&str> = html.split("<figcaption>").skip(1).map(|c| &c[..c.find("</figcaption>").unwrap()]).collect();
+        assert_eq!(captions.len(), signorini::page::figures_of(study).len(), "{file}: a caption per figure");
+        for (caption, name) in captions.iter().zip(signorini::page::figures_of(study)) {
+            let text = &caption[..caption.find(" <span").unwrap_or(caption.len())];
+            assert_eq!(text, signorini::plot::caption(name).unwrap().replace('&', "&amp;"), "{file}: the caption of {name}");
+            assert!(text.contains(" against ") || text.contains("mesh"), "{file}: {name}'s caption names no axes: {text}");
+            assert!(text.len() > 80 && !text.starts_with(name), "{file}: {name}'s caption is its name: {text}");
+        }
+    }
 }
