@@ -4,7 +4,7 @@
 //!
 //! | figure | study / runs | shows |
 //! |---|---|---|
-//! | `ex72_large_error` | `ex72_large`, all runs | two panels against NDF: the error `err_quadrature` on the whole square, and `err_contact` on Gamma_C, for eta_5 as written, without full-contact nodes, repaired (adaptive) and uniform refinement, NDF^-3/2 below all; the rows `7.2-error` and `7.2-error-away-from-corners` of CLAIMS fit them |
+//! | `ex72_large_error` | `ex72_large`, all runs | two panels against NDF: the error `err_quadrature` on the whole square, and `err_contact` on Gamma_C, for eta_5 as written, without full-contact nodes, repaired (adaptive) and uniform refinement, NDF^-3/2 below all; the rows `7.2-error` and `7.2-error-away-from-corners` of CLAIMS fit them; the runs repaired and without full-contact nodes, with the same errors at every level, are drawn and named as every coinciding pair is ([`super::show_coincident`]) |
 //! | `ex72_rollers_error` | `ex72_rollers`, all runs | the same two panels on rollers (no corners); the rows `7.2r-*` fit them |
 
 use super::render::{LineFigure, MARKERS, Panel};

@@ -15,7 +15,7 @@
 //!
 //! | figure | study / runs | shows |
 //! |---|---|---|
-//! | `fig2a` | `ex71`, all runs (the first, `adaptive`, solid; others dashed, hollow markers) | `err_quadrature` (blue circles) and `estimate` (red squares) vs NDF, log-log; NDF^-3/2 reference 2.5x below the adaptive error; a series with the same values as a later one (uniform and uniform_cartesian) gets large hollow markers around it and the later one's legend names it |
+//! | `fig2a` | `ex71`, all runs (the first, `adaptive`, solid; others dashed, hollow markers) | `err_quadrature` (blue circles) and `estimate` (red squares) vs NDF, log-log; NDF^-3/2 reference 2.5x below the adaptive error |
 //! | `fig2b` | `ex71`, all runs | two panels: the efficiency index `efficiency` (= estimate / err_quadrature; recomputed if absent) and the efficiency / l_h, vs NDF, log x; y log if it spans more than a decade, else linear from 0; line at 1 |
 //! | `fig3a` | `ex72`, all runs | `estimate` vs NDF, log-log, plus `err_quadrature` (against the reference solution, its NDF from `reference_ndof` noted in the legend) where present; NDF^-3/2 below the adaptive estimate |
 //! | `fig3b_variant` | `contact_term_ablation`, the run of role `ex72-without-full-contact`, its mesh of level 20 | as `fig3b`, for the run marking with eta_5 without full-contact nodes: the mesh beside the paper's |
@@ -31,7 +31,16 @@
 //! | `deep_error`, `deep_floor` | `deep` | see `plot/deep.rs`: the error of the deep runs to 1e7 unknowns, and error, estimate and round-off floor together |
 //! | `ex72_large_error` | `ex72_large` | see `plot/ex72_large.rs`: Example 7.2's error on the square and on Gamma_C against the reference, every run |
 //! | `ex72_rollers_error` | `ex72_rollers` | the same for Example 7.2 on rollers (`plot/ex72_large.rs`) |
-//! | `estimator_repair` | the runs the CLAIMS row `estimator-repair` reads (`claims::repair::Stored::fitted`: `deep`, `ex72_large`, `estimator_repair`), a 2 x 2 grid, a panel per problem | `err_quadrature` (solid, filled) and `estimate` (dashed, hollow) vs NDF for the repaired run, eta_5 as written, uniform refinement and the repaired run with l_h = 1; the run without full-contact nodes drawn only where it differs from the repaired one (else a note says it coincides) |
+//! | `estimator_repair` | the runs the CLAIMS row `estimator-repair` reads (`claims::repair::Stored::fitted`: `deep`, `ex72_large`, `estimator_repair`), a 2 x 2 grid, a panel per problem | `err_quadrature` (solid, filled) and `estimate` (dashed, hollow) vs NDF for the repaired run, the run without full-contact nodes, eta_5 as written, uniform refinement and the repaired run with l_h = 1 |
+//!
+//! [`SHOWN`] gives each figure's study and the caption its study page shows under it.
+//!
+//! Coinciding series: in every panel of every line figure, a series with the same values as a
+//! later one at every level (e.g. `uniform` and `uniform_cartesian` of ex71, `repaired` and
+//! `without_full_contact` of ex72_large), or values within [`DRAWS_OVER_REL`] of them, would
+//! hide under it; it gets large hollow markers drawn around the later one's, and the later one's
+//! legend says "(same values as …)", naming it, with the largest relative difference where they
+//! are not the same ([`show_coincident`], applied to every figure as it is built).
 //!
 //! Style: log axes labelled at the decades (`10⁻⁴`; also 2x and 5x when less than two decades
 //! show), light grid lines at 2..9 x each decade; one colour and marker shape per series; the
@@ -67,6 +76,7 @@ pub mod render;
 mod repair;
 mod rich;
 
+use crate::analysis::claims::COINCIDE_REL;
 use crate::analysis::problem_names;
 use crate::analysis::roles::{self, Role, Roles};
 use crate::analysis::studies::{self, Study};
@@ -79,48 +89,148 @@ use render::{Figure, HLine, LineFigure, Marker, MeshFigure, PALETTE, Panel, Seri
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
-/// Every figure, in the order drawn. A figure that draws a whole ablation study (`c0_sweep`,
-/// `log_ablation`, ...) is named after it: its name is the study's ([`studies`]).
-pub const FIGURES: [&str; 20] = [
-    "fig2a",
-    "fig2b",
-    "fig3a",
-    "fig3b",
-    "fig3b_variant",
-    "fig4a",
-    "fig4b",
-    studies::C0_SWEEP,
-    studies::LOG_ABLATION,
-    studies::CONTACT_TERM_ABLATION,
-    studies::THETA_ABLATION,
-    "fb_error",
-    "fb_mesh",
-    "hertz_pressure",
-    "hertz_mesh",
-    studies::ESTIMATOR_REPAIR,
-    "deep_error",
-    "deep_floor",
-    "ex72_large_error",
-    "ex72_rollers_error",
+/// A figure: its name (the file stem under `figures/`), the study it is drawn from, and its
+/// caption on the study page (what it shows: the quantities, the runs, the axes).
+#[derive(Clone, Copy, Debug)]
+pub struct Shown {
+    pub name: &'static str,
+    pub study: Study,
+    pub caption: &'static str,
+}
+
+/// Every figure, in the order drawn, with its study and caption (the table above says how each
+/// is drawn). A figure that draws a whole ablation study (`c0_sweep`, `log_ablation`, ...) is
+/// named after it: its name is the study's ([`studies`]).
+pub const SHOWN: [Shown; 20] = [
+    Shown {
+        name: "fig2a",
+        study: studies::EX71,
+        caption: "Example 7.1 (Fig. 2a): the error ‖u − uₕ‖∞ and the estimate C₀ηₕ against the number of unknowns NDF, log-log, for every run of ex71 (the adaptive run solid, the others dashed), with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "fig2b",
+        study: studies::EX71,
+        caption: "Example 7.1 (Fig. 2b): the efficiency index C₀ηₕ / ‖u − uₕ‖∞ (left) and the efficiency index divided by the log factor lₕ (right) against NDF, for every run of ex71, with the line efficiency = 1.",
+    },
+    Shown {
+        name: "fig3a",
+        study: studies::EX72,
+        caption: "Example 7.2 (Fig. 3a): the estimate C₀ηₕ and, where a reference solution was computed, the error ‖u − uₕ‖∞ against it, against NDF, log-log, for every run of ex72, with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "fig3b",
+        study: studies::EX72,
+        caption: "Example 7.2 (Fig. 3b): the adaptive mesh of the run with η₅ as written at level 20 (or its finest saved level, which the title names), active contact nodes red, inactive blue, the obstacle's kink a black diamond.",
+    },
+    Shown {
+        name: "fig3b_variant",
+        study: studies::CONTACT_TERM_ABLATION,
+        caption: "Example 7.2: the adaptive mesh at level 20 of the run that marks with η₅ without full-contact nodes (contact_term_ablation), drawn as Fig. 3b, to set beside the paper's mesh.",
+    },
+    Shown {
+        name: "fig4a",
+        study: studies::EX71,
+        caption: "Example 7.1 (Fig. 4a): the estimator contributions η₁ … η₅ of the run with η₅ as written against NDF, log-log, with the reference rate NDF^−3/2; the legend says what η₆ and η₇ are.",
+    },
+    Shown {
+        name: "fig4b",
+        study: studies::EX72,
+        caption: "Example 7.2 (Fig. 4b): the estimator contributions η₁ … η₇ of the run with η₅ as written against NDF, log-log, with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: studies::C0_SWEEP,
+        study: studies::C0_SWEEP,
+        caption: concat!(
+            "The efficiency C₀ηₕ / ‖u − uₕ‖∞ against NDF, a panel per problem, for every run of c0_sweep with the paper's C₀ = ",
+            c0_paper!(),
+            " (solid) and with the smallest C₀ that bounds the error at every level of the run (dashed), with the line efficiency = 1."
+        ),
+    },
+    Shown {
+        name: studies::LOG_ABLATION,
+        study: studies::LOG_ABLATION,
+        caption: "The efficiency index C₀ηₕ / ‖u − uₕ‖∞ against NDF, a panel per problem, for each log factor lₕ of the estimator in log_ablation (1 + |log h_min|², 1 + |log h_min|, 1), with the line efficiency = 1.",
+    },
+    Shown {
+        name: studies::CONTACT_TERM_ABLATION,
+        study: studies::CONTACT_TERM_ABLATION,
+        caption: "The estimate C₀ηₕ (solid) and its contact term η₅ (dashed) against NDF, log-log, a panel per problem, for each form of η₅ in contact_term_ablation (as written, without full-contact nodes, repaired).",
+    },
+    Shown {
+        name: studies::THETA_ABLATION,
+        study: studies::THETA_ABLATION,
+        caption: "The error ‖u − uₕ‖∞ against NDF, log-log, a panel per problem, for each marking parameter θ of theta_ablation and for uniform refinement (the estimate C₀ηₕ instead where a run has fewer than two errors, as the y label says), with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "fb_error",
+        study: studies::FB,
+        caption: "The free-boundary problem with an exact solution: the error ‖u − uₕ‖∞ (solid) and the estimate C₀ηₕ (dashed) against NDF, log-log, for every run of fb, with the reference rate NDF^−3/2; the legend gives each run's last contact zone against the exact one, [a, 1].",
+    },
+    Shown {
+        name: "fb_mesh",
+        study: studies::FB,
+        caption: "The free-boundary problem: the finest saved adaptive mesh of the run without full-contact nodes (else of the run with η₅ as written), active contact nodes red, inactive blue, the free boundary x = a dashed.",
+    },
+    Shown {
+        name: "hertz_pressure",
+        study: studies::HERTZ,
+        caption: "An elastic cylinder on a rigid flat: the contact pressure at the contact nodes of each run's finest saved mesh against Hertz's, in the units x / a and p / p₀ (left), and its deviation from Hertz's at the vertices (solid) and the edge midpoints (dashed) (right).",
+    },
+    Shown {
+        name: "hertz_mesh",
+        study: studies::HERTZ,
+        caption: "An elastic cylinder on a rigid flat: the finest saved mesh of the adaptive run near the contact (|x| ≤ 1.5a), active contact nodes red, inactive blue, Hertz's half-width a dashed.",
+    },
+    Shown {
+        name: studies::ESTIMATOR_REPAIR,
+        study: studies::ESTIMATOR_REPAIR,
+        caption: "The runs the CLAIMS row estimator-repair reads, a panel per problem: the error ‖u − uₕ‖∞ (solid) and the estimate C₀ηₕ (dashed) against NDF, log-log, for the repaired estimator, η₅ without full-contact nodes, η₅ as written, uniform refinement and the repaired estimator with lₕ = 1, with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "deep_error",
+        study: studies::DEEP,
+        caption: "The deep runs to 10⁷ unknowns: the error ‖u − uₕ‖∞ against NDF, log-log, a panel per problem (Example 7.1, the free-boundary problem), for η₅ as written, without full-contact nodes, repaired and uniform refinement, with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "deep_floor",
+        study: studies::DEEP,
+        caption: "The deep runs with η₅ as written and uniform refinement, a panel per problem: the error ‖u − uₕ‖∞, the estimate C₀ηₕ and a margin times the round-off floor of uₕ (dashed, the margin in the legend; CLAIMS fits no error below it) against NDF, log-log.",
+    },
+    Shown {
+        name: "ex72_large_error",
+        study: studies::EX72_LARGE,
+        caption: "Example 7.2 to about 10⁶ unknowns: the error ‖u − uₕ‖∞ against a reference solution of 4.5 × 10⁶ unknowns, on the whole square (left) and on Γ_C away from the corners (right), against NDF, log-log, for every run of ex72_large (η₅ as written, without full-contact nodes, repaired, uniform refinement), with the reference rate NDF^−3/2.",
+    },
+    Shown {
+        name: "ex72_rollers_error",
+        study: studies::EX72_ROLLERS,
+        caption: "Example 7.2 with the left side on rollers: the error ‖u − uₕ‖∞ against a reference solution of 1.4 × 10⁶ unknowns, on the whole square (left) and on Γ_C (right), against NDF, log-log, for every run of ex72_rollers (η₅ as written, without full-contact nodes, repaired, uniform refinement), with the reference rate NDF^−3/2.",
+    },
 ];
 
-/// The study a figure is drawn from (the table above).
+/// Every figure's name, in the order drawn ([`SHOWN`]).
+pub const FIGURES: [&str; SHOWN.len()] = {
+    let mut names = [""; SHOWN.len()];
+    let mut i = 0;
+    while i < SHOWN.len() {
+        names[i] = SHOWN[i].name;
+        i += 1;
+    }
+    names
+};
+
+fn shown(figure: &str) -> Option<&'static Shown> {
+    SHOWN.iter().find(|s| s.name == figure)
+}
+
+/// The study a figure is drawn from ([`SHOWN`]).
 pub fn study_of(figure: &str) -> Option<Study> {
-    Some(match figure {
-        "fig2a" | "fig2b" | "fig4a" => studies::EX71,
-        "fig3a" | "fig3b" | "fig4b" => studies::EX72,
-        "fig3b_variant" | studies::CONTACT_TERM_ABLATION => studies::CONTACT_TERM_ABLATION,
-        studies::C0_SWEEP => studies::C0_SWEEP,
-        studies::LOG_ABLATION => studies::LOG_ABLATION,
-        studies::THETA_ABLATION => studies::THETA_ABLATION,
-        "fb_error" | "fb_mesh" => studies::FB,
-        "hertz_pressure" | "hertz_mesh" => studies::HERTZ,
-        studies::ESTIMATOR_REPAIR => studies::ESTIMATOR_REPAIR,
-        "deep_error" | "deep_floor" => studies::DEEP,
-        "ex72_large_error" => studies::EX72_LARGE,
-        "ex72_rollers_error" => studies::EX72_ROLLERS,
-        _ => return None,
-    })
+    shown(figure).map(|s| s.study)
+}
+
+/// What a figure shows, one sentence for its caption on the study page ([`SHOWN`]).
+pub fn caption(figure: &str) -> Option<&'static str> {
+    shown(figure).map(|s| s.caption)
 }
 
 /// An estimator term below `ROUNDOFF` times the largest term of its level is round-off: drawn
@@ -244,7 +354,17 @@ pub fn y_ranges(name: &str, shelf: &Shelf, roles: &Roles) -> anyhow::Result<Vec<
 /// A figure, or the reason it cannot be drawn yet.
 type Built = Result<Figure, String>;
 
+/// Figure `name` as drawn: in every panel of a line figure, a series with the same values as
+/// another is marked and named ([`show_coincident`]).
 fn build(name: &str, shelf: &Shelf, roles: &Roles) -> anyhow::Result<Built> {
+    let mut built = draw(name, shelf, roles)?;
+    if let Ok(Figure::Lines(f)) = &mut built {
+        f.panels.iter_mut().for_each(show_coincident);
+    }
+    Ok(built)
+}
+
+fn draw(name: &str, shelf: &Shelf, roles: &Roles) -> anyhow::Result<Built> {
     match name {
         "fig2a" => fig2a(shelf),
         "fig2b" => fig2b(shelf),
@@ -394,38 +514,71 @@ fn error_and_estimate(runs: &[RunRecord], panel: &mut Panel, error_label: &str) 
     }
 }
 
-/// Whether two series hold the same values at the same abscissae (to 1e-12 relative).
-fn same_values(a: &Series, b: &Series) -> bool {
-    a.points.len() == b.points.len()
-        && a.points.iter().zip(&b.points).all(|(p, q)| {
-            p.0 == q.0
-                && match (p.1, q.1) {
-                    (Some(x), Some(y)) => (x - y).abs() <= 1e-12 * x.abs().max(y.abs()),
-                    (x, y) => x.is_none() && y.is_none(),
-                }
-        })
+/// Two series whose values differ by at most this, relative, at every point draw one over the
+/// other: 0.1 % is below a pixel on every axis of the figures (a log axis of a decade and more,
+/// or a linear one from 0, over some 400 px).
+pub const DRAWS_OVER_REL: f64 = 1e-3;
+
+/// The largest relative difference between the values of two series at the same abscissae, at
+/// every point; `None` where their abscissae differ or a value is missing in one only.
+fn largest_difference(a: &Series, b: &Series) -> Option<f64> {
+    if a.points.len() != b.points.len() {
+        return None;
+    }
+    a.points.iter().zip(&b.points).try_fold(0.0f64, |d, (p, q)| {
+        (p.0 == q.0).then_some(())?;
+        match (p.1, q.1) {
+            (Some(x), Some(y)) if x == y => Some(d),
+            (Some(x), Some(y)) => Some(d.max((x - y).abs() / x.abs().max(y.abs()))),
+            (None, None) => Some(d),
+            _ => None,
+        }
+    })
 }
 
-/// Series of `p` that coincide with a later one would hide under it: each such series gets large
-/// hollow markers (drawn around the later one's), and the later one's legend says which it
-/// coincides with (`run` names a series' run in the label).
-fn show_coincident(p: &mut Panel, run: impl Fn(&str) -> String) {
+/// Whether a series has a value that is drawn: a series that is 0 (or missing) everywhere draws
+/// no curve on a log axis, and its legend says so.
+fn drawn(s: &Series) -> bool {
+    s.points.iter().any(|p| p.1.is_some_and(|y| y != 0.0 && y.is_finite()))
+}
+
+/// A series of `p` that coincides with a later one would hide under it: each such series gets
+/// large hollow markers (drawn around the later one's), and the later one's legend names it
+/// ([`told_apart`]): "(same values as X)" where their values agree to [`COINCIDE_REL`] at every
+/// level, as the CLAIMS rows compare runs, and "(same values as X to 2×10⁻⁵)" where they differ
+/// by at most that, relative, below [`DRAWS_OVER_REL`].
+fn show_coincident(p: &mut Panel) {
     for j in 0..p.series.len() {
-        let same: Vec<usize> = (0..j).filter(|&i| same_values(&p.series[i], &p.series[j])).collect();
+        if !drawn(&p.series[j]) {
+            continue;
+        }
+        let same: Vec<(usize, f64)> = (0..j)
+            .filter_map(|i| largest_difference(&p.series[i], &p.series[j]).filter(|&d| d <= DRAWS_OVER_REL).map(|d| (i, d)))
+            .collect();
         if same.is_empty() {
             continue;
         }
-        let names: Vec<String> = same.iter().map(|&i| run(&p.series[i].label)).collect();
-        for &i in &same {
+        let names: Vec<String> = same
+            .iter()
+            .map(|&(i, d)| {
+                let name = told_apart(&p.series[i].label, &p.series[j].label);
+                if d <= COINCIDE_REL { name } else { format!("{name} to {}", sci(d)) }
+            })
+            .collect();
+        for &(i, _) in &same {
             p.series[i].style = p.series[i].style.large();
         }
         p.series[j].label = format!("{} (same values as {})", p.series[j].label, names.join(", "));
     }
 }
 
-/// The run named at the end of a label "…, RUN" (fig2a's labels).
-fn run_of_label(label: &str) -> String {
-    label.rsplit(", ").next().unwrap_or(label).to_string()
+/// What names the series labelled `earlier` beside the one labelled `later`: its label without
+/// the leading ", "-separated parts the two share ("error ‖u − u_h‖, uniform" beside "error
+/// ‖u − u_h‖, uniform_cartesian" is "uniform"); the whole label where it shares none or all.
+fn told_apart(earlier: &str, later: &str) -> String {
+    let (a, b): (Vec<&str>, Vec<&str>) = (earlier.split(", ").collect(), later.split(", ").collect());
+    let shared = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    if shared == 0 || shared == a.len() { earlier.to_string() } else { a[shared..].join(", ") }
 }
 
 fn fig2a(shelf: &Shelf) -> anyhow::Result<Built> {
@@ -435,7 +588,6 @@ fn fig2a(shelf: &Shelf) -> anyhow::Result<Built> {
     };
     let mut p = Panel::new("Example 7.1: error and estimate vs NDF", NDF_DESC, format!("error {ERR} and {ESTIMATE}"));
     error_and_estimate(&runs, &mut p, &format!("error {ERR}"));
-    show_coincident(&mut p, run_of_label);
     p.slopes.push(Slope { anchor: SlopeAnchor::Below(0), ..slope() });
     Ok(Ok(single(p)))
 }
@@ -459,7 +611,6 @@ fn fig2b(shelf: &Shelf) -> anyhow::Result<Built> {
         for (k, r) in runs.iter().enumerate() {
             p.series.push(series(r, r.run.id.clone(), Style::nth(k).dashed(r.run.refine == Refine::Uniform), y));
         }
-        show_coincident(&mut p, |l| l.to_string());
         p.hlines.push(eff_one());
         out.push(p);
     }
@@ -778,6 +929,63 @@ mod tests {
                 let (a, b) = (key(w[0]), key(w[1]));
                 assert!(seen.insert((a.min(b), a.max(b))), "edge drawn twice");
             }
+        }
+    }
+
+    fn line(label: &str, ys: &[f64]) -> Series {
+        Series {
+            label: label.into(),
+            points: ys.iter().enumerate().map(|(i, &y)| (i as f64, Some(y))).collect(),
+            style: Style::nth(0),
+            roundoff: false,
+        }
+    }
+
+    #[test]
+    fn a_series_that_coincides_with_another_is_named_in_the_legend() {
+        let mut p = Panel::new("", "", "");
+        p.series = vec![
+            line("error, repaired", &[1.0, 0.5, 0.25]),
+            line("error, without full contact", &[1.0, 0.5, 0.25 * (1.0 + 1e-14)]),
+            line("error, uniform", &[1.0, 0.5, 0.3]),
+            line("estimate, uniform", &[10.0, 5.0, 3.0]),
+            line("estimate, repaired", &[10.0, 5.0, 3.0 * (1.0 + 2e-5)]),
+            line("η_{6}", &[0.0, 0.0, 0.0]),
+            line("η_{7}", &[0.0, 0.0, 0.0]),
+        ];
+        show_coincident(&mut p);
+        let labels: Vec<&str> = p.series.iter().map(|s| s.label.as_str()).collect();
+        assert_eq!(
+            labels,
+            [
+                "error, repaired",
+                "error, without full contact (same values as repaired)",
+                "error, uniform",
+                "estimate, uniform",
+                "estimate, repaired (same values as uniform to 2.00×10^{-5})",
+                "η_{6}",
+                "η_{7}"
+            ],
+            "a series 0 everywhere draws nothing to hide"
+        );
+        let large: Vec<bool> = p.series.iter().map(|s| s.style.large).collect();
+        assert_eq!(large, [true, false, false, true, false, false, false], "the hidden series is drawn around the other");
+    }
+
+    #[test]
+    fn a_coinciding_series_is_named_by_what_tells_it_apart() {
+        assert_eq!(told_apart("error ‖u‖, uniform", "error ‖u‖, uniform_cartesian"), "uniform");
+        assert_eq!(told_apart("repaired", "without full contact"), "repaired");
+        assert_eq!(told_apart("a, b", "a, b"), "a, b");
+    }
+
+    #[test]
+    fn every_figure_has_its_study_and_a_caption_that_says_what_it_shows() {
+        for f in FIGURES {
+            assert!(study_of(f).is_some(), "figure {f}: no study");
+            let c = caption(f).unwrap_or_else(|| panic!("figure {f}: no caption"));
+            assert!(c.len() > 80 && c.ends_with('.'), "figure {f}: caption {c:?}");
+            assert!(c.contains(" against ") || c.contains(" mesh "), "figure {f}: the caption names no axes: {c:?}");
         }
     }
 

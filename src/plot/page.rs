@@ -188,20 +188,64 @@ fn escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
-/// "1.234e-5", "-" for none.
+/// Text with numbers in it (a CLAIMS row's wording and evidence), HTML-escaped, each number in
+/// scientific notation (`4.4e-4`, `-1.2E+3`) in a `<span class="n">` that never wraps, so that no
+/// line ends inside one (`4.4e-` above `4`).
+fn prose(text: &str) -> String {
+    let text = escape(text);
+    let b = text.as_bytes();
+    let digits = |mut i: usize| {
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        i
+    };
+    let mut out = String::with_capacity(text.len());
+    let (mut copied, mut i) = (0, 0);
+    while i < b.len() {
+        let starts = b[i].is_ascii_digit() && (i == 0 || !(b[i - 1].is_ascii_alphanumeric() || b[i - 1] == b'.' || b[i - 1] == b'_'));
+        if !starts {
+            i += 1;
+            continue;
+        }
+        let start = if i > 0 && b[i - 1] == b'-' { i - 1 } else { i };
+        let mut end = digits(i);
+        if end + 1 < b.len() && b[end] == b'.' && b[end + 1].is_ascii_digit() {
+            end = digits(end + 1);
+        }
+        let mut exponent = end + 1;
+        if exponent < b.len() && (b[end] == b'e' || b[end] == b'E') && (b[exponent] == b'-' || b[exponent] == b'+') {
+            exponent += 1;
+        }
+        let after = digits(exponent);
+        let scientific = end < b.len() && (b[end] == b'e' || b[end] == b'E') && after > exponent;
+        if scientific && (after == b.len() || !b[after].is_ascii_alphanumeric()) {
+            out += &text[copied..start];
+            let _ = write!(out, "<span class=\"n\">{}</span>", &text[start..after]);
+            copied = after;
+            i = after;
+        } else {
+            i = end;
+        }
+    }
+    out + &text[copied..]
+}
+
+/// A number of the run table, every one in the same style: scientific with four significant
+/// digits (`9.117e6`, `1.945e-7`), "–" for none. The cells that hold them never wrap (`td.num`).
 fn num(v: Option<f64>) -> String {
     v.map_or("–".to_string(), |v| format!("{v:.3e}"))
 }
 
 fn run_table(runs: &[RunRecord]) -> String {
     let mut s = String::from(
-        "<table><tr><th>run</th><th>problem</th><th>refinement</th><th>estimator</th><th>levels</th><th>final NDF</th><th>final estimate</th><th>final error</th><th>efficiency</th></tr>\n",
+        "<table class=\"runs\"><tr><th>run</th><th>problem</th><th>refinement</th><th>estimator</th><th>levels</th><th>final NDF</th><th>final estimate</th><th>final error</th><th>efficiency</th></tr>\n",
     );
     for r in runs {
         let last = r.levels.last();
         let _ = writeln!(
             s,
-            "<tr><td>{}</td><td>{}</td><td>{:?}{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            "<tr><td>{}</td><td>{}</td><td>{:?}{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
             escape(&r.run.id),
             escape(&r.run.problem),
             r.run.refine,
@@ -211,7 +255,7 @@ fn run_table(runs: &[RunRecord]) -> String {
             last.map_or("–".into(), |l| l.ndof.to_string()),
             num(last.map(|l| l.terms.estimate)),
             num(last.and_then(|l| l.err_quadrature)),
-            last.and_then(|l| l.efficiency).map_or("–".into(), |e| format!("{e:.2}")),
+            num(last.and_then(|l| l.efficiency)),
         );
     }
     s + "</table>\n"
@@ -234,6 +278,13 @@ fn estimator_settings(config: &crate::estimator::estimate::EstimatorConfig) -> S
     if differ.is_empty() { "default".into() } else { differ.join("; ") }
 }
 
+/// The HTML id of CLAIMS row `id` on a study page: `claim-` and the row's markdown anchor
+/// ([`crate::analysis::claims::anchor`]: lower case, spaces to hyphens, no other punctuation),
+/// so that it is a valid id (`claim-estimator-repair-beyond-the-paper`).
+pub fn claim_id(id: &str) -> String {
+    format!("claim-{}", crate::analysis::claims::anchor(id))
+}
+
 fn claims_table(claims: &[&Claim]) -> String {
     if claims.is_empty() {
         return "<p>No CLAIMS row rests on this study.</p>\n".into();
@@ -243,13 +294,14 @@ fn claims_table(claims: &[&Claim]) -> String {
         // the summary line shows; the claim's full wording and its evidence fold behind it
         let _ = writeln!(
             s,
-            "<tr class=\"claim\" id=\"claim-{id}\"><td><b>{id}</b>: {}<details><summary>the claim in full</summary>{}</details><details><summary>what would fail it</summary>{}</details></td><td>{}</td><td>{}<details><summary>evidence</summary>{}</details></td><td>{}</td></tr>",
-            escape(&c.summary.topic),
-            escape(&c.claim),
-            escape(&crate::analysis::claims::capitalised(&c.criterion.fails_if())),
-            escape(c.summary.paper),
-            escape(&c.summary.headline),
-            escape(&c.measured),
+            "<tr class=\"claim\" id=\"{}\"><td><b>{id}</b>: {}<details><summary>the claim in full</summary>{}</details><details><summary>what would fail it</summary>{}</details></td><td>{}</td><td>{}<details><summary>evidence</summary>{}</details></td><td>{}</td></tr>",
+            claim_id(&c.id),
+            prose(&c.summary.topic),
+            prose(&c.claim),
+            prose(&crate::analysis::claims::capitalised(&c.criterion.fails_if())),
+            prose(c.summary.paper),
+            prose(&c.summary.headline),
+            prose(&c.measured),
             verdict_html(c),
             id = escape(&c.id)
         );
@@ -259,8 +311,8 @@ fn claims_table(claims: &[&Claim]) -> String {
 
 /// The verdict as HTML (the markdown bold of failures dropped), with "fragile" where it is.
 fn verdict_html(c: &Claim) -> String {
-    let fragile = c.fragile.as_ref().map(|f| format!(", <i>fragile</i>: {}", escape(f))).unwrap_or_default();
-    format!("{}{fragile}", escape(&c.verdict.text().replace("**", "")))
+    let fragile = c.fragile.as_ref().map(|f| format!(", <i>fragile</i>: {}", prose(f))).unwrap_or_default();
+    format!("{}{fragile}", prose(&c.verdict.text().replace("**", "")))
 }
 
 /// The index of the study pages: the summary line of every CLAIMS row, each linked to the pages
@@ -274,18 +326,15 @@ pub fn index_page(results: &Path, studies: &[String], claims: &[Claim]) -> Strin
     );
     s += "<table class=\"claims\"><tr><th>claim</th><th>the paper</th><th>measured</th><th>verdict</th><th>studies</th></tr>\n";
     for c in claims {
-        let links: Vec<String> = studies
-            .iter()
-            .filter(|st| rests_on(&c.id, st))
-            .map(|st| format!("<a href=\"{st}.html#claim-{id}\">{st}</a>", id = escape(&c.id)))
-            .collect();
+        let links: Vec<String> =
+            studies.iter().filter(|st| rests_on(&c.id, st)).map(|st| format!("<a href=\"{st}.html#{}\">{st}</a>", claim_id(&c.id))).collect();
         let _ = writeln!(
             s,
             "<tr><td><b>{}</b>: {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             escape(&c.id),
-            escape(&c.summary.topic),
-            escape(c.summary.paper),
-            escape(&c.summary.headline),
+            prose(&c.summary.topic),
+            prose(c.summary.paper),
+            prose(&c.summary.headline),
             verdict_html(c),
             links.join(", ")
         );
@@ -300,7 +349,10 @@ pub fn index_page(results: &Path, studies: &[String], claims: &[Claim]) -> Strin
 const PNG_SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
 
 fn figures_html(figures: &Path, study: &str) -> std::io::Result<String> {
-    let mut s = String::new();
+    let mut s = format!(
+        "<p>In every figure, a series with the same values as another at every level (or within {} %, so that one curve covers the other) is drawn with large hollow markers around the other, whose legend says \"(same values as …)\", with the largest relative difference where they differ.</p>\n",
+        100.0 * crate::plot::DRAWS_OVER_REL
+    );
     for name in figures_of(study) {
         let png = figures.join(format!("{name}.png"));
         match crate::records::read_bytes(&png) {
@@ -317,7 +369,8 @@ fn figures_html(figures: &Path, study: &str) -> std::io::Result<String> {
                 let data = base64::engine::general_purpose::STANDARD.encode(bytes);
                 let _ = writeln!(
                     s,
-                    "<figure><img alt=\"{name}\" src=\"data:image/png;base64,{data}\"><figcaption>{name}</figcaption></figure>"
+                    "<figure id=\"figure-{name}\"><img alt=\"{name}\" src=\"data:image/png;base64,{data}\"><figcaption>{} <span class=\"file\">({name}.png)</span></figcaption></figure>",
+                    escape(crate::plot::caption(name).unwrap_or(name))
                 );
             }
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
@@ -356,7 +409,8 @@ fn provenance_html(text: Option<&str>) -> String {
 const STYLE: &str = "body{font-family:'DejaVu Sans',sans-serif;max-width:1100px;margin:2em auto;color:#222}\
 table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:4px 8px;text-align:left;vertical-align:top}\
 th{background:#f4f4f4}figure{margin:1em 0}img{max-width:100%}.bad{color:#b00}code{font-size:90%}\
-details{margin-top:4px;color:#444}summary{cursor:pointer;color:#06c}";
+details{margin-top:4px;color:#444}summary{cursor:pointer;color:#06c}\
+td.num{white-space:nowrap;text-align:right}.n{white-space:nowrap}figcaption{color:#333}figcaption .file{color:#777;font-size:85%}";
 
 /// The page of `study`: `shelf` holds its records, `figures` its PNGs, `claims` every CLAIMS
 /// row (those of the study are shown), `drift` the drift report if one was found.
@@ -447,10 +501,26 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_figure_has_its_study() {
-        for f in crate::plot::FIGURES {
-            assert!(crate::plot::study_of(f).is_some(), "figure {f} has no study in plot::study_of");
-        }
+    fn numbers_in_the_run_table_print_in_one_style() {
+        assert_eq!(num(Some(9117456.44)), "9.117e6");
+        assert_eq!(num(Some(1.9451e-7)), "1.945e-7");
+        assert_eq!(num(Some(0.45)), "4.500e-1");
+        assert_eq!(num(None), "–");
+    }
+
+    #[test]
+    fn numbers_in_claims_text_never_break() {
+        assert_eq!(
+            prose("C_0 4.4e-4 over 54 runs, NDF 9.5e3–1.1e6, -2.5E+3 < eta2"),
+            "C_0 <span class=\"n\">4.4e-4</span> over 54 runs, NDF <span class=\"n\">9.5e3</span>–<span class=\"n\">1.1e6</span>, <span class=\"n\">-2.5E+3</span> &lt; eta2"
+        );
+        assert_eq!(prose("eta1 1.14, 1e6x, v1.2e3"), "eta1 1.14, 1e6x, v1.2e3");
+    }
+
+    #[test]
+    fn claim_ids_have_no_spaces() {
+        assert_eq!(claim_id("estimator-repair (beyond the paper)"), "claim-estimator-repair-beyond-the-paper");
+        assert_eq!(claim_id("c0"), "claim-c0");
     }
 
     #[test]

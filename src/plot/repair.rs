@@ -1,13 +1,12 @@
 //! The figure `estimator_repair`: a 2 x 2 grid with a panel per problem of the CLAIMS row
 //! `estimator-repair`, drawing exactly the runs that row reads ([`Stored::fitted`]): the
-//! repaired run, eta_5 as written, uniform refinement and the repaired run with l_h = 1. The run
-//! without full-contact nodes is drawn only where it differs from the repaired run; where the two
-//! coincide (same NDF and errors at every common level) a note says so instead of hiding one
-//! curve under the other.
+//! repaired run, the run without full-contact nodes, eta_5 as written, uniform refinement and the
+//! repaired run with l_h = 1. A series with the same values as another (the repaired run's error
+//! and that of the run without full-contact nodes, where their meshes agree at every level) is
+//! marked and named in the legend as in every figure ([`super::show_coincident`]).
 
 use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, ESTIMATE, Figure, NDF_DESC, PALETTE, Style, problem_title, series, slope};
-use crate::analysis::claims::COINCIDE_REL;
 use crate::analysis::claims::repair::{Fitted, PROBLEMS, Stored};
 use crate::analysis::roles::Roles;
 use crate::records::RunRecord;
@@ -19,20 +18,6 @@ fn name(r: &RunRecord) -> String {
     format!("{}/{}", r.study, r.run.id)
 }
 
-/// Same NDF and errors at every common level (to [`COINCIDE_REL`] relative, as the CLAIMS row
-/// compares them), and at least one level.
-fn coincide(a: &RunRecord, b: &RunRecord) -> bool {
-    let n = a.levels.len().min(b.levels.len());
-    n > 0
-        && a.levels.iter().zip(&b.levels).all(|(x, y)| {
-            x.ndof == y.ndof
-                && match (x.err_quadrature, y.err_quadrature) {
-                    (Some(p), Some(q)) => (p - q).abs() <= COINCIDE_REL * p.abs().max(q.abs()),
-                    (p, q) => p.is_none() && q.is_none(),
-                }
-        })
-}
-
 /// One problem's panel.
 fn panel(f: &Fitted) -> Option<Panel> {
     let repaired = f.repaired?;
@@ -41,19 +26,16 @@ fn panel(f: &Fitted) -> Option<Panel> {
         NDF_DESC,
         format!("error {ERR} (solid) and {ESTIMATE} (dashed)"),
     );
-    let mut roles: Vec<(&str, &RunRecord)> = vec![("repaired", repaired)];
-    match f.without_full_contact {
-        Some(w) if coincide(repaired, w) => {
-            p.notes.push(format!("{} = {} at every level (not drawn)", name(w), name(repaired)));
-        }
-        Some(w) => roles.push(("without full-contact nodes", w)),
-        None => {}
-    }
-    roles.extend(
-        [("η_{5} as written", f.as_written), ("uniform", f.uniform), ("repaired, l_{h} = 1", f.l1)]
-            .into_iter()
-            .filter_map(|(n, r)| Some((n, r?))),
-    );
+    let roles: Vec<(&str, &RunRecord)> = [
+        ("repaired", Some(repaired)),
+        ("without full-contact nodes", f.without_full_contact),
+        ("η_{5} as written", f.as_written),
+        ("uniform", f.uniform),
+        ("repaired, l_{h} = 1", f.l1),
+    ]
+    .into_iter()
+    .filter_map(|(n, r)| Some((n, r?)))
+    .collect();
     for (k, (role, r)) in roles.iter().enumerate() {
         let st = Style { color: PALETTE[k % PALETTE.len()], marker: MARKERS[k % MARKERS.len()], dashed: false, filled: true, large: false };
         if r.levels.iter().any(|l| l.err_quadrature.is_some()) {

@@ -584,3 +584,27 @@ fn log_axes_stay_within_two_decades_of_their_data() {
     }
     assert!(wide.is_empty(), "axes far beyond their data:\n{}", wide.join("\n"));
 }
+
+/// In every figure, a series with the same values as an earlier one at every level names it in
+/// its legend (the earlier one drawn with large hollow markers around it): on the stored
+/// results, `repaired` and `without_full_contact` of ex72_large, ex72_rollers and deep, and
+/// `uniform` and `uniform_cartesian` of ex71; a run with values of its own is named by nothing.
+#[test]
+fn a_series_that_coincides_with_another_is_named_in_the_legend() {
+    let figures = scratch("figures-coincide").join("figures");
+    let shelf = crate::common::shelf(&Path::new(env!("CARGO_MANIFEST_DIR")).join("results"));
+    let studies = ["ex71", "deep", "ex72_large", "ex72_rollers"].map(String::from);
+    plot::draw_studies(&shelf, &figures, crate::common::roles(), Some(&studies)).expect("draw_studies");
+    for (name, label, panels) in [
+        ("ex72_large_error", "without full contact (same values as repaired)", 2),
+        ("ex72_rollers_error", "without full contact (same values as repaired)", 2),
+        ("deep_error", "without full contact (same values as repaired)", 1),
+        // the error and the estimate of each
+        ("fig2a", ", uniform_cartesian (same values as uniform)", 2),
+        ("fig2b", "uniform_cartesian (same values as uniform)", 2),
+    ] {
+        let svg = read(&figures.join(format!("{name}.svg")));
+        assert_eq!(svg.matches(label).count(), panels, "{name}: legend {label:?}");
+        assert_eq!(svg.matches("(same values as").count(), panels, "{name}: only the coinciding runs are named");
+    }
+}
