@@ -326,8 +326,11 @@ pub fn index_page(results: &Path, studies: &[String], claims: &[Claim]) -> Strin
     );
     s += "<table class=\"claims\"><tr><th>claim</th><th>the paper</th><th>measured</th><th>verdict</th><th>studies</th></tr>\n";
     for c in claims {
-        let links: Vec<String> =
-            studies.iter().filter(|st| rests_on(&c.id, st)).map(|st| format!("<a href=\"{st}.html#{}\">{st}</a>", claim_id(&c.id))).collect();
+        let links: Vec<String> = studies
+            .iter()
+            .filter(|st| rests_on(&c.id, st))
+            .map(|st| format!("<a href=\"{st}.html#{}\">{st}</a>", claim_id(&c.id)))
+            .collect();
         let _ = writeln!(
             s,
             "<tr><td><b>{}</b>: {}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
