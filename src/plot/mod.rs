@@ -199,12 +199,12 @@ pub const SHOWN: [Shown; 20] = [
     Shown {
         name: "ex72_large_error",
         study: studies::EX72_LARGE,
-        caption: "Example 7.2 to about 10⁶ unknowns: the error ‖u − uₕ‖∞ against a reference solution of 4.5 × 10⁶ unknowns, on the whole square (left) and on Γ_C away from the corners (right), against NDF, log-log, for every run of ex72_large (η₅ as written, without full-contact nodes, repaired, uniform refinement), with the reference rate NDF^−3/2.",
+        caption: "Example 7.2 to about 10⁶ unknowns: the error ‖u − uₕ‖∞ against a finer reference solution (its size in the title), on the whole square (left) and on Γ_C away from the corners (right), against NDF, log-log, for every run of ex72_large (η₅ as written, without full-contact nodes, repaired, uniform refinement), with the reference rate NDF^−3/2.",
     },
     Shown {
         name: "ex72_rollers_error",
         study: studies::EX72_ROLLERS,
-        caption: "Example 7.2 with the left side on rollers: the error ‖u − uₕ‖∞ against a reference solution of 1.4 × 10⁶ unknowns, on the whole square (left) and on Γ_C (right), against NDF, log-log, for every run of ex72_rollers (η₅ as written, without full-contact nodes, repaired, uniform refinement), with the reference rate NDF^−3/2.",
+        caption: "Example 7.2 with the left side on rollers: the error ‖u − uₕ‖∞ against a finer reference solution (its size in the title), on the whole square (left) and on Γ_C (right), against NDF, log-log, for every run of ex72_rollers (η₅ as written, without full-contact nodes, repaired, uniform refinement), with the reference rate NDF^−3/2.",
     },
 ];
 
