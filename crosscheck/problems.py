@@ -1,5 +1,6 @@
-"""Problem data of Examples 7.1 and 7.2, transcribed from the paper's Section 7, and of the
-free-boundary problem `fb` (beyond the paper), transcribed from its definition (the doc comment of `Fb` in src/problems/builtin.rs).
+"""Problem data of Examples 7.1 and 7.2, transcribed from the paper's Section 7, of the
+free-boundary problem `fb` (beyond the paper), transcribed from its definition (the doc comment of `Fb` in src/problems/builtin.rs),
+and of Hertz contact `hertz` (beyond the paper), transcribed from experiments/problems/hertz.toml.
 
 Written independently of the Rust code on purpose: the cross-check is only worth something if the
 data enter twice, once on each side. `check_data` verifies the transcribed f, g and contact stresses
@@ -132,7 +133,22 @@ def problem(name, perturb=None):
             exact=fb_exact(),
             load_breaks=(FB_A,),
         )
-    raise ValueError(f"unknown problem {name!r} (expected ex71, ex72 or fb)")
+    if name == "hertz":
+        # experiments/problems/hertz.toml: the lower half of the unit disc centred at (0, 1),
+        # plane strain E = 1000, nu = 0.3, u = (0, -delta) on the flat side y = 1, delta = 0.005,
+        # no body force, zero traction on the free arc, fixed direction n = (0, -1), chi = y
+        E, nu, delta = 1000.0, 0.3, 0.005
+        return Problem(
+            name="hertz",
+            mu=E / (2 * (1 + nu)),
+            zeta=E * nu / ((1 + nu) * (1 - 2 * nu)),
+            f=None, g=None,
+            u_dirichlet=(0.0, -delta * dscale),
+            normal=(0.0, -1.0),
+            chi=lambda px, py: np.asarray(py, float).copy(),
+            exact=None,
+        )
+    raise ValueError(f"unknown problem {name!r} (expected ex71, ex72, fb or hertz)")
 
 
 def stress(p, grad_u):
