@@ -6,7 +6,8 @@ Per P2 node p, with Omega_p the elements containing p and h_p the diameter of Om
 
     eta_{1,p} = h_p^2 ||f + div sigma(u_h)||_Linf(Omega_p)
     eta_{2,p} = h_p   ||[sigma(u_h)] n||_Linf(Gamma_{p,I})     Gamma_{p,I}: the interior edges through p
-    eta_{3,p} = h_p   ||g - sigma(u_h) n||_Linf(Gamma_{p,N})   p a Neumann node
+    eta_{3,p} = h_p   ||g - sigma(u_h) n||_Linf(Gamma_{p,N})   p a Neumann node (and the traction of
+                                                              components Gamma_D leaves free, p a Dirichlet node)
     eta_{4,p} = h_p   ||t . sigma(u_h) n||_Linf(Gamma_{p,C})   p a contact node
     eta_{5,p} = h_p   ||n . sigma(u_h) n||_Linf(Gamma_{p,C})   p a contact node (contact_term: see below)
     eta_i = max_p eta_{i,p} (i = 1..5),  Psi = eta_1 + ... + eta_5,  l_h = 1 + |log h_min|^2,
@@ -210,7 +211,10 @@ class Evaluator:
                 gap = np.asarray(prob.chi(Xk[:, 0], Xk[:, 1]), float) - uh[t, idx] @ nc
                 penetration[k] = max(0.0, (-gap).max())
                 separation[k] = max(0.0, gap.max())
-            # Dirichlet edges: every problem here prescribes both components (no free component, no term)
+            elif prob.free:
+                # Gamma_D: a component the Dirichlet data leave free carries zero traction (rollers),
+                # so its traction is a Neumann residual, taken by eta_3 at Dirichlet nodes
+                neumann[k] = np.abs(tr[:, list(prob.free)]).max()
         return {"residual": residual, "jump": jump, "neumann": neumann, "tangential": tangential,
                 "normal": normal, "tensile": tensile, "penetration": penetration, "separation": separation}
 
@@ -252,7 +256,7 @@ class Evaluator:
         # the boundary edges of each node's patch (the patch's elements' edges on Gamma_N, Gamma_C)
         for k, (t, le) in enumerate(self.line_owner):
             for p in tris[t]:
-                if parts[k] == PART_NEUMANN and self.part[p] == PART_NEUMANN:
+                if parts[k] == self.part[p] in (PART_NEUMANN, PART_DIRICHLET):
                     e[p, 2] = max(e[p, 2], loc["neumann"][k])
                 elif parts[k] == PART_CONTACT and self.part[p] == PART_CONTACT:
                     has_contact[p] = True
