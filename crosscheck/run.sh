@@ -39,8 +39,8 @@ for p in ex71 ex72 fb; do
 done
 # the estimator's cases (`crosscheck.py estimator`): besides the structured and adaptive ones above
 # (contact_term as_written and tensile_on_full_contact), eta_5 without full-contact nodes on
-# structured meshes, and Hertz from its Gmsh mesh (experiments/hertz.toml's problem and mesh), on
-# the mesh itself and refined adaptively with the repaired contact terms
+# structured meshes, Example 7.2 on rollers, and Hertz from its Gmsh mesh (experiments/hertz.toml's
+# problem and mesh), on the mesh itself and refined adaptively with the repaired contact terms
 est=("$cases/ex71-structured-16" "$cases/ex72-structured-16" "$cases/fb-structured-16")
 for p in ex71 ex72 fb; do
     est+=("$cases/$p-adaptive-10" "$cases/$p-adaptive-repaired-10")
@@ -50,6 +50,11 @@ for p in ex72 fb; do
     "$bin" export --problem "$p" --mesh structured:16 --contact-term without-full-contact --out "$dir" || exit 1
     est+=("$dir")
 done
+# Example 7.2 on rollers (experiments/problems/ex72_rollers.toml): the traction of the component
+# Gamma_D leaves free, in eta_3 at the Dirichlet nodes
+dir="$cases/ex72_rollers-structured-16"
+"$bin" export --problem "$root/experiments/problems/ex72_rollers.toml" --mesh structured:16 --out "$dir" || exit 1
+est+=("$dir")
 hertz=(--problem "$root/experiments/problems/hertz.toml" --mesh "gmsh:$root/experiments/meshes/hertz.msh")
 "$bin" export "${hertz[@]}" --out "$cases/hertz" || exit 1
 "$bin" export "${hertz[@]}" --adapt-levels 4 --contact-term tensile-on-full-contact --out "$cases/hertz-adaptive-repaired-4" || exit 1
