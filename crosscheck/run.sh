@@ -45,7 +45,7 @@ est=("$cases/ex71-structured-16" "$cases/ex72-structured-16" "$cases/fb-structur
 for p in ex71 ex72 fb; do
     est+=("$cases/$p-adaptive-10" "$cases/$p-adaptive-repaired-10")
 done
-for p in ex72 fb; do
+for p in ex71 ex72 fb; do
     dir="$cases/$p-structured-16-without-full-contact"
     "$bin" export --problem "$p" --mesh structured:16 --contact-term without-full-contact --out "$dir" || exit 1
     est+=("$dir")
