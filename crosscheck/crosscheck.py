@@ -5,6 +5,7 @@
     crosscheck.py bench [--sizes 32,64,...]  NGSolve timings of Example 7.2's linear elasticity system
     crosscheck.py bench-cold --n N           one whole linear solve in a fresh process (for the Rust bench)
     crosscheck.py selftest [DIR...]          shows that `compare` fails when one side's data are perturbed
+    crosscheck.py estimator DIR [DIR...]     eta_1..eta_7, eta_h, eta_{i,p} and eta_T recomputed from u_h: must match
 
 Results go to results/crosscheck/ (JSON + Markdown, written atomically). Exit status 1 on any failure.
 """
@@ -26,6 +27,7 @@ sys.path.insert(0, HERE)
 
 import ngsolve as ng  # noqa: E402
 
+import estimator  # noqa: E402
 import fem  # noqa: E402
 import make_case  # noqa: E402
 import problems  # noqa: E402
@@ -52,9 +54,10 @@ def markdown_table(columns, rows):
     return "\n".join(lines) + "\n"
 
 
-def report(name, title, columns, rows, extra, out_dir):
-    """Print a table and write it as NAME.json and NAME.md under out_dir."""
-    table = markdown_table(columns, rows)
+def report(name, title, columns, rows, extra, out_dir, more=""):
+    """Print a table and write it as NAME.json and NAME.md under out_dir (with the markdown `more`
+    after the table)."""
+    table = markdown_table(columns, rows) + more
     print(table)
     if out_dir:
         doc = {"title": title, "ngsolve": ng.__version__, "rows": rows, **extra}
@@ -325,6 +328,113 @@ def cmd_bench(args):
     return True
 
 
+# -- estimator -----------------------------------------------------------------------------------
+TOL_ETA = 1e-9  # every estimator quantity, relative to its largest value in the case (see _scale)
+GLOBAL_TERMS = ("eta1", "eta2", "eta3", "eta4", "eta5", "eta6", "eta7", "l_h", "psi", "eta_h", "estimate")
+ETA_PERTURBATION = 1e-6  # the failure demonstration: u_h at one node moved by this times max |u_h|
+
+
+def estimator_diffs(case, ours, scale_u):
+    """Relative differences between our estimator and the exported one: each global term against
+    case.json's `estimator`, eta_{i,p} (point data eta1..eta5) node by node, eta_T (cell data
+    `indicator`) element by element; each relative to the quantity's largest value (over both
+    codes, and at least the round-off scale _scale gives it)."""
+    theirs = case.meta["estimator"]
+    d = {}
+    for k in GLOBAL_TERMS:
+        d[k] = abs(ours[k] - theirs[k]) / _scale(k, max(abs(ours[k]), abs(theirs[k])), scale_u)
+    pd = case.point_data
+    for i in range(5):
+        a, b = ours["eta_p"][:, i], np.asarray(pd[f"eta{i + 1}"], float)
+        d[f"eta{i + 1}_p"] = float(np.abs(a - b).max() / _scale(None, max(np.abs(a).max(), np.abs(b).max()), scale_u))
+    a, b = ours["eta_T"], np.asarray(case.cell_data["indicator"], float)
+    d["eta_T"] = float(np.abs(a - b).max() / _scale(None, max(np.abs(a).max(), np.abs(b).max()), scale_u))
+    return d
+
+
+def _scale(key, largest, scale_u):
+    """The denominator of a relative difference: the quantity's largest value; for eta_6 and eta_7
+    (maxima of u_h.n - chi, differences of displacements that vanish where u_h.n = chi at the
+    nodes) at least max |u_h|, whose round-off they carry; never zero."""
+    if key in ("eta6", "eta7"):
+        largest = max(largest, scale_u)
+    return largest if largest > 0 else 1.0
+
+
+def estimator_case(path):
+    """Recompute the case's estimator on NGSolve's side and compare; then show that the comparison
+    fails when u_h is perturbed at one node and under the contact-term variants that differ."""
+    t0 = time.perf_counter()
+    case = fem.read_case(path)
+    name = case.meta["problem"]
+    prob = problems.problem(name)
+    cfg = case.meta["estimator_config"]
+    pd = case.point_data
+    missing = [k for k in ("lambda_floor", "eta1", "eta5") if k not in pd]
+    if missing or "indicator" not in case.cell_data:
+        raise ValueError(f"{path}: mesh.vtu lacks {missing or 'indicator'} (export it with this `signorini export`)")
+    ev = estimator.Evaluator(case, prob)
+    U = np.asarray(pd["u"], float)[:, :2]
+    scale_u = float(np.abs(U).max())
+    inputs = (np.asarray(pd["lambda"], float), np.asarray(pd["lambda_floor"], float), pd["active"], pd["contact"])
+    ours = ev.terms(U, *inputs, cfg["contact_term"], cfg["c0"])
+    d = estimator_diffs(case, ours, scale_u)
+    worst = max(d, key=d.get)
+    row = {"case": os.path.basename(os.path.normpath(path)), "problem": name, "contact_term": cfg["contact_term"],
+           "elements": len(case.tris), "full_contact": ours["full_contact_nodes"],
+           **{k: ours[k] for k in ("eta1", "eta5", "eta6", "eta7", "eta_h")},
+           "diff": d, "max_rel_diff": d[worst], "worst": worst}
+    failures = [f"{k} differs by {v:.2e}" for k, v in d.items() if not v <= TOL_ETA]
+    if case.meta.get("full_contact_nodes", ours["full_contact_nodes"]) != ours["full_contact_nodes"]:
+        failures.append(f"full-contact nodes {case.meta['full_contact_nodes']} vs {ours['full_contact_nodes']}")
+
+    # the comparison can fail: u_h moved at the node of the largest eta_T's element, by
+    # ETA_PERTURBATION max |u_h| in both components, must be noticed
+    p0 = int(case.tris[int(np.argmax(ours["eta_T"])), 0])
+    Up = U.copy()
+    Up[p0] += ETA_PERTURBATION * scale_u
+    dp = estimator_diffs(case, ev.terms(Up, *inputs, cfg["contact_term"], cfg["c0"]), scale_u)
+    row["perturbed_u_max_rel_diff"] = max(dp.values())
+    if not row["perturbed_u_max_rel_diff"] > TOL_ETA:
+        failures.append("u_h perturbed at one node went unnoticed")
+    # ... and so must another contact-term variant, wherever it gives other numbers than the declared one
+    noticed = []
+    for term in estimator.CONTACT_TERMS:
+        if term == cfg["contact_term"]:
+            continue
+        other = ev.terms(U, *inputs, term, cfg["c0"], loc=ours["locals"])
+        differs = any(abs(other[k] - ours[k]) > TOL_ETA * _scale(k, abs(ours[k]), scale_u) for k in GLOBAL_TERMS) \
+            or np.abs(other["eta_T"] - ours["eta_T"]).max() > TOL_ETA * np.abs(ours["eta_T"]).max()
+        if not differs:
+            continue
+        dv = max(estimator_diffs(case, other, scale_u).values())
+        noticed.append(f"{term} {dv:.1e}")
+        if not dv > TOL_ETA:
+            failures.append(f"contact_term {term} instead of {cfg['contact_term']} went unnoticed")
+    row["other_contact_terms"] = ", ".join(noticed) if noticed else "same numbers"
+    row["seconds"] = round(time.perf_counter() - t0, 3)
+    row["result"] = "PASS" if not failures else "FAIL: " + "; ".join(failures)
+    return row
+
+
+ESTIMATOR_COLUMNS = ["case", "problem", "contact_term", "elements", "full_contact", "eta_h", "max_rel_diff", "worst",
+                     "perturbed_u_max_rel_diff", "other_contact_terms", "seconds", "result"]
+
+
+def cmd_estimator(args):
+    rows = in_parallel(estimator_case, args.dirs)
+    keys = list(rows[0]["diff"]) if rows else []
+    per_quantity = [{"case": r["case"], **{k: r["diff"][k] for k in keys}} for r in rows]
+    more = (f"\nRelative differences per quantity (tolerance {TOL_ETA:g}; `_p`: node by node, eta_T: element "
+            "by element):\n\n" + markdown_table(["case"] + keys, per_quantity))
+    report("estimator", "NGSolve cross-check of the estimator (eq. 6.3): eta_1..eta_7, eta_h, eta_{i,p}, eta_T "
+           "recomputed from the exported u_h", ESTIMATOR_COLUMNS, rows,
+           {"tolerance_rel": TOL_ETA, "perturbation": ETA_PERTURBATION,
+            "largest_rel_diff_per_quantity": {k: max(r["diff"][k] for r in rows) for k in keys}},
+           args.out_dir, more)
+    return all(r["result"] == "PASS" for r in rows)
+
+
 # -- selftest ------------------------------------------------------------------------------------
 # The datum we perturb for each problem: one that is nonzero there.
 PERTURB = {"ex71": "f", "ex72": "dirichlet", "fb": "f"}
@@ -397,6 +507,9 @@ def main():
                    help="NGSolve's sparse direct solver (pardisospd: MKL PARDISO's LL^T on the symmetric "
                         "matrix, in crosscheck/.venv-bench)")
     p.set_defaults(func=cmd_bench_cold)
+    p = sub.add_parser("estimator")
+    p.add_argument("dirs", nargs="+")
+    p.set_defaults(func=cmd_estimator)
     p = sub.add_parser("selftest")
     p.add_argument("dirs", nargs="*", help="exported cases to perturb (default: generated structured:8 cases)")
     p.set_defaults(func=cmd_selftest)

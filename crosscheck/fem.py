@@ -36,6 +36,7 @@ class Case:
     lines: np.ndarray  # (nl, 3): a b mid
     parts: np.ndarray  # (nl,): 1 Dirichlet, 2 Neumann, 3 contact
     point_data: dict = field(default_factory=dict)
+    cell_data: dict = field(default_factory=dict)  # per triangle (e.g. `indicator`), `part` excepted
 
     @property
     def n_vertices(self):
@@ -48,21 +49,28 @@ def read_case(path):
         meta = json.load(fh)
     tris = lines = None
     parts = None
-    for block, part in zip(m.cells, m.cell_data["part"]):
+    cell_data = {}
+    for b, (block, part) in enumerate(zip(m.cells, m.cell_data["part"])):
         if block.type == "triangle6":
             tris = block.data
+            cell_data = {k: _flat(v[b]) for k, v in m.cell_data.items() if k != "part"}
         elif block.type == "line3":
             lines, parts = block.data, np.asarray(part).reshape(-1)
         else:
             raise ValueError(f"{path}: unexpected cell type {block.type}")
     if tris is None or lines is None:
         raise ValueError(f"{path}: need a triangle6 and a line3 block")
-    # Scalar arrays written with NumberOfComponents="1" come back as (n, 1): flatten them.
-    point_data = {k: (v.reshape(-1) if v.ndim == 2 and v.shape[1] == 1 else v) for k, v in m.point_data.items()}
+    point_data = {k: _flat(v) for k, v in m.point_data.items()}
     case = Case(path, meta, np.asarray(m.points[:, :2], float), np.asarray(tris, np.int64),
-                np.asarray(lines, np.int64), parts, point_data)
+                np.asarray(lines, np.int64), parts, point_data, cell_data)
     _check_layout(case)
     return case
+
+
+def _flat(v):
+    """Scalar arrays written with NumberOfComponents="1" come back as (n, 1): flatten them."""
+    v = np.asarray(v)
+    return v.reshape(-1) if v.ndim == 2 and v.shape[1] == 1 else v
 
 
 def _check_layout(case):
@@ -202,7 +210,8 @@ class Discretisation:
     Unknown numbering: U[k * npts + p] is component k at node p (node numbering of mesh.vtu).
     """
 
-    def __init__(self, case, prob):
+    def __init__(self, case, prob, assemble=True):
+        """assemble=False: the mesh, the space and the change of basis only (no K, no F)."""
         self.case, self.prob = case, prob
         nv, npts = case.n_vertices, len(case.points)
         self.npts = npts
@@ -215,7 +224,10 @@ class Discretisation:
         self.fes = VectorH1(self.mesh, order=2, dirichlet="dirichlet")
         self._build_basis_change()
         self._classify_nodes()
+        if assemble:
+            self._assemble(case, prob)
 
+    def _assemble(self, case, prob):
         a = stiffness_form(self.fes, prob).Assemble()
         # f on triangles crossed by a line where it is not smooth: our own rule (split_load)
         split, F_split = split_load(case, prob, self.mesh) if prob.f is not None else ([], 0.0)

@@ -1,5 +1,7 @@
-"""Problem data of Examples 7.1 and 7.2, transcribed from the paper's Section 7, and of the
-free-boundary problem `fb` (beyond the paper), transcribed from its definition (the doc comment of `Fb` in src/problems/builtin.rs).
+"""Problem data of Examples 7.1 and 7.2, transcribed from the paper's Section 7, of the
+free-boundary problem `fb` (beyond the paper), transcribed from its definition (the doc comment of `Fb` in src/problems/builtin.rs),
+and of Hertz contact `hertz` and Example 7.2 on rollers `ex72_rollers` (beyond the paper), transcribed
+from experiments/problems/hertz.toml and ex72_rollers.toml.
 
 Written independently of the Rust code on purpose: the cross-check is only worth something if the
 data enter twice, once on each side. `check_data` verifies the transcribed f, g and contact stresses
@@ -27,6 +29,7 @@ class Problem:
     chi: object  # gap function: numpy (x, y) -> array
     exact: CF | None  # exact displacement, if known
     load_breaks: tuple = ()  # lines x = c across which f is not smooth (fem.split_load integrates there)
+    free: tuple = ()  # components the Dirichlet data leave free on Gamma_D (zero traction there: rollers)
 
     @property
     def normal_component(self):
@@ -132,7 +135,38 @@ def problem(name, perturb=None):
             exact=fb_exact(),
             load_breaks=(FB_A,),
         )
-    raise ValueError(f"unknown problem {name!r} (expected ex71, ex72 or fb)")
+    if name == "ex72_rollers":
+        # experiments/problems/ex72_rollers.toml: Example 7.2 with u_1 = 0.1 on x = 0 and u_2 free
+        # there (zero shear traction), u_2 = 0 at the point (0, 1/2); read by `estimator` only
+        # (the PDAS of fem.py prescribes both components on Gamma_D and has no point constraint)
+        E, nu = 500.0, 0.3
+        return Problem(
+            name="ex72_rollers",
+            mu=E / (2 * (1 + nu)),
+            zeta=E * nu / ((1 + nu) * (1 - 2 * nu)),
+            f=None, g=None,
+            u_dirichlet=(0.1 * dscale, 0.0),
+            normal=(1.0, 0.0),
+            chi=lambda px, py: -0.2 + 0.5 * np.abs(py - 0.5),
+            exact=None,
+            free=(1,),
+        )
+    if name == "hertz":
+        # experiments/problems/hertz.toml: the lower half of the unit disc centred at (0, 1),
+        # plane strain E = 1000, nu = 0.3, u = (0, -delta) on the flat side y = 1, delta = 0.005,
+        # no body force, zero traction on the free arc, fixed direction n = (0, -1), chi = y
+        E, nu, delta = 1000.0, 0.3, 0.005
+        return Problem(
+            name="hertz",
+            mu=E / (2 * (1 + nu)),
+            zeta=E * nu / ((1 + nu) * (1 - 2 * nu)),
+            f=None, g=None,
+            u_dirichlet=(0.0, -delta * dscale),
+            normal=(0.0, -1.0),
+            chi=lambda px, py: np.asarray(py, float).copy(),
+            exact=None,
+        )
+    raise ValueError(f"unknown problem {name!r} (expected ex71, ex72, fb, ex72_rollers or hertz)")
 
 
 def stress(p, grad_u):

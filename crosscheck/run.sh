@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# `make crosscheck`: export cases with the Rust binary, then run the NGSolve self-test, comparison
-# and rate check on them. Every step runs even if an earlier one failed (all tables get printed);
-# the exit status is non-zero if any failed. Results: {selftest,compare,rates}.{json,md} in
+# `make crosscheck`: export cases with the Rust binary, then run the NGSolve self-test, comparison,
+# rate check and estimator check on them. Every step runs even if an earlier one failed (all tables
+# get printed); the exit status is non-zero if any failed. Results: {selftest,compare,rates,estimator}.{json,md} in
 # $CROSSCHECK_OUT (default results/crosscheck, what `make crosscheck` stores; `make test` writes them
 # under target/ so that a test run changes no tracked file: the tables carry timings).
 set -uo pipefail
@@ -37,6 +37,29 @@ for p in ex71 ex72 fb; do
     "$bin" export --problem "$p" --mesh structured:4 --adapt-levels 10 --contact-term tensile-on-full-contact --out "$dir" || exit 1
     all+=("$dir")
 done
+# the estimator's cases (`crosscheck.py estimator`): besides the structured and adaptive ones above
+# (contact_term as_written and tensile_on_full_contact), eta_5 without full-contact nodes on
+# structured meshes, Example 7.2 on rollers, and Hertz from its Gmsh mesh (experiments/hertz.toml's
+# problem and mesh), on the mesh itself and refined adaptively with the repaired contact terms
+est=("$cases/ex71-structured-16" "$cases/ex72-structured-16" "$cases/fb-structured-16")
+for p in ex71 ex72 fb; do
+    est+=("$cases/$p-adaptive-10" "$cases/$p-adaptive-repaired-10")
+done
+for p in ex71 ex72 fb; do
+    dir="$cases/$p-structured-16-without-full-contact"
+    "$bin" export --problem "$p" --mesh structured:16 --contact-term without-full-contact --out "$dir" || exit 1
+    est+=("$dir")
+done
+# Example 7.2 on rollers (experiments/problems/ex72_rollers.toml): the traction of the component
+# Gamma_D leaves free, in eta_3 at the Dirichlet nodes
+dir="$cases/ex72_rollers-structured-16"
+"$bin" export --problem "$root/experiments/problems/ex72_rollers.toml" --mesh structured:16 --out "$dir" || exit 1
+est+=("$dir")
+hertz=(--problem "$root/experiments/problems/hertz.toml" --mesh "gmsh:$root/experiments/meshes/hertz.msh")
+"$bin" export "${hertz[@]}" --out "$cases/hertz" || exit 1
+"$bin" export "${hertz[@]}" --adapt-levels 4 --contact-term tensile-on-full-contact --out "$cases/hertz-adaptive-repaired-4" || exit 1
+est+=("$cases/hertz" "$cases/hertz-adaptive-repaired-4")
+
 dir="$cases/ex72-reference"
 "$bin" export --problem ex72 --mesh structured:4 --adapt-min-ndof 250000 --theta 0.5 \
     --contact-term without-full-contact --out "$dir" || exit 1
@@ -64,8 +87,8 @@ TOML
 (cd "$own" && "$py" "$root/experiments/meshes/generate.py" disc.geo) || exit 1
 "$bin" solve --problem "$own/disc.toml" --mesh "gmsh:$own/disc.msh" || exit 1
 
-# the self-test and the rates beside the comparison (two processes of its own): each prints its
-# table when it has ended, in this order
+# the self-test, the rates and the estimator check beside the comparison (two processes of its
+# own): each prints its table when it has ended, in this order
 status=0
 mkdir -p "$cases/logs"
 "$py" "$here/crosscheck.py" --out-dir "$out" selftest "$cases/ex71-structured-8" "$cases/ex72-structured-8" "$cases/fb-structured-8" \
@@ -73,9 +96,13 @@ mkdir -p "$cases/logs"
 selftest=$!
 "$py" "$here/crosscheck.py" --out-dir "$out" rates "${exact[@]}" > "$cases/logs/rates.txt" 2>&1 &
 rates=$!
+"$py" "$here/crosscheck.py" --out-dir "$out" estimator "${est[@]}" > "$cases/logs/estimator.txt" 2>&1 &
+estimator=$!
 "$py" "$here/crosscheck.py" --out-dir "$out" compare "${all[@]}" || status=1
 wait "$selftest" || status=1
 cat "$cases/logs/selftest.txt"
 wait "$rates" || status=1
 cat "$cases/logs/rates.txt"
+wait "$estimator" || status=1
+cat "$cases/logs/estimator.txt"
 exit $status

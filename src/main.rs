@@ -1195,7 +1195,9 @@ fn run_export(args: &SolveArgs, out: &std::path::Path) -> Result<()> {
         check_target("--out", &out.join(file))?;
     }
     let (mesh, sol, indicator, r) = run_solve(args)?;
-    for f in report::export_case(out, &mesh, &sol, &indicator, &r)? {
+    // eta_{1,p} .. eta_{5,p} per node, computed again for the file (the solve keeps only eta_T)
+    let nodal = estimate::node_terms(&mesh, problems::by_name(&args.problem)?.as_ref(), &sol, &r.estimator_config);
+    for f in report::export_case(out, &mesh, &sol, &indicator, &nodal, &r)? {
         wrote(&f, format_args!("wrote {}", f.display()));
     }
     Ok(())

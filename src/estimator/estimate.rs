@@ -285,6 +285,28 @@ pub struct Estimate {
 /// assert!(est.terms.estimate >= signorini::norms::linf_error(&mesh, &sol, &u).linf_quadrature);
 /// ```
 pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, config: &EstimatorConfig) -> Estimate {
+    with_node_terms(mesh, problem, sol, config, |nodal, local, lambda_c, l_h| {
+        let (terms, full_contact_nodes, eta5_full_contact) = sum_terms(nodal, l_h, config.c0);
+        let element = element_indicators(mesh, sol, nodal, local, lambda_c, l_h);
+        Estimate { terms, config: *config, element, full_contact_nodes, eta5_full_contact }
+    })
+}
+
+/// (eta_{1,p}, ..., eta_{5,p}) of every P2 node p, scaled by h_p^2 and h_p as [`estimate`] takes
+/// their maxima (eta_i = max_p eta_{i,p}), with the variant's eta_{5,p} at full-contact nodes.
+/// Computed again, not kept by [`estimate`]: `signorini export` writes them for the cross-check.
+pub fn node_terms(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, config: &EstimatorConfig) -> Vec<[f64; 5]> {
+    with_node_terms(mesh, problem, sol, config, |nodal, _, _, _| nodal.iter().map(|n| n.scaled).collect())
+}
+
+/// The nodes' terms, the element locals, Lambda_h^C and l_h, handed to `then`.
+fn with_node_terms<R>(
+    mesh: &Mesh,
+    problem: &dyn Problem,
+    sol: &DiscreteSolution,
+    config: &EstimatorConfig,
+    then: impl FnOnce(&[NodeTerms], &[local::ElementLocal], &LambdaC, f64) -> R,
+) -> R {
     let edge_s = local::edge_samples(config.sampling);
     let stress = local::vertex_stresses(mesh, problem, sol);
     let local = local::element_locals(mesh, problem, sol, config, &stress, &edge_s);
@@ -296,10 +318,8 @@ pub fn estimate(mesh: &Mesh, problem: &dyn Problem, sol: &DiscreteSolution, conf
     let (h_min, _) = mesh.h_range();
     let l_h = config.log_factor.value(h_min);
     let nodal: Vec<NodeTerms> =
-        (0..sol.nodes.len()).into_par_iter().map(|p| node_terms(mesh, sol, config, &patches, &local, &jump, &lambda_c, p)).collect();
-    let (terms, full_contact_nodes, eta5_full_contact) = sum_terms(&nodal, l_h, config.c0);
-    let element = element_indicators(mesh, sol, &nodal, &local, &lambda_c, l_h);
-    Estimate { terms, config: *config, element, full_contact_nodes, eta5_full_contact }
+        (0..sol.nodes.len()).into_par_iter().map(|p| node_terms_at(mesh, sol, config, &patches, &local, &jump, &lambda_c, p)).collect();
+    then(&nodal, &local, &lambda_c, l_h)
 }
 
 /// Which contact edges eta_7 is taken over (Lambda_h^C): those through a contact node with
@@ -397,7 +417,7 @@ struct NodeTerms {
 
 /// Node p's terms, gathered over its patch.
 #[allow(clippy::too_many_arguments)]
-fn node_terms(
+fn node_terms_at(
     mesh: &Mesh,
     sol: &DiscreteSolution,
     config: &EstimatorConfig,

@@ -230,40 +230,56 @@ fn significant(v: f64) -> String {
 /// displacement `u`, the contact force `lambda`, `active` and `contact` (1 on contact nodes); per
 /// triangle the estimator's element indicator `indicator` (eta_T, what the marking compares).
 pub fn solution_vtu(mesh: &Mesh, sol: &DiscreteSolution, indicator: &[f64]) -> String {
+    solution_vtu_with(mesh, sol, indicator, None)
+}
+
+/// [`solution_vtu`], with `nodal` (the estimator's [`crate::estimate::node_terms`]) also the point
+/// data `eta1` .. `eta5` (eta_{i,p}, scaled by h_p^2 or h_p) and `lambda_floor`, the round-off
+/// bound of each contact force (`DiscreteSolution::lambda_floor`, 0 off the contact nodes), which
+/// decides with `lambda` which forces are positive (`DiscreteSolution::positive_forces`:
+/// Lambda_h^C of eta_7). The exported case carries them for the cross-check of the estimator.
+fn solution_vtu_with(mesh: &Mesh, sol: &DiscreteSolution, indicator: &[f64], nodal: Option<&[[f64; 5]]>) -> String {
     let n = sol.nodes.len();
     let (mut lambda, mut active, mut contact) = (vec![0.0; n], vec![0i32; n], vec![0i32; n]);
+    let mut lambda_floor = vec![0.0; n];
     for (k, c) in sol.dofs.contact.iter().enumerate() {
         lambda[c.node] = sol.lambda[k];
+        lambda_floor[c.node] = sol.lambda_floor[k];
         active[c.node] = sol.active[k] as i32;
         contact[c.node] = 1;
     }
-    io::vtu(
-        mesh,
-        &sol.nodes,
-        &[
-            ("u", io::Field::Vector(&sol.u)),
-            ("lambda", io::Field::Scalar(&lambda)),
-            ("active", io::Field::Int(&active)),
-            ("contact", io::Field::Int(&contact)),
-        ],
-        &[("indicator", io::Field::Scalar(indicator))],
-    )
+    let mut point = vec![
+        ("u", io::Field::Vector(&sol.u)),
+        ("lambda", io::Field::Scalar(&lambda)),
+        ("active", io::Field::Int(&active)),
+        ("contact", io::Field::Int(&contact)),
+    ];
+    let terms: Vec<Vec<f64>> = (0..5).map(|i| nodal.map_or_else(Vec::new, |t| t.iter().map(|e| e[i]).collect())).collect();
+    if nodal.is_some() {
+        point.push(("lambda_floor", io::Field::Scalar(&lambda_floor)));
+        for (name, t) in ["eta1", "eta2", "eta3", "eta4", "eta5"].into_iter().zip(&terms) {
+            point.push((name, io::Field::Scalar(t)));
+        }
+    }
+    io::vtu(mesh, &sol.nodes, &point, &[("indicator", io::Field::Scalar(indicator))])
 }
 
 /// Write `mesh.vtu` ([`solution_vtu`]: displacement, contact force, active set, element
-/// indicators) and `case.json` into `dir`; returns the files written.
+/// indicators; and per node the estimator's terms `nodal` and the contact forces' round-off
+/// bounds) and `case.json` into `dir`; returns the files written.
 pub fn export_case(
     dir: &Path,
     mesh: &Mesh,
     sol: &DiscreteSolution,
     indicator: &[f64],
+    nodal: &[[f64; 5]],
     report: &SolveReport,
 ) -> Result<Vec<std::path::PathBuf>> {
     let (vtu, case) = (dir.join("mesh.vtu"), dir.join("case.json"));
     // one batch: both files are checked and written before either lands, so a target that
     // cannot be replaced (a named pipe where case.json goes) leaves no half-written export
     let mut batch = records::Batch::default();
-    batch.add(&vtu, solution_vtu(mesh, sol, indicator).as_bytes())?;
+    batch.add(&vtu, solution_vtu_with(mesh, sol, indicator, Some(nodal)).as_bytes())?;
     batch.add_json(&case, report)?;
     batch.commit()?;
     Ok(vec![vtu, case])

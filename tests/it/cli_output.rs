@@ -1,5 +1,6 @@
 //! What `export` and `adapt --save` write: VTU files ParaView and meshio open, with the
-//! estimator's element indicators as a cell field (the marking's eta_T).
+//! estimator's element indicators as a cell field (the marking's eta_T); `export` also its
+//! terms per node and the contact forces' round-off bounds (the NGSolve cross-check's input).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -51,6 +52,34 @@ fn export_writes_the_element_indicators() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let case: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("case.json")).unwrap()).unwrap();
     assert_eq!(check_indicators(&out.join("mesh.vtu")) as u64, case["n_elements"].as_u64().unwrap());
+}
+
+/// The values of the point field `name`.
+fn point_field(vtu: &str, name: &str) -> Vec<f64> {
+    let point_data = vtu.split("<PointData>").nth(1).and_then(|s| s.split("</PointData>").next()).unwrap();
+    let start = point_data.find(&format!("Name=\"{name}\"")).unwrap_or_else(|| panic!("no point field {name}"));
+    let body = &point_data[start..];
+    let body = &body[body.find('>').unwrap() + 1..body.find("</DataArray>").unwrap()];
+    body.split_whitespace().map(|v| v.parse().unwrap()).collect()
+}
+
+/// The cross-check's fields: eta_{i,p} per node (eta1 .. eta5), whose maxima are case.json's
+/// eta_1 .. eta_5 exactly, and the contact forces' round-off bounds, zero off the contact nodes.
+#[test]
+fn export_writes_the_nodal_terms_and_the_force_floors() {
+    let out = scratch("cli-output-export-nodal");
+    let o = bin().args(["export", "--problem", "fb", "--mesh", "structured:8", "--out"]).arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let case: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("case.json")).unwrap()).unwrap();
+    let vtu = std::fs::read_to_string(out.join("mesh.vtu")).unwrap();
+    let nodes = case["ndof"].as_u64().unwrap() as usize / 2;
+    for i in 1..=5 {
+        let eta = point_field(&vtu, &format!("eta{i}"));
+        assert_eq!(eta.len(), nodes);
+        assert_eq!(eta.iter().fold(0.0f64, |a, v| a.max(*v)), case["estimator"][format!("eta{i}")].as_f64().unwrap(), "eta{i}");
+    }
+    let (floor, contact) = (point_field(&vtu, "lambda_floor"), point_field(&vtu, "contact"));
+    assert!(floor.iter().zip(&contact).all(|(f, c)| if *c == 1.0 { *f > 0.0 } else { *f == 0.0 }));
 }
 
 #[test]
