@@ -8,7 +8,7 @@ data enter twice, once on each side. `check_data` verifies the transcribed f, g 
 of ex71 and fb against NGSolve's symbolic derivatives of the exact solution, so a typo here cannot
 hide.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from ngsolve import CF, IfPos, cos, exp, sin, sqrt, x, y
@@ -139,18 +139,7 @@ def problem(name, perturb=None):
         # experiments/problems/ex72_rollers.toml: Example 7.2 with u_1 = 0.1 on x = 0 and u_2 free
         # there (zero shear traction), u_2 = 0 at the point (0, 1/2); read by `estimator` only
         # (the PDAS of fem.py prescribes both components on Gamma_D and has no point constraint)
-        E, nu = 500.0, 0.3
-        return Problem(
-            name="ex72_rollers",
-            mu=E / (2 * (1 + nu)),
-            zeta=E * nu / ((1 + nu) * (1 - 2 * nu)),
-            f=None, g=None,
-            u_dirichlet=(0.1 * dscale, 0.0),
-            normal=(1.0, 0.0),
-            chi=lambda px, py: -0.2 + 0.5 * np.abs(py - 0.5),
-            exact=None,
-            free=(1,),
-        )
+        return replace(problem("ex72", perturb), name="ex72_rollers", free=(1,))
     if name == "hertz":
         # experiments/problems/hertz.toml: the lower half of the unit disc centred at (0, 1),
         # plane strain E = 1000, nu = 0.3, u = (0, -delta) on the flat side y = 1, delta = 0.005,
