@@ -184,8 +184,8 @@ pub enum ErrorSampling {
 /// Which alternate levels a fit takes. Newest-vertex bisection refines in two-level staircases,
 /// so every fit takes every other level ([`verdict::window`]); `Last` takes the levels of the
 /// run's last level's parity, `Other` those of the level before (its last level dropped). Every
-/// verdict is computed both ways; one that differs is fragile and is not counted as reproduced
-/// in the headline.
+/// verdict is computed both ways; one that differs is fragile, and the headline counts it as
+/// undecided.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Parity {
     Last,
@@ -919,7 +919,7 @@ pub fn claims(shelf: &Shelf, roles: &Roles) -> Result<Vec<Claim>, ClaimsError> {
         "parity",
         "with the other parity of levels",
         "fits on every other level; which ones not given",
-        "Newest-vertex bisection refines in two-level staircases, so every fit takes every other level: every verdict above recomputed on the other alternate levels (the run's last level dropped, the windows ending one level earlier); a verdict that changes is fragile and is not counted as reproduced in the headline".into(),
+        "Newest-vertex bisection refines in two-level staircases, so every fit takes every other level: every verdict above recomputed on the other alternate levels (the run's last level dropped, the windows ending one level earlier); a verdict that changes is fragile and the headline counts it as undecided".into(),
         &parity_flips,
         String::new(),
     ));
@@ -997,7 +997,7 @@ pub fn markdown_for(claims: &[Claim], results: &Path) -> String {
          above c + {b} **different** (faster); the whole interval inside c ± {b} is reproduced; anything else, however close its centre, inconclusive, and so is every fit over a window shorter than {d} decades (a run that ends early: its range says so). \
          **Parity.** Every verdict is computed twice, on the alternate levels of the run's last level and on the other alternate levels (the last level dropped); \
          a verdict that differs between them, or changes with the window (ending 2 or 4 levels earlier) or with the dense sampling of the error, is marked *fragile*, with what changes it, \
-         and is not counted as reproduced in the headline (the rows `parity` and `sampling` list the flips). \
+         and the headline counts it as undecided, a pass or a failure alike (the rows `parity` and `sampling` list the flips). \
          **One rule per kind of claim**, the same on every problem and contact term: a *rate* as above; *efficiency*: the slope of log(estimate / error) against log(NDF) over the same window \
          has an interval containing 0 no wider than {w} (bounded; excluding 0 fails, growing or falling; containing 0 but wider is inconclusive); *efficiency up to l_h*: the same on estimate / error / l_h; \
          *reliability*: the largest error / eta_h over the levels of each error-rate fit window (not from the coarsest mesh) at most C_0 = {C0_PAPER}; \

@@ -129,7 +129,10 @@ fn eta6_eta7(t: &TermRun) -> Claim {
             paper: "vanish",
             headline: eta67.map(|v| format!("largest {v:.1e} ({})", source(r))).unwrap_or("n/a".into()),
         },
-        claim: format!("Ex. 7.1: ||(chi + u_h2)^+||_Linf(Lambda) and ||(-u_h2 - chi)^+||_Linf(Gamma_C) vanish (with {})", t.names()),
+        claim: format!(
+            "Ex. 7.1: ||(chi + u_h2)^+||_Linf(Lambda) and ||(-u_h2 - chi)^+||_Linf(Gamma_C) vanish (contact term: {})",
+            t.names()
+        ),
         measured: eta67.map(|v| format!("max over levels of eta6, eta7: {v:.3e}{}", t.note_text())).unwrap_or("no data".into()),
         verdict: test.verdict(Kind::Paper, eta67.map(Evidence::Value).as_ref()),
         criterion: test,

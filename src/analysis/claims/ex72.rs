@@ -377,7 +377,7 @@ fn corner_refinement(ctx: &Ctx, t: &TermRun) -> std::io::Result<Claim> {
             },
         },
         claim: format!(
-            "Ex. 7.2: the adaptive mesh is refined near the corners where Dirichlet meets Neumann (Fig. 3b): at each corner, smaller elements within {CORNER_NEAR} than at {CORNER_NEAR}–{CORNER_RING} (with {})",
+            "Ex. 7.2: the adaptive mesh is refined near the corners where Dirichlet meets Neumann (Fig. 3b): at each corner, smaller elements within {CORNER_NEAR} than at {CORNER_NEAR}–{CORNER_RING} (contact term: {})",
             t.names()
         ),
         measured: if parts.is_empty() { "no data".into() } else { format!("{}{}", parts.join("; "), t.note_text()) },

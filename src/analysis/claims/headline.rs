@@ -1,7 +1,7 @@
 //! The headline that opens CLAIMS.md: per contact term of eta_5, how many of the paper's own
 //! Section 7 claims reproduce, fail and stay undecided, then the rows beyond the paper and the
 //! measurements counted apart. A verdict that is fragile (another window, the other parity of
-//! levels or the dense sampling changes it) is not counted as reproduced: it is undecided.
+//! levels or the dense sampling changes it) is counted as undecided, a pass or a failure alike.
 
 use super::{Claim, Kind, RowKind, Verdict, terms};
 use crate::estimator::estimate::ContactTerm;
@@ -11,21 +11,22 @@ use crate::estimator::estimate::ContactTerm;
 pub enum Count {
     /// Reproduced (or holds) and not fragile.
     Holds,
-    /// Not reproduced, different, fails.
+    /// Not reproduced, different, fails, and not fragile.
     Fails,
-    /// Inconclusive, no data, or reproduced but fragile.
+    /// Inconclusive, no data, or fragile.
     Undecided,
     /// A measurement without a claim.
     Measured,
 }
 
-/// How `c` counts: a fragile pass is undecided.
+/// How `c` counts: a fragile verdict is undecided.
 pub fn count(c: &Claim) -> Count {
     match c.verdict {
-        Verdict::Reproduced | Verdict::Holds if c.fragile.is_none() => Count::Holds,
-        Verdict::Reproduced | Verdict::Holds | Verdict::Inconclusive | Verdict::NoData => Count::Undecided,
-        Verdict::NotReproduced | Verdict::Different | Verdict::Fails => Count::Fails,
         Verdict::NoClaim => Count::Measured,
+        _ if c.fragile.is_some() => Count::Undecided,
+        Verdict::Reproduced | Verdict::Holds => Count::Holds,
+        Verdict::NotReproduced | Verdict::Different | Verdict::Fails => Count::Fails,
+        Verdict::Inconclusive | Verdict::NoData => Count::Undecided,
     }
 }
 

@@ -145,7 +145,7 @@ fn row(
     fragile: Option<String>,
 ) -> Claim {
     let (id, topic) = labels(s, t, &w);
-    let claim = format!("{} (with {})", w.claim, t.names());
+    let claim = format!("{} (contact term: {})", w.claim, t.names());
     Claim {
         verdict: criterion.verdict(s.kind, t.run.and(evidence).as_ref()),
         id,
