@@ -49,7 +49,7 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 slug: "refinement",
                 topic: "Ex. 7.2: refinement at the free boundary",
                 paper: "refined at the free boundary (Fig. 3b)",
-                claim: "Ex. 7.2: the adaptive mesh is refined around the free boundary (Fig. 3b): the length h_fb of the contact edge straddling a free-boundary point decays faster than NDF^(-1/2) (what uniform refinement gives) beyond its interval".into(),
+                claim: rows::refinement_claim("Ex. 7.2"),
                 extra: String::new(),
             },
         ));

@@ -52,7 +52,7 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 slug: "efficiency",
                 topic: "fb: efficiency index",
                 paper: "bounded, carried over",
-                claim: "fb: the efficiency index estimate / error stays bounded (the rule of 7.1-efficiency)".into(),
+                claim: rows::efficiency_claim(problem_names::FB),
                 extra: String::new(),
             },
         ));

@@ -72,7 +72,7 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 slug: "refinement",
                 topic: "Ex. 7.2 on rollers: refinement at the free boundary",
                 paper: "refined at the free boundary (Fig. 3b)",
-                claim: "Ex. 7.2 on rollers: the adaptive mesh is refined around the free boundary (Fig. 3b): the length h_fb of the contact edge straddling a free-boundary point decays faster than NDF^(-1/2) (what uniform refinement gives) beyond its interval".into(),
+                claim: rows::refinement_claim(problem_names::label(problem_names::EX72_ROLLERS)),
                 extra: String::new(),
             },
         ));
@@ -84,7 +84,7 @@ pub(super) fn claims(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
                 slug: "efficiency",
                 topic: "Ex. 7.2 on rollers: efficiency index",
                 paper: "bounded (Fig. 2b, carried over)",
-                claim: "Ex. 7.2 on rollers: the efficiency index estimate / error stays bounded (the rule of 7.1-efficiency)".into(),
+                claim: rows::efficiency_claim(problem_names::label(problem_names::EX72_ROLLERS)),
                 extra: String::new(),
             },
         ));

@@ -126,6 +126,18 @@ pub(super) struct Words {
     pub extra: String,
 }
 
+/// The claim of a refinement row carried to `problem` ("Ex. 7.2 on rollers"): Fig. 3b's.
+pub(super) fn refinement_claim(problem: &str) -> String {
+    format!(
+        "{problem}: the adaptive mesh is refined around the free boundary (Fig. 3b): the length h_fb of the contact edge straddling a free-boundary point decays faster than NDF^(-1/2) (what uniform refinement gives) beyond its interval"
+    )
+}
+
+/// The claim of an efficiency row carried to `problem` ("fb"): 7.1-efficiency's.
+pub(super) fn efficiency_claim(problem: &str) -> String {
+    format!("{problem}: the efficiency index estimate / error stays bounded (the rule of 7.1-efficiency)")
+}
+
 /// The row's id and topic for term run `t`: "7.1-error-rate (without full-contact nodes = repaired)".
 fn labels(s: &Subject, t: &TermRun, w: &Words) -> (String, String) {
     (format!("{}-{}{}", s.prefix, w.slug, t.suffix()), format!("{}{}", w.topic, t.suffix()))
