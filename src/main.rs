@@ -616,6 +616,15 @@ fn outside_study(flag: &str, path: &std::path::Path) -> Result<()> {
     Ok(())
 }
 
+/// Refuse a results root given by `flag` that lies inside a study folder
+/// ([`study::store::results_place_fault`]), before anything is read or computed.
+fn results_place(flag: &str, results: Option<&std::path::Path>) -> Result<()> {
+    match results.and_then(study::store::results_place_fault) {
+        Some(why) => bail!("{flag} {why}; nothing was read or written"),
+        None => Ok(()),
+    }
+}
+
 /// The switches of `signorini run` that shape what a run does with the store.
 struct RunFlags {
     quick: bool,
@@ -658,6 +667,10 @@ fn run_studies(manifests: &[std::path::PathBuf], shard: Option<&str>, results: O
             if !plan.leftovers.is_empty() && listed.insert((m.study.clone(), String::new())) {
                 let files: Vec<String> = plan.leftovers.iter().map(|f| f.display().to_string()).collect();
                 println!("{} (first removes {} leftover file(s) of an unfinished run: {})", m.study, files.len(), files.join(", "));
+            }
+            if !plan.removals.is_empty() && listed.insert((m.study.clone(), "--fresh".into())) {
+                let files: Vec<String> = plan.removals.iter().map(|f| f.display().to_string()).collect();
+                println!("{} (--fresh first removes {} file(s): {})", m.study, files.len(), files.join(", "));
             }
             for (id, doing) in plan.runs {
                 if listed.insert((m.study.clone(), id.clone())) {
@@ -811,16 +824,7 @@ fn accept_studies(accept: &[String], experiments: &std::path::Path, results: &st
         m.check_runs()?;
     }
     for m in &manifests {
-        let options = study::RunOptions {
-            quick: false,
-            shard: None,
-            fresh: true,
-            replace: false,
-            results: results.to_path_buf(),
-            progress: true,
-            wait_for_lock: false,
-        };
-        study::run_study(m, &options).map_err(|e| accept_advice(e, &m.study))?;
+        study::accept::accept(m, results, true).map_err(|e| accept_advice(e, &m.study))?;
         say!(
             "accepted: {} rewritten from a full rerun of {}; run `signorini figures`, review and commit the change",
             results.join(&m.study).display(),
@@ -1284,21 +1288,26 @@ fn main() -> ExitCode {
             }
         }),
         Command::Adapt(args) => run_adapt(args),
-        Command::Figures { results, figures, experiments, study, wait } => {
-            again_while_written(*wait, || run_figures(results.as_deref(), figures.as_deref(), experiments, study, *wait))
-        }
+        Command::Figures { results, figures, experiments, study, wait } => results_place("--results", results.as_deref())
+            .and_then(|()| again_while_written(*wait, || run_figures(results.as_deref(), figures.as_deref(), experiments, study, *wait))),
         Command::Drift { quick, deep, against, report, merge, accept, study, experiments, results } => {
             let report = report.as_deref().map(|f| ReportFile { path: f, merge: *merge });
+            results_place("--results", Some(results))?;
+            results_place("--against", against.as_deref())?;
             run_drift(*quick, *deep, against.as_deref(), report, accept, study, experiments, results)
         }
         Command::Run { manifests, quick, jobs: _, shard, fresh, replace, results, wait, plan } => {
             let flags = RunFlags { quick: *quick, fresh: *fresh, replace: *replace, wait: *wait, plan: *plan };
+            results_place("--results", results.as_deref())?;
             run_studies(manifests, shard.as_deref(), results.clone(), flags)
         }
         Command::Export { args, out } => run_export(args, out),
-        Command::Report { results, figures, out, study, drift_report, experiments, wait } => again_while_written(*wait, || {
-            run_report(results.as_deref(), figures.as_deref(), out.as_deref(), study, drift_report.as_deref(), experiments, *wait)
-        }),
+        Command::Report { results, figures, out, study, drift_report, experiments, wait } => {
+            results_place("--results", results.as_deref())?;
+            again_while_written(*wait, || {
+                run_report(results.as_deref(), figures.as_deref(), out.as_deref(), study, drift_report.as_deref(), experiments, *wait)
+            })
+        }
     });
     // what was computed and kept stays; output that could not be written is an error
     let result = result.and_then(|()| stdout_result().map_err(|e| stdout_error(&e)));
@@ -1307,7 +1316,8 @@ fn main() -> ExitCode {
         Err(e)
             if e.downcast_ref::<study::Interrupted>().is_some()
                 || e.downcast_ref::<AdaptInterrupted>().is_some()
-                || e.downcast_ref::<DriftInterrupted>().is_some() =>
+                || e.downcast_ref::<DriftInterrupted>().is_some()
+                || e.downcast_ref::<study::accept::AcceptInterrupted>().is_some() =>
         {
             say!("{e:#}");
             ExitCode::from(130)

@@ -147,6 +147,9 @@ pub fn check_target(path: &Path) -> Result<(), NotFileTarget> {
 /// must be), the error names that path and what it is, instead of the system's "File exists".
 /// Every folder the harness creates is created here.
 pub fn create_folder(dir: &Path) -> std::io::Result<()> {
+    if !dir.is_dir() {
+        super::failpoint::step("create folder", dir);
+    }
     std::fs::create_dir_all(dir).map_err(|e| {
         let blocking = dir.ancestors().find_map(|a| std::fs::metadata(a).ok().filter(|m| !m.is_dir()).map(|m| (a, m)));
         let why = match blocking {

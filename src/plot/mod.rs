@@ -329,11 +329,13 @@ fn write_figure(fig: &Figure, dir: &Path, name: &str) -> anyhow::Result<Vec<Path
 
     let png = dir.join(format!("{name}.png"));
     let tmp = dir.join(format!(".{name}.tmp{}.png", std::process::id()));
+    crate::base::failpoint::step("write", &tmp);
     let drawn = {
         // the backend saves the file when presented (or dropped), before the rename below
         glyphs::Glyphs::new(BitMapBackend::new(&tmp, size), FONT_BYTES)
             .and_then(|backend| fig.render(&backend.into_drawing_area(), rich::BITMAP).map(|_| ()))
     };
+    crate::base::failpoint::step("rename", &png);
     if let Err(e) = drawn.and_then(|()| std::fs::rename(&tmp, &png).with_context(|| format!("writing {}", png.display()))) {
         std::fs::remove_file(&tmp).ok();
         return Err(e);

@@ -12,6 +12,7 @@
 mod error;
 mod finite;
 pub mod history;
+pub mod journal;
 pub mod reference;
 pub mod report;
 
@@ -95,6 +96,7 @@ impl Batch {
         replaceable(path)?;
         crate::base::input::create_folder(crate::base::input::folder_of(path))?;
         let tmp = temporary_for(path);
+        crate::base::failpoint::step("write", &tmp);
         let written = std::fs::File::create(&tmp).and_then(|mut f| {
             f.write_all(bytes)?;
             f.sync_all()
@@ -135,6 +137,7 @@ impl Batch {
         let staged = std::mem::take(&mut self.staged);
         let mut rest = staged.iter();
         for (tmp, path, _) in rest.by_ref() {
+            crate::base::failpoint::step("rename", path);
             let renamed = replaceable(path).and_then(|()| std::fs::rename(tmp, path).map_err(step("renaming the temporary file to", path)));
             if let Err(e) = renamed {
                 let _ = std::fs::remove_file(tmp);
@@ -143,6 +146,27 @@ impl Batch {
             }
         }
         Ok(())
+    }
+}
+
+impl Batch {
+    /// The renames that put the staged files into place, as a [`journal::Journal`] of `folder`
+    /// (every staged file must lie inside it), and `removals` after them: what a change of a
+    /// study folder commits as one. The temporary files are the journal's from here on: the
+    /// batch no longer removes them when dropped.
+    pub fn into_journal(mut self, folder: &Path, removals: Vec<std::path::PathBuf>) -> std::io::Result<journal::Journal> {
+        let relative = |p: &Path| {
+            p.strip_prefix(folder)
+                .map(Path::to_path_buf)
+                .map_err(|_| std::io::Error::other(format!("{} is staged outside the folder {} it changes", p.display(), folder.display())))
+        };
+        let mut renames = Vec::new();
+        for (tmp, path, _) in &self.staged {
+            renames.push((relative(tmp)?, relative(path)?));
+        }
+        let removals = removals.iter().map(|p| relative(p)).collect::<std::io::Result<_>>()?;
+        self.staged.clear();
+        Ok(journal::Journal { renames, removals })
     }
 }
 
@@ -423,6 +447,33 @@ fn read_if_present<T: serde::de::DeserializeOwned>(path: &Path) -> std::io::Resu
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
         Err(e) => Err(e),
     }
+}
+
+/// The folders of a results root that hold no study: what the commands write beside the
+/// studies (`figures`, `report` with `--results DIR`, the bench's and the cross-check's tables,
+/// the round-off measurements). No study may be named after one.
+pub const NOT_STUDIES: [&str; 5] = ["figures", "report", "bench", "crosscheck", "roundoff"];
+
+/// Why `name` cannot name a study (its folder `RESULTS/NAME`), if it cannot: empty, `.` or
+/// `..`, hidden (a leading `.`: the harness's own folders, such as the staging folder of
+/// `drift --accept`), a folder the results root holds that is no study ([`NOT_STUDIES`]), or
+/// holding a character other than ASCII letters, digits, `_`, `-` and `.` (a separator would
+/// reach outside the results root). The one rule every study name is held to.
+pub fn study_name_fault(name: &str) -> Option<String> {
+    let fault = if name.is_empty() {
+        "it is empty".to_string()
+    } else if name == "." || name == ".." {
+        format!("`{name}` names a folder that is no study's own (the results root or the one above it)")
+    } else if name.starts_with('.') {
+        "it starts with `.` (hidden names are the harness's own folders)".to_string()
+    } else if NOT_STUDIES.contains(&name) {
+        format!("`{name}` is a folder the results root holds for other outputs ({})", NOT_STUDIES.join(", "))
+    } else if let Some(c) = name.chars().find(|c| !(c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))) {
+        format!("it holds {c:?}; a study name is ASCII letters, digits, `_`, `-` and `.`")
+    } else {
+        return None;
+    };
+    Some(fault)
 }
 
 /// A record file `runs/*.json`: its path, its text, and the run it holds or why it holds none.

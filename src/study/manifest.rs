@@ -86,6 +86,11 @@ pub enum ManifestError {
     Syntax { file: PathBuf, message: String },
     #[error("{file}: key `{key}`: expected {expected}, got {}", crate::base::input::excerpt(got))]
     Invalid { file: PathBuf, key: String, expected: String, got: String },
+    /// The file's name cannot name a study ([`crate::records::study_name_fault`]).
+    #[error(
+        "{file}: a study is named after its manifest's file, and `{study}` cannot name one: {why}. Rename the file (e.g. experiments/my_study.toml)"
+    )]
+    Name { file: PathBuf, study: String, why: String },
 }
 
 #[derive(Clone, Debug, Default, Deserialize)]
@@ -271,6 +276,9 @@ impl Manifest {
         let raw: ManifestToml = toml::from_str(text)
             .map_err(|e| ManifestError::Syntax { file: file.clone(), message: crate::base::toml_text::plain(e.to_string().trim_end()) })?;
         let study = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        if let Some(why) = crate::records::study_name_fault(&study) {
+            return Err(ManifestError::Name { file, study, why });
+        }
         let invalid = Invalid(&file);
         if raw.run.is_empty() {
             return Err(invalid.at("run".into(), "at least one [[run]] table", "none".into()));

@@ -16,6 +16,7 @@
 //! is computed) let shards of one study compute side by side while no run is computed twice;
 //! an interrupt stops after the current level and keeps every finished run ([`Interrupted`]).
 
+pub mod accept;
 pub mod drift;
 pub mod manifest;
 pub mod progress;
@@ -184,6 +185,9 @@ pub enum Planned {
 pub struct Plan {
     pub runs: Vec<(String, Planned)>,
     pub leftovers: Vec<PathBuf>,
+    /// What `--fresh` removes first: every file of the study the store wrote, or a shard's
+    /// runs' records, snapshots and checkpoints.
+    pub removals: Vec<PathBuf>,
 }
 
 /// What `run --plan` prints: each run of `manifest` in `opts`' shard and what `run` would do
@@ -196,9 +200,22 @@ pub fn plan(manifest: &Manifest, opts: &RunOptions) -> Result<Plan> {
     let in_shard = |i: usize| opts.shard.is_none_or(|(k, n)| i % n == k - 1);
     let planned: Vec<RunSpec> =
         manifest.runs.iter().enumerate().filter(|(i, _)| in_shard(*i)).map(|(_, p)| effective_spec(p, opts.quick)).collect();
-    let computed =
-        |planned: Vec<RunSpec>| Plan { runs: planned.into_iter().map(|s| (s.id, Planned::Compute)).collect(), leftovers: Vec::new() };
-    if opts.fresh || !store.dir().root.exists() {
+    let computed = |planned: Vec<RunSpec>| Plan {
+        runs: planned.into_iter().map(|s| (s.id, Planned::Compute)).collect(),
+        leftovers: Vec::new(),
+        removals: Vec::new(),
+    };
+    if opts.fresh {
+        let found = store::owned::inventory(store.dir())?;
+        if !found.foreign.is_empty() && opts.shard.is_none() {
+            return Err(store::owned::refusal("run --fresh", store.dir(), &found.foreign));
+        }
+        let ids: Vec<&str> = planned.iter().map(|s| s.id.as_str()).collect();
+        let of_shard = |p: &PathBuf| run_of_file(store.dir(), p).is_some_and(|r| ids.contains(&r.as_str()));
+        let removals = found.data.into_iter().filter(|p| opts.shard.is_none() || of_shard(p)).collect();
+        return Ok(Plan { removals, ..computed(planned) });
+    }
+    if !store.dir().root.exists() {
         return Ok(computed(planned));
     }
     let checked = match store.check() {
@@ -241,7 +258,19 @@ pub fn plan(manifest: &Manifest, opts: &RunOptions) -> Result<Plan> {
         };
         runs.push((id.clone(), Planned::Remove(why)));
     }
-    Ok(Plan { runs, leftovers: checked.leftovers })
+    Ok(Plan { runs, leftovers: checked.leftovers, removals: Vec::new() })
+}
+
+/// The run a file of a study folder belongs to: `runs/RUN.json`, `.partial/RUN.json` (its
+/// checkpoint), `meshes/RUN_levelL.*`; `None` for the study's shared files.
+fn run_of_file(dir: &crate::records::StudyDir, file: &std::path::Path) -> Option<String> {
+    let name = file.file_name()?.to_string_lossy().into_owned();
+    let folder = file.parent()?.strip_prefix(&dir.root).ok()?.to_str()?.to_string();
+    match folder.as_str() {
+        "meshes" => crate::records::StudyDir::parse_mesh_name(&name).map(|(r, _)| r.to_string()),
+        "runs" | ".partial" => name.strip_suffix(".json").map(str::to_string),
+        _ => None,
+    }
 }
 
 /// Under the study lock: `--fresh`, the orphans of unfinished runs removed, stored runs whose

@@ -66,7 +66,8 @@ fn a_plan_says_what_run_keeps_and_refuses_what_run_refuses() {
     assert_eq!(code, 0, "{err}");
     assert!(out.starts_with("s/a (kept") && out.contains("s/b (replaces the stored run: levels"), "{out}");
     let (code, out, _) = signorini_in(&dir, &["run", "--plan", "--fresh", "exp/s.toml", "--results", "res"]);
-    assert_eq!((code, out.as_str()), (0, "s/a\ns/b\n"));
+    let removes = "s (--fresh first removes 4 file(s): res/s/levels.csv, res/s/provenance.json, res/s/runs/a.json, res/s/runs/b.json)\n";
+    assert_eq!((code, out.as_str()), (0, format!("{removes}s/a\ns/b\n").as_str()));
     // a damaged folder: refused by the plan as by run, naming the file
     std::fs::write(dir.join("exp/s.toml"), STUDY).unwrap();
     std::fs::write(dir.join("res/s/levels.csv"), "").unwrap();

@@ -45,6 +45,7 @@ mod claims_criteria;
 mod cli_output;
 mod consistent_exact;
 mod convergence;
+mod crash_points;
 mod doc_commands;
 mod drift;
 mod drift_tiers;

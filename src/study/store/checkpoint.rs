@@ -116,9 +116,13 @@ pub(super) fn remove(dir: &StudyDir, run: &str) -> Result<()> {
         for e in entries.flatten() {
             let name = e.file_name().to_string_lossy().into_owned();
             if name.starts_with(&own_temporary) && crate::records::is_temporary(&name) {
+                crate::base::failpoint::step("remove", &e.path());
                 let _ = std::fs::remove_file(e.path());
             }
         }
+    }
+    if path.exists() {
+        crate::base::failpoint::step("remove", &path);
     }
     match std::fs::remove_file(&path) {
         Ok(()) => {}
@@ -126,6 +130,9 @@ pub(super) fn remove(dir: &StudyDir, run: &str) -> Result<()> {
         Err(e) => return Err(e).with_context(|| format!("removing {}", path.display())),
     }
     // fails while another run's checkpoint is there: then it stays
-    let _ = std::fs::remove_dir(&partial);
+    if partial.is_dir() {
+        crate::base::failpoint::step("remove folder", &partial);
+        let _ = std::fs::remove_dir(&partial);
+    }
     Ok(())
 }

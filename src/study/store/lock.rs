@@ -120,6 +120,9 @@ fn open(path: &Path) -> Result<std::fs::File> {
     if let Some(parent) = path.parent() {
         crate::base::input::create_folder(parent)?;
     }
+    if !path.exists() {
+        crate::base::failpoint::step("create", path);
+    }
     std::fs::OpenOptions::new()
         .read(true)
         .write(true)

@@ -24,6 +24,7 @@
 pub mod check;
 pub mod checkpoint;
 mod lock;
+pub mod owned;
 pub use lock::{BeingWritten, Held, scratch_folder};
 pub mod shelf;
 pub mod stale;
@@ -51,9 +52,22 @@ pub fn study_folder_above(path: &std::path::Path) -> Option<PathBuf> {
     let existing = absolute.ancestors().find(|a| a.exists())?;
     let resolved = existing.canonicalize().ok()?;
     let rest = absolute.strip_prefix(existing).ok()?;
-    let full = resolved.join(rest);
+    let full = if rest.as_os_str().is_empty() { resolved } else { resolved.join(rest) };
     let is_study = |d: &std::path::Path| d.join("runs").is_dir() || d.join(".locks").is_dir() || d.join(".lock").is_file();
     full.ancestors().find(|d| is_study(d)).map(|d| d.to_path_buf())
+}
+
+/// Why `results` cannot be a results root, if it cannot: it lies inside a study folder
+/// ([`study_folder_above`]: the folder itself, its `runs/`, `meshes/` or any folder below), where
+/// studies stored by it would mix with the study's own files, and `--fresh` or `--replace` of
+/// either would remove the other's. The one rule every `--results` (and `--against`) is held to.
+pub fn results_place_fault(results: &std::path::Path) -> Option<String> {
+    let study = study_folder_above(results)?;
+    Some(format!(
+        "{} is inside the study folder {} (it holds runs/, .lock or .locks): a results root holds study folders and is never inside one. Give a folder outside it (e.g. beside it)",
+        results.display(),
+        study.display()
+    ))
 }
 
 /// The one door to a study's results folder (`results/STUDY/`): readers check it as a whole
@@ -96,8 +110,21 @@ impl Store {
 
     /// The study lock: refused naming the holder if another process holds it, unless `wait`.
     /// Its guard is the only way to change the folder's shared files.
+    /// Before its guard is handed out, a change another process left part-way is carried out
+    /// ([`records::journal::roll_forward`]), so every writer starts from a whole folder.
     pub fn lock(&self, wait: bool) -> Result<Writer<'_>> {
-        Ok(Writer { store: self, _lock: lock::Lock::study(&self.dir, wait)? })
+        let writer = Writer { store: self, _lock: lock::Lock::study(&self.dir, wait)? };
+        let rolled = crate::records::journal::roll_forward(&self.dir.root)
+            .with_context(|| format!("completing the change a stopped process left in {}", self.dir.root.display()))?;
+        if let Some(journal) = rolled {
+            crate::base::note::line(format_args!(
+                "{}: completed a change a stopped process left part-way ({} file(s) put into place, {} removed)",
+                self.study,
+                journal.renames.len(),
+                journal.removals.len()
+            ));
+        }
+        Ok(writer)
     }
 
     /// The lock of run `id`, held while this process computes it: refused naming the process
@@ -199,6 +226,14 @@ impl Store {
     /// what the records render ([`check::summary_faults`]). A record file that does not parse is
     /// a fault of the run its file stem names.
     fn scan(&self) -> Result<Checked> {
+        if crate::records::journal::pending(&self.dir.root).map_or(true, |j| j.is_some()) {
+            bail!(
+                "{}: a change to this folder was stopped part-way ({} lists it); nothing was read. The next command that writes the study completes it: `{}` (it computes nothing that is stored already)",
+                self.dir.root.display(),
+                self.dir.root.join(crate::records::journal::FILE).display(),
+                self.replace_command().replace(" --replace", "")
+            );
+        }
         let files = self.dir.read_run_files().with_context(|| format!("reading the runs in {}", self.dir.root.join("runs").display()))?;
         let mut faults = Vec::new();
         let mut runs = Vec::new();

@@ -9,7 +9,7 @@
 
 use super::check::{files_in, orphans};
 use super::lock::Lock;
-use super::{Checked, Store, checkpoint};
+use super::{Checked, Store, checkpoint, owned};
 use crate::records::{self, Batch, ReferenceRecord, RunRecord, StudyDir};
 use crate::study::manifest::Manifest;
 use crate::study::provenance::{self, Provenance};
@@ -84,36 +84,37 @@ impl Writer<'_> {
         self.remove_stored(run)
     }
 
-    /// Remove a run's record and mesh snapshots (its checkpoint stays).
+    /// Remove a run's record and mesh snapshots (its checkpoint stays), as one change: the run is
+    /// there whole or gone.
     fn remove_stored(&self, run: &RunWriter) -> Result<()> {
         self.same_folder(run)?;
         let dir = &self.store.dir;
-        let file = dir.run_file(&run.id);
-        match std::fs::remove_file(&file) {
-            Ok(()) => {}
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => return Err(e).with_context(|| format!("removing {}", file.display())),
-        }
-        for (name, path) in files_in(&dir.root.join("meshes"))? {
-            if StudyDir::parse_mesh_name(&name).is_some_and(|(r, _)| r == run.id) {
-                std::fs::remove_file(&path).with_context(|| format!("removing {}", path.display()))?;
-            }
-        }
-        Ok(())
+        let mut removals: Vec<std::path::PathBuf> = snapshots_of(dir, &run.id)?;
+        removals.insert(0, dir.run_file(&run.id));
+        commit_as_one(dir, Batch::default(), removals)
     }
 
     /// `--fresh`: remove the runs this process holds (with a shard, only those: the other shards'
-    /// are someone else's), or with `whole` the study's records, snapshots, references and
-    /// checkpoints, every run's lock being in `held` ([`Store::lock_every_run`]).
+    /// are someone else's), or with `whole` every file of the study the store wrote (records,
+    /// snapshots, references, checkpoints, summaries; [`owned::inventory`]), every run's lock
+    /// being in `held` ([`Store::lock_every_run`]). A folder holding a file the store did not
+    /// write is refused, naming it, before anything is removed. The removal is one change: an
+    /// interrupt leaves the study whole or empty.
     pub fn start_over(&self, held: &[RunWriter], whole: bool) -> Result<()> {
         if !whole {
             return held.iter().try_for_each(|run| self.remove_run(run));
         }
-        let root = &self.store.dir.root;
+        let dir = &self.store.dir;
+        let found = owned::inventory(dir)?;
+        if !found.foreign.is_empty() {
+            return Err(owned::refusal("run --fresh", dir, &found.foreign));
+        }
+        commit_as_one(dir, Batch::default(), found.data)?;
         for sub in ["runs", "meshes", "references", ".partial"] {
-            let p = root.join(sub);
-            if p.exists() {
-                std::fs::remove_dir_all(&p).with_context(|| format!("removing {}", p.display()))?;
+            let folder = dir.root.join(sub);
+            if folder.is_dir() {
+                crate::base::failpoint::step("remove folder", &folder);
+                std::fs::remove_dir(&folder).with_context(|| format!("removing the emptied folder {}", folder.display()))?;
             }
         }
         Ok(())
@@ -128,6 +129,7 @@ impl Writer<'_> {
             return Ok(());
         }
         for f in &found {
+            crate::base::failpoint::step("remove", f);
             std::fs::remove_file(f).with_context(|| format!("removing {}", f.display()))?;
         }
         crate::base::note::line(format_args!(
@@ -155,7 +157,7 @@ impl Writer<'_> {
         if self.store.provenance().map_or(true, stale) {
             batch.add_json(&dir.provenance_file(), &provenance_of(manifest, runs, quick))?;
         }
-        Ok(batch.commit()?)
+        commit_as_one(dir, batch, Vec::new())
     }
 
     /// Store a finished run, computed under `run`'s lock. `batch` holds its mesh snapshots,
@@ -192,8 +194,11 @@ impl Writer<'_> {
         batch.add_json(&dir.run_file(&run.id), &record)?;
         batch.add(&dir.csv_file(), &csv_bytes(dir, &runs)?)?;
         batch.add_json(&dir.provenance_file(), &provenance_of(manifest, &runs, quick))?;
-        self.remove_stored(run)?;
-        batch.commit()?;
+        // a replaced run's record is replaced by the rename; its snapshots of levels the new
+        // run does not save go in the same change
+        let staged: Vec<std::path::PathBuf> = batch.paths().map(std::path::Path::to_path_buf).collect();
+        let removals = snapshots_of(dir, &run.id)?.into_iter().filter(|f| !staged.contains(f)).collect();
+        commit_as_one(dir, batch, removals)?;
         checkpoint::remove(dir, &run.id)
     }
 
@@ -224,6 +229,7 @@ impl Writer<'_> {
     /// against it store it again, computed anew ([`Writer::commit_reference`]).
     pub fn remove_reference(&self, key: &str) -> Result<()> {
         let file = self.store.dir.reference_file(key);
+        crate::base::failpoint::step("remove", &file);
         match std::fs::remove_file(&file) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e).with_context(|| format!("removing {}", file.display())),
             _ => Ok(()),
@@ -234,7 +240,7 @@ impl Writer<'_> {
     pub fn commit_reference(&self, reference: &ReferenceRecord) -> Result<()> {
         let mut batch = Batch::default();
         stage_reference(&self.store.dir, reference, &mut batch)?;
-        Ok(batch.commit()?)
+        commit_as_one(&self.store.dir, batch, Vec::new())
     }
 
     /// After a failure part-way through changing the folder (a removal or a rename that failed):
@@ -279,6 +285,30 @@ impl Writer<'_> {
         }
         Ok(())
     }
+}
+
+/// Commit `batch` and remove `removals` in the study folder as one change, through its journal
+/// ([`records::journal`]). An error before the journal is on disk changes nothing (the staged
+/// temporary files are removed); one after it leaves the journal, which the next writer carries
+/// out ([`Store::lock`]).
+fn commit_as_one(dir: &StudyDir, batch: Batch, removals: Vec<std::path::PathBuf>) -> Result<()> {
+    let journal = batch.into_journal(&dir.root, removals)?;
+    let Err(e) = journal.commit(&dir.root) else { return Ok(()) };
+    if matches!(records::journal::pending(&dir.root), Ok(None)) {
+        for (from, _) in &journal.renames {
+            let _ = std::fs::remove_file(dir.root.join(from));
+        }
+    }
+    Err(e).with_context(|| format!("changing {}", dir.root.display()))
+}
+
+/// The mesh snapshots of run `id` present in the folder (`meshes/RUN_levelL.*`).
+fn snapshots_of(dir: &StudyDir, id: &str) -> Result<Vec<std::path::PathBuf>> {
+    Ok(files_in(&dir.root.join("meshes"))?
+        .into_iter()
+        .filter(|(name, _)| StudyDir::parse_mesh_name(name).is_some_and(|(r, _)| r == id))
+        .map(|(_, path)| path)
+        .collect())
 }
 
 /// The provenance of the study as it is now, for these runs: the hashes of its input files are

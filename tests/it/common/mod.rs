@@ -181,3 +181,18 @@ pub fn stored_study(dir: &std::path::Path, manifest: &str, text: &str, results: 
     let (code, out, err) = signorini_in(dir, &["run", manifest, "--results", results]);
     assert_eq!(code, 0, "{out}{err}");
 }
+
+/// Copy the folder `from` with everything in it to `to` (made; symlinks copied as links).
+pub fn copy_tree(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap().flatten() {
+        let (kind, target) = (entry.file_type().unwrap(), to.join(entry.file_name()));
+        if kind.is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else if kind.is_symlink() {
+            std::os::unix::fs::symlink(std::fs::read_link(entry.path()).unwrap(), &target).unwrap();
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}

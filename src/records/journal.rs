@@ -1,0 +1,133 @@
+//! Changes of several files made as one: a [`Journal`] lists them (files renamed into place,
+//! files removed), is written atomically beside the files it changes, then carried out, then
+//! removed. Once the journal is on disk the change is decided: a process stopped part-way
+//! (killed, out of power) leaves the journal, and the next writer carries out what it lists
+//! before anything else ([`roll_forward`]); until then a reader finds the journal and refuses
+//! the folder rather than read a change half made. Before the journal is on disk nothing of the
+//! change is visible (its new files are temporary files or sit in a staging folder).
+//!
+//! This is the write-ahead discipline of storage engines, at the scale of a results folder: a
+//! rename replaces one file atomically, and the journal makes a list of renames and removals
+//! atomic too. Carrying it out again is harmless: a rename whose source is gone and whose
+//! destination exists was done, a removal of a missing file was done.
+
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The journal's file name in the folder it changes.
+pub const FILE: &str = ".journal.json";
+
+/// A list of renames and removals to be made as one. Paths are relative to the folder the
+/// journal sits in (a staging folder beside it is reached through `..`), so a results folder
+/// moved or copied with a journal pending still rolls forward.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct Journal {
+    /// (from, to): `from` renamed onto `to`, replacing it.
+    pub renames: Vec<(PathBuf, PathBuf)>,
+    /// Files removed after the renames.
+    pub removals: Vec<PathBuf>,
+}
+
+impl Journal {
+    /// Whether it changes nothing.
+    pub fn is_empty(&self) -> bool {
+        self.renames.is_empty() && self.removals.is_empty()
+    }
+
+    /// Write the journal into `folder`, carry it out, remove it. An error before the journal is
+    /// on disk changes nothing; an error after it leaves the journal for [`roll_forward`].
+    pub fn commit(&self, folder: &Path) -> std::io::Result<()> {
+        if self.is_empty() {
+            return Ok(());
+        }
+        let file = folder.join(FILE);
+        super::write_json(&file, self)?;
+        self.carry_out(folder)?;
+        crate::base::failpoint::step("remove", &file);
+        std::fs::remove_file(&file).map_err(super::step("removing the finished journal", &file))
+    }
+
+    /// Make every change it lists that is not made yet.
+    fn carry_out(&self, folder: &Path) -> std::io::Result<()> {
+        for (from, to) in &self.renames {
+            let (from, to) = (folder.join(from), folder.join(to));
+            if !from.exists() && to.exists() {
+                continue;
+            }
+            if let Some(parent) = to.parent() {
+                crate::base::input::create_folder(parent)?;
+            }
+            crate::base::failpoint::step("rename", &to);
+            std::fs::rename(&from, &to).map_err(super::step("renaming into place", &to))?;
+        }
+        for gone in &self.removals {
+            let gone = folder.join(gone);
+            crate::base::failpoint::step("remove", &gone);
+            match std::fs::remove_file(&gone) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(super::step("removing", &gone)(e)),
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The journal pending in `folder`, if a process stopped while carrying it out.
+pub fn pending(folder: &Path) -> std::io::Result<Option<Journal>> {
+    let file = folder.join(FILE);
+    if !file.exists() {
+        return Ok(None);
+    }
+    let text = super::read_text(&file)?;
+    serde_json::from_str(&text).map(Some).map_err(|e| super::RecordError::Parse { path: file, error: e }.into())
+}
+
+/// Carry out the journal a stopped process left in `folder`, if any, and remove it; returns it.
+/// Called by every writer of the folder before it changes anything, under its lock.
+pub fn roll_forward(folder: &Path) -> std::io::Result<Option<Journal>> {
+    let Some(journal) = pending(folder)? else { return Ok(None) };
+    journal.carry_out(folder)?;
+    let file = folder.join(FILE);
+    crate::base::failpoint::step("remove", &file);
+    std::fs::remove_file(&file).map_err(super::step("removing the finished journal", &file))?;
+    Ok(Some(journal))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn folder(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("signorini-journal-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("runs")).unwrap();
+        dir
+    }
+
+    #[test]
+    fn a_journal_carried_out_twice_is_carried_out_once() {
+        let dir = folder("twice");
+        std::fs::write(dir.join("runs/.a.json.tmp1.0"), "new").unwrap();
+        std::fs::write(dir.join("runs/a.json"), "old").unwrap();
+        std::fs::write(dir.join("runs/b.json"), "gone").unwrap();
+        let journal = Journal { renames: vec![("runs/.a.json.tmp1.0".into(), "runs/a.json".into())], removals: vec!["runs/b.json".into()] };
+        journal.carry_out(&dir).unwrap();
+        journal.carry_out(&dir).unwrap();
+        assert_eq!(std::fs::read_to_string(dir.join("runs/a.json")).unwrap(), "new");
+        assert!(!dir.join("runs/b.json").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_pending_journal_rolls_forward_and_goes() {
+        let dir = folder("pending");
+        std::fs::write(dir.join("runs/.a.json.tmp1.0"), "new").unwrap();
+        let journal = Journal { renames: vec![("runs/.a.json.tmp1.0".into(), "runs/a.json".into())], removals: vec![] };
+        super::super::write_json(&dir.join(FILE), &journal).unwrap();
+        assert_eq!(pending(&dir).unwrap(), Some(journal.clone()));
+        assert_eq!(roll_forward(&dir).unwrap(), Some(journal));
+        assert_eq!(std::fs::read_to_string(dir.join("runs/a.json")).unwrap(), "new");
+        assert_eq!(pending(&dir).unwrap(), None);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
