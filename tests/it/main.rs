@@ -72,6 +72,7 @@ mod resume;
 mod rollers;
 mod scratch;
 mod store;
+mod store_ownership;
 mod stress_frame;
 mod study;
 mod study_names;
