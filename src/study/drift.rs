@@ -784,6 +784,16 @@ pub fn check(
     // held until the comparisons end: another drift in this checkout waits rather than
     // starting over the reruns this one compares
     let _scratch = if opts.against.is_none() { Some(super::store::scratch_folder(&opts.scratch)?) } else { None };
+    for (m, _) in &planned {
+        let stored = Store::of(&opts.results, m);
+        if let Some(why) = stored.provenance().ok().and_then(|p| super::provenance::history_fault_of(&p, &m.file)) {
+            anyhow::bail!(
+                "{}: {why}. The drift check compares with results of known code; rerun the study on a commit of this history (`signorini drift --accept {}`) and commit its results",
+                stored.dir().root.display(),
+                m.study
+            );
+        }
+    }
     if opts.against.is_none() {
         rerun_all(&planned, opts)?;
     }

@@ -119,6 +119,37 @@ fn git_state(root: &Path) -> GitState {
     (git_commit, git_dirty)
 }
 
+/// Why the commit `prov` names is no commit a reader can check out, if git can tell: the
+/// checkout at `root` (the one `prov`'s manifest belongs to) does not hold it, or holds it off
+/// the history of its HEAD (computed on a branch that was rewritten before it landed). `None`
+/// when the commit is in that history, or when git cannot say (no git, no repository, a
+/// shallow clone that lacks the older history, no commit recorded).
+pub fn history_fault(prov: &Provenance, root: &Path) -> Option<String> {
+    let commit = prov.git_commit.as_deref()?;
+    let dir = root.to_string_lossy();
+    if command("git", &["-C", &dir, "rev-parse", "--is-shallow-repository"])? != "false" {
+        return None;
+    }
+    let status = |args: &[&str]| Command::new("git").args(["-C", &dir]).args(args).output().ok().map(|o| o.status.code());
+    let known = status(&["cat-file", "-e", &format!("{commit}^{{commit}}")])? == Some(0);
+    let ancestor = known && status(&["merge-base", "--is-ancestor", commit, "HEAD"])? == Some(0);
+    let short = &commit[..commit.len().min(12)];
+    match (known, ancestor) {
+        (_, true) => None,
+        (false, _) => Some(format!(
+            "its results name commit {short}, which this repository does not hold (computed on a commit rewritten before it landed?): nobody can check out the code that produced them"
+        )),
+        (true, false) => Some(format!(
+            "its results name commit {short}, which is not in the history of HEAD (computed on a branch that did not land as it was)"
+        )),
+    }
+}
+
+/// [`history_fault`] for the checkout `manifest_path` belongs to.
+pub fn history_fault_of(prov: &Provenance, manifest_path: &Path) -> Option<String> {
+    history_fault(prov, root_of(manifest_path))
+}
+
 /// The code that computes a run: what `provenance.json` names it by (the package version, the
 /// git commit and whether the checkout was dirty) and the SHA-256 of the running executable,
 /// which tells two builds of one dirty checkout apart. A run's checkpoint holds it, and a

@@ -66,6 +66,7 @@ mod parsers;
 mod problem_file_forms;
 mod problem_files;
 mod problems;
+mod provenance_history;
 mod record_schema;
 mod report_page;
 mod resume;

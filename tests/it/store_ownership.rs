@@ -18,7 +18,8 @@ fn fresh_refuses_a_folder_holding_files_it_did_not_write_and_removes_nothing() {
     }
     // a study stored inside the study's runs/ by a --results that pointed there
     std::fs::create_dir_all(dir.join("res/s/runs/inner/t/runs")).unwrap();
-    for args in [&["run", "exp/s.toml", "--fresh", "--results", "res"][..], &["run", "exp/s.toml", "--fresh", "--plan", "--results", "res"]] {
+    for args in [&["run", "exp/s.toml", "--fresh", "--results", "res"][..], &["run", "exp/s.toml", "--fresh", "--plan", "--results", "res"]]
+    {
         let (code, out, err) = signorini_in(&dir, args);
         assert_eq!(code, 1, "{args:?}: {out}{err}");
         for name in ["runs/notes.txt", "meshes/notes.txt", "runs/a.json.bak", "runs/inner"] {
@@ -39,10 +40,11 @@ fn fresh_plan_lists_every_file_fresh_removes_and_a_file_beside_them_refuses_it()
     let (code, out, err) = signorini_in(&dir, &["run", "exp/s.toml", "--fresh", "--plan", "--results", "res"]);
     assert_eq!(code, 0, "{err}");
     let listed = out.lines().next().unwrap();
-    let stored: Vec<String> = ["levels.csv", "meshes/a_level1.json", "meshes/a_level1.vtu", "provenance.json", "runs/a.json", "runs/b.json"]
-        .iter()
-        .map(|f| format!("res/s/{f}"))
-        .collect();
+    let stored: Vec<String> =
+        ["levels.csv", "meshes/a_level1.json", "meshes/a_level1.vtu", "provenance.json", "runs/a.json", "runs/b.json"]
+            .iter()
+            .map(|f| format!("res/s/{f}"))
+            .collect();
     assert_eq!(listed, format!("s (--fresh first removes {} file(s): {})", stored.len(), stored.join(", ")));
     std::fs::write(dir.join("res/s/levels.csv.keep"), "").unwrap();
     let (code, _, err) = signorini_in(&dir, &["run", "exp/s.toml", "--fresh", "--results", "res"]);
