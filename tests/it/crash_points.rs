@@ -227,3 +227,39 @@ fn the_manifest_and_the_results_the_crash_cases_read_are_the_declared_ones() {
     assert_eq!(m.runs.len(), 2);
     assert_eq!(Manifest::parse(Path::new("next/tiny.toml"), &longer()).unwrap().runs[0].spec.levels, 3);
 }
+
+/// A study whose second run is long enough to be interrupted while it computes.
+const LONG: &str = "description = \"a short run, then a long one\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\n\
+[[run]]\nid = \"short\"\nlevels = 2\nsave_levels = [1]\n[[run]]\nid = \"long\"\nlevels = 16\n";
+
+#[test]
+fn an_interrupted_drift_accept_leaves_every_stored_run_as_it_was() {
+    let dir = scratch("accept-interrupted");
+    crate::common::stored_study(&dir, "exp/s.toml", LONG, "res");
+    let before = files(&dir.join("res/s"));
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["drift", "--accept", "s", "--experiments", "exp", "--results", "res"])
+        .stderr(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // interrupted once the staged rerun has finished a run and is inside the next one
+    let staged = dir.join("res/.accept/s/.partial/long.json");
+    let started = std::time::Instant::now();
+    while !staged.exists() {
+        assert!(started.elapsed().as_secs() < 120, "the rerun never reached the long run");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) }, 0);
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(err.contains("is unchanged (every stored run kept)") && err.contains("signorini drift --accept s"), "{err}");
+    assert_eq!(files(&dir.join("res/s")), before, "the stored study changed");
+    // accepted again, uninterrupted: the staging folder is started over and then gone
+    let (code, _, err) = signorini_in(&dir, &["drift", "--accept", "s", "--experiments", "exp", "--results", "res"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!dir.join("res/.accept").exists(), "the staging folder stayed");
+    std::fs::remove_dir_all(&dir).ok();
+}
