@@ -1101,8 +1101,9 @@ fn run_figures(
     if wait {
         study::store::Shelf::wait_for_writers(&results)?;
     }
+    let flag = if figures.is_some() { "--figures" } else { "the default output folder (--figures)" };
     let figures = figures.map(|f| f.to_path_buf()).unwrap_or_else(|| if tracked { "figures".into() } else { results.join("figures") });
-    output_folder("--figures", &figures, "figures writes its PNG and SVG files into a folder there")?;
+    output_folder(flag, &figures, "figures writes its PNG and SVG files into a folder there")?;
     // what the figures and CLAIMS rows need, checked when the manifests are read
     let roles = signorini::analysis::roles::read(experiments)?;
     let (checked, drawn) = figure_studies(&results, tracked, experiments, only)?;
@@ -1153,8 +1154,9 @@ fn run_report(
     }
     let under = |tracked_default: &str, scratch: &str| if tracked { tracked_default.into() } else { results.join(scratch) };
     let figures = figures.map_or_else(|| under("figures", "figures"), |f| f.to_path_buf());
+    let flag = if out.is_some() { "--out" } else { "the default output folder (--out)" };
     let out = out.map_or_else(|| under("target/report", "report"), |o| o.to_path_buf());
-    output_folder("--out", &out, "report writes its pages into a folder there")?;
+    output_folder(flag, &out, "report writes its pages into a folder there")?;
     // --drift-report FILE alone; by default the default report and every one drift writes under
     // target/drift/, each page quoting the newest that covers its study
     let files = match drift_report {

@@ -97,3 +97,21 @@ fn a_results_root_inside_a_study_folder_is_refused_before_anything_is_read() {
     assert!(!dir.join("res/s/t").exists() && !dir.join("res/s/runs/t").exists());
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_default_output_folder_inside_a_study_folder_is_named_as_the_default_not_as_a_flag_given() {
+    let dir = scratch("own-default-out");
+    stored_study(&dir, "exp/s.toml", STUDY, "res");
+    // a study folder under a name the results root keeps for outputs (stored before names were checked)
+    std::fs::rename(dir.join("res/s"), dir.join("res/figures")).unwrap();
+    std::fs::create_dir_all(dir.join("res/report/runs")).unwrap();
+    for (args, default) in [
+        (&["figures", "--results", "res", "--experiments", "exp"], "the default output folder (--figures)"),
+        (&["report", "--results", "res", "--experiments", "exp"], "the default output folder (--out)"),
+    ] {
+        let (code, out, err) = signorini_in(&dir, args);
+        assert_eq!(code, 1, "{args:?}: {out}{err}");
+        assert!(err.contains(default) && err.contains("is inside the study folder"), "{args:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
