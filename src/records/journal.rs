@@ -17,6 +17,10 @@ use std::path::{Path, PathBuf};
 /// The journal's file name in the folder it changes.
 pub const FILE: &str = ".journal.json";
 
+/// The staging folder beside the folders a journal changes (in the same parent): a file
+/// renamed into `FOLDER` may come from `../STAGING/FOLDER/` (the swap of `drift --accept`).
+pub const STAGING: &str = ".accept";
+
 /// A list of renames and removals to be made as one. Paths are relative to the folder the
 /// journal sits in (a staging folder beside it is reached through `..`), so a results folder
 /// moved or copied with a journal pending still rolls forward.
@@ -47,8 +51,32 @@ impl Journal {
         std::fs::remove_file(&file).map_err(super::step("removing the finished journal", &file))
     }
 
-    /// Make every change it lists that is not made yet.
+    /// The first path it lists that reaches outside `folder` (an absolute path, a `..` other
+    /// than a source's way into the staging folder of `folder`), with why: a journal is written
+    /// by the harness and never names one, so one that does was made or edited by hand and is
+    /// carried out nowhere.
+    fn outside(&self, folder: &Path) -> Option<String> {
+        use std::path::Component;
+        let inside = |p: &Path| !p.as_os_str().is_empty() && p.components().all(|c| matches!(c, Component::Normal(_)));
+        let name = folder.file_name()?;
+        let staged = |p: &Path| p.strip_prefix(Path::new("..").join(STAGING).join(name)).is_ok_and(inside);
+        let sources = self.renames.iter().map(|(from, _)| from).find(|p| !inside(p) && !staged(p));
+        let targets = self.renames.iter().map(|(_, to)| to).chain(&self.removals).find(|p| !inside(p));
+        sources.or(targets).map(|p| format!("it names {}, outside {}", p.display(), folder.display()))
+    }
+
+    /// Make every change it lists that is not made yet; a journal naming a path outside the
+    /// folder is refused and nothing is changed ([`Journal::outside`]).
     fn carry_out(&self, folder: &Path) -> std::io::Result<()> {
+        if let Some(why) = self.outside(folder) {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!(
+                    "{}: {why}; the harness never writes such a journal, so nothing it lists was done. Remove it (the change it lists is then not made: `signorini run --replace` recomputes what is at fault)",
+                    folder.join(FILE).display()
+                ),
+            ));
+        }
         for (from, to) in &self.renames {
             let (from, to) = (folder.join(from), folder.join(to));
             if !from.exists() && to.exists() {
@@ -115,6 +143,30 @@ mod tests {
         journal.carry_out(&dir).unwrap();
         assert_eq!(std::fs::read_to_string(dir.join("runs/a.json")).unwrap(), "new");
         assert!(!dir.join("runs/b.json").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_journal_naming_a_path_outside_its_folder_changes_nothing() {
+        let dir = folder("outside");
+        let study = dir.join("s");
+        std::fs::create_dir_all(study.join("runs")).unwrap();
+        std::fs::write(dir.join("victim"), "keep").unwrap();
+        std::fs::write(study.join("runs/a.json"), "a").unwrap();
+        for journal in [
+            Journal { renames: vec![], removals: vec!["runs/a.json".into(), "../victim".into()] },
+            Journal { renames: vec![], removals: vec![dir.join("victim")] },
+            Journal { renames: vec![("runs/a.json".into(), "../victim".into())], removals: vec![] },
+            Journal { renames: vec![("../victim".into(), "runs/b.json".into())], removals: vec![] },
+            Journal { renames: vec![("../.accept/other/x".into(), "runs/b.json".into())], removals: vec![] },
+        ] {
+            let e = journal.carry_out(&study).unwrap_err();
+            assert!(e.to_string().contains("outside"), "{e}");
+            assert_eq!(std::fs::read_to_string(dir.join("victim")).unwrap(), "keep");
+            assert!(study.join("runs/a.json").exists());
+        }
+        let staged = Journal { renames: vec![("../.accept/s/runs/a.json".into(), "runs/a.json".into())], removals: vec![] };
+        assert_eq!(staged.outside(&study), None);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

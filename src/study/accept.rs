@@ -13,7 +13,7 @@ use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 
 /// The folder the reruns of `drift --accept` are staged in, inside the results root.
-pub const STAGING: &str = ".accept";
+pub const STAGING: &str = crate::records::journal::STAGING;
 
 /// `drift --accept` stopped by an interrupt before the swap (exit status 130): the stored study
 /// is unchanged.
