@@ -66,6 +66,7 @@ mod problem_file_forms;
 mod problem_files;
 mod problems;
 mod record_schema;
+mod refusals;
 mod report_page;
 mod resume;
 mod rollers;
