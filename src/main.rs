@@ -749,13 +749,14 @@ const MAX_THREADS_PER_CORE: usize = 8;
 
 /// Build rayon's global pool once, at startup, before anything uses it: `--jobs J` of `run`
 /// ([`threads`]), else `RAYON_NUM_THREADS` as rayon reads it (a positive integer; anything else
-/// means one thread per core), refused above [`MAX_THREADS_PER_CORE`] times the cores. Built
+/// means one thread per core, and a note on standard error says so: [`rayon_threads`]), refused
+/// above [`MAX_THREADS_PER_CORE`] times the cores. Built
 /// lazily, a pool that cannot start its threads (an address-space limit, a process limit) made
 /// the first parallel call panic (battery 12, F6: `RAYON_NUM_THREADS=2000` under `prlimit
 /// --as=4e9`, exit 101); here the failure is an error naming where the thread count came from.
 fn start_threads(jobs: Option<usize>) -> Result<()> {
     let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
-    let env = std::env::var("RAYON_NUM_THREADS").ok().and_then(|v| v.trim().parse::<usize>().ok()).filter(|&n| n > 0);
+    let env = rayon_threads(jobs.is_none(), cores);
     let (builder, from) = match (jobs, env) {
         (Some(j), _) => {
             let n = threads(j)?;
@@ -765,7 +766,7 @@ fn start_threads(jobs: Option<usize>) -> Result<()> {
             "RAYON_NUM_THREADS={n} is more than {MAX_THREADS_PER_CORE} times the {cores} core(s) available to this process: the results do not depend on the thread count, and thousands of threads on a few cores only add overhead (a tiny solve can take minutes). Nothing was computed; set it to at most {} or unset it (one thread per core)",
             MAX_THREADS_PER_CORE * cores
         ),
-        (None, Some(n)) => (rayon::ThreadPoolBuilder::new(), format!("RAYON_NUM_THREADS={n}")),
+        (None, Some(n)) => (rayon::ThreadPoolBuilder::new().num_threads(n), format!("RAYON_NUM_THREADS={n}")),
         (None, None) => (rayon::ThreadPoolBuilder::new(), format!("one thread per core ({cores})")),
     };
     builder.build_global().map_err(|e| {
@@ -773,6 +774,21 @@ fn start_threads(jobs: Option<usize>) -> Result<()> {
             "starting the solver's threads ({from}) failed: {e}. An address-space limit (ulimit -v) or a limit on processes (ulimit -u) can stop threads from starting; nothing was computed. Ask for fewer threads (RAYON_NUM_THREADS, at least 1) or raise the limit"
         )
     })
+}
+
+/// `RAYON_NUM_THREADS` if it is a positive integer. Any other value set means one thread per
+/// core, as rayon reads it; where it decides (`noted`: no `--jobs`), a one-line note says what
+/// was given and what is used instead of ignoring it without a word.
+fn rayon_threads(noted: bool, cores: usize) -> Option<usize> {
+    let given = std::env::var_os("RAYON_NUM_THREADS")?;
+    let n = given.to_str().and_then(|v| v.trim().parse::<usize>().ok()).filter(|&n| n > 0);
+    if n.is_none() && noted {
+        say!(
+            "note: RAYON_NUM_THREADS={:?} is not a positive integer; using one thread per core ({cores}), as when it is unset",
+            given.to_string_lossy()
+        );
+    }
+    n
 }
 
 /// The thread count for `--jobs J`: at least 1; more than the cores available to this process

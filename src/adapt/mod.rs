@@ -8,8 +8,8 @@ pub mod replay;
 mod roundoff;
 
 pub use roundoff::{
-    Caveat, NO_DEFORMATION, RESOLVED_DEFORMATION, RESOLVED_FORCES, ROUNDOFF_ESTIMATE, Resolution, Unresolved, WARNED_FORCES, WARNED_SHAPE,
-    deformation, force_roundoff, resolution,
+    Cause, Caveat, Conditioned, Drowned, NO_DEFORMATION, RESOLVED_DEFORMATION, RESOLVED_FORCES, ROUNDOFF_ESTIMATE, Resolution, TRANSLATED,
+    Unresolved, WARNED_FORCES, WARNED_SHAPE, deformation, force_roundoff, resolution,
 };
 
 use crate::contact::PdasOptions;
@@ -266,7 +266,7 @@ impl AdaptTermination {
                 Some(format!("stopped: the last level has at least stop_ndof = {} unknowns", config.stop_ndof.unwrap_or(0)))
             }
             AdaptTermination::NothingMarked => Some(format!(
-                "stopped: the estimate is zero, or at round-off (u_h has no deformation above {NO_DEFORMATION} delta, or eta_h is at most {ROUNDOFF_ESTIMATE:e} (2 mu + lambda) delta, delta the round-off of u_h: the larger of its round-off floor and 2.2e-16 max |u_h|: u_h is a rigid motion or a field the P2 space reproduces, to round-off, or a rigid translation in the data left it no digits of the deformation), so nothing is marked and the next level would be the same mesh"
+                "stopped: the estimate is zero, or at round-off (u_h has no deformation above {NO_DEFORMATION} delta, or eta_h is at most {ROUNDOFF_ESTIMATE:e} times what u_h's round-off can do to it: the smaller of (2 mu + lambda) delta, delta the round-off of u_h (the larger of its round-off floor and 2.2e-16 max |u_h|), and the largest stress the round-off's energy allows: u_h is a rigid motion or a field the P2 space reproduces, to round-off, or a rigid translation in the data left it no digits of the deformation), so nothing is marked and the next level would be the same mesh"
             )),
             AdaptTermination::FarFromOrigin { level, ndof, worst } => Some(format!(
                 "stopped before level {level} (levels 0 to {} were solved): its refined mesh ({ndof} unknowns) is too fine for its coordinates: {}; or stop the loop before this level: at most {level} levels (levels = {level}, --levels {level}) or at most {} unknowns (max_ndof, --max-ndof)",

@@ -8,20 +8,32 @@ use crate::contact::solve::DiscreteSolution;
 use crate::estimator::estimate::Estimate;
 use crate::mesh::Mesh;
 use crate::mesh::precision::ShapeRoundoff;
-use crate::problems::Problem;
+use crate::problems::{Material, Problem};
 
-/// The estimate is at round-off when eta_h is at most this many times (2 mu + |zeta|) delta, delta
-/// the round-off u_h carries: the larger of its measured round-off floor
-/// ([`DiscreteSolution::roundoff`], one step of iterative refinement, `roundoff_floor` in the
-/// level records) and f64::EPSILON max |u_h| (the representation of its values). eta_h for an
-/// error of size delta (the estimator's terms are stresses times lengths) is about
-/// (2 mu + |zeta|) delta: an exact discrete solution (a rigid translation) gives 6 to 24 of it
-/// (structured:4 to 128), a real estimate 1e15 and more; the deepest stored levels, with
-/// estimates down to 2.2e-5 of (2 mu + |zeta|) max |u_h| and floors near 1e-12 of it, 1e7 and
-/// more. The scale is the round-off, not the displacement: a rigid motion of the body moves
-/// max |u_h| but not the deformation the estimate measures (battery 8: a translation by 5e10 of
-/// Example 7.2 stopped at level 0 as "exact" with an accurate estimate of 8e2, 2.3e4 times its
-/// round-off scale). Asked only of a u_h that resolves its deformation ([`resolution`]).
+/// The estimate is at round-off when eta_h is at most this many times what u_h's round-off can do
+/// to it ([`Body::estimate_roundoff`]): the smaller of two scales of the stress an error of u_h
+/// at its round-off carries (the estimator's terms are stresses times lengths). The first is
+/// (2 mu + |zeta|) delta, delta the round-off u_h carries: the larger of its measured round-off
+/// floor ([`DiscreteSolution::roundoff`], one step of iterative refinement, `roundoff_floor` in
+/// the level records) and f64::EPSILON max |u_h| (the representation of its values). The second
+/// is the largest stress the round-off's energy allows: |sigma(e)|^2 <= 2 max(mu, mu + zeta)
+/// times e's energy density, so sqrt(2 max(mu, mu + zeta) a(c, c)) for the refinement step c
+/// ([`DiscreteSolution::roundoff_energy_at`]), an inverse estimate turning the L2 bound into
+/// one on the estimator's h-weighted maxima; it is at least (2 mu + |zeta|) f64::EPSILON max
+/// |u_h|, the representation's share, which has no energy measured. The two agree within a
+/// factor 2.3 on compressible materials (lambda/mu up to 1.5, the examples and the patch test); on a nearly incompressible one the round-off grows
+/// with lambda/mu along displacements of almost no divergence, whose stress is mu's, not
+/// lambda's, and only the second sees it (Example 7.2 with mu = 1, lambda = 1e8: delta 3e-8 to
+/// 3e-7, `structured:4` to `:64`, and a real estimate of 25 to 33, within 1e3 (2 mu + lambda)
+/// delta but 1.6e3 to 6.2e4 times the second scale). Exact discrete solutions give at most 59
+/// times the smaller scale (a rigid translation 6 to 24 of the first; the patch test and linear
+/// fields with lambda/mu from 1 to 1e8, `structured:4` to `:64`, 0.03 to 59), real estimates
+/// 1e15 and more on well-conditioned data; the deepest stored levels, with estimates down to
+/// 2.2e-5 of (2 mu + |zeta|) max |u_h| and floors near 1e-12 of it, 1e7 and more. The scale is
+/// the round-off, not the displacement: a rigid motion of the body moves max |u_h| but not the
+/// deformation the estimate measures (battery 8: a translation by 5e10 of Example 7.2 stopped
+/// at level 0 as "exact" with an accurate estimate of 8e2, 2.3e4 times its round-off scale).
+/// Asked only of a u_h that resolves its deformation ([`resolution`]).
 pub const ROUNDOFF_ESTIMATE: f64 = 1e3;
 
 /// The largest share of the deformation's size the round-off of u_h may reach
@@ -59,6 +71,29 @@ pub const NO_DEFORMATION: f64 = 30.0;
 /// `structured:16` and `:64` are refused, `structured:4` up to 1e6 kept), fields the
 /// P2 space reproduces (near 1e-15); the stored studies' levels are resolved, far from it.
 pub const EXACT_ROUNDOFF: f64 = 1e-8;
+
+/// u_h's round-off is blamed on a rigid translation in the data (subtract it) when max |u_h|
+/// exceeds this many times the deformation: subtracting the translation shrinks u_h, and the
+/// round-off with it, by up to that factor. Below it no translation large enough to matter is
+/// there to subtract, and the round-off comes from the conditioning of the stiffness matrix
+/// ([`Unresolved::Conditioned`]: a nearly incompressible material, lambda/mu = 1e10 in Example
+/// 7.2, has max |u_h| 0.2 against a deformation of 0.3).
+pub const TRANSLATED: f64 = 10.0;
+
+/// What makes u_h's round-off large, for a message's advice.
+#[derive(Clone, Copy, Debug)]
+pub enum Cause {
+    /// A rigid translation in the data: max |u_h| above [`TRANSLATED`] times the deformation.
+    Translation,
+    /// The conditioning of the stiffness matrix, which grows with the material's lambda/mu.
+    Conditioning { lame_ratio: f64 },
+}
+
+impl Cause {
+    fn of(u_max: f64, deformation: f64, m: Material) -> Cause {
+        if u_max > TRANSLATED * deformation { Cause::Translation } else { Cause::Conditioning { lame_ratio: m.zeta / m.mu } }
+    }
+}
 
 /// The largest round-off bound of a contact force (`lambda_floor`, over the contact nodes) that
 /// is accepted, relative to the largest contact force at an active node ([`force_roundoff`];
@@ -123,12 +158,30 @@ struct Body {
     roundoff: f64,
     /// Its deformation's size ([`deformation`] over its nodes).
     deformation: f64,
+    /// The energy a(c, c) of u_h's refinement step c over its nodes
+    /// ([`DiscreteSolution::roundoff_energy_at`]).
+    energy: f64,
     /// The spread of its coordinates ([`EXACT_ROUNDOFF`]).
     size: f64,
     u_max: f64,
     /// eta_h scaled by its share of the largest element indicator: eta_h itself for the body
     /// that holds it (the whole mesh when it is one body).
     estimate: f64,
+}
+
+/// Per body (`of`: the body of each triangle), the energy a(c, c) of u_h's refinement step c:
+/// the sum of [`DiscreteSolution::roundoff_energy_at`] over its nodes, each counted once.
+fn energies(sol: &DiscreteSolution, of: &[usize], count: usize) -> Vec<f64> {
+    let mut counted = vec![false; sol.u.len()];
+    let mut energy = vec![0.0f64; count];
+    for (t, &b) in of.iter().enumerate() {
+        for &p in &sol.nodes.elements[t] {
+            if !std::mem::replace(&mut counted[p], true) {
+                energy[b] += sol.roundoff_energy_at[p];
+            }
+        }
+    }
+    energy
 }
 
 impl Body {
@@ -144,6 +197,7 @@ impl Body {
             largest[b] = largest[b].max(est.element.get(t).copied().unwrap_or(0.0));
         }
         let top = largest.iter().fold(0.0f64, |a, v| a.max(*v));
+        let energy = energies(sol, &of, count);
         (0..count)
             .map(|b| {
                 let at = &nodes[b];
@@ -155,12 +209,26 @@ impl Body {
                     count,
                     roundoff: floor.max(f64::EPSILON * u_max),
                     deformation: spread(at.iter().map(|&p| &sol.u[p])),
+                    energy: energy[b],
                     size: spread(at.iter().map(|&p| &sol.nodes.coords[p])),
                     u_max,
                     estimate: if top > 0.0 { est.terms.eta_h * largest[b] / top } else { est.terms.eta_h },
                 }
             })
             .collect()
+    }
+
+    /// What u_h's round-off can do to the estimate ([`ROUNDOFF_ESTIMATE`]): the smaller of
+    /// (2 mu + |zeta|) delta and the largest stress the round-off's energy allows, the latter at
+    /// least (2 mu + |zeta|) f64::EPSILON max |u_h| (the representation of u_h's values).
+    fn estimate_roundoff(&self, m: Material) -> f64 {
+        let modulus = 2.0 * m.mu + m.zeta.abs();
+        let by_energy = (2.0 * m.mu.max(m.mu + m.zeta) * self.energy.max(0.0)).sqrt();
+        (modulus * self.roundoff).min(by_energy.max(modulus * f64::EPSILON * self.u_max))
+    }
+
+    fn cause(&self, m: Material) -> Cause {
+        Cause::of(self.u_max, self.deformation, m)
     }
 
     /// ", of body k of the n separate bodies (one point at (x, y))", or nothing for one body.
@@ -177,23 +245,43 @@ impl Body {
         )
     }
 
-    /// What this body's u_h resolves: `Some(false)` resolved, `Some(true)` at round-off, or the
+    /// What this body's u_h resolves: `Ok(false)` resolved, `Ok(true)` at round-off, or the
     /// refusal. A u_h at its round-off is exact only while that round-off is below
     /// [`EXACT_ROUNDOFF`] of the body's size; past it the same finding is a refusal, so a
     /// larger translation is never treated more mildly than a smaller one.
     fn verdict(&self, problem: &dyn Problem) -> Result<bool, Unresolved> {
-        let (delta, deformation) = (self.roundoff, self.deformation);
+        let (delta, deformation, m) = (self.roundoff, self.deformation, problem.material());
         let none = deformation <= NO_DEFORMATION * delta;
         if !none && delta > RESOLVED_DEFORMATION * deformation {
-            return Err(Unresolved::Displacement { roundoff: delta, deformation, u_max: self.u_max, body: self.named() });
+            return Err(match self.cause(m) {
+                Cause::Translation => Unresolved::Displacement { roundoff: delta, deformation, u_max: self.u_max, body: self.named() },
+                Cause::Conditioning { lame_ratio } => self.conditioned(lame_ratio, Drowned::Deformation),
+            });
         }
-        let m = problem.material();
+        let scale = self.estimate_roundoff(m);
         // the estimate is at round-off: its indicators are noise, the maximum strategy marks nothing
-        let at_roundoff = none || self.estimate <= ROUNDOFF_ESTIMATE * (2.0 * m.mu + m.zeta.abs()) * delta;
+        let at_roundoff = none || self.estimate <= ROUNDOFF_ESTIMATE * scale;
         if at_roundoff && delta > EXACT_ROUNDOFF * self.size {
-            return Err(Unresolved::AtRoundoff { roundoff: delta, size: self.size, u_max: self.u_max, body: self.named() });
+            return Err(match self.cause(m) {
+                Cause::Translation => Unresolved::AtRoundoff { roundoff: delta, size: self.size, u_max: self.u_max, body: self.named() },
+                Cause::Conditioning { lame_ratio } if none => self.conditioned(lame_ratio, Drowned::NoDeformation),
+                Cause::Conditioning { lame_ratio } => self.conditioned(lame_ratio, Drowned::Estimate { estimate: self.estimate, scale }),
+            });
         }
         Ok(at_roundoff)
+    }
+
+    /// The refusal of a u_h whose round-off no rigid translation explains ([`TRANSLATED`]).
+    fn conditioned(&self, lame_ratio: f64, drowned: Drowned) -> Unresolved {
+        Unresolved::Conditioned(Conditioned {
+            drowned,
+            roundoff: self.roundoff,
+            deformation: self.deformation,
+            size: self.size,
+            u_max: self.u_max,
+            lame_ratio,
+            body: self.named(),
+        })
     }
 }
 
@@ -223,17 +311,106 @@ pub enum Unresolved {
     )]
     Displacement { roundoff: f64, deformation: f64, u_max: f64, body: String },
     #[error(
-        "u_h does not resolve the deformation{body}: u_h is at its round-off there (no deformation above {NO_DEFORMATION} times it, or an estimate within {ROUNDOFF_ESTIMATE:e} (2 mu + |zeta|) times it), and that round-off, {}, is {:.1e} of the body's size {} (u_h is called exact to round-off only up to {EXACT_ROUNDOFF:e} of it), with u_h up to {} in size: an exact rigid motion and a deformation drowned in the round-off of a displacement that large (a rigid translation in the data) cannot be told apart, so its contact set and estimate would be round-off's. Give the data without the rigid part (subtract the translation from the Dirichlet data and the gap)",
+        "u_h does not resolve the deformation{body}: u_h is at its round-off there (no deformation above {NO_DEFORMATION} times it, or an estimate within {ROUNDOFF_ESTIMATE:e} times what it can do to the estimate), and that round-off, {}, is {:.1e} of the body's size {} (u_h is called exact to round-off only up to {EXACT_ROUNDOFF:e} of it), with u_h up to {} in size: an exact rigid motion and a deformation drowned in the round-off of a displacement that large (a rigid translation in the data) cannot be told apart, so its contact set and estimate would be round-off's. Give the data without the rigid part (subtract the translation from the Dirichlet data and the gap)",
         shown(*.roundoff), .roundoff / .size, shown(*.size), shown(*.u_max)
     )]
     AtRoundoff { roundoff: f64, size: f64, u_max: f64, body: String },
     #[error(
-        "the contact forces are not resolved: their round-off bound reaches {} against a largest contact force of {} ({:.1e} of it; at most {RESOLVED_FORCES:e} is kept){}, so which nodes carry a positive force (Lambda_h^C) and eta_7 would be round-off's; u_h is up to {} in size: a displacement that large against the deformation (a rigid translation in the data) makes the forces' round-off large. Give the data without the rigid part (subtract the translation from the Dirichlet data and the gap)",
+        "the contact forces are not resolved: their round-off bound reaches {} against a largest contact force of {} ({:.1e} of it; at most {RESOLVED_FORCES:e} is kept){}, so which nodes carry a positive force (Lambda_h^C) and eta_7 would be round-off's; u_h is up to {} in size{}",
         shown(*.floor), shown(*.largest), .floor / .largest,
         if *.sunk > 0 { format!(", and {} active node{} carr{} a force under {} own bound", .sunk, if *.sunk == 1 { "" } else { "s" }, if *.sunk == 1 { "ies" } else { "y" }, if *.sunk == 1 { "its" } else { "their" }) } else { String::new() },
-        shown(*.u_max)
+        shown(*.u_max),
+        match .cause {
+            Cause::Translation => ": a displacement that large against the deformation (a rigid translation in the data) makes the forces' round-off large. Give the data without the rigid part (subtract the translation from the Dirichlet data and the gap)".to_string(),
+            Cause::Conditioning { lame_ratio } => format!(", no rigid translation against its deformation: the forces' round-off comes from {}", conditioning(*lame_ratio)),
+        }
     )]
-    Forces { floor: f64, largest: f64, sunk: usize, u_max: f64 },
+    Forces { floor: f64, largest: f64, sunk: usize, u_max: f64, cause: Cause },
+    #[error("{0}")]
+    Conditioned(Conditioned),
+}
+
+/// A u_h whose round-off reaches what it must resolve while no rigid translation explains that
+/// round-off ([`TRANSLATED`]): the stiffness matrix's conditioning does, which subtracting a
+/// translation would not change.
+#[derive(Debug)]
+pub struct Conditioned {
+    pub drowned: Drowned,
+    pub roundoff: f64,
+    pub deformation: f64,
+    /// The spread of the body's coordinates ([`EXACT_ROUNDOFF`]).
+    pub size: f64,
+    pub u_max: f64,
+    pub lame_ratio: f64,
+    /// ", of body k of the n separate bodies ...", or nothing for one body.
+    pub body: String,
+}
+
+/// What u_h's round-off reaches ([`Conditioned`]).
+#[derive(Debug)]
+pub enum Drowned {
+    /// More than [`RESOLVED_DEFORMATION`] of the deformation.
+    Deformation,
+    /// The deformation: none above [`NO_DEFORMATION`] times the round-off.
+    NoDeformation,
+    /// The estimate: within [`ROUNDOFF_ESTIMATE`] times `scale`, what the round-off can do to it.
+    Estimate { estimate: f64, scale: f64 },
+}
+
+impl Conditioned {
+    /// What the round-off reaches, with the numbers that say so.
+    fn found(&self) -> String {
+        let Conditioned { roundoff, deformation, size, body, .. } = self;
+        let (delta, def) = (shown(*roundoff), shown(*deformation));
+        let exact = format!(
+            "{:.1e} of the body's size {} (u_h is called exact to round-off only up to {EXACT_ROUNDOFF:e} of it)",
+            roundoff / size,
+            shown(*size)
+        );
+        match self.drowned {
+            Drowned::Deformation => format!(
+                "u_h does not resolve the deformation{body}: its round-off {delta} is {:.1e} of the deformation's size {def} (the spread of u_h over the nodes, max - min of a component; at most {RESOLVED_DEFORMATION:e} is kept), so its contact set and estimate would be round-off's",
+                roundoff / deformation
+            ),
+            Drowned::NoDeformation => {
+                format!(
+                    "u_h does not resolve the deformation{body}: it has no deformation above {NO_DEFORMATION} times its round-off {delta}, which is {exact}"
+                )
+            }
+            Drowned::Estimate { estimate, scale } => format!(
+                "the estimate cannot be told from round-off{body}: it is {}, within {ROUNDOFF_ESTIMATE:e} times {}, what u_h's round-off can do to it (the largest stress the round-off's energy allows), though u_h resolves its deformation {def} to {:.1e} (round-off {delta}); that round-off is {exact}, so an exact discrete solution and a discretisation error below the round-off's reach look alike",
+                shown(estimate),
+                shown(scale),
+                roundoff / deformation
+            ),
+        }
+    }
+}
+
+impl std::fmt::Display for Conditioned {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(
+            f,
+            "{}. No rigid translation explains that round-off: u_h is up to {} in size against a deformation of {} (a translation is blamed from {TRANSLATED} times the deformation on), so subtracting one would not help. The round-off comes from {}",
+            self.found(),
+            shown(self.u_max),
+            shown(self.deformation),
+            conditioning(self.lame_ratio)
+        )
+    }
+}
+
+/// From this lambda/mu on a material is called nearly incompressible in a message: Poisson's
+/// ratio 0.495 and more in plane strain (lambda/mu = 2 nu / (1 - 2 nu)).
+const NEARLY_INCOMPRESSIBLE: f64 = 100.0;
+
+/// Where a round-off that no translation explains comes from, and what to do: "the
+/// conditioning of the stiffness matrix, ...".
+fn conditioning(lame_ratio: f64) -> String {
+    let nearly = if lame_ratio.abs() >= NEARLY_INCOMPRESSIBLE { ", a nearly incompressible material" } else { "" };
+    format!(
+        "the conditioning of the stiffness matrix (lambda/mu = {lame_ratio:.1e}{nearly}; the conditioning grows with lambda/mu and with refinement): give a material further from incompressibility (a smaller lambda/mu, a Poisson's ratio further from 0.5) or a coarser mesh"
+    )
 }
 
 /// What a resolved solve keeps fewer digits of than it should, or that its estimate is at
@@ -245,7 +422,7 @@ pub enum Caveat {
     /// went on through such levels without a word).
     AtRoundoff,
     /// The contact forces' round-off bound is above [`WARNED_FORCES`] of the largest force.
-    Forces { floor: f64, largest: f64 },
+    Forces { floor: f64, largest: f64, cause: Cause },
     /// The element shapes' relative round-off is above [`WARNED_SHAPE`].
     Shape(ShapeRoundoff),
 }
@@ -256,12 +433,16 @@ impl std::fmt::Display for Caveat {
             Caveat::AtRoundoff => f.write_str(
                 "the estimate is at the round-off of u_h: u_h is exact to round-off (a rigid motion, or a field the P2 space reproduces), or a displacement far larger than its variation (a rigid translation in the data) left it no digits of the deformation; its terms measure round-off, not the discretisation error",
             ),
-            Caveat::Forces { floor, largest } => write!(
+            Caveat::Forces { floor, largest, cause } => write!(
                 f,
-                "the contact forces keep fewer than 6 digits: their round-off bound reaches {} against a largest force of {} ({:.1e} of it), so a force near the edge of the contact zone may fall under it and leave Lambda_h^C and eta_7 (a rigid translation in the data makes the bound grow; give the data without it)",
+                "the contact forces keep fewer than 6 digits: their round-off bound reaches {} against a largest force of {} ({:.1e} of it), so a force near the edge of the contact zone may fall under it and leave Lambda_h^C and eta_7 ({})",
                 shown(*floor),
                 shown(*largest),
-                floor / largest
+                floor / largest,
+                match cause {
+                    Cause::Translation => "a rigid translation in the data makes the bound grow; give the data without it".to_string(),
+                    Cause::Conditioning { lame_ratio } => format!("no rigid translation in the data makes the bound grow, but {}", conditioning(*lame_ratio)),
+                }
             ),
             Caveat::Shape(s) => write!(
                 f,
@@ -328,11 +509,12 @@ pub fn resolution(problem: &dyn Problem, mesh: &Mesh, sol: &DiscreteSolution, es
     if let Some((floor, largest)) = force_roundoff(sol)
         && floor > WARNED_FORCES * largest
     {
-        let sunk = sunk(sol);
+        let (sunk, u_max) = (sunk(sol), u_max(sol));
+        let cause = Cause::of(u_max, deformation(sol), problem.material());
         if floor > RESOLVED_FORCES * largest || sunk > 0 {
-            return Resolution::Unresolved(Unresolved::Forces { floor, largest, sunk, u_max: u_max(sol) });
+            return Resolution::Unresolved(Unresolved::Forces { floor, largest, sunk, u_max, cause });
         }
-        caveats.push(Caveat::Forces { floor, largest });
+        caveats.push(Caveat::Forces { floor, largest, cause });
     }
     let shape = mesh.shape_roundoff();
     if shape.delta > WARNED_SHAPE {

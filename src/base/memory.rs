@@ -30,21 +30,39 @@ pub struct Available {
     pub bytes: f64,
     /// The address-space limit, not the machine, is the bound.
     pub by_address_space: bool,
+    /// The process's address-space limit and virtual size, where it has a limit.
+    pub address_space: Option<AddressSpace>,
+}
+
+/// An address-space limit (`ulimit -v`, `prlimit --as`) and how much of it the process uses.
+#[derive(Clone, Copy, Debug)]
+pub struct AddressSpace {
+    /// The soft limit (RLIMIT_AS, `getrlimit`), in bytes.
+    pub limit: f64,
+    /// The process's virtual size (`/proc/self/statm`), in bytes.
+    pub in_use: f64,
+}
+
+impl AddressSpace {
+    /// What the limit leaves above the virtual size.
+    pub fn left(&self) -> f64 {
+        (self.limit - self.in_use).max(0.0)
+    }
 }
 
 pub fn available() -> Option<Available> {
     let info = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
     let machine = line.split_whitespace().nth(1)?.parse::<f64>().ok()? * 1024.0;
-    Some(match address_space_left() {
-        Some(left) if left < machine => Available { bytes: left, by_address_space: true },
-        _ => Available { bytes: machine, by_address_space: false },
+    let address_space = address_space();
+    Some(match address_space {
+        Some(space) if space.left() < machine => Available { bytes: space.left(), by_address_space: true, address_space },
+        _ => Available { bytes: machine, by_address_space: false, address_space },
     })
 }
 
-/// The address-space limit's soft value (RLIMIT_AS, `getrlimit`) minus the current virtual size
-/// (`/proc/self/statm`, in pages), if there is a limit.
-fn address_space_left() -> Option<f64> {
+/// The address-space limit's soft value and the current virtual size, if there is a limit.
+fn address_space() -> Option<AddressSpace> {
     let mut lim = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
     // SAFETY: getrlimit writes the struct it is given, nothing else
     if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut lim) } != 0 || lim.rlim_cur == libc::RLIM_INFINITY {
@@ -57,7 +75,7 @@ fn address_space_left() -> Option<f64> {
         p if p > 0 => p as f64,
         _ => 4096.0,
     };
-    Some((lim.rlim_cur as f64 - pages * page).max(0.0))
+    Some(AddressSpace { limit: lim.rlim_cur as f64, in_use: pages * page })
 }
 
 /// Address space the solver's threads reserve beyond what [`memory_estimate`] counts (which is
@@ -66,14 +84,31 @@ fn address_space_left() -> Option<f64> {
 /// reserved on 64-bit Linux) and the thread's stack (2 MiB, Rust's default); per worker and the
 /// main thread: the packing buffer of the dense products (faer through private-gemm-x86:
 /// twice the largest CPU cache, allocated on a thread's first product, kept, and allocated
-/// infallibly, so a failure there aborts the process). Counted in full at every check,
-/// although threads that already ran hold theirs inside the current virtual size: an
-/// overestimate of up to this amount, which refuses a level that might just have fit rather
-/// than let the process abort. Measured (`prlimit --as`, ex71 on structured:4, 32 MiB L3): the
-/// solve needs 220, 356 and 603 MB of address space with 1, 2 and 4 threads.
+/// infallibly, so a failure there aborts the process). Threads that have run hold theirs inside
+/// the process's virtual size from then on, so a check counts only what is still to come
+/// ([`reserve_to_come`]). Measured (`prlimit --as`, ex71 on structured:4, 32 MiB L3): the solve
+/// needs 220, 356 and 603 MB of address space with 1, 2 and 4 threads.
 pub fn thread_reserve() -> f64 {
     let workers = rayon::current_num_threads() as f64;
     workers * (64.0 + 2.0) * MIB + (workers + 1.0) * 2.0 * largest_cache()
+}
+
+/// The process's virtual size at its first memory check under an address-space limit
+/// ([`reserve_to_come`]).
+static FIRST_IN_USE: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
+
+/// The part of [`thread_reserve`] not yet inside the virtual size `in_use`: the reserve less
+/// what the virtual size has grown since this process's first check (which the command line
+/// makes before any solve), so that the reserve is counted once per process, not again at
+/// every level of an adaptive loop on top of a virtual size that already holds it. Growth of
+/// another kind (the meshes and solutions a loop keeps) is taken for the reserve too: a level
+/// whose threads have not run yet could be let through by that much, which the loop's kept
+/// data, a few KiB per unknown of the levels solved, keeps far below the reserve while the
+/// threads first run on the smallest levels. Returns (the reserve, what is still to come).
+fn reserve_to_come(in_use: f64) -> (f64, f64) {
+    let reserve = thread_reserve();
+    let first = *FIRST_IN_USE.get_or_init(|| in_use);
+    (reserve, (first + reserve - in_use).clamp(0.0, reserve))
 }
 
 /// The largest cache of CPU 0 in bytes (`/sys/devices/system/cpu/cpu0/cache/index*/size`), or
@@ -101,7 +136,7 @@ pub const UNKNOWN_MEMORY_LIMIT: f64 = 1024.0 * 1024.0 * MIB;
 /// A solve that would not fit in memory.
 #[derive(Debug, thiserror::Error)]
 #[error("{what} has {ndof:.0} unknowns: solving needs about {} (estimate: {basis}), but {}", apart(*.needed, .available.map_or(0.0, |a| a.bytes))[0], match .available {
-    Some(a) if a.by_address_space => format!("this process's address-space limit (ulimit -v) leaves {}", apart(*.needed, a.bytes)[1]),
+    Some(a) if a.by_address_space => format!("this process's address-space limit (ulimit -v) leaves {}{}", apart(*.needed, a.bytes)[1], a.address_space.map_or(String::new(), |s| format!(" (the limit {} less the {} this process uses)", human_bytes(s.limit), human_bytes(s.in_use)))),
     Some(a) => format!("this machine has {} available (MemAvailable in /proc/meminfo)", apart(*.needed, a.bytes)[1]),
     None => format!("this machine's available memory is unknown (no /proc/meminfo) and more than {} is refused", human_bytes(UNKNOWN_MEMORY_LIMIT)),
 })]
@@ -139,24 +174,40 @@ pub fn check_memory(what: &str, ndof: f64) -> Result<(), MemoryError> {
 pub fn check_memory_measured(what: &str, ndof: f64, measured: Option<(f64, f64)>) -> Result<(), MemoryError> {
     let available = available();
     let (mut needed, mut basis) = level_estimate(ndof, measured, available.is_some_and(|a| !a.by_address_space));
-    if available.is_some_and(|a| a.by_address_space) {
-        let reserve = thread_reserve();
-        needed += reserve;
-        // the reserve dwarfs a small level's own need: say where it comes from (battery 13:
-        // "needs 1.7 GiB" for 626 unknowns read like a bug)
-        let workers = rayon::current_num_threads();
-        basis += &format!(
-            ", + {} of address space the threads reserve whatever the size: per each of {workers} worker(s) a 64 MiB malloc arena \
-             and a 2 MiB stack, and per worker and the main thread twice the CPU's largest cache ({}) for the dense products' \
-             packing buffer (fewer threads, RAYON_NUM_THREADS, reserve less)",
-            human_bytes(reserve),
-            human_bytes(largest_cache())
-        );
+    // asked at every check under a limit, so that the first one sets where the reserve starts
+    if let Some(space) = available.and_then(|a| a.address_space) {
+        let (reserve, to_come) = reserve_to_come(space.in_use);
+        if available.is_some_and(|a| a.by_address_space) {
+            needed += to_come;
+            basis += &reserve_basis(reserve, to_come, space.in_use);
+        }
     }
     if needed > available.map_or(UNKNOWN_MEMORY_LIMIT, |a| a.bytes) {
         return Err(MemoryError { what: what.to_string(), ndof, needed, basis, available });
     }
     Ok(())
+}
+
+/// What a check counted of the threads' reserve ([`reserve_to_come`]), for the estimate's
+/// basis: the reserve dwarfs a small level's own need, so its parts are named.
+fn reserve_basis(reserve: f64, to_come: f64, in_use: f64) -> String {
+    let workers = rayon::current_num_threads();
+    let parts = format!(
+        "per each of {workers} worker(s) a 64 MiB malloc arena and a 2 MiB stack, and per worker and the main thread twice the CPU's largest cache ({}) for the dense products' packing buffer; fewer threads, RAYON_NUM_THREADS, reserve less",
+        human_bytes(largest_cache())
+    );
+    if to_come >= reserve {
+        return format!(
+            ", + {} of address space the threads reserve whatever the size, counted once per process ({parts})",
+            human_bytes(reserve)
+        );
+    }
+    format!(
+        ", + {} still to come of the {} of address space the threads reserve whatever the size ({parts}); the rest is counted once, inside the {} this process already uses",
+        human_bytes(to_come),
+        human_bytes(reserve),
+        human_bytes(in_use)
+    )
 }
 
 /// Growth margin on a measured peak scaled to more unknowns.

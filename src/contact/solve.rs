@@ -155,6 +155,11 @@ pub struct DiscreteSolution {
     /// of each separate body of the mesh (`adapt::resolution` takes it per body, so that one
     /// body's rigid motion does not set another's round-off).
     pub roundoff_at: Vec<f64>,
+    /// Per P2 node, its share c . (K c) of the energy a(c, c) of the same refinement step c
+    /// (the Cartesian dot product of c and K c at the node; their sum over a body is that body's
+    /// energy of c, at least 0): what u_h's round-off can do to the stresses
+    /// (`adapt::resolution`).
+    pub roundoff_energy_at: Vec<f64>,
     pub strategy: Strategy,
     /// The KKT conditions' relative values, each within [`certify::TOLERANCE`].
     pub certificate: Certificate,
@@ -285,6 +290,8 @@ pub fn solve(
     let roundoff = roundoff_at.iter().fold(0.0f64, |a, v| a.max(*v));
     // how far one refinement step would move each lambda_p: (K c)_p
     let moved = assembly::stiffness_times(mesh, &nodes, &dofs, problem.material(), &correction).ku;
+    let roundoff_energy_at =
+        correction_at.iter().zip(dofs.displacement(&moved, &zero)).map(|(c, kc)| c[0] * kc[0] + c[1] * kc[1]).collect();
     let lambda_floor = contact_terms.iter().zip(&moved[dofs.n_interior..]).map(|(&terms, &kc)| lambda_roundoff(terms, kc)).collect();
     let u = dofs.displacement(&out.u, &dirichlet);
     let reactions = assembly::point_reactions(mesh, &nodes, &dofs, problem, &u, true);
@@ -319,6 +326,7 @@ pub fn solve(
         force_scale,
         roundoff,
         roundoff_at,
+        roundoff_energy_at,
         strategy,
         certificate,
         timings,

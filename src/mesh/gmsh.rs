@@ -283,6 +283,8 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     let bytes = single_spaced(bytes);
     // the sections gmsh skips are skipped by every reader below: blanked, lines kept
     let bytes = msh_sections::blank_ignored(bytes).map_err(|(line, why)| error(path, Some(line), why))?;
+    refuse_text_declared_binary(path, &bytes)?;
+    refuse_truncated(path, &bytes)?;
     refuse_partitioned(path, &bytes)?;
     let names = physical_names(path, &bytes)?;
     let msh = parse(path, &bytes)?;
@@ -299,6 +301,41 @@ pub fn read(path: &Path) -> Result<GmshFile, MeshError> {
     check_overlaps(path, &vertices, &triangles, &tri_nodes, &line_of)?;
     let (edges, groups) = group_edges(path, line_elems, &used, &node_at, &names, &line_of)?;
     Ok(GmshFile { path: path.to_path_buf(), vertices, triangles, triangle_lines, edges, groups })
+}
+
+/// A file whose `$MeshFormat` header declares binary data (file-type 1) while it holds none is
+/// refused as such: every binary MSH file holds zero bytes (the int 1 written after the header
+/// alone has three), a text file none. Read as binary, its text ended "truncated" at the header.
+fn refuse_text_declared_binary(path: &Path, bytes: &[u8]) -> Result<(), MeshError> {
+    if !msh_nodes::Encoding::of(bytes).is_some_and(|e| e.binary) || bytes.contains(&0) {
+        return Ok(());
+    }
+    let line = msh_sections::header(bytes).map(|h| line_at(bytes, h) + 1);
+    Err(error(
+        path,
+        line,
+        "the $MeshFormat header declares a binary file (file-type 1, its second field), but the data reads as text (the file holds no zero byte, where a binary file's int 1 after the header alone has three): write file-type 0 for an ASCII file (`4.1 0 8`), or save the mesh again as binary",
+    ))
+}
+
+/// A file that ends inside a section it reads (the last section opened has no `$End` line, and
+/// no line after its opening starts a section) is refused as truncated, naming the section and
+/// where the file ends: read on, the cut data of a binary `$Nodes` section were blamed on
+/// whatever its bytes happened to read as (a node tag "the internally reserved value of 0").
+fn refuse_truncated(path: &Path, bytes: &[u8]) -> Result<(), MeshError> {
+    let Some(last) = msh_sections::walk(bytes).pop().filter(|s| s.end.is_none()) else { return Ok(()) };
+    if bytes[last.body..].split(|&b| b == b'\n').any(|l| l.trim_ascii().starts_with(b"$")) {
+        return Ok(());
+    }
+    let (name, end) = (&last.name, line_at(bytes, bytes.len().saturating_sub(1)));
+    Err(error(
+        path,
+        Some(end),
+        format!(
+            "the file ends inside its ${name} section (opened at line {}): no line $End{name} and no section follow, so the file is truncated (cut short while written or copied); write or copy it again",
+            line_at(bytes, last.start)
+        ),
+    ))
 }
 
 /// A partitioned file (Gmsh's `Mesh.partition`) puts its elements on partition entities, listed

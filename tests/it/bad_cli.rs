@@ -248,6 +248,31 @@ fn jobs_beyond_the_cores_are_capped_with_a_note() {
     assert!(err.contains("--jobs must be at least 1"), "{err}");
 }
 
+/// `RAYON_NUM_THREADS` that is not a positive integer means one thread per core, as rayon reads
+/// it, and a one-line note says so rather than nothing.
+#[test]
+fn rayon_threads_that_are_not_a_positive_integer_are_named_in_a_note() {
+    let cores = std::thread::available_parallelism().unwrap().get();
+    for given in ["abc", "-1", "0"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_signorini"))
+            .args(["solve", "--problem", "ex72", "--mesh", "structured:4"])
+            .env("RAYON_NUM_THREADS", given)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{given}: {err}");
+        let note = format!("note: RAYON_NUM_THREADS=\"{given}\" is not a positive integer; using one thread per core ({cores})");
+        assert_eq!(err.lines().filter(|l| l.starts_with(&note)).count(), 1, "{given}: {err}");
+    }
+    let unset = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["solve", "--problem", "ex72", "--mesh", "structured:4"])
+        .env_remove("RAYON_NUM_THREADS")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&unset.stderr);
+    assert!(unset.status.success() && !err.contains("RAYON_NUM_THREADS"), "{err}");
+}
+
 /// A reference solution whose loop ends short of min_ndof says how far it got and why, instead
 /// of "interrupted".
 #[test]

@@ -50,6 +50,30 @@ fn bad_address_space_limit_gives_an_answer_or_the_memory_error_never_a_signal() 
     assert!(solved > 0 && refused > 0, "solved {solved}, refused {refused}: the range should hold both");
 }
 
+/// The threads' address-space reserve is counted once per process, not again at every level on
+/// top of a virtual size that already holds it: under a limit that leaves 512 MiB beyond the
+/// reserve, Example 7.1's adaptive loop runs all 8 levels, as its level 0 fits; a limit of the
+/// reserve alone is refused before level 0, naming what was counted.
+#[test]
+fn the_threads_reserve_is_counted_once_not_again_at_every_level() {
+    let reserve = signorini::base::memory::thread_reserve();
+    let args = ["adapt", "--problem", "ex71", "--levels", "8"];
+    let (code, out, err) = limited((reserve + 512.0 * 1024.0 * 1024.0) as u64, &args);
+    assert_eq!(code, Some(0), "{err}");
+    let rows = out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).count();
+    assert_eq!(rows, 8, "{out}");
+    let (code, out, err) = limited(reserve as u64, &args);
+    assert_eq!(code, Some(1), "{out}{err}");
+    for part in [
+        "structured:4 has 162 unknowns: solving needs about",
+        "of address space the threads reserve whatever the size, counted once per process (per each of",
+        "this process's address-space limit (ulimit -v) leaves",
+        "this process uses)",
+    ] {
+        assert!(err.contains(part), "{part}: {err}");
+    }
+}
+
 /// The exit code of `solve --problem nope` (an error) run by a shell that first applies
 /// `redirect` to its stderr and then execs the binary.
 fn unwritable_stderr(redirect: &str) -> Option<i32> {

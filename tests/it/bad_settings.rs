@@ -110,7 +110,7 @@ fn nothing_to_mark_stops_the_loop_and_says_so() {
     let rows: Vec<&str> = out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).collect();
     assert_eq!(rows.len(), 1, "{out}");
     // (battery 12, F3: the note no longer calls every such u_h exact, translated data can stop here too)
-    assert!(out.contains("# stopped: the estimate is zero, or at round-off (u_h has no deformation above 30 delta, or eta_h is at most 1e3 (2 mu + lambda) delta, delta the round-off of u_h: the larger of its round-off floor and 2.2e-16 max |u_h|: u_h is a rigid motion or a field the P2 space reproduces, to round-off, or a rigid translation in the data left it no digits of the deformation), so nothing is marked"), "{out}");
+    assert!(out.contains("# stopped: the estimate is zero, or at round-off (u_h has no deformation above 30 delta, or eta_h is at most 1e3 times what u_h's round-off can do to it: the smaller of (2 mu + lambda) delta, delta the round-off of u_h (the larger of its round-off floor and 2.2e-16 max |u_h|), and the largest stress the round-off's energy allows: u_h is a rigid motion or a field the P2 space reproduces, to round-off, or a rigid translation in the data left it no digits of the deformation), so nothing is marked"), "{out}");
     // uniform refinement marks everything: all levels are solved
     let (code, out, err) = signorini_in(&d, &["adapt", "--problem", "still.toml", "--levels", "3", "--uniform"]);
     assert_eq!(code, 0, "{err}");

@@ -170,6 +170,34 @@ fn truncated_file_is_an_error_naming_file_and_line() {
     assert!(err.contains("no/such/mesh.msh") && err.contains("cannot read"), "{err}");
 }
 
+/// A binary file cut anywhere inside its `$Nodes` section is named as truncated there, whatever
+/// its cut bytes would read as (a node tag of 0, "the internally reserved value").
+#[test]
+fn binary_file_cut_inside_its_nodes_is_named_truncated() {
+    let whole = std::fs::read(meshes_dir().join("quarter_disc_binary.msh")).unwrap();
+    let find = |what: &[u8]| whole.windows(what.len()).position(|w| w == what).unwrap();
+    let (body, end) = (find(b"$Nodes\n") + 7, find(b"$EndNodes"));
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-gmsh");
+    std::fs::create_dir_all(&dir).unwrap();
+    for cut in (body..end).step_by(5) {
+        let path = dir.join("cut_binary.msh");
+        std::fs::write(&path, &whole[..cut]).unwrap();
+        let err = build_err(&path, &quarter_disc_problem());
+        assert!(err.contains("the file ends inside its $Nodes section (opened at line ") && err.contains("truncated"), "{cut}: {err}");
+        assert!(!err.contains("reserved"), "{cut}: {err}");
+    }
+}
+
+/// An ASCII file whose header declares binary data (file-type 1) is named as such, not as
+/// truncated.
+#[test]
+fn text_under_a_binary_header_is_named_as_such() {
+    let path = write("text_as_binary.msh", &SQUARE.replace("4.1 0 8", "4.1 1 8"));
+    let err = build_err(&path, &square_problem());
+    assert!(err.contains("text_as_binary.msh, line 2: the $MeshFormat header declares a binary file (file-type 1"), "{err}");
+    assert!(err.contains("the data reads as text") && err.contains("`4.1 0 8`") && !err.contains("truncated"), "{err}");
+}
+
 #[test]
 fn group_the_problem_does_not_name_is_an_error_listing_the_groups() {
     let path = write("square_unknown.msh", SQUARE);

@@ -68,6 +68,7 @@ mod problem_files;
 mod problems;
 mod provenance_history;
 mod record_schema;
+mod refusals;
 mod report_page;
 mod resume;
 mod rollers;
