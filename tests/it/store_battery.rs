@@ -1,0 +1,94 @@
+//! The store's writers and the command line under hostile conditions: a journal crafted or
+//! damaged by hand, files planted where the store writes, symlinks, odd places for the results.
+//! Each test names the behaviour the store promises (docs/command-line.md, "What the store
+//! owns, and what an interrupt leaves") in a case where it did not hold.
+
+use crate::common::{scratch, signorini_in, stored_study};
+use std::path::Path;
+
+const STUDY: &str = "description = \"two runs\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:2\"\n\
+[[run]]\nid = \"a\"\nlevels = 2\nsave_levels = [1]\n[[run]]\nid = \"b\"\nlevels = 2\n";
+
+/// Every file under `dir` with its bytes, locks left out (they are created by any writer).
+fn files(dir: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            let p = e.path();
+            if e.file_type().unwrap().is_dir() {
+                stack.push(p);
+            } else if !p.to_string_lossy().ends_with(".lock") {
+                out.insert(p.strip_prefix(dir).unwrap().to_path_buf(), std::fs::read(&p).unwrap_or_default());
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn a_journal_naming_a_file_outside_the_study_is_refused_and_nothing_is_moved() {
+    let dir = scratch("battery-journal-outside");
+    stored_study(&dir, "exp/s.toml", STUDY, "res");
+    let outside = dir.join("outside");
+    std::fs::create_dir_all(&outside).unwrap();
+    let victim = outside.join("notes.txt");
+    let stolen = outside.join("stolen.json");
+    let victim_abs = victim.display().to_string();
+    let stolen_abs = stolen.display().to_string();
+    // a journal is only ever written by the store, naming files of its folder (and the staging
+    // folder ../.accept/STUDY of drift --accept): each of these names another place
+    let crafted = [
+        serde_json::json!({ "renames": [], "removals": [victim_abs] }),
+        serde_json::json!({ "renames": [], "removals": ["../../outside/notes.txt"] }),
+        serde_json::json!({ "renames": [["runs/a.json", stolen_abs]], "removals": [] }),
+        serde_json::json!({ "renames": [["runs/a.json", "../../outside/stolen.json"]], "removals": [] }),
+        serde_json::json!({ "renames": [[victim_abs, "runs/c.json"]], "removals": [] }),
+        serde_json::json!({ "renames": [["../../outside/notes.txt", "runs/c.json"]], "removals": [] }),
+        serde_json::json!({ "renames": [["../.accept/s/../../../outside/notes.txt", "runs/c.json"]], "removals": [] }),
+    ];
+    let stored = files(&dir.join("res/s"));
+    for journal in crafted {
+        std::fs::write(&victim, "mine").unwrap();
+        let text = journal.to_string();
+        std::fs::write(dir.join("res/s/.journal.json"), &text).unwrap();
+        for args in [
+            &["run", "exp/s.toml", "--results", "res"][..],
+            &["drift", "--accept", "s", "--experiments", "exp", "--results", "res"],
+            &["run", "exp/s.toml", "--plan", "--results", "res"],
+        ] {
+            let (code, out, err) = signorini_in(&dir, args);
+            assert_ne!(code, 0, "{text}, then {args:?} succeeded: {out}{err}");
+            assert!(err.contains(".journal.json") && err.contains("outside"), "{text}, then {args:?}: the refusal does not say why: {err}");
+            assert_eq!(std::fs::read_to_string(&victim).unwrap(), "mine", "{text}, then {args:?}: a file outside the study was moved");
+            assert!(!stolen.exists(), "{text}, then {args:?}: a record was moved out of the study");
+            let mut now = files(&dir.join("res/s"));
+            assert_eq!(now.remove(Path::new(".journal.json")).as_deref(), Some(text.as_bytes()), "{args:?}: the journal changed");
+            assert_eq!(now, stored, "{text}, then {args:?}: the study folder changed");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_damaged_journal_is_named_as_one_no_writer_can_carry_out_not_as_a_change_the_next_writer_completes() {
+    let dir = scratch("battery-journal-damaged");
+    stored_study(&dir, "exp/s.toml", STUDY, "res");
+    for text in ["", "{\"renames\": [[\"runs/.a", "null", "{}"] {
+        std::fs::write(dir.join("res/s/.journal.json"), text).unwrap();
+        for args in [
+            &["run", "exp/s.toml", "--results", "res"][..],
+            &["figures", "--results", "res", "--experiments", "exp", "--figures", "figs"],
+            &["report", "--results", "res", "--experiments", "exp", "--out", "pages"],
+        ] {
+            let (code, out, err) = signorini_in(&dir, args);
+            assert_eq!(code, 1, "{text:?}, then {args:?}: {out}{err}");
+            // the reader's advice (run the next writer, which "completes it") led to a writer
+            // that failed on the same file with a parse error and no way out
+            assert!(!err.contains("completes it"), "{text:?}, then {args:?}: advises a writer that cannot complete it: {err}");
+            assert!(err.contains("not a journal the store writes"), "{text:?}, then {args:?}: {err}");
+            assert!(err.contains("remove it"), "{text:?}, then {args:?}: names no way out: {err}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
