@@ -100,14 +100,30 @@ impl Journal {
     }
 }
 
-/// The journal pending in `folder`, if a process stopped while carrying it out.
+/// The journal pending in `folder`, if a process stopped while carrying it out. A file there
+/// that is not a journal the harness writes (it does not parse, or it names a path outside the
+/// folder: [`Journal::outside`]) is an error of kind `InvalidData` that says so, for readers
+/// and writers alike: no command carries it out.
 pub fn pending(folder: &Path) -> std::io::Result<Option<Journal>> {
     let file = folder.join(FILE);
     if !file.exists() {
         return Ok(None);
     }
     let text = super::read_text(&file)?;
-    serde_json::from_str(&text).map(Some).map_err(|e| super::RecordError::Parse { path: file, error: e }.into())
+    let damaged = |why: String| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!(
+                "{} is not a journal the store writes ({why}); no command carries it out, and nothing it lists was done. Compare what it lists with the folder, then remove it by hand (`signorini run --replace` recomputes what is at fault)",
+                file.display()
+            ),
+        )
+    };
+    let journal: Journal = serde_json::from_str(&text).map_err(|e| damaged(format!("it does not parse: {e}")))?;
+    if let Some(why) = journal.outside(folder) {
+        return Err(damaged(why));
+    }
+    Ok(Some(journal))
 }
 
 /// Carry out the journal a stopped process left in `folder`, if any, and remove it; returns it.

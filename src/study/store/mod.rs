@@ -226,7 +226,13 @@ impl Store {
     /// what the records render ([`check::summary_faults`]). A record file that does not parse is
     /// a fault of the run its file stem names.
     fn scan(&self) -> Result<Checked> {
-        if crate::records::journal::pending(&self.dir.root).map_or(true, |j| j.is_some()) {
+        let pending = crate::records::journal::pending(&self.dir.root);
+        if let Err(e) = &pending
+            && e.kind() == std::io::ErrorKind::InvalidData
+        {
+            bail!("{e}; nothing was read");
+        }
+        if pending.map_or(true, |j| j.is_some()) {
             bail!(
                 "{}: a change to this folder was stopped part-way ({} lists it); nothing was read. The next command that writes the study completes it: `{}` (it computes nothing that is stored already)",
                 self.dir.root.display(),
