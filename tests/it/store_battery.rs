@@ -92,3 +92,66 @@ fn a_damaged_journal_is_named_as_one_no_writer_can_carry_out_not_as_a_change_the
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_study_named_runs_is_refused_before_it_makes_the_results_root_look_like_a_study_folder() {
+    let dir = scratch("battery-name-runs");
+    stored_study(&dir, "exp/s.toml", STUDY, "res");
+    std::fs::write(dir.join("exp/runs.toml"), STUDY).unwrap();
+    // stored, res/runs/ made res look like a study folder (a folder holding runs/): every
+    // command on res was refused from then on, the study s with it
+    let (code, out, err) = signorini_in(&dir, &["run", "exp/runs.toml", "--results", "res"]);
+    assert_eq!(code, 1, "a study named runs was stored: {out}{err}");
+    assert!(err.contains("runs") && err.contains("study"), "{err}");
+    assert!(!dir.join("res/runs").exists(), "res/runs was made");
+    let (code, out, err) = signorini_in(&dir, &["run", "exp/s.toml", "--results", "res"]);
+    assert_eq!(code, 0, "the results root is still usable: {out}{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_results_root_in_the_staging_folder_of_drift_accept_is_refused_so_an_accept_cannot_remove_what_it_stored() {
+    let dir = scratch("battery-staging-root");
+    stored_study(&dir, "exp/s.toml", STUDY, "res");
+    // stored into res/.accept, the study was removed without a word by the next
+    // `drift --accept s --results res`, which reruns into res/.accept/s and removes it
+    for place in ["res/.accept", "res/.accept/", "res/.accept/inner"] {
+        for args in
+            [&["run", "exp/s.toml", "--results", place][..], &["drift", "--accept", "s", "--experiments", "exp", "--results", place]]
+        {
+            let (code, out, err) = signorini_in(&dir, args);
+            assert_eq!(code, 1, "{args:?}: {out}{err}");
+            assert!(err.contains(".accept"), "{args:?}: {err}");
+        }
+    }
+    assert!(!dir.join("res/.accept").exists(), "the staging folder was made");
+    let (code, out, err) = signorini_in(&dir, &["drift", "--accept", "s", "--experiments", "exp", "--results", "res"]);
+    assert_eq!(code, 0, "{out}{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_study_name_starting_with_a_dash_is_refused_since_no_flag_could_name_it() {
+    let dir = scratch("battery-name-dash");
+    std::fs::create_dir_all(dir.join("exp")).unwrap();
+    std::fs::write(dir.join("exp/-s.toml"), STUDY).unwrap();
+    // stored, it could be named only as `--accept=-s`: `drift --accept -s` said
+    // "unexpected argument '-s' found", and so did `--study -s`
+    let (code, out, err) = signorini_in(&dir, &["run", "exp/-s.toml", "--results", "res"]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(err.contains("`-s` cannot name one"), "{err}");
+    assert!(!dir.join("res/-s").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn report_given_a_file_for_its_results_folder_says_so_rather_than_naming_a_drift_report() {
+    let dir = scratch("battery-report-file");
+    stored_study(&dir, "exp/s.toml", STUDY, "res");
+    std::fs::write(dir.join("afile"), "x").unwrap();
+    // said "reading the drift report afile/drift-report.json: Not a directory"
+    let (code, out, err) = signorini_in(&dir, &["report", "--results", "afile", "--experiments", "exp", "--out", "pages"]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(err.contains("--results afile") && err.contains("file") && !err.contains("drift report"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
