@@ -155,3 +155,59 @@ fn report_given_a_file_for_its_results_folder_says_so_rather_than_naming_a_drift
     assert!(err.contains("--results afile") && err.contains("file") && !err.contains("drift report"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `chown -R uid:gid` of `dir`.
+fn chown_tree(dir: &Path, id: u32) {
+    std::os::unix::fs::lchown(dir, Some(id), Some(id)).unwrap();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        if e.file_type().unwrap().is_dir() {
+            chown_tree(&e.path(), id);
+        } else {
+            std::os::unix::fs::lchown(e.path(), Some(id), Some(id)).unwrap();
+        }
+    }
+}
+
+#[test]
+fn a_change_that_fails_after_its_journal_is_written_says_the_journal_is_pending_and_what_completes_it() {
+    // permissions bind only for another user: as root, the command runs as nobody (setpriv)
+    // SAFETY: geteuid has no preconditions
+    let root = unsafe { libc::geteuid() } == 0;
+    if !root || std::process::Command::new("setpriv").arg("--version").output().is_err() {
+        eprintln!("skipped: needs root and setpriv to run a command as another user");
+        return;
+    }
+    let dir = scratch("battery-journal-pending");
+    stored_study(&dir, "exp/s.toml", STUDY, "res");
+    const NOBODY: u32 = 65534;
+    chown_tree(&dir, NOBODY);
+    use std::os::unix::fs::PermissionsExt;
+    let runs = dir.join("res/s/runs");
+    for (args, what) in [
+        (&["run", "exp/s.toml", "--fresh", "--results", "res"][..], "run --fresh"),
+        (&["drift", "--accept", "s", "--experiments", "exp", "--results", "res"], "drift --accept"),
+    ] {
+        std::fs::set_permissions(&runs, std::fs::Permissions::from_mode(0o555)).unwrap();
+        let out = std::process::Command::new("setpriv")
+            .args([&format!("--reuid={NOBODY}"), &format!("--regid={NOBODY}"), "--clear-groups", env!("CARGO_BIN_EXE_signorini")])
+            .args(args)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        std::fs::set_permissions(&runs, std::fs::Permissions::from_mode(0o755)).unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{what}: {err}");
+        // the journal is on disk and the change part made: the message said only
+        // "removing R/s/runs/a.json: Permission denied", while every reader now refuses the folder
+        assert!(dir.join("res/s/.journal.json").exists(), "{what}: no journal pending: {err}");
+        assert!(
+            err.contains(".journal.json") && err.contains("completes"),
+            "{what}: the message does not say the change is pending: {err}"
+        );
+        let (code, out, err) = signorini_in(&dir, &["run", "exp/s.toml", "--results", "res"]);
+        assert_eq!(code, 0, "{what}: {out}{err}");
+        assert!(err.contains("completed a change"), "{what}: {err}");
+        chown_tree(&dir, NOBODY);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
