@@ -46,7 +46,15 @@ impl Journal {
         }
         let file = folder.join(FILE);
         super::write_json(&file, self)?;
-        self.carry_out(folder)?;
+        self.carry_out(folder).map_err(|e| {
+            std::io::Error::new(
+                e.kind(),
+                format!(
+                    "{e}; the change is listed in {} (perhaps part made): readers refuse the folder until the next command that writes the study completes it (once the cause is fixed)",
+                    file.display()
+                ),
+            )
+        })?;
         crate::base::failpoint::step("remove", &file);
         std::fs::remove_file(&file).map_err(super::step("removing the finished journal", &file))
     }
