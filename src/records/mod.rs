@@ -456,7 +456,9 @@ pub const NOT_STUDIES: [&str; 5] = ["figures", "report", "bench", "crosscheck", 
 
 /// Why `name` cannot name a study (its folder `RESULTS/NAME`), if it cannot: empty, `.` or
 /// `..`, hidden (a leading `.`: the harness's own folders, such as the staging folder of
-/// `drift --accept`), a folder the results root holds that is no study ([`NOT_STUDIES`]), or
+/// `drift --accept`), starting with `-` (read as a flag), `runs` (a results root holding
+/// `runs/` is taken for a study folder), a folder the results root holds that is no study
+/// ([`NOT_STUDIES`]), or
 /// holding a character other than ASCII letters, digits, `_`, `-` and `.` (a separator would
 /// reach outside the results root). The one rule every study name is held to.
 pub fn study_name_fault(name: &str) -> Option<String> {
@@ -466,6 +468,10 @@ pub fn study_name_fault(name: &str) -> Option<String> {
         format!("`{name}` names a folder that is no study's own (the results root or the one above it)")
     } else if name.starts_with('.') {
         "it starts with `.` (hidden names are the harness's own folders)".to_string()
+    } else if name.starts_with('-') {
+        "it starts with `-`, which the command line reads as a flag (`drift --accept -s` is refused as an unknown flag)".to_string()
+    } else if name == "runs" {
+        "`runs` would make the results root look like a study folder (a folder holding runs/ is one), and every command would then refuse the results root".to_string()
     } else if NOT_STUDIES.contains(&name) {
         format!("`{name}` is a folder the results root holds for other outputs ({})", NOT_STUDIES.join(", "))
     } else if let Some(c) = name.chars().find(|c| !(c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))) {
