@@ -62,6 +62,17 @@ pub fn study_folder_above(path: &std::path::Path) -> Option<PathBuf> {
 /// studies stored by it would mix with the study's own files, and `--fresh` or `--replace` of
 /// either would remove the other's. The one rule every `--results` (and `--against`) is held to.
 pub fn results_place_fault(results: &std::path::Path) -> Option<String> {
+    // the staging folder of `drift --accept` (RESULTS/.accept) is the store's: an accept of
+    // RESULTS reruns into RESULTS/.accept/STUDY and removes it, with what was stored there
+    let staging = crate::records::journal::STAGING;
+    let absolute = std::path::absolute(results).unwrap_or_else(|_| results.to_path_buf());
+    let resolved = absolute.ancestors().find(|a| a.exists()).and_then(|a| a.canonicalize().ok());
+    if absolute.components().chain(resolved.iter().flat_map(|r| r.components())).any(|c| c.as_os_str() == staging) {
+        return Some(format!(
+            "{} is inside a staging folder of drift --accept ({staging}/ of a results root), which the next accept there reruns into and removes. Give a folder outside it",
+            results.display()
+        ));
+    }
     let study = study_folder_above(results)?;
     Some(format!(
         "{} is inside the study folder {} (it holds runs/, .lock or .locks): a results root holds study folders and is never inside one. Give a folder outside it (e.g. beside it)",
