@@ -1165,6 +1165,9 @@ fn run_report(
     let roles = signorini::analysis::roles::read(experiments)?;
     let tracked = results.is_none_or(is_tracked_results);
     let results = results.map_or_else(|| std::path::PathBuf::from("results"), |r| r.to_path_buf());
+    if results.exists() && !results.is_dir() {
+        bail!("--results {}: this is a file; report reads the study folders of a results folder: give a folder's path", results.display());
+    }
     if wait {
         study::store::Shelf::wait_for_writers(&results)?;
     }
