@@ -233,3 +233,45 @@ fn a_hidden_json_file_in_runs_is_no_record_and_fresh_accept_and_replace_leave_it
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn figures_wait_ends_when_the_writer_it_waits_for_has_exited_even_before_its_parent_reaps_it() {
+    let dir = scratch("battery-wait-zombie");
+    let longer = STUDY.replace("levels = 2", "levels = 7").replace("structured:2", "structured:4");
+    stored_study(&dir, "exp/s.toml", &longer, "res");
+    // a driver that starts `run --fresh` and, before it waits for that child, calls
+    // `figures --wait`: the child, ended but not yet reaped, is a zombie that holds no lock, yet
+    // kill(pid, 0) found it "running" and figures --wait waited for it forever
+    let mut writer = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["run", "exp/s.toml", "--fresh", "--results", "res"])
+        .current_dir(&dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(150));
+    let mut reader = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .args(["report", "--wait", "--results", "res", "--experiments", "exp", "--out", "pages"])
+        .current_dir(&dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    let ended = loop {
+        if let Some(status) = reader.try_wait().unwrap() {
+            break Some(status);
+        }
+        if start.elapsed() > std::time::Duration::from_secs(60) {
+            break None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    };
+    if ended.is_none() {
+        reader.kill().ok();
+    }
+    let out = reader.wait_with_output().unwrap();
+    assert!(writer.wait().unwrap().success());
+    assert!(ended.is_some(), "report --wait still waited 60 s after its writer ended: {}", String::from_utf8_lossy(&out.stderr));
+    std::fs::remove_dir_all(&dir).ok();
+}
