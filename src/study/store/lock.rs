@@ -192,13 +192,25 @@ fn named_pid(text: &str) -> Option<u32> {
     text.trim().strip_prefix("process ")?.split_whitespace().next()?.parse().ok()
 }
 
-/// Whether process `pid` exists (signal 0 checks without sending; EPERM: it exists, owned by
-/// another user).
+/// Whether process `pid` exists and has not ended (signal 0 checks without sending; EPERM: it
+/// exists, owned by another user). A process that has exited but that its parent has not reaped
+/// yet (a zombie: state `Z` in /proc/PID/stat) has ended: it holds no lock, and `--wait`
+/// waiting for it waited as long as its parent did not wait for it (a driver that starts `run`
+/// and calls `figures --wait` before reaping it: forever).
 pub(super) fn running(pid: u32) -> bool {
     let Ok(pid) = libc::pid_t::try_from(pid) else { return false };
     // SAFETY: kill with signal 0 sends nothing; it only reports whether the process exists
     let r = unsafe { libc::kill(pid, 0) };
-    r == 0 || std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM)
+    let exists = r == 0 || std::io::Error::last_os_error().raw_os_error() == Some(libc::EPERM);
+    exists && !zombie(pid)
+}
+
+/// Whether process `pid` has exited and waits to be reaped (Linux's /proc; elsewhere: no).
+fn zombie(pid: libc::pid_t) -> bool {
+    let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else { return false };
+    // "PID (COMMAND) STATE ...": the command may hold spaces and parentheses, the state follows
+    // the last ')'
+    stat.rsplit_once(')').and_then(|(_, rest)| rest.split_whitespace().next()).is_some_and(|state| matches!(state, "Z" | "X"))
 }
 
 /// A locked file made this process's lock: its text names the process, its command and since when.
