@@ -549,7 +549,12 @@ impl StudyDir {
     pub fn read_run_files(&self) -> std::io::Result<Vec<RunFile>> {
         let dir = self.root.join("runs");
         let mut files: Vec<PathBuf> = match std::fs::read_dir(&dir) {
-            Ok(rd) => rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|e| e == "json")).collect(),
+            // a hidden name (`.NAME.json`) is no record: no run id starts with `.`
+            Ok(rd) => rd
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e == "json"))
+                .filter(|p| !p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.')))
+                .collect(),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
             Err(e) => return Err(step("reading the directory", &dir)(e)),
         };

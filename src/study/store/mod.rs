@@ -165,7 +165,12 @@ impl Store {
             };
             let mut held = Vec::new();
             for id in &ids {
-                held.push(self.lock_run(id, wait).context("--fresh removes every run of the study; it waits for none without --wait")?);
+                // the advice is for a lock another process holds, not for a failure to lock
+                let lock = self.lock_run(id, wait).map_err(|e| match e.downcast_ref::<Held>() {
+                    Some(_) => e.context("--fresh removes every run of the study; it waits for none without --wait"),
+                    None => e,
+                })?;
+                held.push(lock);
             }
             let writer = self.lock(wait)?;
             if only.is_some() {

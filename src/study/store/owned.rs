@@ -30,12 +30,14 @@ pub struct Inventory {
 type Fits = fn(&str) -> bool;
 
 /// The store's sub-folders, with the test a file name in each must pass.
+/// (A name starting with `.` is never one the store gives a record, a snapshot, a checkpoint or
+/// a lock: every run id starts with a letter or a digit. Its temporary files are matched apart.)
 const FOLDERS: [(&str, Fits); 5] = [
-    ("runs", |n| n.ends_with(".json")),
-    ("references", |n| n.ends_with(".json")),
-    (".partial", |n| n.ends_with(".json")),
-    ("meshes", |n| StudyDir::parse_mesh_name(n).is_some()),
-    (".locks", |n| n.ends_with(".lock")),
+    ("runs", |n| n.ends_with(".json") && !n.starts_with('.')),
+    ("references", |n| n.ends_with(".json") && !n.starts_with('.')),
+    (".partial", |n| n.ends_with(".json") && !n.starts_with('.')),
+    ("meshes", |n| StudyDir::parse_mesh_name(n).is_some() && !n.starts_with('.')),
+    (".locks", |n| n.ends_with(".lock") && !n.starts_with('.')),
 ];
 
 /// Sort every entry of `dir`'s folder (missing: empty). A sub-folder of a store folder, or a
