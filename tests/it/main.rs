@@ -74,7 +74,7 @@ mod resume;
 mod rollers;
 mod scratch;
 mod store;
-mod store_battery;
+mod store_integrity;
 mod store_ownership;
 mod stress_frame;
 mod study;

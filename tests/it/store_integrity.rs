@@ -1,7 +1,7 @@
 //! The store's writers and the command line under hostile conditions: a journal crafted or
 //! damaged by hand, files planted where the store writes, symlinks, odd places for the results.
 //! Each test names the behaviour the store promises (docs/command-line.md, "What the store
-//! owns, and what an interrupt leaves") in a case where it did not hold.
+//! owns, and what an interrupt leaves") in a case built to break it.
 
 use crate::common::{scratch, signorini_in, stored_study};
 use std::path::Path;
@@ -28,7 +28,7 @@ fn files(dir: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> 
 
 #[test]
 fn a_journal_naming_a_file_outside_the_study_is_refused_and_nothing_is_moved() {
-    let dir = scratch("battery-journal-outside");
+    let dir = scratch("integrity-journal-outside");
     stored_study(&dir, "exp/s.toml", STUDY, "res");
     let outside = dir.join("outside");
     std::fs::create_dir_all(&outside).unwrap();
@@ -72,7 +72,7 @@ fn a_journal_naming_a_file_outside_the_study_is_refused_and_nothing_is_moved() {
 
 #[test]
 fn a_damaged_journal_is_named_as_one_no_writer_can_carry_out_not_as_a_change_the_next_writer_completes() {
-    let dir = scratch("battery-journal-damaged");
+    let dir = scratch("integrity-journal-damaged");
     stored_study(&dir, "exp/s.toml", STUDY, "res");
     for text in ["", "{\"renames\": [[\"runs/.a", "null", "{}"] {
         std::fs::write(dir.join("res/s/.journal.json"), text).unwrap();
@@ -95,7 +95,7 @@ fn a_damaged_journal_is_named_as_one_no_writer_can_carry_out_not_as_a_change_the
 
 #[test]
 fn a_study_named_runs_is_refused_before_it_makes_the_results_root_look_like_a_study_folder() {
-    let dir = scratch("battery-name-runs");
+    let dir = scratch("integrity-name-runs");
     stored_study(&dir, "exp/s.toml", STUDY, "res");
     std::fs::write(dir.join("exp/runs.toml"), STUDY).unwrap();
     // stored, res/runs/ made res look like a study folder (a folder holding runs/): every
@@ -111,7 +111,7 @@ fn a_study_named_runs_is_refused_before_it_makes_the_results_root_look_like_a_st
 
 #[test]
 fn a_results_root_in_the_staging_folder_of_drift_accept_is_refused_so_an_accept_cannot_remove_what_it_stored() {
-    let dir = scratch("battery-staging-root");
+    let dir = scratch("integrity-staging-root");
     stored_study(&dir, "exp/s.toml", STUDY, "res");
     // stored into res/.accept, the study was removed without a word by the next
     // `drift --accept s --results res`, which reruns into res/.accept/s and removes it
@@ -132,7 +132,7 @@ fn a_results_root_in_the_staging_folder_of_drift_accept_is_refused_so_an_accept_
 
 #[test]
 fn a_study_name_starting_with_a_dash_is_refused_since_no_flag_could_name_it() {
-    let dir = scratch("battery-name-dash");
+    let dir = scratch("integrity-name-dash");
     std::fs::create_dir_all(dir.join("exp")).unwrap();
     std::fs::write(dir.join("exp/-s.toml"), STUDY).unwrap();
     // stored, it could be named only as `--accept=-s`: `drift --accept -s` said
@@ -146,7 +146,7 @@ fn a_study_name_starting_with_a_dash_is_refused_since_no_flag_could_name_it() {
 
 #[test]
 fn report_given_a_file_for_its_results_folder_says_so_rather_than_naming_a_drift_report() {
-    let dir = scratch("battery-report-file");
+    let dir = scratch("integrity-report-file");
     stored_study(&dir, "exp/s.toml", STUDY, "res");
     std::fs::write(dir.join("afile"), "x").unwrap();
     // said "reading the drift report afile/drift-report.json: Not a directory"
@@ -177,7 +177,7 @@ fn a_change_that_fails_after_its_journal_is_written_says_the_journal_is_pending_
         eprintln!("skipped: needs root and setpriv to run a command as another user");
         return;
     }
-    let dir = scratch("battery-journal-pending");
+    let dir = scratch("integrity-journal-pending");
     stored_study(&dir, "exp/s.toml", STUDY, "res");
     const NOBODY: u32 = 65534;
     chown_tree(&dir, NOBODY);
@@ -214,7 +214,7 @@ fn a_change_that_fails_after_its_journal_is_written_says_the_journal_is_pending_
 
 #[test]
 fn a_hidden_json_file_in_runs_is_no_record_and_fresh_accept_and_replace_leave_it() {
-    let dir = scratch("battery-hidden-json");
+    let dir = scratch("integrity-hidden-json");
     stored_study(&dir, "exp/s.toml", STUDY, "res");
     // a run id starts with a letter or digit, so the store never writes runs/.NAME.json: the
     // file is the user's, yet each of these removed it and exited 0
@@ -235,7 +235,7 @@ fn a_hidden_json_file_in_runs_is_no_record_and_fresh_accept_and_replace_leave_it
 
 #[test]
 fn figures_wait_ends_when_the_writer_it_waits_for_has_exited_even_before_its_parent_reaps_it() {
-    let dir = scratch("battery-wait-zombie");
+    let dir = scratch("integrity-wait-zombie");
     let longer = STUDY.replace("levels = 2", "levels = 7").replace("structured:2", "structured:4");
     stored_study(&dir, "exp/s.toml", &longer, "res");
     // a driver that starts `run --fresh` and, before it waits for that child, calls
