@@ -87,7 +87,8 @@ fn swap(live: &StudyDir, staged: &StudyDir) -> Result<()> {
     let old = owned::inventory(live)?;
     let relative =
         |dir: &StudyDir, p: &Path| p.strip_prefix(&dir.root).map(Path::to_path_buf).expect("an inventory lists paths in its folder");
-    let up = Path::new("..").join(staged.root.strip_prefix(live.root.parent().unwrap_or(Path::new(""))).unwrap_or(&staged.root));
+    // the staged folder as the journal reaches it from the live one: `../.accept/STUDY`
+    let up = Path::new("..").join(STAGING).join(live.root.file_name().unwrap_or_default());
     let names: Vec<PathBuf> = new
         .data
         .iter()
