@@ -9,8 +9,8 @@
 //!   plot/             figures and study pages, from records only
 //!   analysis/         rates, verdict rules, the claims of Section 7, Hertz
 //!   study/            manifests, runner, store, references, provenance, drift
-//!   adapt/            SOLVE -> ESTIMATE -> MARK -> REFINE, replaying a stored history
-//!   records/          level, run and solve records; atomic writes
+//!   records/          run and solve records; atomic writes
+//!   adapt/            SOLVE -> ESTIMATE -> MARK -> REFINE, level records, replaying a refinement history
 //!   estimator/        eta_1 .. eta_7 and their variants
 //!   contact/          active-set method, the SOLVE step, KKT certificate, error norms
 //!   fem/              P2 unknowns, element stiffness, assembly

@@ -2,12 +2,12 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
+use signorini::adapt::Refine;
 use signorini::adapt::{self, AdaptConfig};
 use signorini::contact::PdasOptions;
 use signorini::contact::sampling::Sampling;
 use signorini::estimate::{self, ContactTerm, EstimatorConfig, LogFactor};
 use signorini::mesh::MeshSpec;
-use signorini::records::Refine;
 use signorini::{norms, problems, report, solve, study};
 use std::process::ExitCode;
 

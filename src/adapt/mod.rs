@@ -4,8 +4,13 @@
 //! solves any level again, and it can start from a later level ([`run_from`], [`Start`]): how an
 //! interrupted deep run resumes.
 
+pub mod history;
+mod level;
 pub mod replay;
 mod roundoff;
+
+pub use history::{BadFlags, Flags, History, LevelHistory};
+pub use level::{LevelRecord, Refine, float_fields, is_measurement};
 
 pub use roundoff::{
     Cause, Caveat, Conditioned, Drowned, NO_DEFORMATION, RESOLVED_DEFORMATION, RESOLVED_FORCES, ROUNDOFF_ESTIMATE, Resolution, TRANSLATED,
@@ -19,7 +24,6 @@ use crate::estimator::estimate::{self, ConfigError, Estimate, EstimatorConfig};
 use crate::mesh::Mesh;
 use crate::mesh::refine::{self, Refinement};
 use crate::problems::Problem;
-use crate::records::{Flags, History, LevelHistory, LevelRecord, Refine};
 use std::ops::ControlFlow;
 use std::time::Instant;
 
@@ -82,19 +86,6 @@ pub enum AdaptError {
 }
 
 impl AdaptConfig {
-    /// The loop's settings for a study run.
-    pub fn for_run(spec: &crate::records::RunSpec) -> Self {
-        AdaptConfig {
-            levels: spec.levels,
-            max_ndof: spec.max_ndof,
-            stop_ndof: spec.stop_ndof,
-            refine: spec.refine,
-            theta: spec.theta,
-            estimator: spec.estimator,
-            ..Default::default()
-        }
-    }
-
     /// Check every setting: the one validation behind the command line and the manifests.
     /// With theta > 1 the maximum strategy marks nothing and the loop solves one mesh over and
     /// over; with `levels = 0` or `max_ndof = 0` it solves nothing.

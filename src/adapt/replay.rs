@@ -4,11 +4,11 @@
 //! drift check's replay tier compares with the stored record of a deep level, and how an
 //! interrupted run resumes ([`resume`]).
 
+use super::BadFlags;
 use super::{AdaptConfig, AdaptError, History, LevelRecord, Solved, Start};
 use crate::contact::norms::Reference;
 use crate::mesh::{Mesh, refine};
 use crate::problems::Problem;
-use crate::records::BadFlags;
 
 /// A history that does not rebuild the run it belongs to.
 #[derive(Debug, thiserror::Error)]

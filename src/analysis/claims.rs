@@ -452,8 +452,7 @@ impl Ctx<'_> {
     fn reference_error(&self, r: &RunRecord) -> Option<ReferenceError> {
         let (spec, ndof) = (r.run.reference.as_ref()?, r.reference_ndof?);
         let runs = self.shelf.runs(&r.study).ok()?;
-        let adaptive =
-            |x: &&RunRecord| x.run.refine == crate::records::Refine::Adaptive && x.run.estimator.log_factor == LogFactor::Squared;
+        let adaptive = |x: &&RunRecord| x.run.refine == crate::adapt::Refine::Adaptive && x.run.estimator.log_factor == LogFactor::Squared;
         let along = runs
             .iter()
             .filter(adaptive)
@@ -694,7 +693,7 @@ fn theta_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             last.map_or(0, |l| l.ndof),
             ctx.values(r, Q::Error).last().copied().flatten().map_or("n/a".into(), |e| format!("{e:.2e}"))
         ));
-        if r.run.refine == crate::records::Refine::Adaptive {
+        if r.run.refine == crate::adapt::Refine::Adaptive {
             let short = |p: &RateReport| if p.main.spans_enough() { String::new() } else { " (under two decades: no verdict)".into() };
             let text = format!("θ = {}: {}", r.run.theta, rep.map_or("n/a".into(), |p| format!("{}{}", p.main.text(), short(&p))));
             match headline.iter_mut().find(|(p, _)| *p == r.run.problem) {

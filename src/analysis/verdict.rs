@@ -292,8 +292,8 @@ impl RateVerdict {
 /// The variable the theory speaks of for this run: h_min under uniform refinement, NDF otherwise.
 pub fn abscissa_of(run: &RunRecord) -> Abscissa {
     match run.run.refine {
-        crate::records::Refine::Uniform => Abscissa::InverseHMin,
-        crate::records::Refine::Adaptive => Abscissa::Ndof,
+        crate::adapt::Refine::Uniform => Abscissa::InverseHMin,
+        crate::adapt::Refine::Adaptive => Abscissa::Ndof,
     }
 }
 

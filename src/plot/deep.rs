@@ -69,7 +69,7 @@ pub(super) fn deep_floor(shelf: &Shelf, roles: &Roles) -> anyhow::Result<Built> 
                 large: false,
             };
             p.series.push(series(r, format!("{label}: error {ERR}"), style(0, false, true), |l| l.err_quadrature));
-            if r.run.refine != crate::records::Refine::Uniform {
+            if r.run.refine != crate::adapt::Refine::Uniform {
                 p.series.push(series(r, format!("{label}: {ESTIMATE}"), style(1, false, false), |l| Some(l.terms.estimate)));
             }
             p.series.push(series(r, format!("{label}: {FLOOR_MARGIN} × round-off floor"), style(2, true, false), |l| {

@@ -50,7 +50,7 @@ fn error_figure(shelf: &Shelf, labels: Labels) -> anyhow::Result<Built> {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
-    type Field = fn(&crate::records::LevelRecord) -> Option<f64>;
+    type Field = fn(&crate::adapt::LevelRecord) -> Option<f64>;
     let panels_of: [(&str, &str, Field); 2] =
         [("the whole square", "", |l| l.err_quadrature), (labels.contact, " on Γ_{C}", |l| l.err_contact)];
     let mut panels = Vec::new();

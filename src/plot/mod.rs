@@ -76,12 +76,13 @@ pub mod render;
 mod repair;
 mod rich;
 
+use crate::adapt::{LevelRecord, Refine};
 use crate::analysis::claims::COINCIDE_REL;
 use crate::analysis::problem_names;
 use crate::analysis::roles::{self, Role, Roles};
 use crate::analysis::studies::{self, Study};
 use crate::estimator::estimate::{C0_PAPER, ContactTerm, LogFactor, c0_paper};
-use crate::records::{LevelRecord, MeshSnapshot, Refine, RunRecord};
+use crate::records::{MeshSnapshot, RunRecord};
 use crate::study::store::Shelf;
 use anyhow::Context;
 use plotters::prelude::*;

@@ -249,7 +249,7 @@ fn run_table(runs: &[RunRecord]) -> String {
             escape(&r.run.id),
             escape(&r.run.problem),
             r.run.refine,
-            if matches!(r.run.refine, crate::records::Refine::Adaptive) { format!(", θ = {}", r.run.theta) } else { String::new() },
+            if matches!(r.run.refine, crate::adapt::Refine::Adaptive) { format!(", θ = {}", r.run.theta) } else { String::new() },
             escape(&estimator_settings(&r.run.estimator)),
             r.levels.len(),
             last.map_or("–".into(), |l| l.ndof.to_string()),

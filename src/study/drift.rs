@@ -34,7 +34,8 @@
 use super::manifest::DERIVED;
 use super::manifest::{DriftSpec, Manifest, Tolerance};
 use super::store::Store;
-use crate::records::{LevelRecord, RunRecord};
+use crate::adapt::LevelRecord;
+use crate::records::RunRecord;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -184,7 +185,7 @@ fn compare_level(
     keys.sort();
     keys.dedup();
     for key in keys {
-        if crate::records::is_measurement(key) {
+        if crate::adapt::is_measurement(key) {
             continue; // timings and memory are never compared
         }
         let (sv, fv) = (s.get(key), f.get(key));
@@ -378,7 +379,7 @@ fn compare_histories(study: &str, stored: &RunRecord, fresh: &RunRecord, out: &m
         (Some(s), Some(f)) => (s, f),
         (None, None) => return,
         (s, f) => {
-            let text = |h: Option<&crate::records::History>| h.map_or("(missing)".to_string(), |h| format!("{} levels", h.levels.len()));
+            let text = |h: Option<&crate::adapt::History>| h.map_or("(missing)".to_string(), |h| format!("{} levels", h.levels.len()));
             out.push(row(study, id, None, "history", text(s.as_ref()), text(f.as_ref()), None, "exact".into()));
             return;
         }
@@ -390,7 +391,7 @@ fn compare_histories(study: &str, stored: &RunRecord, fresh: &RunRecord, out: &m
 
 /// The first level at which two refinement histories differ, as far as the shorter goes: the
 /// level, what differs (`mesh`, `marks`, `initial_active`) and the two sides, for a row.
-fn first_history_difference(s: &crate::records::History, f: &crate::records::History) -> Option<(usize, &'static str, String, String)> {
+fn first_history_difference(s: &crate::adapt::History, f: &crate::adapt::History) -> Option<(usize, &'static str, String, String)> {
     s.levels.iter().zip(&f.levels).find_map(|(a, b)| {
         if a.mesh != b.mesh || a.n_elements != b.n_elements {
             Some((a.level, "mesh", format!("{} elements, {}", a.n_elements, a.mesh), format!("{} elements, {}", b.n_elements, b.mesh)))

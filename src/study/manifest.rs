@@ -55,16 +55,17 @@
 //! every run before any is solved.
 
 use crate::adapt::AdaptConfig;
+use crate::adapt::Refine;
 use crate::contact::sampling::Sampling;
 use crate::estimator::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
 use crate::mesh::MeshSpec;
-use crate::records::{ReferenceSpec, Refine, RunSpec};
+use crate::records::{ReferenceSpec, RunSpec};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// A derived field's value as a function of its record.
-pub type Definition = fn(&crate::records::LevelRecord) -> Option<f64>;
+pub type Definition = fn(&crate::adapt::LevelRecord) -> Option<f64>;
 
 /// Fields that are functions of other fields of the same record, checked as such (the stored
 /// and the fresh value each equal the function of the record's own fields, to the bit) rather
@@ -504,7 +505,7 @@ fn parse_run(
         constants,
         inputs,
     };
-    AdaptConfig::for_run(&spec).validate().map_err(|e| invalid.at(key(e.key), &e.expected, e.got))?;
+    spec.adapt_config().validate().map_err(|e| invalid.at(key(e.key), &e.expected, e.got))?;
     let quick_levels = r.quick_levels.or(d.quick_levels).unwrap_or(levels.min(6));
     if quick_levels == 0 || quick_levels > levels {
         return Err(invalid.at(key("quick_levels"), &format!("a number in 1..={levels} (levels)"), quick_levels.to_string()));
@@ -544,7 +545,7 @@ fn check_drift(drift: &DriftSpec, runs: &[PlannedRun], invalid: &Invalid) -> Res
             }
         }
     }
-    let floats = crate::records::float_fields();
+    let floats = crate::adapt::float_fields();
     for (key, tol) in
         std::iter::once(("default".to_string(), &drift.default)).chain(drift.fields.iter().map(|(k, t)| (format!("fields.{k}"), t)))
     {
@@ -820,7 +821,7 @@ impl Manifest {
         mesh_spec
             .build(problem.as_ref())
             .map_err(|e| invalid("mesh", format!("a mesh problem {} can be solved on", spec.problem), format!("{:?}: {e}", spec.mesh)))?;
-        AdaptConfig::for_run(spec).check_initial(ndof, &spec.mesh).map_err(|e| invalid(e.key, e.expected, e.got))?;
+        spec.adapt_config().check_initial(ndof, &spec.mesh).map_err(|e| invalid(e.key, e.expected, e.got))?;
         if let Some(rf) = &spec.reference {
             if problem.exact().is_some() {
                 return Err(invalid(

@@ -630,7 +630,7 @@ fn run_one(
     progress: bool,
 ) -> Result<Option<RunRecord>> {
     let Some(prepared) = prepare(study, spec, manifest_file, progress)? else { return Ok(None) };
-    let config = AdaptConfig::for_run(spec);
+    let config = spec.adapt_config();
     let start = start_of(study, spec, run, meshes, &prepared, &config, progress)?;
     let Some((result, at_roundoff)) = loop_of(study, spec, run, meshes, &prepared, &config, start, progress)? else { return Ok(None) };
     // why a run ended before its last level, and which levels measure round-off, are said here,
@@ -762,7 +762,7 @@ fn loop_of(
             let kept_level = keep_level(study, spec, run, meshes, &level, prepared).and_then(|()| {
                 kept.levels.push(r.clone());
                 kept.history.levels.push(level.history.clone());
-                kept.next_active = level.next_active.map(crate::records::Flags::encode);
+                kept.next_active = level.next_active.map(crate::adapt::Flags::encode);
                 if level.continues { run.keep(&kept) } else { Ok(()) }
             });
             if let Err(e) = kept_level {
@@ -793,7 +793,7 @@ pub fn replay_stored_level(manifest: &Manifest, stored: &RunRecord, level: usize
     let history = stored.history.as_ref().ok_or_else(|| anyhow::anyhow!("{what}: the stored run has no refinement history"))?;
     let prepared = prepare(&manifest.study, spec, &manifest.file, progress)?.ok_or_else(|| anyhow::anyhow!("{what}: interrupted"))?;
     let mesh0 = prepared.initial_mesh()?;
-    let config = AdaptConfig::for_run(spec);
+    let config = spec.adapt_config();
     let problem = prepared.problem.as_ref();
     let spinner = Progress::new(progress, 0, &what);
     let (_, solved) = prepared

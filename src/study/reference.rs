@@ -4,6 +4,7 @@
 //! ([`replay`]), to the same numbers.
 
 use crate::adapt::{self, AdaptConfig};
+use crate::adapt::{Flags, Refine};
 use crate::base::element::{self, N_NODES};
 use crate::contact::norms::Displacement;
 use crate::mesh::{
@@ -11,7 +12,7 @@ use crate::mesh::{
     locate::{Hit, Locator},
 };
 use crate::problems::Problem;
-use crate::records::{Flags, Rebuild, ReferenceSpec, Refine};
+use crate::records::{Rebuild, ReferenceSpec};
 
 /// A P2 field on a mesh with an R*-tree for point location ([`Locator`]).
 pub struct ReferenceField {
@@ -101,7 +102,7 @@ pub fn compute(
     problem: &dyn Problem,
     mesh_spec: &MeshSpec,
     spec: &ReferenceSpec,
-    on_level: &mut dyn FnMut(&crate::records::LevelRecord) -> std::ops::ControlFlow<()>,
+    on_level: &mut dyn FnMut(&crate::adapt::LevelRecord) -> std::ops::ControlFlow<()>,
 ) -> Result<Option<ReferenceField>, ReferenceError> {
     let mesh = mesh_spec.build(problem).map_err(|e| adapt::AdaptError::Solve(e.into()))?;
     let config = config_of(spec);

@@ -10,10 +10,10 @@
 use crate::common;
 use common::*;
 use signorini::adapt::{self, AdaptConfig, Level};
+use signorini::adapt::{LevelRecord, Refine};
 use signorini::estimate::{ContactTerm, EstimatorConfig};
 use signorini::mesh::{Mesh, dist};
 use signorini::problems::{Ex71, Ex72, Exact, Part, Problem};
-use signorini::records::{LevelRecord, Refine};
 use std::ops::ControlFlow;
 use std::time::Instant;
 

@@ -21,9 +21,9 @@
 
 use super::common::msh::{grid, msh};
 use super::common::{mesh, scratch, signorini_in};
+use signorini::adapt::Refine;
 use signorini::adapt::{self, AdaptConfig, AdaptError, AdaptTermination, Level, Start};
 use signorini::problems::Fb;
-use signorini::records::Refine;
 use std::ops::ControlFlow;
 
 #[test]

@@ -139,7 +139,7 @@ fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 fn reproducible(record: &signorini::records::RunRecord) -> serde_json::Value {
     let mut v = serde_json::to_value(&record.levels).unwrap();
     for level in v.as_array_mut().unwrap() {
-        level.as_object_mut().unwrap().retain(|k, _| !signorini::records::is_measurement(k));
+        level.as_object_mut().unwrap().retain(|k, _| !signorini::adapt::is_measurement(k));
     }
     serde_json::json!({ "run": record.run, "levels": v })
 }

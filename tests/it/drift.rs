@@ -141,7 +141,7 @@ fn declared() -> Vec<(Manifest, Vec<RunRecord>)> {
 #[test]
 fn declared_tolerances_catch_a_relative_change_of_1e_5_wherever_round_off_allows() {
     // roundoff_floor is compared by its order of magnitude (test below), not to 1e-5
-    let floats: Vec<_> = signorini::records::float_fields().into_iter().filter(|f| !ORDER_OF_MAGNITUDE.contains(&f.as_str())).collect();
+    let floats: Vec<_> = signorini::adapt::float_fields().into_iter().filter(|f| !ORDER_OF_MAGNITUDE.contains(&f.as_str())).collect();
     let (mut checked, mut limited) = (0, Vec::new());
     for (m, stored) in declared() {
         assert!(!stored.is_empty(), "{}: no stored results", m.study);

@@ -2,9 +2,10 @@
 //! the SVGs carry the axis and legend text, and studies without results are skipped, not errors.
 //! The figures are left in `target/tmp/figures-test/figures/` for a look.
 
+use signorini::adapt::{LevelRecord, Refine};
 use signorini::estimate::{ContactTerm, EstimatorConfig, LogFactor};
 use signorini::plot::{self, FIGURES};
-use signorini::records::{LevelRecord, MeshSnapshot, Refine, RunRecord, RunSpec, StudyDir, write_json};
+use signorini::records::{MeshSnapshot, RunRecord, RunSpec, StudyDir, write_json};
 use std::path::{Path, PathBuf};
 
 fn level(level: usize, ndof: usize, err: Option<f64>, c0: f64, eta: [f64; 7]) -> LevelRecord {

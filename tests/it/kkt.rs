@@ -19,8 +19,8 @@ fn kkt_holds_for_both_examples() {
 /// every contact force from eta_7) leaves the forces counted as positive as they were.
 #[test]
 fn inactive_forces_stay_below_their_round_off_bound_on_adaptive_levels() {
+    use signorini::adapt::Refine;
     use signorini::adapt::{self, AdaptConfig, Level};
-    use signorini::records::Refine;
     use std::ops::ControlFlow;
     for name in problems::KNOWN {
         let p = problems::by_name(name).unwrap();

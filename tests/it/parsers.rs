@@ -2,7 +2,6 @@
 //! input: never a panic, and every rejection names what was wrong.
 
 use proptest::prelude::*;
-use signorini::adapt::AdaptConfig;
 use signorini::mesh::MeshSpec;
 use signorini::report::parse_probe;
 use signorini::study::manifest::Manifest;
@@ -185,7 +184,7 @@ proptest! {
             Ok(m) => {
                 prop_assert!(misspelled.is_empty(), "accepted unknown keys {:?}:\n{}", misspelled, text);
                 for p in &m.runs {
-                    prop_assert_eq!(AdaptConfig::for_run(&p.spec).validate(), Ok(()));
+                    prop_assert_eq!(p.spec.adapt_config().validate(), Ok(()));
                     prop_assert!(p.quick_levels >= 1 && p.quick_levels <= p.spec.levels);
                     prop_assert!(p.spec.save_levels.iter().all(|&l| l < p.spec.levels));
                     prop_assert!(MeshSpec::parse(&p.spec.mesh).is_ok());

@@ -6,9 +6,9 @@
 
 use crate::common;
 use common::*;
+use signorini::adapt::Refine;
 use signorini::adapt::{self, AdaptConfig};
 use signorini::problems::{FileProblem, Problem};
-use signorini::records::Refine;
 use signorini::study::reference;
 use std::path::Path;
 

@@ -31,7 +31,7 @@ fn fixture() -> String {
 fn numbers(r: &RunRecord) -> serde_json::Value {
     let mut v = serde_json::to_value(r).unwrap();
     for l in v["levels"].as_array_mut().unwrap() {
-        l.as_object_mut().unwrap().retain(|k, _| !signorini::records::is_measurement(k));
+        l.as_object_mut().unwrap().retain(|k, _| !signorini::adapt::is_measurement(k));
     }
     v
 }
@@ -158,7 +158,7 @@ fn stored_reference_replays_to_the_computed_one() {
     let mut marks = altered.history.levels[level].marks.decode().unwrap();
     let first_unmarked = marks.iter().position(|m| !m).unwrap();
     marks[first_unmarked] = true;
-    altered.history.levels[level].marks = signorini::records::Flags::encode(&marks);
+    altered.history.levels[level].marks = signorini::adapt::Flags::encode(&marks);
     let e = reference::replay(problem.as_ref(), &mesh_spec, reference_spec, &altered, &m.drift)
         .err()
         .expect("altered marks do not replay")

@@ -3,9 +3,10 @@
 //! centres are told from the coarse end of a grading, and the `fb` rows of CLAIMS.md read
 //! synthetic records (and say "no data" without them).
 
+use signorini::adapt::{LevelRecord, Refine};
 use signorini::claims::{self, Verdict};
 use signorini::estimate::EstimatorConfig;
-use signorini::records::{LevelRecord, MeshSnapshot, Refine, RunRecord, RunSpec, StudyDir, write_json};
+use signorini::records::{MeshSnapshot, RunRecord, RunSpec, StudyDir, write_json};
 use signorini::verdict::{self, RateReport, RateVerdict, refinement};
 use std::path::PathBuf;
 

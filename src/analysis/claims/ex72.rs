@@ -210,7 +210,7 @@ fn corners(ctx: &Ctx, a72: Option<&RunRecord>, errors: &Errors) -> Claim {
     let peaks = a72
         .filter(|r| r.levels.iter().any(|l| l.max_indicator_x != 0.0 || l.max_indicator_y != 0.0))
         .map(|r| {
-            let near = |l: &crate::records::LevelRecord| {
+            let near = |l: &crate::adapt::LevelRecord| {
                 [[0.0, 0.0], [0.0, 1.0]].iter().any(|c| crate::mesh::dist(*c, [l.max_indicator_x, l.max_indicator_y]) <= 0.05)
             };
             let n = r.levels.iter().filter(|l| near(l)).count();
@@ -278,7 +278,7 @@ fn eta6_eta7(a72: Option<&RunRecord>) -> Claim {
                 _ => plateaus.push((h, i, i)),
             }
         }
-        let fit = |f: fn(&crate::records::LevelRecord) -> f64| {
+        let fit = |f: fn(&crate::adapt::LevelRecord) -> f64| {
             let pts: Vec<(f64, f64)> =
                 plateaus.iter().map(|p| (p.0, f(&r.levels[p.2]))).filter(|p| p.1 > 1e-14).map(|p| (p.0.ln(), p.1.ln())).collect();
             crate::base::stats::fit_line(&pts)

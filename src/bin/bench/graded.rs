@@ -183,7 +183,7 @@ struct Built {
     problem: Box<dyn signorini::problems::Problem>,
     run: String,
     level: Option<usize>,
-    stored: Option<records::LevelRecord>,
+    stored: Option<signorini::adapt::LevelRecord>,
 }
 
 fn build(case: &str, ndof: f64) -> Result<Built> {

@@ -5,7 +5,8 @@
 //! the next mesh is rebuilt from the initial one by the stored marks (`adapt::replay`). The
 //! checkpoint is not a result: git ignores `.partial/`, and it is removed when the run lands.
 
-use crate::records::{Flags, History, LevelRecord, RunSpec, StudyDir};
+use crate::adapt::{Flags, History, LevelRecord};
+use crate::records::{RunSpec, StudyDir};
 use crate::study::provenance::CodeVersion;
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
