@@ -31,7 +31,7 @@ test: build
 	$(TIMED) check $(CARGO) check --release --locked --all-targets
 	$(TIMED) venv crosscheck/setup.sh
 	@date +%s > target/test-compiled
-	$(TIMED) fmt $(CARGO) fmt --check
+	$(TIMED) fmt $(CARGO) fmt --all --check
 	$(TIMED) clippy $(CARGO) clippy --release --locked --all-targets -- -D warnings
 	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || command -v google-chrome >/dev/null || [ -n "$$CHROMIUM" ] || echo "NOTE: no chromium on this machine: the browser check of the study pages (tests/it/report_page.rs) is SKIPPED (apt-get install chromium; CI installs it)"
 	@# the tests' scratch folders (std::env::temp_dir) under target/, emptied first, not left in /tmp

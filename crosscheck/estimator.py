@@ -1,5 +1,5 @@
 """The a posteriori estimator of the paper (Section 6, eq. 6.3), evaluated on NGSolve's side from an
-exported case's mesh and u_h: a second implementation of src/estimator/, written from the paper's
+exported case's mesh and u_h: a second implementation of crates/numerics/src/estimator/, written from the paper's
 formulas and the Rust code's declared choices (README.md, "The estimator"), sharing no code with it.
 
 Per P2 node p, with Omega_p the elements containing p and h_p the diameter of Omega_p:

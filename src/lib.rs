@@ -1,50 +1,28 @@
 //! signorini: a P2 finite element harness for the Signorini contact problem and its
 //! supremum-norm a posteriori error estimator (Khandelwal, Porwal, Wadhawan).
 //!
-//! The crate is built in floors, one folder each; code uses only its own floor and the floors
-//! below (`tests/it/layers.rs` checks it, and that no two files use each other):
+//! The workspace is built in floors; each crate is one or more of them, and a crate uses only
+//! the crates below it (the compiler keeps that; `tests/it/layers.rs` keeps the floors inside a
+//! crate). Top first:
 //!
 //! ```text
-//!   main.rs, bin/     the command line, the benchmark
-//!   plot/             figures and study pages, from records only
-//!   analysis/         rates, verdict rules, the claims of Section 7, Hertz
-//!   study/            manifests, runner, store, references, provenance, drift
-//!   records/          run and solve records; atomic writes
-//!   adapt/            SOLVE -> ESTIMATE -> MARK -> REFINE, level records, replaying a refinement history
-//!   estimator/        eta_1 .. eta_7 and their variants
-//!   contact/          active-set method, the SOLVE step, KKT certificate, error norms
-//!   fem/              P2 unknowns, element stiffness, assembly
-//!   sparse/           symmetric CSC, orderings, symbolic and numeric Cholesky
-//!   mesh/             triangulations, refinement, Gmsh, point location
-//!   problems/         the Problem trait, boundary parts, built-ins, problem files
-//!   base/             reference element, statistics, memory
+//!   signorini            main.rs, bin/: the command line, the benchmark; this prelude
+//!   signorini-claims     plot/, analysis/: figures, study pages, verdict rules, Section 7's claims
+//!   signorini-harness    study/, records/: manifests, runner, store, drift; records, atomic writes
+//!   signorini-numerics   adapt/, estimator/, contact/, fem/, sparse/, mesh/, problems/, base/
 //! ```
 //!
 //! Three entry points: [`solve::solve`] (one discrete solution on a mesh, certified by its KKT
 //! conditions), [`adapt::run`] (the adaptive loop) and [`study::run_study`] (a declared study
-//! into its results folder). Every module has one path in the crate (`crate::contact::solve`);
-//! the most used keep a short name at the root for users, examples and tests
-//! (`signorini::solve`, `signorini::estimate`, `signorini::cholesky`), which code inside the
-//! crate never uses (`tests/it/layers.rs` reads the `pub use` lines below and checks it).
+//! into its results folder). This crate re-exports every floor under its own name
+//! (`signorini::mesh`, `signorini::study`) and the most used modules under a short one
+//! (`signorini::solve`, `signorini::estimate`, `signorini::cholesky`): the users' prelude, for
+//! examples, tests and user programs. Code inside the crates never uses it.
 
-// `!(x > 0.0)` is how this crate rejects NaN together with the out-of-range values, on purpose.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
+pub use signorini_claims::{analysis, plot};
+pub use signorini_harness::{records, study};
+pub use signorini_numerics::{adapt, base, contact, estimator, fem, mesh, problems, sparse};
 
-pub mod adapt;
-pub mod analysis;
-pub mod base;
-pub mod contact;
-pub mod estimator;
-pub mod fem;
-pub mod mesh;
-pub mod plot;
-pub mod problems;
-pub mod records;
-pub mod sparse;
-pub mod study;
-
-// The users' prelude: short names at the root (`signorini::solve`, `signorini::estimate`) for
-// examples, tests and user programs; inside the crate only the full paths (`crate::contact::solve`).
 pub use analysis::{claims, hertz, verdict};
 pub use base::{element, memory};
 pub use contact::{certify, norms, solve};

@@ -1,4 +1,4 @@
-//! The adaptive loop (src/adapt.rs) end to end.
+//! The adaptive loop (crates/numerics/src/adapt.rs) end to end.
 //!
 //! 4. meshes stay conforming, tagged, shape regular (NVB: min angle 45 degrees on these meshes)
 //!    and keep the kink vertex of Example 7.2 through 30 adaptive levels;

@@ -1,4 +1,4 @@
-//! The checks that an exact solution a problem file declares is one (src/contact/consistent/)
+//! The checks that an exact solution a problem file declares is one (crates/numerics/src/contact/consistent/)
 //! look at every point where the data enter the discrete problem, on curved parts too (battery
 //! 6, findings 1 and 3): tension on a contact arc was certified, because edges on a `[curves]`
 //! circle were left out; a bump in the Dirichlet data or the body force between the sampled

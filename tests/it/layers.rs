@@ -1,39 +1,27 @@
-//! The house stays layered: every file of `src/` belongs to a floor (a folder, or one file for
-//! a floor of one file), and its code refers only to its own floor and the floors below
-//! (`use` lines and paths alike, `crate::`, `super::` and child modules; doc comments and
-//! `#[cfg(test)]` modules are not counted), and no two files refer to each other, directly or
-//! around a longer circle, except that a module may use the items of the module that declares
-//! it (a folder's `mod.rs` assembles its files: `mesh/gmsh.rs` builds the `Mesh` of
-//! `mesh/mod.rs`, whose `MeshSpec::build` calls it). The floors, bottom first, are those of
-//! `src/lib.rs`'s crate docs.
-//!
-//! Every `crate::` path is a module's one canonical path: lib.rs's short names (its `pub use`
-//! lines, read from the file) are the users' prelude, never used inside the crate, and a path
-//! that resolves to no module of `src/` is an error too (a checker that dropped it would pass
-//! whatever it hides).
+//! The house stays layered. Between crates the compiler keeps the floors (a crate can use only
+//! the crates it depends on, and Cargo refuses a cycle). Inside a crate this test keeps them:
+//! every file of a crate's `src/` belongs to a floor (a folder), and its code refers only to its
+//! own floor and the floors below (`use` lines and paths alike: `crate::`, `super::` however
+//! many times, and child modules; comments and `#[cfg(test)]` modules are not counted), and no
+//! two files refer to each other, directly or around a longer circle, except that a module may
+//! use the items of the module that declares it (a folder's `mod.rs` assembles its files:
+//! `mesh/gmsh.rs` builds the `Mesh` of `mesh/mod.rs`, whose `MeshSpec::build` calls it). A
+//! `crate::` or `super::` path that resolves to no module of the crate is an error too (a
+//! checker that dropped it would pass whatever it hides).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-/// Floors, bottom first: (name, path prefixes under `src/`).
-const FLOORS: &[(&str, &[&str])] = &[
-    ("base", &["base/"]),
-    ("problems", &["problems/"]),
-    ("mesh", &["mesh/"]),
-    ("sparse", &["sparse/"]),
-    ("fem", &["fem/"]),
-    ("contact", &["contact/"]),
-    ("estimator", &["estimator/"]),
-    ("adapt", &["adapt/"]),
-    ("records", &["records/"]),
-    ("study", &["study/"]),
-    ("analysis", &["analysis/"]),
-    ("plot", &["plot/"]),
-    ("cli", &["main.rs", "bin/"]),
+/// The member crates (folder under the repository) and their floors, bottom first, as their
+/// lib.rs's docs draw them.
+const CRATES: &[(&str, &[&str])] = &[
+    ("crates/numerics", &["base", "problems", "mesh", "sparse", "fem", "contact", "estimator", "adapt"]),
+    ("crates/harness", &["records", "study"]),
+    ("crates/claims", &["analysis", "plot"]),
 ];
 
-fn src() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
+fn repo() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
 /// Every `.rs` file under `dir`, folders too (also read by `study_names`).
@@ -48,81 +36,25 @@ pub(crate) fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// "contact::solve" for src/contact/solve.rs, "contact" for src/contact/mod.rs.
+/// "contact::solve" for contact/solve.rs, "contact" for contact/mod.rs.
 fn module_of(rel: &str) -> String {
-    let m = rel.trim_end_matches(".rs").trim_end_matches("/mod");
-    m.replace('/', "::")
-}
-
-fn floor_of(rel: &str) -> Option<usize> {
-    FLOORS.iter().position(|(_, prefixes)| prefixes.iter().any(|p| rel.starts_with(p)))
+    rel.trim_end_matches(".rs").trim_end_matches("/mod").replace('/', "::")
 }
 
 /// The code of a file: without comments and without its `#[cfg(test)]` module.
 fn code(text: &str) -> Vec<(usize, String)> {
-    let mut out = Vec::new();
-    for (i, line) in text.lines().enumerate() {
-        if line.trim_start().starts_with("#[cfg(test)]") {
-            break;
-        }
-        let code = line.split("//").next().unwrap_or("");
-        out.push((i + 1, code.to_string()));
-    }
-    out
+    let lines = text.lines().take_while(|l| !l.trim_start().starts_with("#[cfg(test)]"));
+    lines.enumerate().map(|(i, l)| (i + 1, l.split("//").next().unwrap_or("").to_string())).collect()
 }
 
-/// lib.rs's short names, read from its `pub use` lines (`pub use a::{b, c as d};`, `pub use a::b;`),
-/// each with the path it stands for: `("element", "base::element")`.
-fn aliases(src: &Path) -> Vec<(String, String)> {
-    let lib = std::fs::read_to_string(src.join("lib.rs")).unwrap();
-    let text: String = code(&lib).into_iter().map(|(_, l)| l + "\n").collect();
-    let mut out = Vec::new();
-    for statement in text.split(';').map(str::trim).filter_map(|s| s.strip_prefix("pub use ")) {
-        let statement: String = statement.split_whitespace().collect::<Vec<_>>().join(" ");
-        let (base, items) = match statement.split_once("::{") {
-            Some((base, rest)) => (base.to_string(), rest.trim_end_matches('}').split(',').map(str::trim).map(String::from).collect()),
-            None => match statement.rsplit_once("::") {
-                Some((base, item)) => (base.to_string(), vec![item.to_string()]),
-                None => (String::new(), vec![statement.clone()]),
-            },
-        };
-        for item in items.iter().filter(|i| !i.is_empty()) {
-            let (name, alias) = item.split_once(" as ").unwrap_or((item, item));
-            let full = if base.is_empty() { name.to_string() } else { format!("{base}::{name}") };
-            out.push((alias.trim().to_string(), full.trim_start_matches("self::").to_string()));
-        }
-    }
-    out
-}
-
-/// The file (relative to src/) a module path resolves to: the longest prefix that is a module
-/// (a short name of lib.rs stands for its module).
-fn resolve(path: &[&str], modules: &BTreeMap<String, String>, aliases: &[(String, String)]) -> Option<String> {
-    let mut segs: Vec<String> = path.iter().map(|s| s.to_string()).collect();
-    if let Some((_, to)) = aliases.iter().find(|(a, _)| Some(a.as_str()) == path.first().copied()) {
-        let mut expanded: Vec<String> = to.split("::").map(String::from).collect();
-        expanded.extend(segs.drain(1..));
-        segs = expanded;
-    }
-    (1..=segs.len()).rev().find_map(|k| modules.get(&segs[..k].join("::")).cloned())
-}
-
-/// What [`scan`] finds: every file's references to other files (target, line), and the
-/// `crate::` paths that are not a module's canonical path (through a short name of lib.rs) or
-/// that resolve to no module.
-struct Scan {
-    refs: BTreeMap<String, BTreeMap<String, usize>>,
-    bad_paths: Vec<String>,
-}
-
-/// The paths of a `use` tree after `crate::` at `at` of `text`: one path, or one per item of a
-/// group `crate::{a::b, c}` (nested groups stop at their module); segments, empty ones dropped.
-fn crate_paths(text: &str, at: usize) -> Vec<Vec<String>> {
+/// The module paths of a `use` tree at the start of `text`: one path, or one per item of a
+/// group `{a::b, c}` (nested groups stop at their module); segments, empty ones dropped.
+fn tree_paths(text: &str) -> Vec<Vec<String>> {
     let segments = |s: &str| -> Vec<String> {
         let path = s.trim_start().split(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':')).next().unwrap_or("");
         path.split("::").filter(|s| !s.is_empty()).map(String::from).collect()
     };
-    let Some(group) = text[at..].strip_prefix('{') else { return vec![segments(&text[at..])] };
+    let Some(group) = text.strip_prefix('{') else { return vec![segments(text)] };
     let (mut depth, mut items, mut item) = (0usize, Vec::new(), String::new());
     for c in group.chars() {
         match c {
@@ -141,18 +73,51 @@ fn crate_paths(text: &str, at: usize) -> Vec<Vec<String>> {
     items.iter().map(|i| segments(i)).filter(|p| !p.is_empty()).collect()
 }
 
-/// Scan the crate at `src`. With `children_too: false`, a module's references to the modules it
-/// declares are left out (see the module docs).
+/// What [`scan`] finds in a crate: every file's references to other files (target, line) and
+/// the paths that resolve to no module.
+struct Scan {
+    refs: BTreeMap<String, BTreeMap<String, usize>>,
+    bad_paths: Vec<String>,
+}
+
+/// The file a module path resolves to: the longest prefix that is a module.
+fn resolve(segs: &[String], modules: &BTreeMap<String, String>) -> Option<String> {
+    (1..=segs.len()).rev().find_map(|k| modules.get(&segs[..k].join("::")).cloned())
+}
+
+/// Where a path starting at `at` of `code` (just after `crate::`, or at the first `super::` of
+/// a chain) leads, from module `me`: the absolute module path, `super::` counted however often.
+fn absolute(code: &str, at: usize, me: &str, from_crate: bool) -> Vec<Vec<String>> {
+    if from_crate {
+        return tree_paths(&code[at..]);
+    }
+    let mut rest = &code[at..];
+    let mut base: Vec<String> = me.split("::").filter(|s| !s.is_empty()).map(String::from).collect();
+    while let Some(r) = rest.strip_prefix("super::") {
+        base.pop();
+        rest = r;
+    }
+    tree_paths(rest).into_iter().map(|p| base.iter().cloned().chain(p).collect()).collect()
+}
+
+/// Scan the crate whose sources are at `src`. With `children_too: false`, a module's references
+/// to the modules it declares are left out (see the module docs).
 fn scan(src: &Path, children_too: bool) -> Scan {
     let mut files = Vec::new();
     rust_files(src, &mut files);
     let rel = |p: &PathBuf| p.strip_prefix(src).unwrap().to_string_lossy().replace('\\', "/");
-    let modules: BTreeMap<String, String> =
-        files.iter().map(rel).filter(|r| r != "lib.rs" && r != "main.rs" && !r.starts_with("bin/")).map(|r| (module_of(&r), r)).collect();
-    let aliases = aliases(src);
-    let path_re = |s: &str, at: usize| -> Vec<String> {
-        s[at..].split(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':')).next().unwrap_or("").split("::").map(String::from).collect()
-    };
+    let mut modules: BTreeMap<String, String> = files.iter().map(rel).filter(|r| r != "lib.rs").map(|r| (module_of(&r), r)).collect();
+    // a `#[macro_export]` macro is an item of the crate root, `crate::NAME`, defined in its file
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        for (at, _) in text.match_indices("#[macro_export]") {
+            let name = text[at..]
+                .split("macro_rules!")
+                .nth(1)
+                .and_then(|r| r.split(|c: char| !(c.is_alphanumeric() || c == '_')).find(|w| !w.is_empty()));
+            modules.extend(name.map(|n| (n.to_string(), rel(f))));
+        }
+    }
     let mut out = Scan { refs: BTreeMap::new(), bad_paths: Vec::new() };
     for f in &files {
         let r = rel(f);
@@ -161,6 +126,24 @@ fn scan(src: &Path, children_too: bool) -> Scan {
         }
         let me = module_of(&r);
         let text = std::fs::read_to_string(f).unwrap();
+        let lines = code(&text);
+        let joined: String = lines.iter().map(|(_, l)| format!("{l}\n")).collect();
+        let mut refs: BTreeMap<String, usize> = BTreeMap::new();
+        let line_at = |at: usize| lines[joined[..at].matches('\n').count()].0;
+        let mut starts: Vec<(usize, bool)> =
+            joined.match_indices("crate::").filter(|(at, _)| !joined[..*at].ends_with('$')).map(|(at, _)| (at + 7, true)).collect();
+        starts.extend(joined.match_indices("super::").filter(|(at, _)| !joined[..*at].ends_with("::")).map(|(at, _)| (at, false)));
+        for (at, from_crate) in starts {
+            for segs in absolute(&joined, at, &me, from_crate) {
+                match resolve(&segs, &modules) {
+                    Some(t) if t != r => {
+                        refs.entry(t).or_insert(line_at(at));
+                    }
+                    Some(_) => {}
+                    None => out.bad_paths.push(format!("{r}:{}: `{}` resolves to no module of the crate", line_at(at), segs.join("::"))),
+                }
+            }
+        }
         let children: BTreeSet<String> = text
             .lines()
             .filter_map(|l| {
@@ -172,49 +155,13 @@ fn scan(src: &Path, children_too: bool) -> Scan {
                     .map(String::from)
             })
             .collect();
-        let mut refs: BTreeMap<String, usize> = BTreeMap::new();
-        let add = |refs: &mut BTreeMap<String, usize>, target: Option<String>, line: usize| {
-            if let Some(t) = target.filter(|t| *t != r) {
-                refs.entry(t).or_insert(line);
-            }
-        };
-        // `crate::` paths over the whole code (a `use crate::{...}` group spans lines)
-        let lines = code(&text);
-        let joined: String = lines.iter().map(|(_, l)| format!("{l}\n")).collect();
-        for (at, _) in joined.match_indices("crate::").filter(|(at, _)| !joined[..*at].ends_with('$')) {
-            let line = lines[joined[..at].matches('\n').count()].0;
-            for segs in crate_paths(&joined, at + "crate::".len()) {
-                let shown = format!("crate::{}", segs.join("::"));
-                let first = segs[0].as_str();
-                if !modules.keys().any(|m| m.split("::").next() == Some(first))
-                    && let Some((_, to)) = aliases.iter().find(|(a, _)| a == first)
-                {
-                    out.bad_paths
-                        .push(format!("src/{r}:{line}: `{shown}` goes through lib.rs's short name `{first}`: write `crate::{to}`"));
-                }
-                let target = resolve(&segs.iter().map(String::as_str).collect::<Vec<_>>(), &modules, &aliases);
-                if target.is_none() {
-                    out.bad_paths.push(format!("src/{r}:{line}: `{shown}` resolves to no module of src/"));
-                }
-                add(&mut refs, target, line);
-            }
-        }
-        for (line, c) in lines {
-            for (at, _) in c.match_indices("super::") {
-                if at > 0 && c[..at].ends_with("::") {
-                    continue;
-                }
-                let parent = me.rsplit_once("::").map_or(String::new(), |(p, _)| p.to_string());
-                let mut segs: Vec<String> = if parent.is_empty() { Vec::new() } else { parent.split("::").map(String::from).collect() };
-                segs.extend(path_re(&c, at + "super::".len()));
-                add(&mut refs, resolve(&segs.iter().map(String::as_str).collect::<Vec<_>>(), &modules, &aliases), line);
-            }
-            for child in children.iter().filter(|_| children_too) {
+        for (line, c) in lines.iter().filter(|_| children_too) {
+            for child in &children {
                 let used = c
                     .match_indices(&format!("{child}::"))
                     .any(|(at, _)| at == 0 || !c[..at].ends_with(|ch: char| ch.is_alphanumeric() || ch == '_' || ch == ':'));
-                if used {
-                    add(&mut refs, modules.get(&format!("{me}::{child}")).cloned(), line);
+                if let Some(t) = modules.get(&format!("{me}::{child}")).filter(|_| used) {
+                    refs.entry(t.clone()).or_insert(*line);
                 }
             }
         }
@@ -223,98 +170,51 @@ fn scan(src: &Path, children_too: bool) -> Scan {
     out
 }
 
-fn references_with(children_too: bool) -> BTreeMap<String, BTreeMap<String, usize>> {
-    scan(&src(), children_too).refs
-}
-
-fn references() -> BTreeMap<String, BTreeMap<String, usize>> {
-    references_with(true)
+fn floor_of(floors: &[&str], rel: &str) -> Option<usize> {
+    floors.iter().position(|f| rel.starts_with(&format!("{f}/")))
 }
 
 #[test]
-fn every_crate_path_is_canonical_and_resolves() {
-    let bad = scan(&src(), true).bad_paths;
-    assert!(bad.is_empty(), "crate:: paths that are not a module's canonical path:\n{}", bad.join("\n"));
-}
-
-/// A scratch crate of two floors (`mesh/` below `study/`) whose lib.rs has `extra` added, and
-/// whose `mesh/io.rs` holds `code`: what [`scan`] says about it.
-fn scan_scratch(name: &str, extra: &str, code: &str) -> Scan {
-    let dir = std::env::temp_dir().join(format!("signorini-layers-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let files = [
-        ("lib.rs", format!("pub mod mesh;\npub mod study;\n{extra}\n")),
-        ("mesh/mod.rs", "pub mod io;\n".to_string()),
-        ("mesh/io.rs", format!("{code}\n")),
-        ("study/mod.rs", "pub mod store;\n".to_string()),
-        ("study/store.rs", "pub struct StudyDir;\n".to_string()),
-    ];
-    for (path, text) in files {
-        std::fs::create_dir_all(dir.join(path).parent().unwrap()).unwrap();
-        std::fs::write(dir.join(path), text).unwrap();
+fn every_path_resolves_to_a_module_of_its_crate() {
+    for (dir, _) in CRATES {
+        let bad = scan(&repo().join(dir).join("src"), true).bad_paths;
+        assert!(bad.is_empty(), "{dir}: paths that resolve to no module:\n{}", bad.join("\n"));
     }
-    let out = scan(&dir, true);
-    std::fs::remove_dir_all(&dir).unwrap();
-    out
-}
-
-/// An upward reference through a short name of lib.rs (`pub use study::store;`, then
-/// `crate::store::X` in `mesh/`) is found: as a path that is not canonical, and as the
-/// upward reference it is.
-#[test]
-fn a_path_through_a_short_name_of_lib_rs_fails() {
-    let scan = scan_scratch("alias", "pub use study::store;", "use crate::store::StudyDir;");
-    assert_eq!(
-        scan.bad_paths,
-        ["src/mesh/io.rs:1: `crate::store::StudyDir` goes through lib.rs's short name `store`: write `crate::study::store`"],
-        "{:?}",
-        scan.bad_paths
-    );
-    assert_eq!(scan.refs["mesh/io.rs"].get("study/store.rs"), Some(&1), "{:?}", scan.refs);
-    // the canonical path is found as the upward reference, and is no bad path
-    let canonical = scan_scratch("canonical", "pub use study::store;", "use crate::study::store::StudyDir;");
-    assert!(canonical.bad_paths.is_empty(), "{:?}", canonical.bad_paths);
-    assert_eq!(canonical.refs["mesh/io.rs"].get("study/store.rs"), Some(&1));
-}
-
-/// A `crate::` path that resolves to no module is an error, not dropped; in a group too.
-#[test]
-fn a_path_that_resolves_to_no_module_fails() {
-    let scan = scan_scratch("unresolved", "", "use crate::nowhere::Thing;");
-    assert_eq!(scan.bad_paths, ["src/mesh/io.rs:1: `crate::nowhere::Thing` resolves to no module of src/"]);
-    let group = scan_scratch("group", "", "use crate::{\n    study::store::StudyDir,\n    nowhere,\n};");
-    assert_eq!(group.bad_paths, ["src/mesh/io.rs:1: `crate::nowhere` resolves to no module of src/"]);
-    assert_eq!(group.refs["mesh/io.rs"].get("study/store.rs"), Some(&1));
 }
 
 #[test]
-fn every_file_belongs_to_a_floor() {
-    let refs = references();
-    let homeless: Vec<&String> = refs.keys().filter(|f| floor_of(f).is_none()).collect();
-    assert!(homeless.is_empty(), "files on no floor (add them to FLOORS, and to lib.rs's diagram): {homeless:?}");
+fn every_file_belongs_to_a_floor_of_its_crate() {
+    for (dir, floors) in CRATES {
+        let refs = scan(&repo().join(dir).join("src"), true).refs;
+        let homeless: Vec<&String> = refs.keys().filter(|f| floor_of(floors, f).is_none()).collect();
+        assert!(homeless.is_empty(), "{dir}: files on no floor (add the floor to CRATES, and to lib.rs's diagram): {homeless:?}");
+    }
+}
+
+/// The upward references of a crate: "file:line (floor) refers to file (floor)".
+fn upward(src: &Path, floors: &[&str]) -> Vec<String> {
+    let mut up = Vec::new();
+    for (file, targets) in scan(src, true).refs {
+        let Some(fl) = floor_of(floors, &file) else { continue };
+        for (t, line) in targets {
+            if let Some(tf) = floor_of(floors, &t).filter(|&tf| tf > fl) {
+                up.push(format!("{file}:{line} ({}) refers to {t} ({})", floors[fl], floors[tf]));
+            }
+        }
+    }
+    up
 }
 
 #[test]
 fn every_reference_points_down_or_within_its_floor() {
-    let refs = references();
-    let mut up = Vec::new();
-    for (file, targets) in &refs {
-        let Some(fl) = floor_of(file) else { continue };
-        for (t, line) in targets {
-            if let Some(tf) = floor_of(t)
-                && tf > fl
-            {
-                up.push(format!("src/{file}:{line} ({}) refers to src/{t} ({})", FLOORS[fl].0, FLOORS[tf].0));
-            }
-        }
+    for (dir, floors) in CRATES {
+        let up = upward(&repo().join(dir).join("src"), floors);
+        assert!(up.is_empty(), "{dir}: references to a higher floor:\n{}", up.join("\n"));
     }
-    assert!(up.is_empty(), "references to a higher floor:\n{}", up.join("\n"));
 }
 
-#[test]
-fn no_two_files_refer_to_each_other() {
-    let refs = references_with(false);
-    // depth-first search for a cycle, reporting it with the lines
+/// A circle of references, if the crate at `src` has one: the files around it.
+fn circle(src: &Path) -> Option<Vec<String>> {
     fn visit<'a>(
         f: &'a str,
         refs: &'a BTreeMap<String, BTreeMap<String, usize>>,
@@ -327,9 +227,7 @@ fn no_two_files_refer_to_each_other() {
             match state.get(t.as_str()) {
                 Some(1) => {
                     let start = stack.iter().position(|s| *s == t).unwrap();
-                    let mut circle: Vec<String> = stack[start..].iter().map(|s| format!("src/{s}")).collect();
-                    circle.push(format!("src/{t}"));
-                    return Some(circle);
+                    return Some(stack[start..].iter().map(|s| s.to_string()).chain([t.clone()]).collect());
                 }
                 Some(_) => {}
                 None => {
@@ -343,20 +241,66 @@ fn no_two_files_refer_to_each_other() {
         state.insert(f, 2);
         None
     }
+    let refs = scan(src, false).refs;
     let mut state = BTreeMap::new();
-    for f in refs.keys() {
-        if !state.contains_key(f.as_str()) {
-            let mut stack = Vec::new();
-            if let Some(circle) = visit(f, &refs, &mut state, &mut stack) {
-                panic!("an import cycle: {}", circle.join(" -> "));
-            }
+    refs.keys().find_map(|f| if state.contains_key(f.as_str()) { None } else { visit(f, &refs, &mut state, &mut Vec::new()) })
+}
+
+#[test]
+fn no_two_files_refer_to_each_other() {
+    for (dir, _) in CRATES {
+        if let Some(c) = circle(&repo().join(dir).join("src")) {
+            panic!("{dir}: an import cycle: {}", c.join(" -> "));
         }
     }
 }
 
-/// What only the store reads in a results folder: its layout ([`signorini::records::StudyDir`]),
-/// its records, snapshots and summaries, and the file system itself. Each line of
-/// `src/analysis/` and `src/plot/` naming one is a reader going past the integrity check.
+/// A scratch crate whose files are `files` (path under src/, text): what [`scan`] says of it.
+fn scan_scratch(name: &str, files: &[(&str, &str)]) -> Scan {
+    let dir = std::env::temp_dir().join(format!("signorini-layers-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    for (path, text) in files {
+        std::fs::create_dir_all(dir.join(path).parent().unwrap()).unwrap();
+        std::fs::write(dir.join(path), format!("{text}\n")).unwrap();
+    }
+    let out = scan(&dir, false);
+    std::fs::remove_dir_all(&dir).unwrap();
+    out
+}
+
+/// `super::super::x` from `a/b/c.rs` is `a::x`, not `a::b`: a cycle through it is found, and an
+/// upward reference through it too.
+#[test]
+fn a_path_up_two_modules_resolves_to_the_grandparent_s_child() {
+    let files = [
+        ("lib.rs", "pub mod a;"),
+        ("a/mod.rs", "pub mod b;\npub mod x;"),
+        ("a/b/mod.rs", "pub mod c;"),
+        ("a/b/c.rs", "fn f() { super::super::x::g(); }"),
+        ("a/x.rs", "use crate::a::b::c::f;"),
+    ];
+    let scan = scan_scratch("supers", &files);
+    assert_eq!(scan.refs["a/b/c.rs"].get("a/x.rs"), Some(&1), "{:?}", scan.refs);
+    assert!(scan.bad_paths.is_empty(), "{:?}", scan.bad_paths);
+    let grouped = scan_scratch("supers-group", &[files[0], files[1], files[2], ("a/b/c.rs", "use super::super::{x::g, b};"), files[4]]);
+    assert_eq!(grouped.refs["a/b/c.rs"].get("a/x.rs"), Some(&1), "{:?}", grouped.refs);
+}
+
+/// A `crate::` path that resolves to no module is an error, not dropped; in a group too.
+#[test]
+fn a_path_that_resolves_to_no_module_fails() {
+    let files = [("lib.rs", "pub mod mesh;\npub mod study;"), ("mesh/mod.rs", "pub mod io;"), ("study/mod.rs", "pub struct StudyDir;")];
+    let one = scan_scratch("unresolved", &[files[0], files[1], files[2], ("mesh/io.rs", "use crate::nowhere::Thing;")]);
+    assert_eq!(one.bad_paths, ["mesh/io.rs:1: `nowhere::Thing` resolves to no module of the crate"]);
+    let group =
+        scan_scratch("group", &[files[0], files[1], files[2], ("mesh/io.rs", "use crate::{\n    study::StudyDir,\n    nowhere,\n};")]);
+    assert_eq!(group.bad_paths, ["mesh/io.rs:1: `nowhere` resolves to no module of the crate"]);
+    assert_eq!(group.refs["mesh/io.rs"].get("study/mod.rs"), Some(&1));
+}
+
+/// What only the store reads in a results folder: its layout (`records::StudyDir`), its records,
+/// snapshots and summaries, and the file system itself. Each line of the claims crate naming one
+/// is a reader going past the integrity check.
 const PAST_THE_DOOR: &[&str] = &[
     "StudyDir",
     "read_runs",
@@ -370,16 +314,16 @@ const PAST_THE_DOOR: &[&str] = &[
     "stored_problem",
 ];
 
-/// The files above the store read nothing but through it, except these lines (file, what):
-/// the figures' PNGs and the drift report, which are not results files.
+/// The claims crate reads nothing but through the store, except these lines (file, what): the
+/// figures' PNGs and the drift report, which are not results files.
 const NOT_RESULTS: &[(&str, &str)] = &[("plot/page.rs", "std::fs::read(&png)"), ("plot/page.rs", "std::fs::read_to_string(drift_report)")];
 
-/// The door by construction: `src/analysis/` and `src/plot/` get a study's records, mesh
-/// snapshots, provenance and problem only from a `store::Shelf` (made by the store after its
-/// integrity check); none names a results folder's layout, reads a record or opens a file of
+/// The door by construction: the claims crate gets a study's records, mesh snapshots,
+/// provenance and problem only from a `store::Shelf` (made by the store after its integrity
+/// check); none of its files names a results folder's layout, reads a record or opens a file of
 /// it. The check is shown to catch each name on a scratch line.
 #[test]
-fn analysis_and_plot_read_results_only_through_the_shelf() {
+fn claims_and_figures_read_results_only_through_the_shelf() {
     let past = |rel: &str, line: &str| -> Option<&'static str> {
         let allowed = NOT_RESULTS.iter().any(|(f, what)| rel == *f && line.contains(what));
         PAST_THE_DOOR.iter().copied().find(|name| line.contains(name)).filter(|_| !allowed)
@@ -388,17 +332,16 @@ fn analysis_and_plot_read_results_only_through_the_shelf() {
         assert!(past("plot/mod.rs", probe).is_some(), "the check misses {probe}");
     }
     assert!(past("plot/page.rs", "match std::fs::read(&png) {").is_none());
+    let src = repo().join("crates/claims/src");
     let mut files = Vec::new();
-    for floor in ["analysis", "plot"] {
-        rust_files(&src().join(floor), &mut files);
-    }
+    rust_files(&src, &mut files);
     assert!(files.len() > 10, "{files:?}");
     let mut bad = Vec::new();
     for f in &files {
-        let rel = f.strip_prefix(src()).unwrap().to_string_lossy().replace('\\', "/");
+        let rel = f.strip_prefix(&src).unwrap().to_string_lossy().replace('\\', "/");
         for (n, line) in code(&std::fs::read_to_string(f).unwrap()) {
             if let Some(name) = past(&rel, &line) {
-                bad.push(format!("src/{rel}:{n}: {name}: {}", line.trim()));
+                bad.push(format!("crates/claims/src/{rel}:{n}: {name}: {}", line.trim()));
             }
         }
     }

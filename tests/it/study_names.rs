@@ -15,7 +15,7 @@ fn repo() -> &'static Path {
 }
 
 /// The files that define names: study-name literals are written there and nowhere else.
-const DEFINITIONS: [&str; 2] = ["src/analysis/studies.rs", "src/analysis/problem_names.rs"];
+const DEFINITIONS: [&str; 2] = ["crates/claims/src/analysis/studies.rs", "crates/claims/src/analysis/problem_names.rs"];
 
 /// The string literals of Rust source `text` (their contents, unescaped only as far as `\"`),
 /// each with its line: comments, char literals and lifetimes are skipped; raw strings are read.
@@ -105,7 +105,7 @@ fn declared() -> BTreeSet<String> {
 /// outside [`DEFINITIONS`].
 fn literal_uses(names: &BTreeSet<String>) -> Vec<String> {
     let mut files = Vec::new();
-    for dir in ["src/analysis", "src/plot"] {
+    for dir in ["crates/claims/src/analysis", "crates/claims/src/plot"] {
         crate::layers::rust_files(&repo().join(dir), &mut files);
     }
     files.sort();

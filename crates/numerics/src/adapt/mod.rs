@@ -1,0 +1,567 @@
+//! The adaptive loop of Section 7: SOLVE -> ESTIMATE -> MARK -> REFINE, one level per turn,
+//! with an observer that sees every level (what the study runner records). The loop keeps a
+//! refinement [`History`] (marks and warm starts per level) from which [`replay`] rebuilds and
+//! solves any level again, and it can start from a later level ([`run_from`], [`Start`]): how an
+//! interrupted deep run resumes.
+
+pub mod history;
+mod level;
+pub mod replay;
+mod roundoff;
+
+pub use history::{BadFlags, Flags, History, LevelHistory};
+pub use level::{LevelRecord, Refine, float_fields, is_measurement};
+
+pub use roundoff::{
+    Cause, Caveat, Conditioned, Drowned, NO_DEFORMATION, RESOLVED_DEFORMATION, RESOLVED_FORCES, ROUNDOFF_ESTIMATE, Resolution, TRANSLATED,
+    Unresolved, WARNED_FORCES, WARNED_SHAPE, deformation, force_roundoff, resolution,
+};
+
+use crate::contact::PdasOptions;
+use crate::contact::norms::{self, Reference};
+use crate::contact::solve::{self, DiscreteSolution, SolveError};
+use crate::estimator::estimate::{self, ConfigError, Estimate, EstimatorConfig};
+use crate::mesh::Mesh;
+use crate::mesh::refine::{self, Refinement};
+use crate::problems::Problem;
+use std::ops::ControlFlow;
+use std::time::Instant;
+
+/// Settings of the loop; [`AdaptConfig::validate`] checks them.
+#[derive(Clone, Debug)]
+pub struct AdaptConfig {
+    /// Number of levels solved (level 0 is the initial mesh).
+    pub levels: usize,
+    /// Stop before solving a level with more unknowns than this.
+    pub max_ndof: Option<usize>,
+    /// Stop after solving the first level with at least this many unknowns (it is not refined).
+    pub stop_ndof: Option<usize>,
+    pub refine: Refine,
+    pub theta: f64,
+    pub estimator: EstimatorConfig,
+    pub pdas: PdasOptions,
+    /// Start each level's active-set method from the previous level's active set.
+    pub warm_start: bool,
+}
+
+/// Why the loop could not run: settings out of range (checked before anything is solved) or a
+/// level whose solve failed.
+#[derive(Debug, thiserror::Error)]
+pub enum AdaptError {
+    /// A setting of the loop outside its range ([`ConfigError`], the estimator's error type: one
+    /// for all settings).
+    #[error("adaptive loop settings: {0}")]
+    Config(#[from] ConfigError),
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    /// The solve of level `level` (its mesh with `ndof` unknowns) failed: a refusal of the data
+    /// or a solver that did not converge, named with the level it happened at (battery 19: a
+    /// body force refused at level 1 of `solve --adapt-levels 3` named no level).
+    #[error("level {level} ({ndof} unknowns): {error}")]
+    SolveAt { level: usize, ndof: usize, error: Box<SolveError> },
+    /// The estimate of level `level` is not a finite number (nothing of that level is kept).
+    #[error("level {level}: {error}")]
+    Estimate { level: usize, error: estimate::NotFinite },
+    /// The next level would not fit in memory: levels `0..level` were solved (and seen by the
+    /// observer), level `level` was not.
+    #[error("stopped before level {level} ({}): {error}", if *level == 0 { "no level was solved".to_string() } else { format!("levels 0 to {} were solved", level - 1) })]
+    Memory { level: usize, error: crate::base::memory::MemoryError },
+    /// A start at or beyond the last level: nothing is left to solve.
+    #[error("nothing to solve: the loop starts at level {start} and has {levels} levels")]
+    NothingToSolve { start: usize, levels: usize },
+    /// A start at a later level whose mesh is above `max_ndof`: nothing is left to solve (the
+    /// loop never hands out such a start: the level before it does not continue).
+    #[error("nothing to solve: the loop starts at level {start}, whose mesh has {ndof} unknowns, above max_ndof {max}")]
+    BeyondMaxNdof { start: usize, ndof: usize, max: usize },
+    #[error(transparent)]
+    Replay(#[from] replay::ReplayError),
+    /// Refining level `level` into the next failed (levels `0..=level` were solved and seen by
+    /// the observer).
+    #[error("refining level {level} (levels 0 to {level} were solved): {error}")]
+    Refine { level: usize, error: crate::mesh::MeshError },
+    /// Level `level`'s u_h does not resolve its deformation, or its contact forces are at their
+    /// round-off ([`resolution`]).
+    #[error("level {level}: {error}")]
+    Unresolved { level: usize, error: Unresolved },
+}
+
+impl AdaptConfig {
+    /// Check every setting: the one validation behind the command line and the manifests.
+    /// With theta > 1 the maximum strategy marks nothing and the loop solves one mesh over and
+    /// over; with `levels = 0` or `max_ndof = 0` it solves nothing.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let bad = |key, expected: &str, got: String| Err(ConfigError { key, expected: expected.into(), got });
+        if self.levels == 0 {
+            return bad("levels", "a number of levels >= 1", "0".into());
+        }
+        if self.max_ndof == Some(0) {
+            return bad("max_ndof", "a number of unknowns >= 1", "0".into());
+        }
+        if self.stop_ndof == Some(0) {
+            return bad("stop_ndof", "a number of unknowns >= 1", "0".into());
+        }
+        if let (Some(stop), Some(max)) = (self.stop_ndof, self.max_ndof)
+            && stop > max
+        {
+            // the loop stops before a level above max_ndof, so no level could reach stop_ndof
+            return bad(
+                "stop_ndof",
+                &format!("a number of unknowns <= max_ndof = {max} (no level above max_ndof is solved, so this stop is never reached)"),
+                stop.to_string(),
+            );
+        }
+        if !(self.theta > 0.0 && self.theta <= 1.0) {
+            return bad("theta", "a number in (0, 1]", ConfigError::number(self.theta));
+        }
+        self.estimator.validate()?;
+        if self.pdas.max_iterations == 0 {
+            return bad("pdas.max_iterations", "a number of iterations >= 1", "0".into());
+        }
+        Ok(())
+    }
+
+    /// Check `max_ndof` against the initial mesh `mesh` of `ndof` unknowns: level 0 is always
+    /// solved, so a `max_ndof` below it would contradict itself (refused, not a silent level 0).
+    pub fn check_initial(&self, ndof: f64, mesh: &str) -> Result<(), ConfigError> {
+        match self.max_ndof {
+            Some(max) if (max as f64) < ndof => Err(ConfigError {
+                key: "max_ndof",
+                expected: format!(
+                    "a number of unknowns >= {ndof:.0} (the initial mesh {mesh} has {ndof:.0}, and level 0 is always solved)"
+                ),
+                got: max.to_string(),
+            }),
+            _ => Ok(()),
+        }
+    }
+}
+
+impl Default for AdaptConfig {
+    fn default() -> Self {
+        AdaptConfig {
+            levels: 20,
+            max_ndof: None,
+            stop_ndof: None,
+            refine: Refine::Adaptive,
+            theta: 0.5,
+            estimator: EstimatorConfig::default(),
+            pdas: PdasOptions::default(),
+            warm_start: true,
+        }
+    }
+}
+
+/// What the observer sees at each level.
+pub struct Level<'a> {
+    pub record: &'a LevelRecord,
+    pub mesh: &'a Mesh,
+    pub solution: &'a DiscreteSolution,
+    pub estimate: &'a Estimate,
+    /// The level's entry of the refinement history.
+    pub history: &'a LevelHistory,
+    /// The loop goes on to a next level (false at the last level, which is not refined).
+    pub continues: bool,
+    /// The active set the next level starts from, if it continues with warm starts.
+    pub next_active: Option<&'a [bool]>,
+    /// What the level's numbers keep fewer digits of than they should ([`resolution`]).
+    pub caveats: &'a [Caveat],
+}
+
+/// Mark by the maximum strategy: eta_T >= theta max eta_T.
+pub fn mark_maximum(indicators: &[f64], theta: f64) -> Vec<bool> {
+    let max = indicators.iter().cloned().fold(0.0, f64::max);
+    indicators.iter().map(|&e| max > 0.0 && e >= theta * max).collect()
+}
+
+/// Centroid of the first element with the largest indicator.
+fn largest_indicator_centroid(mesh: &Mesh, indicators: &[f64]) -> [f64; 2] {
+    let centroid = |t: usize| {
+        let v = mesh.triangles[t].map(|i| mesh.vertices[i]);
+        [(v[0][0] + v[1][0] + v[2][0]) / 3.0, (v[0][1] + v[1][1] + v[2][1]) / 3.0]
+    };
+    let max = indicators.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    // elements within TIE of the largest count as tied (round-off moves indicators by about
+    // 1e-10 relative, results/roundoff/), and the tie goes to the smallest centroid (x, then y):
+    // otherwise which of two near-equal corners wins would depend on the summation order
+    const TIE: f64 = 1e-8;
+    (0..indicators.len())
+        .filter(|&t| indicators[t] >= max - TIE * max.abs())
+        .map(centroid)
+        .min_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])))
+        .unwrap_or([f64::NAN; 2])
+}
+
+/// The longest contact edge with both active and inactive nodes (`LevelRecord::h_free_boundary`).
+pub fn free_boundary_edge(mesh: &Mesh, sol: &DiscreteSolution) -> Option<f64> {
+    mesh.boundary
+        .iter()
+        .zip(&sol.nodes.boundary_nodes)
+        .filter(|(e, _)| e.part == crate::problems::Part::Contact)
+        .filter_map(|(e, nodes)| {
+            let active: Vec<bool> = nodes.iter().map(|&n| sol.dofs.contact_index[n].is_some_and(|k| sol.active[k])).collect();
+            (active.contains(&true) && active.contains(&false)).then(|| crate::mesh::dist(mesh.vertices[e.v[0]], mesh.vertices[e.v[1]]))
+        })
+        .reduce(f64::max)
+}
+
+/// Active set for the refined mesh: a new contact node starts active where the previous level's
+/// discrete solution (transferred exactly, P2 in P2) touches the obstacle.
+fn transfer_active_set(old_mesh: &Mesh, old: &DiscreteSolution, refinement: &Refinement, problem: &dyn Problem) -> Vec<bool> {
+    let new_nodes = crate::mesh::P2Nodes::new(&refinement.mesh);
+    let u = refine::transfer_p2(old_mesh, &old.nodes, &old.u, refinement, &new_nodes);
+    let dofs = crate::fem::assembly::DofMap::new(&new_nodes, problem);
+    let scale = u.iter().fold(0.0f64, |a, v| a.max(v[0].abs()).max(v[1].abs())).max(f64::MIN_POSITIVE);
+    dofs.contact
+        .iter()
+        .map(|c| {
+            let v = u[c.node];
+            v[0] * c.normal[0] + v[1] * c.normal[1] >= c.gap - 1e-10 * scale
+        })
+        .collect()
+}
+
+/// Why [`run`] stopped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AdaptTermination {
+    /// All `AdaptConfig::levels` levels were solved.
+    LevelsReached,
+    /// The next level would have had more unknowns than `AdaptConfig::max_ndof` (it was not solved).
+    MaxNdofReached,
+    /// The last level solved has at least `AdaptConfig::stop_ndof` unknowns.
+    StopNdofReached,
+    /// The observer returned `ControlFlow::Break` (checked before the other two: an observer that
+    /// stops at the last level is reported here).
+    StoppedByObserver,
+    /// The estimate of the last level solved is zero on every element, or at round-off
+    /// ([`Resolution::AtRoundoff`]): the maximum strategy marks nothing, so the next level would
+    /// be the same mesh again (not solved).
+    NothingMarked,
+    /// The refined mesh of level `level` (of `ndof` unknowns) has an element whose shape f64 no
+    /// longer resolves at its coordinates (`worst`, [`Mesh::shape_roundoff_refused`]: a mesh far
+    /// from the origin refined deep, battery 13, F5); levels `0..level` were solved and seen by
+    /// the observer, that one was not. A stop, not an error of the loop, so that a study keeps
+    /// the levels solved; the command line exits 1 as for the memory stop ([`Self::is_error`]).
+    FarFromOrigin { level: usize, ndof: usize, worst: crate::mesh::precision::ShapeRoundoff },
+}
+
+impl AdaptTermination {
+    /// Why the loop stopped before its last level, in a sentence (None: all levels were solved,
+    /// or the caller stopped it and knows why).
+    pub fn note(self, config: &AdaptConfig) -> Option<String> {
+        match self {
+            AdaptTermination::LevelsReached | AdaptTermination::StoppedByObserver => None,
+            AdaptTermination::MaxNdofReached => {
+                Some(format!("stopped: the next level would have more than max_ndof = {} unknowns", config.max_ndof.unwrap_or(0)))
+            }
+            AdaptTermination::StopNdofReached => {
+                Some(format!("stopped: the last level has at least stop_ndof = {} unknowns", config.stop_ndof.unwrap_or(0)))
+            }
+            AdaptTermination::NothingMarked => Some(format!(
+                "stopped: the estimate is zero, or at round-off (u_h has no deformation above {NO_DEFORMATION} delta, or eta_h is at most {ROUNDOFF_ESTIMATE:e} times what u_h's round-off can do to it: the smaller of (2 mu + lambda) delta, delta the round-off of u_h (the larger of its round-off floor and 2.2e-16 max |u_h|), and the largest stress the round-off's energy allows: u_h is a rigid motion or a field the P2 space reproduces, to round-off, or a rigid translation in the data left it no digits of the deformation), so nothing is marked and the next level would be the same mesh"
+            )),
+            AdaptTermination::FarFromOrigin { level, ndof, worst } => Some(format!(
+                "stopped before level {level} (levels 0 to {} were solved): its refined mesh ({ndof} unknowns) is too fine for its coordinates: {}; or stop the loop before this level: at most {level} levels (levels = {level}, --levels {level}) or at most {} unknowns (max_ndof, --max-ndof)",
+                level - 1,
+                crate::mesh::MeshError::from(worst),
+                ndof - 1
+            )),
+        }
+    }
+
+    /// Whether the command line ends with an error (exit 1) after the levels it printed, as for
+    /// the memory stop: the loop could not reach the levels asked for, for a reason the user
+    /// acts on (a study keeps the levels solved, with the note on its summary line).
+    pub fn is_error(self) -> bool {
+        matches!(self, AdaptTermination::FarFromOrigin { .. })
+    }
+}
+
+/// What [`run`] returns: the state of the last level solved and why the loop stopped (in the
+/// shape of argmin's `OptimizationResult`).
+pub struct AdaptResult {
+    /// The mesh of the last level solved (not refined further).
+    pub mesh: Mesh,
+    /// The discrete solution on `mesh`.
+    pub solution: DiscreteSolution,
+    /// The estimate of that solution.
+    pub estimate: Estimate,
+    /// One record per level solved, in order; the last one describes `mesh`.
+    pub records: Vec<LevelRecord>,
+    /// The refinement history of every level in `records`.
+    pub history: History,
+    pub termination: AdaptTermination,
+}
+
+/// Where the loop starts: the mesh of level `level`, the active set its solve starts from, and
+/// the records and history of the levels before it (empty from level 0).
+pub struct Start {
+    pub mesh: Mesh,
+    pub level: usize,
+    pub initial_active: Option<Vec<bool>>,
+    pub records: Vec<LevelRecord>,
+    pub history: History,
+}
+
+impl Start {
+    /// Level 0 on `mesh`.
+    pub fn new(mesh: Mesh) -> Self {
+        Start { mesh, level: 0, initial_active: None, records: Vec::new(), history: History::default() }
+    }
+}
+
+/// One level solved, estimated and marked (not yet refined).
+pub struct Solved {
+    pub record: LevelRecord,
+    pub solution: DiscreteSolution,
+    pub estimate: Estimate,
+    pub marks: Vec<bool>,
+    /// What its numbers keep fewer digits of than they should ([`resolution`]).
+    pub caveats: Vec<Caveat>,
+}
+
+/// SOLVE, ESTIMATE and MARK on the mesh of level `level`, the contact solve started from
+/// `initial_active` (if `config.warm_start`): everything of a level but the refinement. Its
+/// record's `t_refine` and `t_level` are zero (the loop sets them).
+pub fn solve_level(
+    problem: &dyn Problem,
+    mesh: &Mesh,
+    level: usize,
+    config: &AdaptConfig,
+    reference: Option<Reference>,
+    initial_active: Option<Vec<bool>>,
+    measured: Option<(f64, f64)>,
+) -> Result<Solved, AdaptError> {
+    let ndof = mesh.p2_ndof();
+    // before every level, not only the first: an adaptive loop grows until it does not fit;
+    // `measured`: unknowns and peak resident bytes of a measured solve, if known (the previous
+    // level's in the loop, the level's own stored one in a replay)
+    crate::base::memory::check_memory_measured(&format!("level {level} of the adaptive loop"), ndof as f64, measured)
+        .map_err(|error| AdaptError::Memory { level, error })?;
+    let mut options = config.pdas.clone();
+    if config.warm_start {
+        options.initial_active = initial_active;
+    }
+    let t0 = Instant::now();
+    let sol =
+        solve::solve(mesh, problem, &options, &mut |_| {}).map_err(|error| AdaptError::SolveAt { level, ndof, error: Box::new(error) })?;
+    let t_solve = t0.elapsed().as_secs_f64();
+    let t0 = Instant::now();
+    let est = estimate::estimate(mesh, problem, &sol, &config.estimator);
+    // the estimator samples the data at points of its own (a dense lattice, edge points)
+    if let Some(bad) = problem.bad_datum() {
+        return Err(SolveError::Data(bad).into());
+    }
+    est.terms.check_finite().map_err(|error| AdaptError::Estimate { level, error })?;
+    let t_estimate = t0.elapsed().as_secs_f64();
+    let (at_roundoff, caveats) = match resolution(problem, mesh, &sol, &est) {
+        Resolution::Unresolved(error) => return Err(AdaptError::Unresolved { level, error }),
+        Resolution::AtRoundoff => (true, vec![Caveat::AtRoundoff]),
+        Resolution::Resolved(caveats) => (false, caveats),
+    };
+    let error = reference.map(|r| norms::linf_error(mesh, &sol, r));
+    let marks = match config.refine {
+        Refine::Adaptive if at_roundoff => vec![false; mesh.n_triangles()],
+        Refine::Adaptive => mark_maximum(&est.element, config.theta),
+        Refine::Uniform => vec![true; mesh.n_triangles()],
+    };
+    let (h_min, h_max) = mesh.h_range();
+    let peak = largest_indicator_centroid(mesh, &est.element);
+    let zone = sol.contact_zone();
+    let t = &est.terms;
+    let ct = &sol.timings.contact;
+    let record = LevelRecord {
+        level,
+        ndof: 2 * sol.nodes.len(),
+        ndof_free: sol.dofs.n_free,
+        n_elements: mesh.n_triangles(),
+        h_min,
+        h_max,
+        min_angle: mesh.min_angle_degrees(),
+        contact_nodes: sol.dofs.contact.len(),
+        active_nodes: sol.active_count(),
+        full_contact_nodes: est.full_contact_nodes,
+        pdas_iterations: sol.pdas.len(),
+        zone_min: zone.map(|z| z[0]),
+        zone_max: zone.map(|z| z[1]),
+        terms: *t,
+        err_quadrature: error.map(|e| e.linf_quadrature),
+        err_dense: error.map(|e| e.linf_dense),
+        err_nodal: error.map(|e| e.linf_nodal),
+        efficiency: error.map(|e| t.estimate / e.linf_quadrature),
+        err_contact: reference.and_then(|r| norms::linf_error_contact(mesh, &sol, r)),
+        err_right_half: reference
+            .and_then(|r| norms::linf_error_where(mesh, &sol, r, crate::contact::sampling::Sampling::Dense, &|x| x[0] >= 0.5)),
+        roundoff_floor: sol.roundoff,
+        h_free_boundary: free_boundary_edge(mesh, &sol),
+        max_indicator_x: peak[0],
+        max_indicator_y: peak[1],
+        // counted on the last level too, so a shorter run is an exact prefix of a longer one
+        marked: marks.iter().filter(|m| **m).count(),
+        t_assembly: sol.timings.assembly,
+        t_factorisation: ct.symbolic + ct.numeric + ct.schur,
+        t_active_set: ct.active_set,
+        t_solve,
+        t_estimate,
+        t_refine: 0.0,
+        t_level: 0.0,
+        t_roundoff: sol.timings.roundoff,
+        mem_peak_mib: None,
+    };
+    Ok(Solved { record, solution: sol, estimate: est, marks, caveats })
+}
+
+/// Run the loop from `mesh`. `reference` gives the displacement errors are measured against
+/// (an exact solution or a reference solution), if any. The observer sees every level and may
+/// stop the loop.
+///
+/// `config` must be valid ([`AdaptConfig::validate`]); at least level 0 is always solved.
+///
+/// ```rust
+/// use signorini_numerics::adapt::{self, AdaptConfig, AdaptTermination};
+/// use signorini_numerics::mesh::MeshSpec;
+/// use signorini_numerics::problems::{self, Problem};
+/// use std::ops::ControlFlow;
+///
+/// let problem = problems::by_name("ex71").unwrap();
+/// let mesh = MeshSpec::parse("structured:2").unwrap().build(problem.as_ref()).unwrap();
+/// let config = AdaptConfig { levels: 3, ..Default::default() };
+/// config.validate().unwrap();
+/// let exact = problem.exact().unwrap();
+/// let u = |x: [f64; 2]| exact.u(x);
+/// let result = adapt::run(problem.as_ref(), mesh, &config, Some(&u), &mut |_| ControlFlow::Continue(())).unwrap();
+/// assert_eq!(result.termination, AdaptTermination::LevelsReached);
+/// assert_eq!(result.records.len(), 3);
+/// assert_eq!(result.history.levels.len(), 3);
+/// assert_eq!(result.records[2].ndof, 2 * result.solution.nodes.len());
+/// assert!(result.records[2].err_quadrature.unwrap() < result.records[0].err_quadrature.unwrap());
+/// ```
+pub fn run(
+    problem: &dyn Problem,
+    mesh: Mesh,
+    config: &AdaptConfig,
+    reference: Option<Reference>,
+    observer: &mut dyn FnMut(Level) -> ControlFlow<()>,
+) -> Result<AdaptResult, AdaptError> {
+    run_from(problem, Start::new(mesh), config, reference, observer)
+}
+
+/// [`run`] from a later level: `start` holds the mesh of level `start.level`, the active set its
+/// solve starts from and the records and history of the levels before (a resumed run:
+/// [`replay::resume`]). The same numbers as the uninterrupted loop, level for level.
+pub fn run_from(
+    problem: &dyn Problem,
+    start: Start,
+    config: &AdaptConfig,
+    reference: Option<Reference>,
+    observer: &mut dyn FnMut(Level) -> ControlFlow<()>,
+) -> Result<AdaptResult, AdaptError> {
+    config.validate()?;
+    if start.level >= config.levels {
+        return Err(AdaptError::NothingToSolve { start: start.level, levels: config.levels });
+    }
+    if start.level == 0 {
+        config.check_initial(start.mesh.p2_ndof() as f64, "of level 0")?;
+    }
+    let Start { mut mesh, level: first, mut initial_active, mut records, mut history } = start;
+    let mut state: Option<(Mesh, DiscreteSolution, Estimate)> = None;
+    let mut termination = AdaptTermination::LevelsReached;
+    for level in first..config.levels {
+        if let Some(max) = config.max_ndof
+            && level > 0
+            && mesh.p2_ndof() > max
+        {
+            if state.is_none() {
+                return Err(AdaptError::BeyondMaxNdof { start: level, ndof: mesh.p2_ndof(), max });
+            }
+            termination = AdaptTermination::MaxNdofReached;
+            break;
+        }
+        // the level before is not needed while this one solves (the loop returns it only when
+        // this level is not solved): its mesh, u_h and estimate added to the peak memory (fb
+        // adaptive to 2.6e6 unknowns: peak resident 4.09 -> 3.91 GB without them)
+        drop(state.take());
+        let t_level = Instant::now();
+        let previous = records.last().and_then(LevelRecord::measured_peak);
+        let measured = crate::base::memory::reset_peak_resident();
+        let started_from = initial_active.take().filter(|_| config.warm_start);
+        let Solved { mut record, solution: sol, estimate: est, marks, caveats } =
+            solve_level(problem, &mesh, level, config, reference, started_from.clone(), previous)?;
+        let entry = LevelHistory {
+            level,
+            n_elements: mesh.n_triangles(),
+            mesh: mesh.fingerprint(),
+            initial_active: started_from.as_deref().map(Flags::encode),
+            marks: Flags::encode(&marks),
+        };
+        let reached = config.stop_ndof.is_some_and(|s| mesh.p2_ndof() >= s);
+        let unmarked = config.refine == Refine::Adaptive && !marks.contains(&true);
+        let next = if level + 1 == config.levels || reached || unmarked {
+            None
+        } else {
+            let t0 = Instant::now();
+            let refined = refine::refine(&mesh, &marks).map(|refinement| {
+                let active = config.warm_start.then(|| transfer_active_set(&mesh, &sol, &refinement, problem));
+                (refinement.mesh, active)
+            });
+            record.t_refine = t0.elapsed().as_secs_f64();
+            Some(refined)
+        };
+        // a refined mesh whose element shapes f64 no longer resolves ends the loop before its
+        // level, as the memory check does, not as an error of its solve (Mesh::check)
+        let far = match &next {
+            Some(Ok((m, _))) => {
+                m.shape_roundoff_refused().map(|worst| AdaptTermination::FarFromOrigin { level: level + 1, ndof: m.p2_ndof(), worst })
+            }
+            _ => None,
+        };
+        // a refined mesh above max_ndof is not solved: the loop ends here, and this level says
+        // it does not continue, so a run interrupted now keeps no checkpoint of a level it
+        // would never solve (battery 16, F1: resuming from one solved nothing and panicked)
+        let over = match (&next, config.max_ndof) {
+            (Some(Ok((m, _))), Some(max)) => m.p2_ndof() > max,
+            _ => false,
+        };
+        let next = if far.is_some() || over { None } else { next };
+        record.t_level = t_level.elapsed().as_secs_f64();
+        record.mem_peak_mib = crate::base::memory::peak_resident().filter(|_| measured).map(|b| b / (1024.0 * 1024.0));
+        let flow = observer(Level {
+            record: &record,
+            mesh: &mesh,
+            solution: &sol,
+            estimate: &est,
+            history: &entry,
+            continues: next.is_some(),
+            next_active: next.as_ref().and_then(|n| n.as_ref().ok()).and_then(|(_, a)| a.as_deref()),
+            caveats: &caveats,
+        });
+        records.push(record);
+        history.levels.push(entry);
+        state = Some((mesh, sol, est));
+        if flow.is_break() {
+            termination = AdaptTermination::StoppedByObserver;
+            break;
+        }
+        if reached {
+            termination = AdaptTermination::StopNdofReached;
+        } else if next.is_none() && unmarked && level + 1 < config.levels {
+            termination = AdaptTermination::NothingMarked;
+        } else if let Some(far) = far {
+            termination = far;
+        } else if over {
+            termination = AdaptTermination::MaxNdofReached;
+        }
+        match next {
+            Some(Ok((m, active))) => {
+                mesh = m;
+                initial_active = active;
+            }
+            Some(Err(error)) => return Err(AdaptError::Refine { level, error }),
+            None => break,
+        }
+    }
+    // every way out of the loop above solved a level first (first < levels), or returned
+    let Some((mesh, solution, estimate)) = state else {
+        return Err(AdaptError::NothingToSolve { start: first, levels: config.levels });
+    };
+    Ok(AdaptResult { mesh, solution, estimate, records, history, termination })
+}
