@@ -14,10 +14,13 @@
 //!
 //! Three entry points: [`solve::solve`] (one discrete solution on a mesh, certified by its KKT
 //! conditions), [`adapt::run`] (the adaptive loop) and [`study::run_study`] (a declared study
-//! into its results folder). This crate re-exports every floor under its own name
+//! into its results folder); every command of the command line is a function of [`commands`].
+//! This crate re-exports every floor under its own name
 //! (`signorini::mesh`, `signorini::study`) and the most used modules under a short one
 //! (`signorini::solve`, `signorini::estimate`, `signorini::cholesky`): the users' prelude, for
 //! examples, tests and user programs. Code inside the crates never uses it.
+
+pub mod commands;
 
 pub use signorini_claims::{analysis, plot};
 pub use signorini_harness::{records, study};
