@@ -453,7 +453,7 @@ mod tests {
     #[test]
     fn bounded_only_with_a_narrow_interval_around_zero() {
         assert_eq!(judge_trend(&fit(0.02, 0.12, 2.0)), Trend::Bounded);
-        // contains 0 but 0.43 wide: no verdict, even with a flat centre (the old |slope| < 0.05 escape)
+        // contains 0 but 0.43 wide: no verdict, even with a flat centre (no |slope| < 0.05 escape)
         assert_eq!(judge_trend(&fit(0.02, 0.215, 2.0)), Trend::Inconclusive);
         assert_eq!(judge_trend(&fit(-0.02, 0.37, 2.0)), Trend::Inconclusive);
         assert_eq!(judge_trend(&fit(0.04, 0.01, 2.0)), Trend::Growing, "a small slope known precisely is a trend");
