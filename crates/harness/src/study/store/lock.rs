@@ -313,7 +313,7 @@ pub(super) fn wait_for_writers(dir: &StudyDir) -> Result<()> {
 
 /// The folder of the run locks (`STUDY/.locks`), where it exists, is a folder: one that is a file
 /// is named by every writer (which takes the study lock first) and reader, also where every
-/// run is finished and no run lock is opened (`run` then refuses, not "0 run(s) executed").
+/// run is finished and no run lock is opened (`run` then names it too, never "0 run(s) executed").
 fn check_run_lock_folder(dir: &StudyDir) -> Result<()> {
     let folder = dir.root.join(".locks");
     match std::fs::metadata(&folder) {
