@@ -240,7 +240,7 @@ fn adaptive_point(run: &str) -> Result<AdaptiveRun> {
     Ok(r)
 }
 
-/// Issue 25's bounds on the adaptive run to 1e7 NDF.
+/// The performance bounds on the adaptive run to 1e7 NDF.
 fn adaptive_targets(r: &AdaptiveRun) -> Vec<Target> {
     let note = format!("{}: {} levels to {} NDF; phase times per level in its record", r.run, r.levels, r.last_ndof);
     let reached = r.last_ndof >= 10_000_000;

@@ -419,7 +419,7 @@ mod tests {
         let kappa: f64 = 3.0 - 4.0 * 0.3;
         assert!((4.0 * l * l - 1.0 - kappa * kappa - 2.0 * kappa * (l * std::f64::consts::PI).cos()).abs() < 1e-12);
         assert!((l - 0.7112).abs() < 5e-4, "{l}");
-        // error reduction per halving of h: 2^-lambda = 0.611 (the issue measured 0.608)
+        // error reduction per halving of h: 2^-lambda = 0.611 (0.608 as measured)
         assert!((0.5f64.powf(l) - 0.61).abs() < 0.01);
     }
 
