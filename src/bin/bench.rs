@@ -6,7 +6,7 @@
 //! active-set iteration. Then what a user sees: whole contact solves in fresh processes (mesh,
 //! assembly, ordering, factorisation, active set, displacement and contact force), interleaved
 //! with NGSolve's whole linear solves of the same system in fresh processes, medians of three,
-//! and one scale point; the table of the targets of issue 15 with met / not met. Then the
+//! and one scale point; the table of the performance targets with met / not met. Then the
 //! graded section (bench/graded.rs, alone with `--graded-only`): a factorisation's phases on the
 //! deep study's graded levels beside the grid's and METIS's, in `results/bench/graded.json`.
 //! Speed lives here, never in timed tests.
@@ -240,7 +240,7 @@ fn adaptive_point(run: &str) -> Result<AdaptiveRun> {
     Ok(r)
 }
 
-/// Issue 25's bounds on the adaptive run to 1e7 NDF.
+/// The performance bounds on the adaptive run to 1e7 NDF.
 fn adaptive_targets(r: &AdaptiveRun) -> Vec<Target> {
     let note = format!("{}: {} levels to {} NDF; phase times per level in its record", r.run, r.levels, r.last_ndof);
     let reached = r.last_ndof >= 10_000_000;
@@ -426,7 +426,7 @@ impl Target {
     }
 }
 
-/// The performance targets (issues 15 and 25), each with the measured value and whether it is met.
+/// The performance targets, each with the measured value and whether it is met.
 fn targets(phases: &[SizeResult], rates: &[FactorRate], cold: &[ColdSize], scale: Option<&ColdSize>) -> Vec<Target> {
     let mut t = Vec::new();
     let med = |v: Vec<f64>| if v.is_empty() { None } else { Some(median(v)) };
@@ -522,7 +522,7 @@ fn targets(phases: &[SizeResult], rates: &[FactorRate], cold: &[ColdSize], scale
             met: Some(met),
             note: s.ngsolve_missing.clone().unwrap_or_default(),
         };
-        // issue 25's bounds at structured:1024; any other scale point only has to run and fit
+        // the scale point's bounds at structured:1024; any other scale point only has to run and fit
         let (time_goal, mem_goal) = if s.n == 1024 { (50.0, 10.0 * 1024.0) } else { (f64::INFINITY, 24.0 * 1024.0) };
         let goal = |g: f64, unit: &str| if g.is_finite() { format!("<= {g:.0} {unit}") } else { "runs".into() };
         t.push(row(
@@ -992,7 +992,7 @@ fn breakdown(r: &SizeResult) {
     println!("  {:<62} {:>8.3} s", "total", total);
 }
 
-/// Our medians next to NGSolve's for the same meshes (targets of issue 7): assembly, one linear
+/// Our medians next to NGSolve's for the same meshes: assembly, one linear
 /// solve (symbolic + numeric factorisation + solve), our contact solve against our own linear
 /// solve and against NGSolve's, and peak memory. Printed and returned for the JSON record.
 fn side_by_side(ours: &[SizeResult], ngsolve: &std::path::Path) -> Vec<serde_json::Value> {

@@ -1,4 +1,4 @@
-//! `make bench`'s graded section (issue 42, item 1): where the time of a factorisation goes on
+//! `make bench`'s graded section: where the time of a factorisation goes on
 //! the deep study's graded meshes, beside the uniform grid of the same size and METIS's ordering.
 //!
 //! The deep study's level records say that a graded level at 2e6 NDF spends more time in

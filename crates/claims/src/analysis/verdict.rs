@@ -419,7 +419,7 @@ mod tests {
         let kappa: f64 = 3.0 - 4.0 * 0.3;
         assert!((4.0 * l * l - 1.0 - kappa * kappa - 2.0 * kappa * (l * std::f64::consts::PI).cos()).abs() < 1e-12);
         assert!((l - 0.7112).abs() < 5e-4, "{l}");
-        // error reduction per halving of h: 2^-lambda = 0.611 (the issue measured 0.608)
+        // error reduction per halving of h: 2^-lambda = 0.611 (0.608 as measured)
         assert!((0.5f64.powf(l) - 0.61).abs() < 0.01);
     }
 
@@ -453,7 +453,7 @@ mod tests {
     #[test]
     fn bounded_only_with_a_narrow_interval_around_zero() {
         assert_eq!(judge_trend(&fit(0.02, 0.12, 2.0)), Trend::Bounded);
-        // contains 0 but 0.43 wide: no verdict, even with a flat centre (the old |slope| < 0.05 escape)
+        // contains 0 but 0.43 wide: no verdict, even with a flat centre (no |slope| < 0.05 escape)
         assert_eq!(judge_trend(&fit(0.02, 0.215, 2.0)), Trend::Inconclusive);
         assert_eq!(judge_trend(&fit(-0.02, 0.37, 2.0)), Trend::Inconclusive);
         assert_eq!(judge_trend(&fit(0.04, 0.01, 2.0)), Trend::Growing, "a small slope known precisely is a trend");

@@ -26,8 +26,8 @@ pub fn figures_of(study: &str) -> Vec<&'static str> {
 pub fn claim_studies(id: &str) -> &'static [Study] {
     use studies::*;
     match id {
-        // every stored run with an error (claims::c0_claim; battery 16, F3: the pages said
-        // "No CLAIMS row rests on this study" of studies whose runs it reads)
+        // every stored run with an error (claims::c0_claim: no page says "No CLAIMS row rests
+        // on this study" of a study whose runs it reads)
         _ if id.starts_with("c0") => ALL,
         // every row recomputed: every study a row reads
         "parity" => ALL,
@@ -59,9 +59,9 @@ pub fn rests_on(id: &str, study: &str) -> bool {
 /// The drift reports the pages may quote, and the command a page advises where none covers its
 /// study. `report --drift-report FILE` quotes that file alone; by default, the default report
 /// and every one `drift` writes under `target/drift/` (`report-STUDY.json` for `drift --study
-/// STUDY`), so the command a page advises makes the next page "checked" (battery 12, F5: the
-/// advised `signorini drift --study S` wrote `target/drift/report-S.json`, which `report` never
-/// read, and the page said "not checked" forever).
+/// STUDY`), so the command a page advises makes the next page "checked" (the advised
+/// `signorini drift --study S` writes `target/drift/report-S.json`, which `report` reads, so no
+/// page stays "not checked" after it).
 pub struct DriftReports {
     /// The reports read, in the order given (the default or named one first).
     reports: Vec<serde_json::Value>,
@@ -72,7 +72,7 @@ pub struct DriftReports {
 impl DriftReports {
     /// Read `files` (one that cannot be read or parsed is an error naming it; one that does not
     /// exist is skipped, unless `named`: a file the user named is an error when it is missing,
-    /// as a typo would otherwise read as "no drift report" (battery 18, F2)); `advice` is the
+    /// as a typo would otherwise read as "no drift report"); `advice` is the
     /// command a page advises, `STUDY` in place of the study.
     pub fn read(files: &[PathBuf], named: bool, advice: &str) -> anyhow::Result<DriftReports> {
         use anyhow::Context;
@@ -263,7 +263,7 @@ fn run_table(runs: &[RunRecord]) -> String {
 
 /// The estimator settings of a run that differ from the defaults (`contact_term = as_written;
 /// c0 = 1`), as the manifest's `[estimator]` keys; "default" where none do. Runs that differ
-/// only there had the same refinement cell (battery 13).
+/// only there share their refinement cell: this cell tells them apart.
 fn estimator_settings(config: &numerics::estimator::estimate::EstimatorConfig) -> String {
     let (Ok(serde_json::Value::Object(set)), Ok(serde_json::Value::Object(default))) =
         (serde_json::to_value(config), serde_json::to_value(numerics::estimator::estimate::EstimatorConfig::default()))
@@ -394,7 +394,7 @@ fn provenance_html(text: Option<&str>) -> String {
     let Ok(serde_json::Value::Object(map)) = serde_json::from_str::<serde_json::Value>(text) else {
         return "<p>provenance.json is not a JSON object.</p>\n".into();
     };
-    // what a reader can trust of it (battery 18, F4): the store checks three fields against the
+    // what a reader can trust of it: the store checks three fields against the
     // records; the others are a note that nothing can check
     let mut s = String::from(
         "<p>As recorded when the study was written. <code>study</code>, <code>runs</code> and the input files' hashes are checked against the records by every command that reads the folder; the other fields (the commit, <code>quick</code>, the machine, the date, ...) are a note of how the study was made, and nothing checks them: a hand edit of them goes unnoticed.</p>\n<table class=\"provenance\">\n",

@@ -61,8 +61,8 @@ fn replaceable(path: &Path) -> std::io::Result<()> {
 }
 
 /// What a write that failed with EFBIG ran into: the process's file-size limit (RLIMIT_FSIZE,
-/// `ulimit -f`), with the size of the file, so that the message says what to raise (battery 16:
-/// it named the file only). Empty for any other error.
+/// `ulimit -f`), with the size of the file, so that the message says what to raise, not only
+/// which file. Empty for any other error.
 fn size_limit_note(e: &std::io::Error, len: usize) -> String {
     if e.raw_os_error() != Some(libc::EFBIG) {
         return String::new();
@@ -453,7 +453,7 @@ impl StudyDir {
     /// (what the store's integrity check reads: a record's run id must be its file name, its
     /// text what [`json_bytes`] writes for it). A file whose text is no record (truncated, not
     /// JSON, a link to another file) comes with the parser's error, for the check to name as a
-    /// fault of its run (battery 14, F5: an error here left `run --replace` no way past it).
+    /// fault of its run (not an error here, which would leave `run --replace` no way past it).
     pub fn read_run_files(&self) -> std::io::Result<Vec<RunFile>> {
         let dir = self.root.join("runs");
         let mut files: Vec<PathBuf> = match std::fs::read_dir(&dir) {

@@ -70,7 +70,7 @@ pub struct SolveReport {
     pub free_residual: f64,
     /// u_h's round-off floor ([`DiscreteSolution::roundoff`]: one step of iterative
     /// refinement), as a level record's `roundoff_floor`: an estimate near it measures round-off
-    /// (the warning `solve` prints on stderr then), so a JSON reader can tell too (battery 12).
+    /// (the warning `solve` prints on stderr then), so a JSON reader can tell too.
     pub roundoff_floor: f64,
     pub error: Option<LinfError>,
     pub error_sampling: NormPoints,

@@ -412,7 +412,7 @@ fn first_history_difference(s: &numerics::adapt::History, f: &numerics::adapt::H
 /// file shows here; `--deep` computes it by the adaptive loop and compares every level.) Against
 /// another folder (`against`), whose files no replay checks, the record of the last level is
 /// compared too, as levels are (the fields a one-solve replay cannot give left out), and the
-/// final active set exactly (battery 17, F2: a hand-edited `last.eta_h` passed as "none").
+/// final active set exactly (a hand-edited `last.eta_h` there is a drift, never "none").
 fn compare_references(study: &str, stored: &Store, fresh: &Store, runs: &[RunRecord], spec: &DriftSpec, against: bool) -> Vec<DriftRow> {
     let mut out = Vec::new();
     let keys: std::collections::BTreeSet<String> = runs.iter().filter_map(|r| crate::records::ReferenceRecord::key_of(&r.run)).collect();
@@ -549,8 +549,8 @@ pub struct DriftOptions {
     /// Rerun deep studies ([`super::manifest::DeepTier`]) to the end; without it they are rerun
     /// in their tiers.
     pub deep: bool,
-    /// Compare with the records already in this results folder instead of rerunning (used to
-    /// measure round-off: the studies rerun with another ordering or thread count).
+    /// Compare with the records already in this results folder instead of rerunning (how
+    /// round-off is measured: the studies rerun with another ordering or thread count).
     pub against: Option<PathBuf>,
     /// Where fresh runs are written (emptied first, study by study).
     pub scratch: PathBuf,
@@ -574,7 +574,7 @@ pub struct DriftReport {
     pub not_compared: Vec<String>,
     /// `against` is the stored results folder itself (the same folder by another path, a
     /// symlink): every record was compared with itself. That checks the folder's readers, not
-    /// its numbers, and a study page never quotes it as a rerun (battery 11, N1).
+    /// its numbers, and a study page never quotes it as a rerun.
     #[serde(default)]
     pub self_comparison: bool,
     /// With `against`: the studies whose records there are byte-identical to the stored ones,
@@ -587,8 +587,7 @@ pub struct DriftReport {
 /// to them (their hashes, `records` and `against_records`), timings (`t_*`) included: no rerun
 /// reproduces a run's timings, so the other folder is a copy of the stored one, or the folder
 /// itself. That checks that the copy reads back, not the numbers, and a study page never quotes
-/// it as a rerun (battery 12, F4: `drift --against` a `cp -r` copy said "no drift: rerun and
-/// compared"). The folder itself ([`same_folder`]) is the case where every record is its own copy.
+/// it as a rerun (`drift --against` a `cp -r` copy is never "rerun and compared"). The folder itself ([`same_folder`]) is the case where every record is its own copy.
 pub fn compared_a_copy(entry: &Value) -> bool {
     let stored = entry.get("records").and_then(Value::as_object);
     stored.is_some_and(|s| !s.is_empty() && entry.get("against_records").and_then(Value::as_object) == Some(s))

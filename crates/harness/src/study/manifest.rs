@@ -782,7 +782,7 @@ impl Manifest {
 /// levels near it measure the reference's error, not theirs. 1.5 is below the smallest margin
 /// of the stored studies, 1.89 (`ex72`'s uniform run, NDF 132,098, against its adaptive
 /// reference of 250,070; hertz's manifest keeps 3.3 by convention), so that none is refused,
-/// and far above a reference coarser than the run (battery 10's F3: NDF 218 against 710).
+/// and far above a reference coarser than the run (such as NDF 218 against 710).
 pub const REFERENCE_MARGIN: f64 = 1.5;
 
 /// Whether a reference of `reference_ndof` unknowns is too coarse to measure a level of

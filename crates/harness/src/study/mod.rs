@@ -180,7 +180,7 @@ pub enum Planned {
 }
 
 /// What `run` would do ([`plan`]): each run, by id, and the leftover files of unfinished runs it
-/// removes first (battery 20: the plan named neither the runs `--replace` removes nor these).
+/// removes first (the plan names both these and the runs `--replace` removes).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Plan {
     pub runs: Vec<(String, Planned)>,
@@ -193,7 +193,7 @@ pub struct Plan {
 /// What `run --plan` prints: each run of `manifest` in `opts`' shard and what `run` would do
 /// with it, read from the results folder through the same check and the same refusal as `run`'s
 /// set-up (a folder `run` refuses, damaged or with runs stored with another spec, is refused
-/// here too; battery 13: the plan listed three runs and exited 0 where `run` refused). Changes
+/// here too, never listed with exit status 0 where `run` refuses). Changes
 /// nothing. A folder another process writes now is read as it is, with a note that says so.
 pub fn plan(manifest: &Manifest, opts: &RunOptions) -> Result<Plan> {
     let store = Store::of(&opts.results, manifest);
@@ -296,8 +296,8 @@ fn set_up(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &RunOpt
     let mut runs = checked.runs;
     let mut stale = store::stale::damaged(&checked.faults);
     stale.extend(store::stale::stale_runs(manifest, &runs, planned));
-    // a refusal changes nothing: it comes before any file is removed (battery 19: the snapshots
-    // and reference of a run whose record was damaged went as orphans, then run refused)
+    // a refusal changes nothing: it comes before any file is removed (so the snapshots and
+    // reference of a run whose record is damaged are not removed as orphans before it)
     if !stale.is_empty() && !opts.replace && !opts.fresh {
         return Err(store::stale::refusal(manifest, store.dir(), &stale));
     }

@@ -55,8 +55,8 @@ pub enum AdaptError {
     #[error(transparent)]
     Solve(#[from] SolveError),
     /// The solve of level `level` (its mesh with `ndof` unknowns) failed: a refusal of the data
-    /// or a solver that did not converge, named with the level it happened at (battery 19: a
-    /// body force refused at level 1 of `solve --adapt-levels 3` named no level).
+    /// or a solver that did not converge, named with the level it happened at (a refusal at a
+    /// later level names that level, not only the data).
     #[error("level {level} ({ndof} unknowns): {error}")]
     SolveAt { level: usize, ndof: usize, error: Box<SolveError> },
     /// The estimate of level `level` is not a finite number (nothing of that level is kept).
@@ -238,7 +238,7 @@ pub enum AdaptTermination {
     NothingMarked,
     /// The refined mesh of level `level` (of `ndof` unknowns) has an element whose shape f64 no
     /// longer resolves at its coordinates (`worst`, [`Mesh::shape_roundoff_refused`]: a mesh far
-    /// from the origin refined deep, battery 13, F5); levels `0..level` were solved and seen by
+    /// from the origin refined deep); levels `0..level` were solved and seen by
     /// the observer, that one was not. A stop, not an error of the loop, so that a study keeps
     /// the levels solved; the command line exits 1 as for the memory stop ([`Self::is_error`]).
     FarFromOrigin { level: usize, ndof: usize, worst: crate::mesh::precision::ShapeRoundoff },
@@ -516,7 +516,7 @@ pub fn run_from(
         };
         // a refined mesh above max_ndof is not solved: the loop ends here, and this level says
         // it does not continue, so a run interrupted now keeps no checkpoint of a level it
-        // would never solve (battery 16, F1: resuming from one solved nothing and panicked)
+        // would never solve (resuming from one would solve nothing)
         let over = match (&next, config.max_ndof) {
             (Some(Ok((m, _))), Some(max)) => m.p2_ndof() > max,
             _ => false,

@@ -31,15 +31,16 @@ use crate::problems::{Material, Problem};
 /// 1e15 and more on well-conditioned data; the deepest stored levels, with estimates down to
 /// 2.2e-5 of (2 mu + |zeta|) max |u_h| and floors near 1e-12 of it, 1e7 and more. The scale is
 /// the round-off, not the displacement: a rigid motion of the body moves max |u_h| but not the
-/// deformation the estimate measures (battery 8: a translation by 5e10 of Example 7.2 stopped
-/// at level 0 as "exact" with an accurate estimate of 8e2, 2.3e4 times its round-off scale).
+/// deformation the estimate measures (Example 7.2 translated by 5e10 has an accurate estimate of
+/// 8e2, 2.3e4 times its round-off scale, which a scale of max |u_h| would stop at level 0 as
+/// "exact").
 /// Asked only of a u_h that resolves its deformation ([`resolution`]).
 pub const ROUNDOFF_ESTIMATE: f64 = 1e3;
 
 /// The largest share of the deformation's size the round-off of u_h may reach
 /// ([`resolution`]): beyond it u_h keeps fewer than 2 digits of the deformation, and the contact
-/// set and the estimate are the round-off's (battery 11, N3: Example 7.2 translated rigidly by
-/// 1e12 lost an active node and eta_7, by 1e16 every active node, all certified). Not 1e-3:
+/// set and the estimate are the round-off's (Example 7.2 translated rigidly by 1e12 loses an
+/// active node and eta_7, by 1e16 every active node, all certified). Not 1e-3:
 /// Example 7.2 translated by 5e10 keeps its estimate to 1e-2 with a measured round-off of 2.6e-3
 /// to 4.9e-3 of the deformation (`structured:8`, and level 1 from `structured:4`), and
 /// `tests/it/bad_battery8_contact.rs` holds it accepted; the stored studies stay below 1e-9 of it.
@@ -57,8 +58,8 @@ pub const NO_DEFORMATION: f64 = 30.0;
 /// at which a body whose u_h is at its round-off (no deformation above [`NO_DEFORMATION`] times
 /// it, or an estimate within [`ROUNDOFF_ESTIMATE`] of it) is called exact to round-off; beyond
 /// it that body is refused ([`Unresolved::AtRoundoff`]). u_h alone cannot tell an exact rigid
-/// translation from a deformation drowned in the round-off of a large one (battery 13, F3:
-/// Example 7.2 translated by 1e13 to 1e17 measures as an exact translation does, its
+/// translation from a deformation drowned in the round-off of a large one (Example 7.2
+/// translated by 1e13 to 1e17 measures as an exact translation does, its
 /// deformation 1.5 to 30 times its round-off, its estimate 6 to 50 times (2 mu + |zeta|)
 /// delta), and the data cannot either once they are rounded (at 1e16 the gap and the
 /// Dirichlet data are all 1e16). What tells them apart is the round-off against the body: a
@@ -98,7 +99,7 @@ impl Cause {
 /// The largest round-off bound of a contact force (`lambda_floor`, over the contact nodes) that
 /// is accepted, relative to the largest contact force at an active node ([`force_roundoff`];
 /// beyond it [`Unresolved::Forces`]). A rigid translation c of the data makes the bounds grow
-/// like c and leaves the forces (battery 12, F1): on Example 7.2 the share is about 6e-12 c /
+/// like c and leaves the forces: on Example 7.2 the share is about 6e-12 c /
 /// deformation on `structured:16`, and eta_7 fell from 5.120e-3 to 1.9e-6 at c = 1e10 (a share
 /// of 5.8e-2, two active forces under their bounds), was 1.2% off at 3e9 (1.9e-2) and 0.4% at
 /// 1e9 (6.4e-3); on `structured:4` and `:8` it held to shares of 0.1 and 0.17. The finer the
@@ -144,9 +145,9 @@ pub fn deformation(sol: &DiscreteSolution) -> f64 {
 /// One edge-connected body of the mesh ([`crate::contact::certify::bodies`], the split the
 /// rigid-motion check and the gap bound take) and what its u_h resolves: round-off, deformation
 /// and estimate are each body's own, so that one body's rigid motion neither sets another's
-/// round-off nor hides in its deformation (battery 13, F4: a second body translated by 1e11
-/// made Example 7.2's genuine estimate "at round-off"; by 1e14 its round-off terms made the
-/// estimate 8.5 times larger, and the deformation, spread over both, hid it).
+/// round-off nor hides in its deformation (taken over the whole mesh, a second body translated
+/// by 1e11 would make Example 7.2's genuine estimate "at round-off"; by 1e14 its round-off terms
+/// would make the estimate 8.5 times larger, and the deformation, spread over both, hide it).
 struct Body {
     /// Where it is, for a message: a vertex of its first triangle, and how many bodies there are.
     point: [f64; 2],
@@ -418,8 +419,8 @@ fn conditioning(lame_ratio: f64) -> String {
 #[derive(Clone, Debug)]
 pub enum Caveat {
     /// The solve is [`Resolution::AtRoundoff`]: its estimate's terms, and an efficiency index
-    /// against an error at round-off too, measure round-off (battery 14, F4: a uniform loop
-    /// went on through such levels without a word).
+    /// against an error at round-off too, measure round-off (a uniform loop does not go on
+    /// through such levels without a word).
     AtRoundoff,
     /// The contact forces' round-off bound is above [`WARNED_FORCES`] of the largest force.
     Forces { floor: f64, largest: f64, cause: Cause },
@@ -476,11 +477,11 @@ pub enum Resolution {
 /// The one decision, for `solve`, every level of `adapt` and every study, of what a solve's
 /// numbers resolve, taken body by body ([`Body`]). For each body the deformation comes first:
 /// one whose round-off reaches 1e-2 of a deformation it does have is unresolved, whatever its
-/// estimate (battery 12, F3); then whether it is at round-off (no deformation above 30 times its
+/// estimate; then whether it is at round-off (no deformation above 30 times its
 /// round-off, or an estimate at it: an exact discrete solution), which is granted only while the
-/// round-off is below [`EXACT_ROUNDOFF`] of the body's size and refused past it (battery 13, F3:
-/// asked before the refusal, "no deformation" took in every translation past the refused window,
-/// so 1e11 was refused and 2e11 to 1e17 answered with eta_7 = 0). The first body refused refuses
+/// round-off is below [`EXACT_ROUNDOFF`] of the body's size and refused past it (asked before
+/// the refusal, "no deformation" would take in every translation past the refused window: 1e11
+/// refused, 2e11 to 1e17 answered with eta_7 = 0). The first body refused refuses
 /// the solve, named when the mesh has several: its u_h or estimate would be round-off's, in the
 /// estimate's maxima too. The solve is at round-off when every body is; a body at round-off
 /// next to resolved ones adds indicators of at most its round-off, below 1e-8 of its size, and
@@ -490,10 +491,10 @@ pub enum Resolution {
 /// [`WARNED_FORCES`]) and the element shapes ([`WARNED_SHAPE`]; beyond
 /// [`crate::mesh::precision::SHAPE_ROUNDOFF_REFUSED`] the mesh check has refused the mesh). The
 /// forces are not asked of a solve at round-off: an exact solution that touches the obstacle
-/// without pressing on it has forces at their own round-off (battery 9's S3, u = 0.5 - 1e-9 x
-/// on `structured:32`: 2e-11 against bounds of 1e-2 of it), and its eta_7 is declared round-off
-/// with the rest; the silent eta_7 = 0 of battery 13's F3 came through a translated u_h called
-/// at round-off, which [`EXACT_ROUNDOFF`] now refuses before.
+/// without pressing on it has forces at their own round-off (u = 0.5 - 1e-9 x on
+/// `structured:32`: 2e-11 against bounds of 1e-2 of it), and its eta_7 is declared round-off
+/// with the rest; a translated u_h is refused by [`EXACT_ROUNDOFF`] before it could be called
+/// at round-off, so its eta_7 is never a silent 0.
 pub fn resolution(problem: &dyn Problem, mesh: &Mesh, sol: &DiscreteSolution, est: &Estimate) -> Resolution {
     let mut at_roundoff = true;
     for body in Body::all(sol, est) {

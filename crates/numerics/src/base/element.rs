@@ -101,8 +101,8 @@ pub fn triangle_rule(degree: usize) -> Rule<2> {
 /// three points with barycentric coordinates (a, a, 1 - 2a), a = (6 -+ sqrt 15) / 21. The points
 /// over which the "quadrature" L-infinity norms are taken: a maximum over the collapsed rule's
 /// points ([`triangle_rule`]), which are symmetric only under the reflection fixing one vertex,
-/// depended on how a triangle's vertices are labelled, so a problem mirrored onto the same mesh
-/// reported an error 20-25% smaller (battery 13, F2).
+/// would depend on how a triangle's vertices are labelled, so a problem mirrored onto the same
+/// mesh would report an error 20-25% smaller.
 pub fn symmetric_rule_5() -> Rule<2> {
     let r = 15f64.sqrt();
     let mut points = vec![[1.0 / 3.0, 1.0 / 3.0]];

@@ -187,8 +187,8 @@ pub const EXCERPT_LINE: usize = 2000;
 /// `message` with every line longer than [`EXCERPT_LINE`] characters cut to its first and last
 /// 500 and the count of those between: what every error that quotes a user's input shows of it
 /// (a manifest of one 200 MB line must not come back as a 200 MB message). The end is kept
-/// because the reason follows the quote (`cannot parse "...": the ( at character 4001 nests ...`;
-/// battery 13: cut after the first 1000, the reason was lost). Errors of manifests, problem
+/// because the reason follows the quote (`cannot parse "...": the ( at character 4001 nests ...`:
+/// a cut after the first 1000 would lose the reason). Errors of manifests, problem
 /// files and meshes format their text through it.
 pub fn excerpt(message: &str) -> String {
     if message.lines().all(|l| l.chars().count() <= EXCERPT_LINE) {

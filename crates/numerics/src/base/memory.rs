@@ -150,7 +150,7 @@ pub struct MemoryError {
 }
 
 /// `a` and `b` as [`human_bytes`], with as many decimals (up to 4) as it takes for two
-/// different sizes to read differently (battery 16: "needs about 1.7 GiB ... leaves 1.7 GiB").
+/// different sizes to read differently (never "needs about 1.7 GiB ... leaves 1.7 GiB").
 fn apart(a: f64, b: f64) -> [String; 2] {
     let mut pair = [human_bytes(a), human_bytes(b)];
     for decimals in 2..=4 {

@@ -288,8 +288,8 @@ impl ContactSolver {
             // K's own factor is used only where the active-set iteration starts from the
             // unconstrained solution or takes no step ([`Self::factor_k`]): a level warm-started
             // from the previous level's active set factorises only matrices with it imposed
-            // (issue 42: fb as written factorised K on every level and never used it, a third
-            // of its numeric time at 2e6 unknowns). The same factors are computed where used.
+            // (factorising K on every level, unused, would cost fb a third of its numeric time at
+            // 2e6 unknowns). The same factors are computed where used.
             Strategy::Refactor => solver.matrix = Some(matrix),
         }
         Ok(solver)

@@ -2,10 +2,10 @@
 //! of the line p + t n inside the body that holds p, from p into the body (the piece holding p
 //! and every piece beyond it on that side; holes between do not count). The gap bound of
 //! [`plausible`](super::plausible) takes it (a gap chi(p) below minus the chord pushes the body
-//! through itself along n at p). Neither the body's extent along n (battery 13, F1: an L-shaped
-//! body's 0.1-thick flange was pushed 0.5 through its clamped top, certified, because the column
-//! on its end made the extent 5) nor the whole mesh's (battery 12, F2: a second body 5 above a
-//! thin plate) bounds it.
+//! through itself along n at p). Neither the body's extent along n (by it, an L-shaped body's
+//! 0.1-thick flange could be pushed 0.5 through its clamped top, certified, because the column
+//! on its end makes the extent 5) nor the whole mesh's (a second body 5 above a thin plate)
+//! bounds it.
 //!
 //! The body is bounded by its boundary edges, straight between the mesh's vertices (a point of a
 //! curved edge lies off that chord by less than the edge's length). The line crosses them at
@@ -14,13 +14,13 @@
 //! (the larger chord counts: a point at a corner takes the more favourable of its two sides, as
 //! the normal check does). The sum stops at a piece whose far end lies on Gamma_D where the
 //! displacement along n is prescribed: that end is held, so material beyond it is no room for
-//! the face (battery 15, F1: a C-shaped body's clamped 0.1 flange was pushed 0.15 through its
-//! clamped top, certified, because its upper arm across open air added to the sum; a block's
-//! 0.01 floor over a clamped hole likewise). A held end is where its Dirichlet data put it: data
+//! the face (without that stop, a C-shaped body's clamped 0.1 flange could be pushed 0.15
+//! through its clamped top, certified, its upper arm across open air adding to the sum; a
+//! block's 0.01 floor over a clamped hole likewise). A held end is where its Dirichlet data put it: data
 //! that move it towards the face by `toward` leave the face that much less room, and data that
-//! move it away leave more ([`Room::left`]; battery 16, F2: a 0.1 plate whose top is held at
-//! u_y = -0.05 took chi = -0.08, certified, with its bottom face ending above its top, and one
-//! held at +0.05 was refused at -0.12). So a gap that is not negative is checked too where the
+//! move it away leave more ([`Room::left`]: a 0.1 plate whose top is held at u_y = -0.05 has
+//! room 0.05, so chi = -0.08, which would end its bottom face above its top, is refused, and one
+//! held at +0.05 has room 0.15, so chi = -0.12 is accepted). So a gap that is not negative is checked too where the
 //! Dirichlet data move a held end (`[0, -0.2]` on a 0.1 plate's top with chi = 0.01 turned the
 //! plate inside out). The boundary edges are in an R*-tree ([`rstar`], as in
 //! [`mesh::locate`](crate::mesh::locate)), built at the first negative gap, so that a point
@@ -208,8 +208,8 @@ impl Line {
     /// `reach`) ends the piece holding `p`, and the chord is that piece and every piece beyond
     /// it on the same side of `p`: all the body's material the line meets going into the body
     /// from `p`. Only the material counts, not the holes between: a hole behind the contact face
-    /// is room the face may move into (battery 14, F1: a 0.01 ligament under a 0.85 tall hole
-    /// was refused at a gap of -0.02, the first piece alone), and the body is pushed through
+    /// is room the face may move into (a 0.01 ligament under a 0.85 tall hole is not refused at
+    /// a gap of -0.02, as the first piece alone would have it), and the body is pushed through
     /// itself only where the gap exceeds all of it. A vertex on the line counts on the side
     /// `strict` says (false: with the vertices at positive distance), so each vertex is on one
     /// side and the crossings come in pairs. The sum ends with the first piece whose far end
@@ -326,8 +326,8 @@ mod tests {
         // from the top, going down the same way
         let down = Line { p: [0.5, 1.0], d: [0.0, 1.0] }.chord(&free, false, 1.0).unwrap().0;
         assert!((down - 0.15).abs() < 1e-12, "{down}");
-        // a clamped hole holds the ligament's far end: the chord is the ligament (battery 15,
-        // F1), going up and going down
+        // a clamped hole holds the ligament's far end: the chord is the ligament, going up and
+        // going down
         let clamped = block(true);
         // and the held end is named, with the direction into the body
         let (up, end) = Line { p: [0.5, 0.0], d: [0.0, -1.0] }.chord(&clamped, false, 1.0).unwrap();

@@ -11,8 +11,8 @@
 //!   contact conditions are checked (`consistent::boundary::sample`: the Gauss points and
 //!   pieces no longer than the body's size over 4096 along every contact edge, on a curve with
 //!   the curve's normal): a stretch of bad data between the nodes is refused on every mesh, not
-//!   only where refinement puts a node in it (battery 8: a reversed normal 0.005 long was
-//!   certified on structured:4 and 8). A normal with
+//!   only where refinement puts a node in it (checked at the nodes only, a reversed normal 0.005
+//!   long would be certified on structured:4 and 8). A normal with
 //!   n . n_out < 0 is reversed (the constraint would pull the body into the obstacle); one with
 //!   n . n_out < cos 80 degrees (within 10 degrees of the boundary) is nearly tangent: the
 //!   constraint would act mostly along the surface, limiting sliding, and the normal gap it
@@ -23,9 +23,9 @@
 //! * **A contact node carries one direction.** The node holds one constraint u . n <= chi; where
 //!   the normal differs between its two contact edges (two sides of the square with `normal =
 //!   "outward"`, two circles meeting at an angle, a declared normal that jumps there) the node is
-//!   held along one of them only and could pass the obstacle along the other (battery 10: the
-//!   corner of two contact sides took the bottom's normal and passed the side wall by 8% of the
-//!   gap, certified). Refused, naming the node and both normals ([`ContactDataError::Corner`]).
+//!   held along one of them only and could pass the obstacle along the other (the corner of two
+//!   contact sides that takes the bottom's normal can pass the side wall by 8% of the gap,
+//!   certified). Refused, naming the node and both normals ([`ContactDataError::Corner`]).
 //! * **The obstacle does not overlap the body by more than its thickness.** A gap chi(p) < -D,
 //!   D the body's chord through p along the contact normal n (the length of the piece of the
 //!   line p + t n inside the edge-connected body holding p, up to a held end of Gamma_D, which
@@ -48,8 +48,8 @@
 //! * **No node of the closure of Gamma_C is left unconstrained along n.** Where one component
 //!   is prescribed (rollers meeting the contact part, a symmetry hold on it) and the normal has a
 //!   part along the free one, u . n depends on a free unknown that no constraint bounds (the node
-//!   is not a contact node): a certified answer could pass the obstacle there (a seventh battery
-//!   found a Hertz symmetry hold sinking by 6.7e-5). Refused, naming the node
+//!   is not a contact node): a certified answer could pass the obstacle there (a Hertz symmetry
+//!   hold on the contact part can sink by 6.7e-5). Refused, naming the node
 //!   ([`ContactDataError::HalfPrescribed`]); imposing the constraint on the free component alone is
 //!   not built.
 //!
@@ -145,7 +145,7 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
     let diameter = super::consistent::diameter(mesh);
     let chords = Chords::of(mesh, nodes, problem);
     // the normal at each node and sampled point first: a normal nearly tangent or reversed is
-    // named as such, never as a corner where it merely turns fast (battery 11, N6)
+    // named as such, never as a corner where it merely turns fast
     check_nodes(mesh, nodes, dofs, problem, &outward, &chords)?;
     check_sampled(mesh, nodes, problem, &chords)?;
     check_corners(mesh, dofs, problem, diameter)?;
@@ -156,9 +156,9 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
 /// on one of its contact edges next to it ([`check_corners`]). A real angle, not round-off: a
 /// smooth normal reaches it over [`PART_END`](crate::mesh::PART_END) of the body's size only by
 /// turning 1e6 radians per body size (a jump for every purpose), and a normal evaluated from
-/// expressions at far translated coordinates keeps its direction to about 1e-9 (battery 11, N6:
-/// `["x - 0.5", "-1e-3"]` turned by 1e-6 over 1e-9 of the size and was called a corner at the
-/// former 1e-6). Below it, the one direction a node holds differs from the other side's by less
+/// expressions at far translated coordinates keeps its direction to about 1e-9
+/// (`["x - 0.5", "-1e-3"]` turns by 1e-6 over 1e-9 of the size, which a bound of 1e-6 would call
+/// a corner). Below it, the one direction a node holds differs from the other side's by less
 /// than 1e-3 of a displacement along it.
 pub const CORNER_ANGLE: f64 = 1e-3;
 
@@ -167,8 +167,8 @@ pub const CORNER_ANGLE: f64 = 1e-3;
 /// size inside the edge, as the part check takes a vertex): where they differ by more than
 /// [`CORNER_ANGLE`] the vertex is a corner of the normal (two contact sides of the square with
 /// `normal = "outward"`, two circles meeting at an angle, a declared normal that jumps there),
-/// and its one constraint u . n <= chi holds the body along one direction only (battery 10: the
-/// corner of two contact sides took the bottom's normal and passed the side wall, certified).
+/// and its one constraint u . n <= chi holds the body along one direction only (a corner of two
+/// contact sides that takes the bottom's normal can pass the side wall, certified).
 /// Built-in problems and declared constant normals have no corner.
 fn check_corners(mesh: &Mesh, dofs: &DofMap, problem: &dyn Problem, diameter: f64) -> Result<(), Box<ContactDataError>> {
     let angle = |a: [f64; 2], b: [f64; 2]| (a[0] * b[1] - a[1] * b[0]).abs().atan2(a[0] * b[0] + a[1] * b[1]);

@@ -1,8 +1,8 @@
 //! A point constraint must take no force. A displacement prescribed at a single point is no
 //! constraint of the continuous problem in 2-D (a point has zero H^1 capacity): the force it
-//! takes on a mesh tends to zero as h -> 0, so each mesh would solve another problem (battery
-//! 14, F3: u = (0.3, 0) at the centre of Example 7.2 gave a different solution on every mesh
-//! and an estimate that grew with refinement). Its one meaningful use is removing a rigid
+//! takes on a mesh tends to zero as h -> 0, so each mesh would solve another problem (u = (0.3,
+//! 0) at the centre of Example 7.2 gives a different solution on every mesh and an estimate
+//! that grows with refinement). Its one meaningful use is removing a rigid
 //! motion (rollers: u_2 = 0 at one point), which the loads leave in equilibrium: the reaction
 //! is zero up to round-off. So the solve refuses a point constraint whose reaction is above
 //! its round-off, and everything that solves (solve, adapt, studies) gets the refusal.
@@ -43,8 +43,8 @@ pub struct PointReactionError {
 /// all the nodal forces; the point's own terms with (K c)_p alone, 4 times, were exceeded 1.9
 /// times on ex72_rollers' uniform level 11 (2.6e5 unknowns). Measured with every unknown's
 /// terms (ex72_rollers, adaptive as written to 3.5e5 unknowns and uniform to 2.6e5): the
-/// reaction is at most 9e-5 of the bound on every level, a margin of 1e4; battery 14's u_1 =
-/// 0.3 at the centre of Example 7.2 is 3e8 (structured:64) to 1e11 (structured:4) times its
+/// reaction is at most 9e-5 of the bound on every level, a margin of 1e4; u_1 = 0.3 at the
+/// centre of Example 7.2 is 3e8 (structured:64) to 1e11 (structured:4) times its
 /// bound.
 pub fn check_reactions(
     nodes: &P2Nodes,
@@ -100,8 +100,8 @@ pub struct PointOnDirichletError {
 }
 
 /// Refuse a point constraint's value on a component Gamma_D also prescribes at its vertex
-/// unless it equals Gamma_D's value there (battery 14: `u = [0.25, 0]` at a rollers' point with
-/// `dirichlet = [0.1, "free"]` was accepted, one of the two values silently dropped). Equal
+/// unless it equals Gamma_D's value there (`u = [0.25, 0]` at a rollers' point with
+/// `dirichlet = [0.1, "free"]` would keep one of the two values and silently drop the other). Equal
 /// values are redundant but harmless and stay accepted. Equal is to 1e-12 of the prescribed
 /// displacements' scale (the largest |value| of the Dirichlet data at Gamma_D's nodes and of the
 /// point values): the same value written two ways (`0.1` at the point, an expression of the

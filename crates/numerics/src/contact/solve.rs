@@ -464,8 +464,8 @@ impl DiscreteSolution {
                 }
             }
             // a closed loop walked back to its start: a run still open there and a first zone
-            // from s = 0 are one arc through the start (battery 10, F7: reported as two zones,
-            // and zone_min/zone_max as the whole loop); it is written [s_first, s_last + L]
+            // from s = 0 are one arc through the start (not two zones, with zone_min/zone_max the
+            // whole loop); it is written [s_first, s_last + L]
             let closed = edges[e][1] == edges[start][0];
             match (run, zones.get(first_zone).copied()) {
                 (Some(last), Some(head)) if closed && head.s[0] == 0.0 => {

@@ -188,7 +188,7 @@ fn check_folds(
 
 /// No two triangles overlap geometrically ([`super::overlap`]): the topology [`check_folds`]
 /// checks can be perfect for two bodies meshed in one place (each its own nodes) or crossing
-/// each other, whose solution would be either body's at a point (battery 7). Named by the
+/// each other, whose solution would be either body's at a point. Named by the
 /// triangles' tags and lines and a point inside both.
 fn check_overlaps(
     path: &Path,
@@ -320,8 +320,8 @@ fn refuse_text_declared_binary(path: &Path, bytes: &[u8]) -> Result<(), MeshErro
 
 /// A file that ends inside a section it reads (the last section opened has no `$End` line, and
 /// no line after its opening starts a section) is refused as truncated, naming the section and
-/// where the file ends: read on, the cut data of a binary `$Nodes` section were blamed on
-/// whatever its bytes happened to read as (a node tag "the internally reserved value of 0").
+/// where the file ends: read on, the cut data of a binary `$Nodes` section would be blamed on
+/// whatever its bytes happen to read as (a node tag "the internally reserved value of 0").
 fn refuse_truncated(path: &Path, bytes: &[u8]) -> Result<(), MeshError> {
     let Some(last) = msh_sections::walk(bytes).pop().filter(|s| s.end.is_none()) else { return Ok(()) };
     if bytes[last.body..].split(|&b| b == b'\n').any(|l| l.trim_ascii().starts_with(b"$")) {
@@ -358,8 +358,8 @@ fn refuse_partitioned(path: &Path, bytes: &[u8]) -> Result<(), MeshError> {
 /// made one space and none at the ends of a line, outside double quotes (a physical name keeps
 /// its spaces); lines stay where they are, so every line number still names the file's line.
 /// MSH separates fields by white space of any length, as Gmsh reads it, but `mshio` takes one
-/// space only: a valid file written with aligned columns was refused, naming a line far from
-/// the first double space. A binary file is returned as it is (its data are bytes, not text).
+/// space only: it refuses a valid file written with aligned columns, naming a line far from the
+/// first double space. A binary file is returned as it is (its data are bytes, not text).
 fn single_spaced(bytes: Vec<u8>) -> Vec<u8> {
     if msh_nodes::Encoding::of(&bytes).is_none_or(|e| e.binary) {
         return bytes;

@@ -339,8 +339,8 @@ impl Mesh {
     /// comparisons (`comparisons`, lhs - rhs) changes sign, located by bisection between the
     /// ends and those points. A part that ends inside an edge would be decided by the midpoint,
     /// and the contact or Dirichlet part would silently grow or shrink to the mesh's vertices
-    /// (battery 6: contact for y < 0.6 read as y < 0.5 on structured:4; battery 7: a band 0.002
-    /// wide between two samples was dropped on structured:4 and 8, refused on 16). What can still
+    /// (contact for y < 0.6 would read as y < 0.5 on structured:4; a band 0.002 wide between two
+    /// samples would be dropped on structured:4 and 8, refused on 16). What can still
     /// escape: one comparison that changes sign twice between two adjacent samples (a band
     /// written as a single comparison, `(y - c)^2 < w^2`, narrower than 1/16 of an edge), and a
     /// change within [`PART_END`] of the body's size from an end of the edge (the `1e-12` of

@@ -23,7 +23,7 @@ pub struct Section {
 }
 
 /// A section name as a message shows it: control characters escaped (a file's bytes must not
-/// drive the terminal: battery 9 cleared it with an escape sequence), at most 60 characters.
+/// drive the terminal: an escape sequence could clear it), at most 60 characters.
 fn shown(name: &str) -> String {
     let mut out = String::new();
     for (i, c) in name.chars().enumerate() {
@@ -173,7 +173,7 @@ mod tests {
     }
 
     /// A section name is shown with its control characters escaped and cut to 60 characters
-    /// (battery 9: an escape sequence in a name cleared the terminal of whoever read the error).
+    /// (an escape sequence in a name would otherwise clear the terminal of whoever reads the error).
     #[test]
     fn a_section_name_in_a_message_cannot_drive_the_terminal() {
         let long = "x".repeat(100);

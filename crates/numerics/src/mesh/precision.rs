@@ -1,9 +1,9 @@
 //! What the vertices' coordinates can resolve of the elements they describe. A coordinate x
 //! carries a round-off of eps |x| (f64's unit round-off eps = 2.2e-16), so a triangle of height
 //! h placed at distance |x| from the origin has its shape known only to about eps |x| / h: a
-//! mesh translated far from the origin loses digits of every element (battery 12, F7: an 8x8
-//! grid of the unit square moved to (1e13, 1e13) changed eta_6 by 35% with no word, and at 1e15
-//! its Dirichlet side was misread as a line, "the body can move rigidly").
+//! mesh translated far from the origin loses digits of every element (an 8x8 grid of the unit
+//! square moved to (1e13, 1e13) changes eta_6 by 35%, and at 1e15 its Dirichlet side reads as a
+//! line, "the body can move rigidly").
 
 use super::{Mesh, MeshError};
 

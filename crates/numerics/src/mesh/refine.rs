@@ -147,7 +147,7 @@ impl Edges {
 /// A new vertex put on a curve (the closest point to a curved boundary edge's midpoint) can
 /// turn a child triangle over where the mesh is thinner there than the curve's sagitta over the
 /// edge (a concave curve, a hole): that is refused by name ([`MeshError::TurnedByCurve`]), as the
-/// projection's doing, not the mesh's vertex order (battery 10, F10).
+/// projection's doing, not the mesh's vertex order.
 ///
 /// # Panics
 /// If `marked.len()` differs from the number of triangles, or the mesh is not conforming (an edge

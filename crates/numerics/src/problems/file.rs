@@ -101,8 +101,8 @@ struct PartsToml {
 }
 
 /// Exactly two values: a point, a vector, a row of a gradient. serde reads a longer TOML array
-/// into `[T; 2]` by dropping the rest (`[1, 0.5, 0]` was the point (1, 0.5), an exact solution
-/// with three components used two); this type refuses it, for every pair of a problem file.
+/// into `[T; 2]` by dropping the rest (`[1, 0.5, 0]` would be the point (1, 0.5), an exact
+/// solution with three components would use two); this type refuses it, for every pair of a problem file.
 #[derive(Clone, Debug)]
 struct Two<T>([T; 2]);
 

@@ -117,8 +117,8 @@ pub trait Problem: Send + Sync {
     /// The constraint direction n of u . n <= chi at `x` on Gamma_C, where the body's outward
     /// unit normal is `outward` (on the contact edge in question: its curve's, or the straight
     /// edge's, `Mesh::outward_at`). A declared direction ignores `outward`; `normal =
-    /// "outward"` returns it, so every edge gets its own (battery 10: a nearest circle or
-    /// square side gave a flat side another part's normal).
+    /// "outward"` returns it, so every edge gets its own (the nearest circle or square side
+    /// could give a flat side another part's normal).
     fn contact_normal(&self, x: [f64; 2], outward: [f64; 2]) -> [f64; 2];
     /// The gap chi: the constraint is u . n <= chi on Gamma_C.
     fn gap(&self, x: [f64; 2]) -> f64;

@@ -80,7 +80,7 @@ pub(super) fn orphans(dir: &StudyDir, runs: &[RunRecord]) -> Result<Vec<PathBuf>
     let keys: Vec<String> = runs.iter().filter_map(|r| records::ReferenceRecord::key_of(&r.run)).collect();
     // runs whose record is there but could not be read (a damaged record, a fault of its run):
     // what they saved and what they are measured against is not known, so none of it is an
-    // orphan (battery 19: removed as such, a truncated record's snapshots and reference were lost)
+    // orphan (a truncated record's snapshots and reference are kept, not removed as orphans)
     let unread: Vec<String> = files_in(&runs_dir)?
         .into_iter()
         .filter_map(|(name, _)| {
@@ -172,8 +172,8 @@ fn without_path(text: &str, file: &std::path::Path) -> String {
 pub fn first_difference(a: &str, b: &str) -> (String, String) {
     let (al, bl): (Vec<&str>, Vec<&str>) = (a.lines().collect(), b.lines().collect());
     let Some(i) = (0..al.len().max(bl.len())).find(|&i| al.get(i) != bl.get(i)) else {
-        // the same lines: what differs is how they end (`lines` drops "\r\n" and a last "\n";
-        // battery 17: a CRLF levels.csv read "line 72: (none)" on both sides)
+        // the same lines: what differs is how they end (`lines` drops "\r\n" and a last "\n",
+        // so a CRLF levels.csv would otherwise read "line 72: (none)" on both sides)
         return (line_endings(a), line_endings(b));
     };
     let (la, lb): (Vec<char>, Vec<char>) = (al.get(i).unwrap_or(&"").chars().collect(), bl.get(i).unwrap_or(&"").chars().collect());
@@ -314,7 +314,7 @@ pub fn reference_faults(dir: &StudyDir, runs: &[RunRecord]) -> Vec<Fault> {
 
 #[cfg(test)]
 mod tests {
-    /// Battery 17, F3: texts with the same lines differ in their line ends; the message says so
+    /// Texts with the same lines that differ in their line ends: the message says so
     /// rather than "line 72: (none)" on both sides.
     #[test]
     fn the_same_lines_with_other_line_ends_are_named_as_such() {

@@ -102,8 +102,8 @@ impl Lock {
 
 /// The lock of a scratch folder a whole command reruns studies into (`drift`'s
 /// `target/drift/full`): the file `FOLDER.lock` beside it, held until the command ends. A second
-/// process waits for it, saying who holds it: two drifts in one checkout otherwise started over
-/// each other's reruns and compared what the other had removed (battery 9: a false drift).
+/// process waits for it, saying who holds it: two drifts in one checkout would otherwise start
+/// over each other's reruns and compare what the other had removed (a false drift).
 pub fn scratch_folder(folder: &Path) -> Result<Lock> {
     let mut name = folder.file_name().map(|n| n.to_os_string()).unwrap_or_else(|| "scratch".into());
     name.push(".lock");
@@ -227,7 +227,7 @@ fn own(mut file: std::fs::File, path: &Path) -> Result<Lock> {
 /// A study folder another process is writing, found by a reader: what it writes, who, and the
 /// lock that says so. Its records are what the writer has not finished changing (`run --fresh`
 /// has removed them, a run's record is not there yet), so a reader names the writer instead of
-/// reporting them as missing or drifted (battery 11, N5).
+/// reporting them as missing or drifted.
 #[derive(Debug, thiserror::Error)]
 #[error(
     "{what} is being written by {holder}: what it holds now is not what it will hold, so nothing was read; run this again when that process has finished (the lock is {})",
@@ -281,9 +281,9 @@ pub(super) fn writer_of(dir: &StudyDir) -> Result<Option<BeingWritten>> {
 /// Wait until no other process writes `dir` ([`writer_of`]): for each writer found, block on a
 /// shared lock of the lock file it holds (saying who it is, once per process), then look again;
 /// and where no lock is held, wait until every process seen writing has ended. A `run` holds no
-/// lock for a moment between committing one run and claiming the next (battery 14, F2: `figures
-/// --wait` woke in that moment and then met the next run's lock, exit 1, or read the study with
-/// its later runs missing, exit 0). What a reader given `--wait` does before it reads (the Slurm
+/// lock for a moment between committing one run and claiming the next: a reader that woke in
+/// that moment would meet the next run's lock (exit 1) or read the study with its later runs
+/// missing (exit 0). What a reader given `--wait` does before it reads (the Slurm
 /// finish job of one array, while another array's tasks still hold the folder). A process that
 /// starts writing after the wait makes the read refuse as without `--wait`: never a silent read.
 pub(super) fn wait_for_writers(dir: &StudyDir) -> Result<()> {
@@ -313,7 +313,7 @@ pub(super) fn wait_for_writers(dir: &StudyDir) -> Result<()> {
 
 /// The folder of the run locks (`STUDY/.locks`), where it exists, is a folder: one that is a file
 /// is named by every writer (which takes the study lock first) and reader, also where every
-/// run is finished and no run lock is opened (battery 13: `run` then said "0 run(s) executed").
+/// run is finished and no run lock is opened (`run` then names it too, never "0 run(s) executed").
 fn check_run_lock_folder(dir: &StudyDir) -> Result<()> {
     let folder = dir.root.join(".locks");
     match std::fs::metadata(&folder) {

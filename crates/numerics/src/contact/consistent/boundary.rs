@@ -3,24 +3,25 @@
 //! prescribed value, on Gamma_N sigma(u) n is the traction, in a component Gamma_D leaves free
 //! (rollers) the traction is zero, on Gamma_C u . n <= chi, sigma_nn <= 0,
 //! (chi - u . n) sigma_nn = 0 and sigma(u) n has no part across the contact normal (frictionless). A mistyped gap or traction otherwise gives an
-//! exact solution of another problem, and errors that never converge (battery: chi = -0.05 in
-//! Example 7.1 kept the error at 5e-2 on every mesh, certified).
+//! exact solution of another problem, and errors that never converge (chi = -0.05 in Example
+//! 7.1 keeps the error at 5e-2 on every mesh, every solve certified).
 //!
 //! Checked on every boundary edge of the mesh at every point where the discrete problem reads
 //! the data there: its end points and midpoint (the P2 nodes, where the Dirichlet data, the gap
 //! and the contact normal are taken) and the Gauss points of the traction
 //! ([`crate::fem::assembly::edge_points`]). An edge on a curve (`[curves]`) is checked at the
 //! curve's points closest to those, with the curve's own normal: its chord is off the curve, and
-//! the chord's normal is not the body's (battery 6: tension on a contact arc was certified when
-//! curved edges were left out). The points depend on the mesh, but every value of the data the
-//! discrete problem sees is checked (battery 6: a bump in the Dirichlet data between sampled
-//! midpoints passed on some meshes). On Neumann edges the estimator's edge points (both
+//! the chord's normal is not the body's (with curved edges left out, tension on a contact arc
+//! would be certified). The points depend on the mesh, but every value of the data the
+//! discrete problem sees is checked (a bump in the Dirichlet data between sampled midpoints
+//! passes on the meshes that put no point in it). On Neumann edges the estimator's edge points (both
 //! samplings, [`crate::contact::sampling::Sampling::edge_parameters`]) are checked too: it reads
 //! the traction there.
 //!
 //! The contact conditions are not data the discrete problem reads between its nodes, yet an
-//! exact solution that goes through the obstacle between them is not one (battery 7: a dip 0.008
-//! wide was certified on structured:4 and 8, refused on 16 and at level 4 of `adapt`). So every
+//! exact solution that goes through the obstacle between them is not one (checked at the nodes
+//! only, a dip 0.008 wide would be certified on structured:4 and 8, refused on 16 and at level 4
+//! of `adapt`). So every
 //! contact edge is also cut into equal pieces no longer than the body's size (the diagonal of the
 //! mesh's bounding box) over [`CONTACT_DENSITY`], and all four contact conditions are checked at
 //! their ends. The rule: a violation longer than that spacing along Gamma_C is refused on every
@@ -128,7 +129,7 @@ pub(super) fn gradient_points(mesh: &Mesh, nodes: &P2Nodes) -> Vec<([f64; 2], f6
 /// over the points and the largest |u| over the body's size (the diagonal of the mesh's bounding
 /// box). For a stress-free exact solution (a rigid motion written with identities, sin^2 + cos^2)
 /// the largest |sigma(u) n| is the round-off of its gradient, and a tolerance relative to it
-/// refused that round-off as "tangential traction 2e-19" (battery 10, F4).
+/// would refuse that round-off as "tangential traction 2e-19".
 fn stress_scale(problem: &dyn Problem, exact: &dyn Exact, mesh: &Mesh, points: &[Point], scale_u: f64) -> f64 {
     let material = problem.material();
     let finite = |v: f64| if v.is_finite() { v } else { 0.0 };

@@ -10,8 +10,8 @@
 //! triangles spread over the mesh; the gradient also at every point where it enters the discrete
 //! problem or the estimate, the points of the Neumann edges where the traction `"exact"` =
 //! sigma(grad) n is read (`boundary::gradient_points`: the P2 nodes, the traction's Gauss points,
-//! the estimator's edge points; battery 7: a band in a hand-written grad, divergence-free, between the centroids
-//! was certified on structured:4 to 32); the body force also at every point where the assembly
+//! the estimator's edge points; a band in a hand-written grad, divergence-free, between the centroids
+//! would otherwise be certified on structured:4 to 32); the body force also at every point where the assembly
 //! evaluates it on this mesh (`fem::assembly::load_points`: whatever f the discrete problem
 //! sees is checked). The steps are `s` and `s / 2`, `s` a thousandth of the
 //! triangle's (or boundary edge's) longest edge. A central difference is second-order, so the two steps differ by
@@ -107,7 +107,7 @@ impl Sample {
     /// The mismatch, if it is one: beyond [`CONSISTENT`] times `scale`, and [`BEYOND`] times
     /// what the quotients cannot resolve: the two steps' difference, or their round-off where
     /// that is larger (two quotients of a displacement large against its variation can agree
-    /// by chance to far below their round-off: battery 9, u = (0.5 - 1e-9 x, 0)).
+    /// by chance to far below their round-off, as for u = (0.5 - 1e-9 x, 0)).
     fn contradicts(&self, scale: f64) -> bool {
         let off = (self.fine.value - self.declared).abs();
         let unresolved = (self.coarse.value - self.fine.value).abs().max(self.coarse.roundoff).max(self.fine.roundoff);
@@ -278,7 +278,7 @@ struct Kept {
 /// sampled centroids, and at every point where the assembly evaluates f on this mesh
 /// ([`crate::fem::assembly::LoadPoints`]), each with the step of its triangle. Whatever value of f
 /// the discrete problem sees is checked, so a file is not accepted on one mesh and refused on
-/// another for a mismatch between samples (battery 6). Returns the first mismatch with its
+/// another for a mismatch between samples. Returns the first mismatch with its
 /// component, and the number of points compared.
 ///
 /// The points (about 36 a triangle) are streamed, [`CHUNK`] triangles at a time, and only those
@@ -344,7 +344,7 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Resul
     };
     let steps = steps(mesh);
     let pts = points(mesh, &steps);
-    // the gradient also where it enters: the traction "exact" = sigma(grad) n (battery 7)
+    // the gradient also where it enters: the traction "exact" = sigma(grad) n
     let mut grad_pts = pts.clone();
     grad_pts.extend(boundary::gradient_points(mesh, nodes));
     let sampled = grad_pts.len();
@@ -372,7 +372,7 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Resul
     let material = problem.material();
     // a body force's scale is no less than the stress the gradient implies over the body's size:
     // for a stress-free exact solution (a rigid motion written as cosh(3 x)^2 - sinh(3 x)^2 - 0.001 y)
-    // the largest |f| and |div sigma| are the round-off of the symbolic gradient (battery 10, F4)
+    // the largest |f| and |div sigma| are the round-off of the symbolic gradient
     let gradient = grad_pts
         .iter()
         .flat_map(|&(at, _)| exact.grad(at).into_iter().flatten())

@@ -3,20 +3,21 @@
 //!
 //! exmex has `min`, `max` and `atan2` as binary operators and reads the call syntax by
 //! rewriting `f(a, b)` to `((a)f(b))` as it tokenizes, with one flag for the parenthesis to
-//! close: a call inside the second argument of another (`min(1, max(0, s))`) reset it, and the
-//! expression was refused as "parentheses mismatch"; a call with three arguments was blamed on
-//! the parentheses too, and one with one argument on exmex's internals ("1 ops and 1 node").
+//! close: a call inside the second argument of another (`min(1, max(0, s))`) resets it, and
+//! exmex refuses the expression as "parentheses mismatch"; it blames a call with three arguments
+//! on the parentheses too, and one with one argument on its internals ("1 ops and 1 node").
 //! [`infix`] does exmex's rewrite itself, for any nesting, from the matched parentheses: the
 //! call's name and `(` become `((`, its comma `)f(`, its `)` `))`, so exmex sees no comma and
-//! the expressions that parsed before read into the same operations. A call with another number
-//! of arguments, a comma outside a call of these, and parentheses that do not match are named.
+//! the expressions exmex's own rewrite parses read into the same operations. A call with
+//! another number of arguments, a comma outside a call of these, and parentheses that do not
+//! match are named.
 
 /// The functions of two arguments (exmex's binary operators with call syntax).
 pub(super) const TWO_ARGUMENTS: [&str; 3] = ["min", "max", "atan2"];
 
 /// The deepest nesting of parentheses an expression may have. exmex's parse of nested calls
-/// takes time quadratic in their depth (battery 13: `abs(abs(...))` 40k deep took 2 s, 200k deep
-/// over 120 s); no expression a problem needs comes near this.
+/// takes time quadratic in their depth (`abs(abs(...))` 40k deep takes 2 s, 200k deep over
+/// 120 s); no expression a problem needs comes near this.
 pub(super) const MAX_NESTING: usize = 1000;
 
 /// An open parenthesis: where it is (character index), the function it calls (if a name

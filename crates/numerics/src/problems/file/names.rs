@@ -5,7 +5,7 @@
 //! exmex knows more than these: `log` (which it reads as ln, where many engineers read log10),
 //! and `log2 cbrt round ceil trunc fract asinh acosh atanh` and the constants `π`, `τ`, which
 //! are not documented here. A name exmex does not know (`ab(y)`, `cot(1)`) or a number run into
-//! a name (`0x10`) gave exmex's internals ("a number/variable cannot be on the right of a
+//! a name (`0x10`) gets exmex's internals ("a number/variable cannot be on the right of a
 //! closing parenthesis", "0 ops and 2 node"); each is refused here by name, before exmex parses.
 
 use exmex::{FloatOpsFactory, MakeOperators};
@@ -58,8 +58,8 @@ pub(super) fn refused_name(text: &str, known: &[&str]) -> Option<String> {
         i = end;
         let name: String = chars[start..end].iter().map(|&(_, c)| c).collect();
         let called = chars[end..].iter().find(|&&(_, c)| !c.is_whitespace()).is_some_and(|&(_, c)| c == '(');
-        // made only for a message: formatting `text` for every name made a long expression's
-        // check quadratic (battery 13: 200k nested calls took over 120 s)
+        // made only for a message: formatting `text` for every name would make a long
+        // expression's check quadratic (200k nested calls: over 120 s)
         let at = || format!("at character {} of {text:?}", start + 1);
         if name == "log" {
             return Some(format!(
