@@ -38,6 +38,7 @@
 //! two-decade window, has an interval containing 0 and no wider than 0.3; an interval containing 0
 //! but wider than 0.3 is inconclusive, whatever its centre (a flat centre is no evidence with a
 //! wide interval), and so is a window shorter than two decades.
+//! The method: `docs/method.md`, section "From rates to verdicts".
 
 use harness::records::RunRecord;
 

@@ -3,6 +3,7 @@
 //! refinement [`History`] (marks and warm starts per level) from which [`replay`] rebuilds and
 //! solves any level again, and it can start from a later level ([`run_from`], [`Start`]): how an
 //! interrupted deep run resumes.
+//! The method: `docs/method.md`, sections "MARK: the maximum strategy" and "The loop and its stops".
 
 pub mod history;
 mod level;

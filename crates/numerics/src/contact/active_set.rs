@@ -35,6 +35,7 @@
 //! Refactor strategy keeps the matrix (it imposes each iteration's constraints on its values
 //! while loading them, without a copy) and computes where its entries go again for each load,
 //! released before the factorisation as well.
+//! The method: `docs/method.md`, section "SOLVE: the primal–dual active set method".
 
 use crate::sparse::cholesky;
 use crate::sparse::csc::SymCsc;

@@ -1,5 +1,6 @@
 //! The SOLVE step: one discrete Signorini solution (paper eq. 3.4) on a given mesh, with the
 //! discrete contact force (eq. 4.5) and its KKT report.
+//! The method: `docs/method.md`, sections "The discrete contact force" and "The certificate a solve passes before it reports".
 
 use crate::base::element::{self, Affine};
 use crate::contact::certify::{self, Certificate, KktError, KktInput, RigidMotionError};

@@ -25,6 +25,7 @@
 //! inactive nodes carry round-off. Vector norms are the largest component.
 //! Norms are maxima over a declared sampling: the element quadrature points or a dense lattice
 //! (elements), Gauss points or equispaced points with the end points (edges).
+//! The method: `docs/method.md`, section "ESTIMATE: eta_1 .. eta_7".
 
 mod local;
 pub mod repair;

@@ -5,6 +5,7 @@
 //! so the contact constraint u(p).n <= chi_h(p) acts on a single unknown for any normal.
 //! The unknowns are numbered so that every contact normal unknown comes last (the block `C`);
 //! the contact solver relies on that to work on a small Schur complement.
+//! The method: `docs/method.md`, section "The discretisation".
 
 use crate::base::element::{self, Affine, EDGE_VERTICES, N_NODES};
 use crate::mesh::{Mesh, P2Nodes};
