@@ -213,7 +213,7 @@ pub fn field(run: &RunRecord, name: &str) -> Vec<Option<f64>> {
     run.levels.iter().map(|l| serde_json::to_value(l).ok().and_then(|v| v[name].as_f64())).collect()
 }
 
-/// A rate over the last decade of a run, and the same fit over the windows ending
+/// A rate over the last window of a run (at least [`MIN_DECADES`] decades), and the same fit over the windows ending
 /// `WINDOW_SHIFT` and 2 `WINDOW_SHIFT` levels earlier.
 #[derive(Clone, Debug)]
 pub struct RateReport {
