@@ -1,5 +1,6 @@
-//! The adaptive loop of Section 7: SOLVE -> ESTIMATE -> MARK -> REFINE, one level per turn,
-//! with an observer that sees every level (what the study runner records). The loop keeps a
+//! The adaptive loop of Section 7: SOLVE -> ESTIMATE -> MARK -> REFINE, one level per turn
+//! ([`AdaptState::step`]: the loop's state, stepped), with an observer that sees every level
+//! (what the study runner records). The loop keeps a
 //! refinement [`History`] (marks and warm starts per level) from which [`replay`] rebuilds and
 //! solves any level again, and it can start from a later level ([`run_from`], [`Start`]): how an
 //! interrupted deep run resumes.
@@ -456,35 +457,76 @@ pub fn run_from(
     reference: Option<Reference>,
     observer: &mut dyn FnMut(Level) -> ControlFlow<()>,
 ) -> Result<AdaptResult, AdaptError> {
-    config.validate()?;
-    if start.level >= config.levels {
-        return Err(AdaptError::NothingToSolve { start: start.level, levels: config.levels });
+    let mut state = AdaptState::new(start, config)?;
+    loop {
+        if let Some(termination) = state.step(problem, config, reference, observer)? {
+            return state.finish(termination, config);
+        }
     }
-    if start.level == 0 {
-        config.check_initial(start.mesh.p2_ndof() as f64, "of level 0")?;
+}
+
+/// The loop between two levels (the state of [`run_from`]): the mesh of the next level and the
+/// active set its solve starts from, the records and history of the levels solved, and the last
+/// level's mesh, solution and estimate. [`AdaptState::step`] solves one level; a caller that
+/// steps the loop itself sees each level as [`run`]'s observer does.
+pub struct AdaptState {
+    /// The level the next step solves.
+    level: usize,
+    /// The level the loop started at.
+    first: usize,
+    /// The mesh of level `level` (None once a step has ended the loop).
+    mesh: Option<Mesh>,
+    initial_active: Option<Vec<bool>>,
+    /// The record of every level solved, from level 0.
+    pub records: Vec<LevelRecord>,
+    /// The refinement history of every level in `records`.
+    pub history: History,
+    /// The last level solved: its mesh, u_h and estimate.
+    last: Option<(Mesh, DiscreteSolution, Estimate)>,
+}
+
+impl AdaptState {
+    /// The loop at `start`, its settings checked (`config` must hold for every step).
+    pub fn new(start: Start, config: &AdaptConfig) -> Result<Self, AdaptError> {
+        config.validate()?;
+        if start.level >= config.levels {
+            return Err(AdaptError::NothingToSolve { start: start.level, levels: config.levels });
+        }
+        if start.level == 0 {
+            config.check_initial(start.mesh.p2_ndof() as f64, "of level 0")?;
+        }
+        let Start { mesh, level, initial_active, records, history } = start;
+        Ok(AdaptState { level, first: level, mesh: Some(mesh), initial_active, records, history, last: None })
     }
-    let Start { mut mesh, level: first, mut initial_active, mut records, mut history } = start;
-    let mut state: Option<(Mesh, DiscreteSolution, Estimate)> = None;
-    let mut termination = AdaptTermination::LevelsReached;
-    for level in first..config.levels {
+
+    /// SOLVE, ESTIMATE and MARK the next level, show it to `observer`, REFINE its mesh into the
+    /// next one: why the loop ends after this level, or None when it goes on.
+    pub fn step(
+        &mut self,
+        problem: &dyn Problem,
+        config: &AdaptConfig,
+        reference: Option<Reference>,
+        observer: &mut dyn FnMut(Level) -> ControlFlow<()>,
+    ) -> Result<Option<AdaptTermination>, AdaptError> {
+        let level = self.level;
+        let Some(mesh) = self.mesh.take() else { return Err(AdaptError::NothingToSolve { start: level, levels: config.levels }) };
         if let Some(max) = config.max_ndof
             && level > 0
             && mesh.p2_ndof() > max
         {
-            if state.is_none() {
+            if self.last.is_none() {
                 return Err(AdaptError::BeyondMaxNdof { start: level, ndof: mesh.p2_ndof(), max });
             }
-            termination = AdaptTermination::MaxNdofReached;
-            break;
+            return Ok(Some(AdaptTermination::MaxNdofReached));
         }
         // the level before is not needed while this one solves (the loop returns it only when
         // this level is not solved): its mesh, u_h and estimate added to the peak memory (fb
         // adaptive to 2.6e6 unknowns: peak resident 4.09 -> 3.91 GB without them)
-        drop(state.take());
+        drop(self.last.take());
         let t_level = Instant::now();
-        let previous = records.last().and_then(LevelRecord::measured_peak);
+        let previous = self.records.last().and_then(LevelRecord::measured_peak);
         let measured = crate::base::memory::reset_peak_resident();
-        let started_from = initial_active.take().filter(|_| config.warm_start);
+        let started_from = self.initial_active.take().filter(|_| config.warm_start);
         let Solved { mut record, solution: sol, estimate: est, marks, caveats } =
             solve_level(problem, &mesh, level, config, reference, started_from.clone(), previous)?;
         let entry = LevelHistory {
@@ -507,7 +549,7 @@ pub fn run_from(
             record.t_refine = t0.elapsed().as_secs_f64();
             Some(refined)
         };
-        // a refined mesh whose element shapes f64 no longer resolves ends the loop before its
+        // a refined mesh whose element shapes f64 does not resolve ends the loop before its
         // level, as the memory check does, not as an error of its solve (Mesh::check)
         let far = match &next {
             Some(Ok((m, _))) => {
@@ -535,34 +577,41 @@ pub fn run_from(
             next_active: next.as_ref().and_then(|n| n.as_ref().ok()).and_then(|(_, a)| a.as_deref()),
             caveats: &caveats,
         });
-        records.push(record);
-        history.levels.push(entry);
-        state = Some((mesh, sol, est));
+        self.records.push(record);
+        self.history.levels.push(entry);
+        self.last = Some((mesh, sol, est));
         if flow.is_break() {
-            termination = AdaptTermination::StoppedByObserver;
-            break;
+            return Ok(Some(AdaptTermination::StoppedByObserver));
         }
-        if reached {
-            termination = AdaptTermination::StopNdofReached;
+        let termination = if reached {
+            AdaptTermination::StopNdofReached
         } else if next.is_none() && unmarked && level + 1 < config.levels {
-            termination = AdaptTermination::NothingMarked;
+            AdaptTermination::NothingMarked
         } else if let Some(far) = far {
-            termination = far;
+            far
         } else if over {
-            termination = AdaptTermination::MaxNdofReached;
-        }
+            AdaptTermination::MaxNdofReached
+        } else {
+            AdaptTermination::LevelsReached
+        };
         match next {
             Some(Ok((m, active))) => {
-                mesh = m;
-                initial_active = active;
+                self.mesh = Some(m);
+                self.initial_active = active;
+                self.level += 1;
+                Ok(None)
             }
-            Some(Err(error)) => return Err(AdaptError::Refine { level, error }),
-            None => break,
+            Some(Err(error)) => Err(AdaptError::Refine { level, error }),
+            None => Ok(Some(termination)),
         }
     }
-    // every way out of the loop above solved a level first (first < levels), or returned
-    let Some((mesh, solution, estimate)) = state else {
-        return Err(AdaptError::NothingToSolve { start: first, levels: config.levels });
-    };
-    Ok(AdaptResult { mesh, solution, estimate, records, history, termination })
+
+    /// The loop's result once a step has ended it with `termination`.
+    pub fn finish(self, termination: AdaptTermination, config: &AdaptConfig) -> Result<AdaptResult, AdaptError> {
+        // every way out of the loop solved a level first (first < levels), or returned an error
+        let Some((mesh, solution, estimate)) = self.last else {
+            return Err(AdaptError::NothingToSolve { start: self.first, levels: config.levels });
+        };
+        Ok(AdaptResult { mesh, solution, estimate, records: self.records, history: self.history, termination })
+    }
 }
