@@ -7,7 +7,7 @@ SCRATCH := $(or $(CARGO_TARGET_DIR),target)/test-scratch
 # each step of make test timed into target/test-steps (its last line lists them)
 TIMED := scripts/timed.sh
 
-.PHONY: all build test cluster-test figures reproduce drift crosscheck bench roundoff meshes mesh clean
+.PHONY: all build test measured cluster-test figures reproduce drift crosscheck bench roundoff meshes mesh clean
 
 all: build
 
@@ -23,9 +23,13 @@ build:
 # step fails if the run changed any file git sees.
 # The first steps only install and compile (the test binaries and the example; the dependencies as
 # clippy reads them, which `cargo check` and clippy share; the cross-check's Python environment):
-# the last line gives their time apart from the checks' own.
+# the last line gives their time apart from the checks' own. The last line starts with
+# "N passed, N failed, N skipped" over every test binary and the doc tests of the cargo test step
+# (for CI tools), then the timing; make test writes only under target/ (its numbers there are what
+# `make measured` copies into docs/measured.json).
 test: build
-	@mkdir -p target && date +%s > target/test-started && rm -f target/test-steps
+	@mkdir -p target && date +%s > target/test-started && rm -f target/test-steps target/test-summary target/test-counts target/test-finished
+	@(git rev-parse --short HEAD 2>/dev/null || echo unknown) > target/test-commit
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-before-test
 	$(TIMED) build-tests $(CARGO) build --release --locked --all-targets
 	$(TIMED) check $(CARGO) check --release --locked --all-targets
@@ -33,17 +37,31 @@ test: build
 	@date +%s > target/test-compiled
 	$(TIMED) fmt $(CARGO) fmt --all --check
 	$(TIMED) clippy $(CARGO) clippy --release --locked --all-targets -- -D warnings
-	@command -v chromium >/dev/null || command -v chromium-browser >/dev/null || command -v google-chrome >/dev/null || [ -n "$$CHROMIUM" ] || echo "NOTE: no chromium on this machine: the browser check of the study pages (tests/it/report_page.rs) is SKIPPED (apt-get install chromium; CI installs it)"
+	@scripts/chromium.sh >/dev/null || echo "NOTE: no chromium on this machine: the browser check of the study pages (tests/it/report_page.rs) is SKIPPED, and counted as skipped (apt-get install chromium; CI installs it)"
 	@# the tests' scratch folders (std::env::temp_dir) under target/, emptied first, not left in /tmp
 	@rm -rf $(SCRATCH) && mkdir -p $(SCRATCH)
-	TMPDIR=$(abspath $(SCRATCH)) $(TIMED) cargo-test $(CARGO) test --release --locked
+	@# cargo's output as it prints it, kept in target/cargo-test.log; without chromium the browser test
+	@# is skipped by name; target/test-summary gets "N passed, N failed, N skipped" over every test
+	@# binary and the doc tests (scripts/test-summary.sh), printed again as make test's last line
+	TMPDIR=$(abspath $(SCRATCH)) $(TIMED) cargo-test scripts/cargo-test.sh $(CARGO) test --release --locked --no-fail-fast
 	$(TIMED) example $(CARGO) run --release --locked --example own_problem
 	$(TIMED) drift $(BIN) drift
 	$(TIMED) report $(BIN) report
 	SIGNORINI=$(abspath $(BIN)) CROSSCHECK_OUT=target/crosscheck-report $(TIMED) crosscheck crosscheck/run.sh
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-after-test
 	@diff target/status-before-test target/status-after-test >/dev/null || { echo "make test changed files git sees (before/after below); test outputs belong under target/"; diff target/status-before-test target/status-after-test; exit 1; }
-	@echo "make test: PASSED in $$(( $$(date +%s) - $$(cat target/test-started) )) s after make build: $$(( $$(cat target/test-compiled) - $$(cat target/test-started) )) s compiling the tests, the example and clippy's dependencies and installing the cross-check's Python environment, then $$(( $$(date +%s) - $$(cat target/test-compiled) )) s of checks (fmt, clippy, cargo test, the example, drift: none, study pages, NGSolve cross-check; the tree unchanged). Seconds per step: $$(tr '\n' ' ' < target/test-steps)"
+	@date +%s > target/test-finished
+	@echo "$$(cat target/test-summary); make test: PASSED in $$(( $$(cat target/test-finished) - $$(cat target/test-started) )) s after make build: $$(( $$(cat target/test-compiled) - $$(cat target/test-started) )) s compiling the tests, the example and clippy's dependencies and installing the cross-check's Python environment, then $$(( $$(cat target/test-finished) - $$(cat target/test-compiled) )) s of checks (fmt, clippy, cargo test, the example, drift: none, study pages, NGSolve cross-check; the tree unchanged). Seconds per step: $$(tr '\n' ' ' < target/test-steps)"
+
+# Copy the numbers of the last make test (what it left in target/) and of its /usr/bin/time -v log
+# into docs/measured.json and docs/measured.md, deliberately (make test itself writes only under
+# target/). On a fresh clone: `mkdir -p target && /usr/bin/time -v -o target/time.txt .ci/run`, then
+# `make measured TIME_LOG=target/time.txt LOAD="nearly idle"` (idle, nearly idle or under load;
+# BUILD_TIME_LOG=F adds make build's time from `/usr/bin/time -v -o F make build`, run first);
+# commit both files, and update the quotes that tests/it/measured_numbers.rs then names.
+measured:
+	@test -n "$(TIME_LOG)" && test -n "$(LOAD)" || { echo 'usage: make measured TIME_LOG=target/time.txt LOAD="idle|nearly idle|under load"'; exit 2; }
+	scripts/measured.py test --time-log $(TIME_LOG) --load "$(LOAD)" $(if $(BUILD_TIME_LOG),--build-time-log $(BUILD_TIME_LOG))
 
 # A one-node Slurm cluster on this machine (as root; installs slurm-wlm and munge with apt-get
 # if missing), a study submitted as an array of shards, a task cancelled mid-run, two arrays at

@@ -62,6 +62,7 @@ mod hertz;
 mod kkt;
 mod layers;
 mod manifest;
+mod measured_numbers;
 mod parsers;
 mod problem_file_forms;
 mod problem_files;
