@@ -560,7 +560,7 @@ fn targets(phases: &[SizeResult], rates: &[FactorRate], cold: &[ColdSize], scale
 /// The targets' table, printed.
 fn print_targets(t: &[Target]) {
     let opt = |v: Option<f64>, p: usize| v.map_or("-".to_string(), |v| format!("{v:.p$}"));
-    println!("\ntargets (issues 15 and 25; our cold contact solve against NGSolve's cold linear solve, fresh processes, medians):");
+    println!("\ntargets (our cold contact solve against NGSolve's cold linear solve, fresh processes, medians):");
     println!("{:<60} {:>8} {:>10} {:>10} {:>7}  {:<15} {:<8} note", "target", "N", "ours", "reference", "value", "goal", "met");
     for r in t {
         println!(

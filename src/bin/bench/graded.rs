@@ -143,7 +143,7 @@ fn cases(o: &Options) -> Vec<String> {
 pub fn section(o: &Options) -> Result<()> {
     let exe = std::env::current_exe()?;
     println!(
-        "\ngraded meshes (issue 42): levels nearest {:.2e} NDF of {DEEP}, rebuilt from their stored histories, beside the grid; one process each:",
+        "\ngraded meshes: levels nearest {:.2e} NDF of {DEEP}, rebuilt from their stored histories, beside the grid; one process each:",
         o.ndof
     );
     let mut out: Vec<Case> = Vec::new();
