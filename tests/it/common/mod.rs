@@ -196,3 +196,106 @@ pub fn copy_tree(from: &std::path::Path, to: &std::path::Path) {
         }
     }
 }
+
+/// The text of `tests/fixtures/BASE` with each `from` replaced by its `to` (each must be there).
+pub fn edited(base: &str, edits: &[(&str, &str)]) -> String {
+    let mut text = fixture(base);
+    for (from, to) in edits {
+        assert!(text.contains(from), "{from} not in {base}");
+        text = text.replace(from, to);
+    }
+    text
+}
+
+/// `signorini ARGS` in a fresh folder holding `v.toml` (fixture `base` with `edits`, see
+/// [`edited`]), `qd.msh` (the quarter disc) and `sq.msh` (the Gmsh square), removed afterwards:
+/// (exit code, stdout, stderr), never a panic or a signal.
+pub fn run_edited(name: &str, base: &str, edits: &[(&str, &str)], args: &[&str]) -> (i32, String, String) {
+    let dir = scratch(&format!("edited-{name}"));
+    std::fs::write(dir.join("v.toml"), edited(base, edits)).unwrap();
+    std::fs::write(dir.join("qd.msh"), fixture("gmsh_renumbered/plain.msh")).unwrap();
+    std::fs::write(dir.join("sq.msh"), fixture("square.msh")).unwrap();
+    let answer = signorini_in(&dir, args);
+    std::fs::remove_dir_all(&dir).ok();
+    answer
+}
+
+/// `signorini ARGS` in `dir` without progress lines: (exit code, stdout followed by stderr),
+/// never a panic.
+pub fn output_in(dir: &std::path::Path, args: &[&str]) -> (i32, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(dir)
+        .env("SIGNORINI_PROGRESS", "off")
+        .args(args)
+        .output()
+        .unwrap();
+    let all = String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert!(!all.contains("panicked"), "{all}");
+    (o.status.code().unwrap_or(-1), all)
+}
+
+/// `signorini solve` of the Gmsh square's problem (fixture `bad_data_gmsh.toml` with `edits`)
+/// on `tests/fixtures/square.msh` with `mesh_edits` (each replaced once): (exit code, stdout and
+/// stderr).
+pub fn solve_gmsh_square(name: &str, edits: &[(&str, &str)], mesh_edits: &[(&str, &str)]) -> (i32, String) {
+    let dir = scratch(&format!("gmsh-square-{name}"));
+    for (file, fixture_name, edits) in [("v.toml", "bad_data_gmsh.toml", edits), ("sq.msh", "square.msh", mesh_edits)] {
+        let mut text = fixture(fixture_name);
+        for (from, to) in edits {
+            assert!(text.contains(from), "{from} not in {fixture_name}");
+            text = text.replacen(from, to, 1);
+        }
+        std::fs::write(dir.join(file), text).unwrap();
+    }
+    let out = output_in(&dir, &["solve", "--problem", "v.toml", "--mesh", "gmsh:sq.msh"]);
+    std::fs::remove_dir_all(&dir).ok();
+    out
+}
+
+/// `signorini ARGS` run in the repository's root: (exit code, stdout, stderr), as [`signorini_in`].
+pub fn signorini_in_repo(args: &[&str]) -> (i32, String, String) {
+    signorini_in(std::path::Path::new(env!("CARGO_MANIFEST_DIR")), args)
+}
+
+/// The path of `tests/fixtures/NAME`, as a string for an argument list.
+pub fn fixture_path(name: &str) -> String {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(name).display().to_string()
+}
+
+/// `signorini ARGS` in `dir` without progress lines, killed after 20 s (a hang is a failure, not
+/// a wait): (exit code, stdout, stderr); never a panic or a signal.
+pub fn signorini_in_time(dir: &std::path::Path, args: &[&str]) -> (i32, String, String) {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(dir)
+        .args(args)
+        .env("SIGNORINI_PROGRESS", "off")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(20) {
+            child.kill().unwrap();
+            panic!("signorini {args:?} hung (killed after 20 s)");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let o = child.wait_with_output().unwrap();
+    let (out, err) = (String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned());
+    assert!(!err.contains("panicked"), "{err}");
+    (o.status.code().unwrap_or_else(|| panic!("killed by a signal: {err}")), out, err)
+}
+
+/// Write a study `NAME.toml` in `dir` of ex71 on structured:2 with one run `id` (2 levels, quick
+/// form 1) and `extra` appended; its file name.
+pub fn one_run_manifest(dir: &std::path::Path, name: &str, id: &str, extra: &str) -> String {
+    let file = format!("{name}.toml");
+    let text = format!(
+        "description = \"t\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:2\"\nlevels = 2\nquick_levels = 1\n[[run]]\nid = \"{id}\"\n{extra}"
+    );
+    std::fs::write(dir.join(&file), text).unwrap();
+    file
+}
