@@ -2,7 +2,7 @@
 //! verdict, readers given `--wait` wait for the writer through all its runs, and two drift checks
 //! in one checkout take turns.
 
-use crate::common::{scratch, signorini_in, stored_study};
+use crate::common::{finish, scratch, signorini_in, stored_study};
 use std::process::{Command, Stdio};
 
 /// A study of one run that takes a few seconds (Example 7.1, 19 adaptive levels from
@@ -126,11 +126,6 @@ fn drift(dir: &std::path::Path) -> std::process::Child {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap()
-}
-
-fn finish(child: std::process::Child) -> (i32, String) {
-    let o = child.wait_with_output().unwrap();
-    (o.status.code().unwrap_or(-1), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
 }
 
 #[test]

@@ -5,7 +5,7 @@
 //! every group.
 
 use crate::common::msh::{grid, msh};
-use crate::common::{fixture, scratch, signorini_in};
+use crate::common::{fixture, level_rows, scratch, signorini_in};
 
 fn repo(path: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path)
@@ -363,11 +363,6 @@ fn ex72_with(dir: &std::path::Path, name: &str, key: &str, line: &str) -> String
     file
 }
 
-/// Level rows of `adapt`'s table.
-fn rows(out: &str) -> usize {
-    out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).count()
-}
-
 #[test]
 fn contact_data_on_a_stretch_between_nodes_is_refused_on_every_mesh_before_level_0() {
     let dir = scratch("contact-data-bands");
@@ -389,7 +384,7 @@ fn contact_data_on_a_stretch_between_nodes_is_refused_on_every_mesh_before_level
         }
         let (code, out, err) = signorini_in(&dir, &["adapt", "--problem", &file, "--mesh", "structured:4", "--levels", "6"]);
         assert_ne!(code, 0, "{name}: {out}");
-        assert_eq!(rows(&out), 0, "{name}: refused before level 0: {out}");
+        assert_eq!(level_rows(&out), 0, "{name}: refused before level 0: {out}");
         assert!(err.contains(says), "{name}: {err}");
     }
     // the same file without the band passes (the check refuses the band, not the problem)

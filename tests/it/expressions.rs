@@ -2,10 +2,10 @@
 //! before a power, chains of powers, products without a star, `log`), every listed function is
 //! accepted, two-argument calls nest, nesting is bounded, whitespace separates.
 
-use crate::common::{fixture, run_edited, scratch, signorini_in};
-use signorini::problems::{FileProblem, Problem};
+use crate::common::{estimator_line, fixture, parse_problem, run_edited, scratch, signorini_in};
+use signorini::problems::Problem;
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 const SQUARE: &str = "bad_data_square.toml";
 
@@ -89,15 +89,10 @@ fn deep_nesting_is_refused_at_once_with_its_reason() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The problem text parsed, or its error's message.
-fn parse(text: &str) -> Result<FileProblem, String> {
-    FileProblem::parse(Path::new("p.toml"), text).map_err(|e| e.to_string())
-}
-
 /// chi = `expr` of the square problem, evaluated at `x`.
 fn chi(expr: &str, x: [f64; 2]) -> f64 {
     let text = fixture(SQUARE).replace(CHI, &format!("chi = \"{expr}\""));
-    parse(&text).unwrap_or_else(|e| panic!("{expr}: {e}")).gap(x)
+    parse_problem(&text).unwrap_or_else(|e| panic!("{expr}: {e}")).gap(x)
 }
 
 #[test]
@@ -133,7 +128,7 @@ fn two_argument_calls_nest_in_either_argument_with_the_right_value() {
     }
     // a constant defined by a nested call of another, declared after it
     let text = fixture(SQUARE).replace(CHI, "chi = \"s*x\"") + "\n[constants]\ns = \"min(1, max(0, a))\"\na = 0.4\n";
-    let got = parse(&text).unwrap_or_else(|e| panic!("{e}")).gap([x, y]);
+    let got = parse_problem(&text).unwrap_or_else(|e| panic!("{e}")).gap([x, y]);
     assert!((got - 0.4 * 0.3).abs() < 1e-16, "{got}");
 }
 
@@ -227,11 +222,6 @@ mod nestings {
             prop_assert!(got == want || (got - want).abs() <= 1e-13 * want.abs().max(1.0), "{}: {} against {}", text, got, want);
         }
     }
-}
-
-/// The `estimator:` line of a solve's output.
-fn estimator_line(out: &str) -> String {
-    out.lines().find(|l| l.starts_with("estimator:")).unwrap_or_default().to_string()
 }
 
 #[test]

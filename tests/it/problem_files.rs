@@ -4,7 +4,7 @@
 //! the file, the key and the position.
 
 use crate::common;
-use crate::common::{fixture, scratch, signorini_in};
+use crate::common::{fixture, parse_problem, scratch, signorini_in};
 use common::*;
 use signorini::adapt::{self, AdaptConfig};
 use signorini::norms;
@@ -499,11 +499,6 @@ fn a_pair_with_a_third_value_is_refused_not_cut_to_two() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The problem text parsed, or its error's message.
-fn parse(text: &str) -> Result<FileProblem, String> {
-    FileProblem::parse(Path::new("p.toml"), text).map_err(|e| e.to_string())
-}
-
 /// The square problem with a point constraint and an exact solution added, every pair valid.
 fn with_every_pair() -> String {
     let base = fixture(SQUARE);
@@ -515,9 +510,9 @@ fn with_every_pair() -> String {
 #[test]
 fn every_pair_valued_key_refuses_a_third_value() {
     let good = with_every_pair();
-    assert!(parse(&good).is_ok(), "{:?}", parse(&good).err());
+    assert!(parse_problem(&good).is_ok(), "{:?}", parse_problem(&good).err());
     let normal = good.replace("normal = \"outward\"", "normal = [0, -1]");
-    assert!(parse(&normal).is_ok(), "{:?}", parse(&normal).err());
+    assert!(parse_problem(&normal).is_ok(), "{:?}", parse_problem(&normal).err());
     for (key, from, to) in [
         ("body_force", "body_force = [\"0\", \"-1\"]", "body_force = [\"0\", \"-1\", \"0\"]"),
         ("traction", "traction = [\"0\", \"0\"]", "traction = [\"0\", \"0\", \"0\"]"),
@@ -530,15 +525,15 @@ fn every_pair_valued_key_refuses_a_third_value() {
         ("grad", "grad = [[\"0\", \"0\"], [\"0\", \"0\"]]", "grad = [[\"0\", \"0\"], [\"0\", \"0\"], [\"0\", \"0\"]]"),
     ] {
         assert!(good.contains(from), "{from}");
-        let err = parse(&good.replace(from, to)).map(|_| ()).expect_err(to);
+        let err = parse_problem(&good.replace(from, to)).map(|_| ()).expect_err(to);
         assert!(err.contains(key) && err.contains("two"), "{to}: {err}");
     }
-    let err = parse(&normal.replace("normal = [0, -1]", "normal = [0, -1, 0]")).map(|_| ()).expect_err("normal");
+    let err = parse_problem(&normal.replace("normal = [0, -1]", "normal = [0, -1, 0]")).map(|_| ()).expect_err("normal");
     assert!(err.contains("normal") && err.contains("two"), "{err}");
     // a circle's centre (groups and a curve)
     let circle = fixture("bad_data_gmsh.toml") + "\n[curves.bottom]\ncircle = { centre = [0.5, 2], radius = 2 }\n";
-    assert!(parse(&circle).is_ok(), "{:?}", parse(&circle).err());
-    let err = parse(&circle.replace("[0.5, 2]", "[0.5, 2, 0]")).map(|_| ()).expect_err("centre");
+    assert!(parse_problem(&circle).is_ok(), "{:?}", parse_problem(&circle).err());
+    let err = parse_problem(&circle.replace("[0.5, 2]", "[0.5, 2, 0]")).map(|_| ()).expect_err("centre");
     assert!(err.contains("centre") && err.contains("two"), "{err}");
 }
 

@@ -4,7 +4,7 @@
 //! at their round-off are named; overflow and underflow are named as the data's scale.
 
 use crate::common::msh::{grid, msh};
-use crate::common::{fixture, scratch, signorini_in};
+use crate::common::{estimator_line, fixture, level_rows, scratch, signorini_in};
 use std::path::Path;
 
 fn translated(c: &str) -> String {
@@ -390,11 +390,6 @@ fn ex72_with(dir: &std::path::Path, name: &str, key: &str, line: &str) -> String
     file
 }
 
-/// Level rows of `adapt`'s table.
-fn rows(out: &str) -> usize {
-    out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).count()
-}
-
 /// A rigid translation moves max |u_h| but not the deformation the estimate measures: the loop
 /// refines as without it, and an exact rigid translation still stops at level 0. (A
 /// translation by 5e10 puts the contact forces' round-off at 0.1 of
@@ -415,7 +410,7 @@ fn a_rigid_translation_does_not_make_an_accurate_estimate_round_off() {
     assert!(err.contains("the contact forces are not resolved") && !out.contains("# stopped"), "{out}{err}");
     let (code, out, err) = shifted("1e9");
     assert_eq!(code, 0, "{err}");
-    assert_eq!(rows(&out), 3, "{out}");
+    assert_eq!(level_rows(&out), 3, "{out}");
     assert!(!out.contains("# stopped"), "{out}");
     // the estimate is the untranslated problem's
     let (code, plain, err) = signorini_in(&dir, &["adapt", "--problem", "ex72", "--mesh", "structured:4", "--levels", "1"]);
@@ -473,11 +468,6 @@ fn a_rigid_translation_of_the_data_keeps_the_contact_forces_of_eta_7() {
         assert!((eta7(e) - eta7(&seen[0])).abs() <= 1e-3 * eta7(&seen[0]), "eta_7 moved by the translation: {seen:?}");
     }
     std::fs::remove_dir_all(&dir).ok();
-}
-
-/// The `estimator:` line of a solve's output.
-fn estimator_line(out: &str) -> String {
-    out.lines().find(|l| l.starts_with("estimator:")).unwrap_or_default().to_string()
 }
 
 #[test]

@@ -4,21 +4,13 @@
 //! what needs it; a role declared twice in a study is refused; the repository's manifests declare
 //! every role needed; and a role is not part of what the provenance hashes.
 
-use crate::common::{parse_err, scratch, signorini_in};
+use crate::common::{copy_dir, parse_err, scratch, signorini_in};
 use signorini::analysis::roles::{self, NEEDED};
 use signorini::study::manifest::{self, Manifest};
 use std::path::{Path, PathBuf};
 
 fn repo() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap().flatten() {
-        let target = to.join(e.file_name());
-        if e.path().is_dir() { copy_dir(&e.path(), &target) } else { std::fs::copy(e.path(), target).map(|_| ()).unwrap() }
-    }
 }
 
 /// A scratch copy of `experiments/` with `ex71.toml`'s run `adaptive` renamed and its role

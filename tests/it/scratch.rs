@@ -3,21 +3,13 @@
 //! --study S`) without touching the tracked tree or `make test`'s drift report; a comparison
 //! with nothing to compare, or with records made from an edited manifest, says so.
 
-use crate::common::scratch;
 use crate::common::signorini_in;
+use crate::common::{copy_dir, scratch};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 fn repo() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap().flatten() {
-        let target = to.join(e.file_name());
-        if e.path().is_dir() { copy_dir(&e.path(), &target) } else { std::fs::copy(e.path(), target).map(|_| ()).unwrap() }
-    }
 }
 
 /// Every file under `dir` with its contents' hash, sorted by path.

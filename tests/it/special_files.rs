@@ -2,7 +2,7 @@
 //! expected (a manifest, problem, mesh, record, snapshot, summary or lock), or a file where a folder
 //! must be, is refused naming it, at once and without reading it; no write replaces one.
 
-use crate::common::{fixture, one_run_manifest, scratch, signorini_in, signorini_in_time, stored_study};
+use crate::common::{fixture, one_run_manifest, scratch, signorini_in, signorini_in_time, stored_study, stored_two_runs};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -64,20 +64,6 @@ fn a_lock_folder_that_is_a_file_is_named_also_when_every_run_is_finished() {
         assert!(err.contains(".locks is a regular file, not a folder: move it away"), "{args:?}: {err}");
     }
     std::fs::remove_dir_all(&dir).ok();
-}
-
-/// A stored study of two runs, one adaptive, one uniform.
-const TWO_RUNS: &str = "description = \"s\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\ntheta = 0.5\nlevels = 4\nquick_levels = 2\n[[run]]\nid = \"a\"\nrefine = \"adaptive\"\n[[run]]\nid = \"c\"\nrefine = \"uniform\"\n";
-
-fn stored_two_runs(name: &str) -> std::path::PathBuf {
-    let dir = scratch(name);
-    std::fs::create_dir_all(dir.join("experiments")).unwrap();
-    std::fs::write(dir.join("experiments/s.toml"), TWO_RUNS).unwrap();
-    for results in ["res", "fresh"] {
-        let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", results]);
-        assert_eq!(code, 0, "{out}{err}");
-    }
-    dir
 }
 
 #[test]

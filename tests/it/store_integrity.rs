@@ -3,7 +3,7 @@
 //! Each test names the behaviour the store promises (docs/command-line.md, "What the store
 //! owns, and what an interrupt leaves") in a case built to break it.
 
-use crate::common::{scratch, signorini_in, stored_study};
+use crate::common::{finish, scratch, signorini_in, stored_study, stored_two_runs};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -274,20 +274,6 @@ fn figures_wait_ends_when_the_writer_it_waits_for_has_exited_even_before_its_par
     assert!(writer.wait().unwrap().success());
     assert!(ended.is_some(), "report --wait still waited 60 s after its writer ended: {}", String::from_utf8_lossy(&out.stderr));
     std::fs::remove_dir_all(&dir).ok();
-}
-
-/// A stored study of two runs, one adaptive, one uniform.
-const TWO_RUNS: &str = "description = \"s\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\ntheta = 0.5\nlevels = 4\nquick_levels = 2\n[[run]]\nid = \"a\"\nrefine = \"adaptive\"\n[[run]]\nid = \"c\"\nrefine = \"uniform\"\n";
-
-fn stored_two_runs(name: &str) -> std::path::PathBuf {
-    let dir = scratch(name);
-    std::fs::create_dir_all(dir.join("experiments")).unwrap();
-    std::fs::write(dir.join("experiments/s.toml"), TWO_RUNS).unwrap();
-    for results in ["res", "fresh"] {
-        let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", results]);
-        assert_eq!(code, 0, "{out}{err}");
-    }
-    dir
 }
 
 #[test]
@@ -788,11 +774,6 @@ fn spawn(dir: &Path, args: &[&str]) -> std::process::Child {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap()
-}
-
-fn finish(child: std::process::Child) -> (i32, String) {
-    let o = child.wait_with_output().unwrap();
-    (o.status.code().unwrap_or(-1), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
 }
 
 /// Wait until run a's checkpoint exists: its process holds the run's lock and computes it.

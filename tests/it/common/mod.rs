@@ -299,3 +299,48 @@ pub fn one_run_manifest(dir: &std::path::Path, name: &str, id: &str, extra: &str
     std::fs::write(dir.join(&file), text).unwrap();
     file
 }
+
+/// Copy the folder `from` to `to` (made), following symlinks.
+pub fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let target = to.join(e.file_name());
+        if e.path().is_dir() { copy_dir(&e.path(), &target) } else { std::fs::copy(e.path(), target).map(|_| ()).unwrap() }
+    }
+}
+
+/// The `estimator:` line of a solve's output.
+pub fn estimator_line(out: &str) -> String {
+    out.lines().find(|l| l.starts_with("estimator:")).unwrap_or_default().to_string()
+}
+
+/// Wait for `child` (its output piped): (exit code, stdout followed by stderr).
+pub fn finish(child: std::process::Child) -> (i32, String) {
+    let o = child.wait_with_output().unwrap();
+    (o.status.code().unwrap_or(-1), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
+}
+
+/// The problem text parsed, or its error's message.
+pub fn parse_problem(text: &str) -> Result<signorini::problems::FileProblem, String> {
+    signorini::problems::FileProblem::parse(std::path::Path::new("p.toml"), text).map_err(|e| e.to_string())
+}
+
+/// Level rows of `adapt`'s table.
+pub fn level_rows(out: &str) -> usize {
+    out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).count()
+}
+
+/// A scratch folder with the study of two runs ([`TWO_RUNS`]) stored into `res` and `fresh`.
+pub fn stored_two_runs(name: &str) -> std::path::PathBuf {
+    let dir = scratch(name);
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    std::fs::write(dir.join("experiments/s.toml"), TWO_RUNS).unwrap();
+    for results in ["res", "fresh"] {
+        let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", results]);
+        assert_eq!(code, 0, "{out}{err}");
+    }
+    dir
+}
+
+/// A stored study of two runs, one adaptive, one uniform.
+const TWO_RUNS: &str = "description = \"s\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\ntheta = 0.5\nlevels = 4\nquick_levels = 2\n[[run]]\nid = \"a\"\nrefine = \"adaptive\"\n[[run]]\nid = \"c\"\nrefine = \"uniform\"\n";
