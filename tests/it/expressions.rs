@@ -50,7 +50,7 @@ fn a_chain_of_powers_is_refused_not_read_left_to_right() {
         }
     }
     for chi in ["0.0001*2^(3^2)", "0.0001*(2^3)^2", "0.001 + x^2*y^2", "0.001 + 2^x - y^2", "0.001 + (x^2)^2"] {
-        let (code, out, err) = run_edited("power-ok", SQUARE, &[(CHI, &format!("chi = {chi:?}"))], SOLVE_SQ);
+        let (code, out, err) = run_edited("chained-power-ok", SQUARE, &[(CHI, &format!("chi = {chi:?}"))], SOLVE_SQ);
         assert!(code == 0 && out.contains("certified:") || err.contains("overlap the body"), "{chi}: {err}");
         assert!(!err.contains("without parentheses"), "{chi}: {err}");
     }
