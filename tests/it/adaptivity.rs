@@ -393,7 +393,7 @@ fn ex71_observed_rates() {
         }
     }
     assert!(failures.is_empty(), "rates changed:\n{}", failures.join("\n"));
-    // Frozen finding: adaptive refinement driven by eta_5 as written is worse than uniform
+    // Frozen measurement: adaptive refinement driven by eta_5 as written is worse than uniform
     // refinement. Measured: adaptive NDF 46070, error 8.16e-6; uniform NDF 33282, error 3.01e-6.
     let (uniform, adaptive) = (&histories[0], &histories[2]);
     let (n_a, e_a) = (adaptive.last().unwrap().0, adaptive.last().unwrap().1[6]);

@@ -274,3 +274,16 @@ fn a_verdict_that_depends_on_the_parity_of_levels_is_fragile() {
     let parity = c.iter().find(|r| r.id == "parity").expect("the row parity");
     assert!(parity.summary.headline.starts_with(&format!("{flips} of ")), "{}", parity.summary.headline);
 }
+
+#[test]
+fn the_c0_row_names_the_runs_it_leaves_out() {
+    let claims = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/results/CLAIMS.md")).unwrap();
+    // the row's claim and measured lines
+    let at = claims.find("in all experiments with repaired").expect("row c0 (repaired), where the l_h = 1 runs are");
+    let row = claims[at..].lines().take_while(|l| !l.starts_with("**Verdict")).collect::<Vec<_>>().join("\n");
+    assert!(row.contains("whose eta_h carries the paper's log factor l_h (6.3)"), "{row}");
+    assert!(row.contains("Left out, with another l_h:"), "{row}");
+    // the estimator repair's l_h = 1 runs have an error and another eta_h: named, not counted
+    assert!(row.contains("estimator_repair/ex71_adaptive_l1 (log_factor one)"), "{row}");
+    assert!(!row.contains("estimator_repair/ex71_adaptive_l1: estimate/error"), "{row}");
+}

@@ -1,9 +1,11 @@
 //! The checks that an exact solution a problem file declares is one (crates/numerics/src/contact/consistent/)
-//! look at every point where the data enter the discrete problem, on curved parts too (battery
-//! 6, findings 1 and 3): tension on a contact arc was certified, because edges on a `[curves]`
-//! circle were left out; a bump in the Dirichlet data or the body force between the sampled
-//! points passed on some meshes and was refused on others, or at level 15 of an adaptive run.
+//! look at every point where the data enter the discrete problem, on curved parts too: tension on
+//! a contact arc is refused, edges on a `[curves]` circle included; a bump in the Dirichlet data
+//! or the body force between the sampled points is refused on every mesh and before the first
+//! level of an adaptive run. A stress-free exact solution with round-off in its gradient, and one
+//! large against its variation, are accepted.
 
+use crate::common::{scratch, signorini_in};
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -121,12 +123,11 @@ fn a_body_force_bump_between_sampled_points_is_refused_on_every_mesh() {
     assert!(!out.lines().any(|l| l.trim_start().starts_with("1 ")), "no level is computed before the refusal: {out}");
 }
 
-/// Battery 7, finding 4: `exact.grad` written by hand with an extra 0.5 b(y) in its diagonal,
-/// b a band of half-width 0.01 around y = 0.5 whose sigma is divergence-free (the body force
-/// check cannot see it), changes the traction `"exact"` on the sides x = 0 and x = 1. It was
-/// certified on structured:4 to 32 (no sampled centroid in the band) with the error stuck at
-/// 2e-2: the gradient is now checked where the traction reads it, and refused on every mesh;
-/// the correct gradient written by hand passes.
+/// `exact.grad` written by hand with an extra 0.5 b(y) in its diagonal, b a band of half-width
+/// 0.01 around y = 0.5 whose sigma is divergence-free (the body force check cannot see it),
+/// changes the traction `"exact"` on the sides x = 0 and x = 1, between the sampled centroids of
+/// structured:4 to 32: the gradient is checked where the traction reads it, and refused on every
+/// mesh; the correct gradient written by hand passes.
 #[test]
 fn a_hand_written_gradient_wrong_where_the_traction_reads_it_is_refused_on_every_mesh() {
     let u = r#"u = ["y^2*(y - 1)", "exp(y)*(1 - y)*y*(x - 2)"]"#;
@@ -152,7 +153,7 @@ grad = [["0{extra}", "3*y^2 - 2*y"], ["exp(y)*(1 - y)*y", "(x - 2)*exp(y)*(1 - y
 
 /// Example 7.1 with a dip of depth 0.01 and half-width `w` at x = `x0` on the contact edge
 /// y = 0: u_2 -= 0.01 b^3 / w^6, b = (w^2 - (x - x0)^2 - y^2)_+, with the body force and the
-/// gradient changed to match (battery 7's repro/dip.py), so only the contact condition breaks:
+/// gradient changed to match, so only the contact condition breaks:
 /// u . n = -u_2 = 0.01 > chi = 0 at x0.
 fn dip(x0: f64, w: f64) -> String {
     let a = -0.01 / w.powi(6);
@@ -179,8 +180,7 @@ grad = [["0", "3*y^2 - 2*y"], ["exp(y)*(1 - y)*y + ({a:?})*(0 - 6*(x - {x0:?})*{
     )
 }
 
-/// Battery 7, finding 5: a dip 0.008 wide through the obstacle between the contact nodes was
-/// certified on structured:4 and 8 and refused on 16 (and by `adapt` at its fifth level): the
+/// A dip 0.008 wide through the obstacle between the contact nodes of structured:4 and 8: the
 /// contact conditions are checked at a density tied to the body, not the mesh, so it is refused
 /// on every mesh, and by `adapt` before its first level.
 #[test]
@@ -197,4 +197,63 @@ fn an_exact_solution_through_the_obstacle_between_contact_nodes_is_refused_on_ev
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("the exact solution does not satisfy") && err.contains("on Gamma_C"), "{err}");
     assert!(!out.lines().any(|l| l.trim_start().starts_with("1 ")), "no level is computed before the refusal: {out}");
+}
+
+/// A stress-free exact solution (a rigid motion written with identities, its tractions
+/// round-off such as 2e-19) is accepted: the tractions are judged against a stress scale no less
+/// than the one the size of u and grad u implies; a real traction mismatch is still refused.
+#[test]
+fn a_stress_free_exact_solution_with_round_off_in_its_gradient_is_accepted() {
+    let dir = scratch("consistent-exact-rigid");
+    let text = "dirichlet = \"exact\"\ntraction = TRACTION\n[material]\nmu = 1\nlambda = 1\n[parts]\ncontact = \"y < 1e-12\"\ndirichlet = \"x < 1e-12\"\n[contact]\nnormal = \"outward\"\nchi = 1\n[exact]\nu = U\n";
+    for u in
+        ["[\"0.01 - 0.001*y*(sin(x)^2 + cos(x)^2)\", \"0.001*log10(10^x)\"]", "[\"0.01*(cosh(x)^2 - sinh(x)^2) - 0.001*y\", \"0.001*x\"]"]
+    {
+        std::fs::write(dir.join("p.toml"), text.replace("TRACTION", "\"exact\"").replace("U", u)).unwrap();
+        let (code, _, err) = signorini_in(&dir, &["solve", "--problem", "p.toml", "--mesh", "structured:4"]);
+        assert_eq!(code, 0, "{u}: {err}");
+    }
+    // a traction 1e-7 where sigma(u) n = 0: refused
+    let u = "[\"0.01 - 0.001*y\", \"0.001*x\"]";
+    std::fs::write(dir.join("p.toml"), text.replace("TRACTION", "[0, \"1e-7\"]").replace("U", u)).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["solve", "--problem", "p.toml", "--mesh", "structured:4"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("the traction on Gamma_N"), "{err}");
+}
+
+const LARGE_AGAINST_ITS_VARIATION: &str = r#"description = "a displacement large against its variation"
+body_force = [0, 0]
+traction = "exact"
+dirichlet = "exact"
+[material]
+mu = 1
+lambda = 1
+[parts]
+contact = "y < 1e-12"
+dirichlet = "y > 1 - 1e-12"
+[contact]
+normal = "outward"
+chi = 0
+[exact]
+u = ["0.5 - 1e-9*x", "0"]
+"#;
+
+#[test]
+fn an_exact_solution_large_against_its_variation_is_accepted_and_a_wrong_gradient_still_refused() {
+    let dir = scratch("consistent-exact-exact-solution-large");
+    std::fs::write(dir.join("s3.toml"), LARGE_AGAINST_ITS_VARIATION).unwrap();
+    for mesh in ["structured:4", "structured:8", "structured:32"] {
+        let (code, out, err) = signorini_in(&dir, &["solve", "--problem", "s3.toml", "--mesh", mesh]);
+        assert_eq!(code, 0, "{mesh}: {err}");
+        assert!(out.contains("error Linf"), "{out}");
+    }
+    // the same file with a gradient written wrong by a factor of 3 (well above what the
+    // differences resolve) is refused, blaming the written entry
+    let wrong = LARGE_AGAINST_ITS_VARIATION
+        .replace("u = [\"0.5 - 1e-9*x\", \"0\"]", "u = [\"0.5 - 1e-9*x\", \"0\"]\ngrad = [[\"-3e-9\", \"0\"], [\"0\", \"0\"]]");
+    std::fs::write(dir.join("wrong.toml"), wrong).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["solve", "--problem", "wrong.toml", "--mesh", "structured:8"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("gradient contradicts its displacement") && err.contains("`exact.grad[0][0]`"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -19,6 +19,7 @@
 //! Progress lines are switched off (`SIGNORINI_PROGRESS=off`): a step slower than 10 s prints
 //! one, so whether they appear depends on the machine's speed, not on the command.
 
+use crate::common::copy_dir;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -93,14 +94,6 @@ fn output_matches(expected: &[String], printed: &[&str]) -> bool {
         None => printed.is_empty(),
         Some((e, rest)) if e == "..." => (0..=printed.len()).any(|skip| output_matches(rest, &printed[skip..])),
         Some((e, rest)) => printed.first().is_some_and(|p| line_matches(e, p.trim_end()) && output_matches(rest, &printed[1..])),
-    }
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap().flatten() {
-        let target = to.join(e.file_name());
-        if e.path().is_dir() { copy_dir(&e.path(), &target) } else { std::fs::copy(e.path(), target).map(|_| ()).unwrap() }
     }
 }
 

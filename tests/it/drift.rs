@@ -1,5 +1,6 @@
 //! The drift check reports what moved, with the right row, and passes an unperturbed copy.
 
+use crate::common::{output_in, scratch, signorini_in, stored_study};
 use signorini::records::{RunRecord, StudyDir};
 use signorini::study::drift::{DECADES, ORDER_OF_MAGNITUDE, compare_study, observed_rate};
 use signorini::study::manifest::Manifest;
@@ -380,4 +381,298 @@ fn roundoff_floor_is_compared_by_its_order_of_magnitude() {
         let visible = stored[0].levels[level].roundoff_floor * 20.0 > 1e-3 * scale;
         assert_eq!(caught, visible, "level {level}: factor 20 ({rows:?})");
     }
+}
+
+const TWO_SHORT_RUNS: &str = r#"description = "two short runs"
+[defaults]
+problem = "ex71"
+mesh = "structured:4"
+levels = 3
+save_levels = [1]
+[[run]]
+id = "a"
+[[run]]
+id = "b"
+theta = 0.3
+"#;
+
+fn checkpoint_levels(file: &std::path::Path) -> usize {
+    let Ok(text) = std::fs::read_to_string(file) else { return 0 };
+    serde_json::from_str::<serde_json::Value>(&text).ok().and_then(|v| v["levels"].as_array().map(|l| l.len())).unwrap_or(0)
+}
+
+const LONG: &str = r#"description = "one run long enough to be stopped"
+[defaults]
+problem = "ex71"
+mesh = "structured:4"
+theta = 0.5
+[[run]]
+id = "long"
+levels = 22
+"#;
+
+/// The text of the Drift section of a study page.
+fn drift_section(page: &std::path::Path) -> String {
+    let html = std::fs::read_to_string(page).unwrap();
+    let start = html.find("<h2>Drift</h2>").unwrap_or_else(|| panic!("{html}"));
+    html[start..].split("<h2>Claims").next().unwrap().to_string()
+}
+
+#[test]
+fn the_page_quotes_a_drift_report_only_for_the_records_it_compared() {
+    let dir = scratch("drift-page-quotes-drift");
+    stored_study(&dir, "exp/st.toml", TWO_SHORT_RUNS, "x");
+    // a copy of the folder compared with it (the folder with itself is no check)
+    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "y"]);
+    assert_eq!(code, 0, "{err}");
+    let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "exp", "--against", "y", "--results", "x"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("y/drift-report.json")).unwrap()).unwrap();
+    let hashes = &report["studies"][0]["records"];
+    assert_eq!(hashes["a"].as_str().map(str::len), Some(64), "{report}");
+    // both sides' records, each by its own hash (two runs differ in their timings)
+    assert_eq!(report["studies"][0]["against_records"]["a"].as_str().map(str::len), Some(64), "{report}");
+    let page = dir.join("y/report/st.html");
+    let (code, _, err) = signorini_in(&dir, &["report", "--experiments", "exp", "--results", "y"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(drift_section(&page).contains("<b>no drift</b>"), "{}", drift_section(&page));
+    // run b again with other levels: the report did not see the record now shown
+    std::fs::write(dir.join("exp/st.toml"), TWO_SHORT_RUNS.replace("theta = 0.3", "theta = 0.3\nlevels = 4")).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "y", "--replace"]);
+    assert_eq!(code, 0, "{err}");
+    let (code, _, err) = signorini_in(&dir, &["report", "--experiments", "exp", "--results", "y"]);
+    assert_eq!(code, 0, "{err}");
+    let section = drift_section(&page);
+    assert!(!section.contains("no drift"), "{section}");
+    assert!(section.contains("not checked: the drift report of") && section.contains("run(s) b changed since"), "{section}");
+    // a report without hashes (an older harness) speaks for no records
+    let mut old = report.clone();
+    old["studies"][0].as_object_mut().unwrap().retain(|k, _| !k.ends_with("records"));
+    std::fs::write(dir.join("y/drift-report.json"), serde_json::to_string_pretty(&old).unwrap()).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["report", "--experiments", "exp", "--results", "y"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(drift_section(&page).contains("records no hashes"), "{}", drift_section(&page));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn drift_advises_drift_when_interrupted_or_refused_by_a_lock() {
+    let dir = scratch("drift-drift-advice");
+    stored_study(&dir, "exp/long.toml", LONG, "res");
+    // M4: a run of the study holds its lock (here: this test, through the library)
+    let store = signorini::study::store::Store::new(&dir.join("res"), "long");
+    let held = store.lock_run("long", false).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "exp", "--results", "res", "--accept", "long"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(err.contains("drift --accept long: run long of") && err.contains("then run `signorini drift --accept long` again"), "{err}");
+    assert!(!err.contains("--wait") && !err.contains("--fresh"), "{err}");
+    drop(held);
+    // M3: SIGINT while drift reruns the study into its scratch folder
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["drift", "--experiments", "exp", "--results", "res", "--report", "d.json"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while checkpoint_levels(&dir.join("target/drift/full/long/.partial/long.json")) < 2 {
+        assert!(started.elapsed().as_secs() < 120, "drift never started its rerun");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) }, 0);
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(err.contains("drift: interrupted while rerunning long into its scratch folder target/drift/full"), "{err}");
+    assert!(err.contains("Run the same `signorini drift` again") && !err.contains("Resume with"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn drift_against_the_stored_folder_itself_says_so_and_the_page_does_not_quote_it() {
+    let dir = scratch("drift-self");
+    stored_study(
+        &dir,
+        "exp/st.toml",
+        "description = \"two levels of Example 7.2\"\n[defaults]\nproblem = \"ex72\"\nmesh = \"structured:4\"\n[[run]]\nid = \"a\"\nlevels = 2\n",
+        "x",
+    );
+    std::os::unix::fs::symlink(dir.join("x"), dir.join("link")).unwrap();
+    for against in ["x", "./x/", "link"] {
+        let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "exp", "--against", against, "--results", "x"]);
+        assert_eq!(code, 0, "{against}: {out}{err}");
+        assert!(out.contains("is the stored results folder itself") && out.contains("nothing was rerun"), "{against}: {out}");
+    }
+    let (code, _, err) = signorini_in(&dir, &["report", "--experiments", "exp", "--results", "x"]);
+    assert_eq!(code, 0, "{err}");
+    let page = std::fs::read_to_string(dir.join("x/report/st.html")).unwrap();
+    assert!(page.contains("compared this folder with itself") && !page.contains("<b>no drift</b>"), "{page}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A cut drift report makes `report` fail with more than the parser's words: the refusal says
+/// how it came about and what to do.
+#[test]
+fn a_cut_drift_report_is_refused_with_what_to_do() {
+    let dir = scratch("drift-cut-report");
+    let repo = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::write(dir.join("cut.json"), "{\"studies\": [").unwrap();
+    // from the repository (its records name their problem files relative to it)
+    let (cut, page) = (dir.join("cut.json"), dir.join("page"));
+    let args = ["report", "--study", "ex71", "--drift-report", cut.to_str().unwrap(), "--out", page.to_str().unwrap()];
+    let (code, out, err) = signorini_in(repo, &args);
+    assert_ne!(code, 0, "{out}{err}");
+    assert!(err.contains("cut.json") && err.contains("run `signorini drift` to write it again"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+const ADAPTIVE_STUDY: &str = "description = \"three adaptive levels\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\n[[run]]\nid = \"a\"\nrefine = \"adaptive\"\nlevels = 3\n";
+
+/// The Drift paragraph of a study page.
+fn drift_paragraph(page: &Path) -> String {
+    let page = std::fs::read_to_string(page).unwrap();
+    let at = page.find("<h2>Drift</h2>").expect("a Drift section");
+    page[at..].split("</p>").next().unwrap().to_string()
+}
+
+#[test]
+fn drift_against_a_copy_of_the_stored_folder_is_no_rerun() {
+    let dir = scratch("drift-copy");
+    stored_study(&dir, "exp/st.toml", ADAPTIVE_STUDY, "res");
+    let status = std::process::Command::new("cp").args(["-r", "res", "cp1"]).current_dir(&dir).status().unwrap();
+    assert!(status.success());
+    let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "exp", "--against", "cp1", "--results", "res"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(err.contains("the records of st in cp1 are byte-identical to the stored ones, timings (t_*) included"), "{err}");
+    assert!(err.contains("cp1 is a copy of the stored folder, not a rerun"), "{err}");
+    let (code, _, err) =
+        signorini_in(&dir, &["report", "--experiments", "exp", "--results", "res", "--drift-report", "cp1/drift-report.json"]);
+    assert_eq!(code, 0, "{err}");
+    let said = drift_paragraph(&dir.join("res/report/st.html"));
+    assert!(said.contains("not checked") && said.contains("a copy of this folder, not a rerun"), "{said}");
+    assert!(!said.contains("no drift") && !said.contains("rerun and compared"), "{said}");
+    // a real rerun into another folder differs in its timings: compared, and quoted as such
+    let (code, _, err) = signorini_in(&dir, &["run", "exp/st.toml", "--results", "again"]);
+    assert_eq!(code, 0, "{err}");
+    let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "exp", "--against", "again", "--results", "res"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(!err.contains("byte-identical"), "{err}");
+    let (code, _, err) =
+        signorini_in(&dir, &["report", "--experiments", "exp", "--results", "res", "--drift-report", "again/drift-report.json"]);
+    assert_eq!(code, 0, "{err}");
+    let said = drift_paragraph(&dir.join("res/report/st.html"));
+    assert!(said.contains("<b>no drift</b>: rerun and compared"), "{said}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_pages_drift_advice_makes_the_next_page_checked() {
+    let dir = scratch("drift-advice");
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    std::fs::write(dir.join("experiments/rf.toml"), ADAPTIVE_STUDY).unwrap();
+    // the tracked results/ and a scratch folder: each page's advice, run as given, checks it
+    for (results, page) in [(None, "target/report/rf.html"), (Some("res"), "res/report/rf.html")] {
+        let mut run = vec!["run", "experiments/rf.toml"];
+        let mut report = vec!["report", "--study", "rf"];
+        if let Some(r) = results {
+            run.extend(["--results", r]);
+            report.extend(["--results", r]);
+        }
+        let (code, _, err) = signorini_in(&dir, &run);
+        assert_eq!(code, 0, "{err}");
+        let (code, _, err) = signorini_in(&dir, &report);
+        assert_eq!(code, 0, "{err}");
+        let said = drift_paragraph(&dir.join(page));
+        let advice = said.split("<code>").nth(1).and_then(|a| a.split("</code>").next()).unwrap_or_else(|| panic!("no advice: {said}"));
+        let expected = match results {
+            None => "signorini drift --study rf".to_string(),
+            Some(r) => format!("signorini drift --study rf --results {r}"),
+        };
+        assert_eq!(advice, expected, "{said}");
+        let args: Vec<&str> = advice.split(' ').skip(1).collect();
+        let (code, out, err) = signorini_in(&dir, &args);
+        assert_eq!(code, 0, "{advice}: {out}{err}");
+        let (code, _, err) = signorini_in(&dir, &report);
+        assert_eq!(code, 0, "{err}");
+        let said = drift_paragraph(&dir.join(page));
+        assert!(said.contains("<b>no drift</b>: rerun and compared at every level"), "after `{advice}`: {said}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+const REF: &str = "description = \"tiny ex72 with a reference\"\n[defaults]\nproblem = \"ex72\"\nmesh = \"structured:4\"\ntheta = 0.5\nlevels = 8\nmax_ndof = 20000\n[defaults.reference]\ntheta = 0.5\nmin_ndof = 30000\ncontact_term = \"without_full_contact\"\n[[run]]\nid = \"adaptive\"\nrole = \"as-written\"\n";
+
+#[test]
+fn drift_against_a_copy_whose_reference_record_was_edited_names_the_field() {
+    let dir = scratch("drift-ref");
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    std::fs::write(dir.join("experiments/ref.toml"), REF).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/ref.toml", "--results", "res"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(std::process::Command::new("cp").args(["-r", "res", "alt"]).current_dir(&dir).status().unwrap().success());
+    let against = ["drift", "--against", "alt", "--results", "res", "--experiments", "experiments", "--study", "ref"];
+    let (code, out, err) = signorini_in(&dir, &against);
+    assert_eq!(code, 0, "an unchanged copy: {out}{err}");
+    let file = std::fs::read_dir(dir.join("alt/ref/references")).unwrap().next().unwrap().unwrap().path();
+    let mut reference: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    reference["last"]["eta_h"] = serde_json::json!(1.5);
+    std::fs::write(&file, serde_json::to_string_pretty(&reference).unwrap()).unwrap();
+    let (code, out, err) = signorini_in(&dir, &against);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("last.eta_h") && out.contains("reference "), "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+const SCRATCH_STUDY: &str =
+    "description = \"scratch\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\ntheta = 0.5\n[[run]]\nid = \"a\"\nlevels = 2\n";
+
+#[test]
+fn a_named_drift_report_that_does_not_exist_is_an_error_and_the_page_says_what_provenance_checks() {
+    let dir = scratch("drift-report");
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    std::fs::write(dir.join("experiments/mine.toml"), SCRATCH_STUDY).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/mine.toml", "--results", "res"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let report = ["report", "--results", "res", "--experiments", "experiments", "--drift-report", "res/drift-reprot.json"];
+    let (code, out, err) = signorini_in(&dir, &report);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(err.contains("res/drift-reprot.json") && err.contains("does not exist"), "{err}");
+    // without the flag, a missing default report is "not checked", and the page is written
+    let (code, out, err) = signorini_in(&dir, &["report", "--results", "res", "--experiments", "experiments"]);
+    assert_eq!(code, 0, "{out}{err}");
+    let page = std::fs::read_to_string(dir.join("res/report/mine.html")).unwrap();
+    assert!(page.contains("nothing checks them"), "{page}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn drift_against_a_folder_from_where_there_is_no_stored_results_folder_is_named() {
+    let dir = std::env::temp_dir().join(format!("signorini-drift-noresults-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(dir.join("exp")).unwrap();
+    std::fs::create_dir_all(dir.join("empty")).unwrap();
+    let text =
+        "description = \"t\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:2\"\nlevels = 2\nquick_levels = 1\n[[run]]\nid = \"a\"\n";
+    std::fs::write(dir.join("exp/s.toml"), text).unwrap();
+    let (code, out) = output_in(&dir, &["run", "exp/s.toml", "--results", "s7"]);
+    assert_eq!(code, 0, "{out}");
+    // from a folder without ./results: an error naming it, not a drift with advice to rerun
+    let empty = dir.join("empty");
+    let (code, out) = output_in(&empty, &["drift", "--against", "../s7", "--experiments", "../exp"]);
+    assert_eq!(code, 1, "{out}");
+    assert!(
+        out.contains("no stored results folder `results` (relative to the current folder): it does not exist; pass --results DIR"),
+        "{out}"
+    );
+    assert!(!out.contains("field(s)") && !out.contains("rerun the study"), "{out}");
+    // a file where the folder should be, and without --against (nothing is rerun first)
+    std::fs::write(empty.join("results"), "").unwrap();
+    let (code, out) = output_in(&empty, &["drift", "--quick", "--experiments", "../exp"]);
+    assert!(code == 1 && out.contains("no stored results folder `results`") && out.contains("is not a folder"), "{out}");
+    assert!(!empty.join("target").exists(), "drift reran a study before refusing");
+    // named with --results, the same comparison is no drift
+    let (code, out) = output_in(&empty, &["drift", "--against", "../s7", "--experiments", "../exp", "--results", "../s7"]);
+    assert_eq!(code, 0, "{out}");
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -255,7 +255,7 @@ impl Problem for Scaled<'_> {
 
 /// The scale factor: below 1, because Example 7.2 scaled by 3.7 pushes its clamped side 0.37 and
 /// its obstacle 0.74 into a body 1 wide, which the gap bound refuses (its held end counts where
-/// the Dirichlet data put it, battery 16 F2).
+/// the Dirichlet data put it).
 const K: f64 = 0.37;
 
 fn check_scaling(problem: &dyn Problem, spec: &str) {

@@ -2,10 +2,12 @@
 //! refinement, errors naming the line; the contact zone as arc-length intervals.
 
 use crate::common;
+use crate::common::{fixture, run_edited, scratch, signorini_in, solve_gmsh_square};
 use common::*;
 use signorini::mesh::{Mesh, MeshError, MeshSpec};
 use signorini::problems::{Curve, Material, Part, Problem};
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 /// A problem that names physical groups: `groups` maps a name to its part and curve. The body is
 /// pushed down (f = (0, -1)) onto a flat foundation under y = 0 (n = (0, -1), chi = 0).
@@ -572,4 +574,409 @@ fn hertz_mesh_gives_one_contact_interval_around_the_lowest_point() {
     assert!(z.from[0] < 0.0 && z.to[0] > 0.0 && z.s[1] - z.s[0] < 0.3, "{z:?}");
     assert!(z.s[0] < 0.3f64.asin() && 0.3f64.asin() - 1e-3 < z.s[1], "{z:?}");
     assert!(sol.kkt().max_penetration <= 1e-12);
+}
+
+const QD: &str = "gmsh_renumbered/quarter_disc.toml";
+
+const SOLVE_QD: &[&str] = &["solve", "--problem", "v.toml", "--mesh", "gmsh:qd.msh"];
+
+const ADAPT_QD: &[&str] = &["adapt", "--problem", "v.toml", "--mesh", "gmsh:qd.msh", "--levels", "4"];
+
+#[test]
+fn a_physical_group_the_mesh_file_lacks_is_named() {
+    // the unchanged problem solves: the refusals below are the names' doing
+    let (code, out, err) = run_edited("groups-ok", QD, &[("", "")], SOLVE_QD);
+    assert!(code == 0 && out.contains("certified:"), "{err}");
+    for (case, from, to, group) in [
+        ("misspelt", r#"contact = ["bottom"]"#, r#"contact = ["bottom", "botom"]"#, "botom"),
+        ("misspelt-dirichlet", r#"dirichlet = ["left"]"#, r#"dirichlet = ["left", "lef"]"#, "lef"),
+        ("surface", r#"neumann = ["arc"]"#, r#"neumann = ["arc", "body"]"#, "body"),
+    ] {
+        for args in [SOLVE_QD, ADAPT_QD] {
+            let (code, _, err) = run_edited(case, QD, &[(from, to)], args);
+            assert_eq!(code, 1, "{case}: {err}");
+            for says in [
+                "qd.msh".to_string(),
+                format!(r#"names the physical group "{group}", which is not a group of boundary lines of this file"#),
+                r#"its groups of lines: "bottom", "arc", "left""#.to_string(),
+            ] {
+                assert!(err.contains(&says), "{case}: no {says:?} in\n{err}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_curve_the_boundary_does_not_follow_is_refused_before_refining() {
+    let arc = "arc = { circle = { centre = [0, 0], radius = 1 } }";
+    for (case, to) in [
+        ("centre", "arc = { circle = { centre = [0, 1], radius = 1 } }"),
+        ("radius", "arc = { circle = { centre = [0, 0], radius = 1.01 } }"),
+    ] {
+        for args in [SOLVE_QD, ADAPT_QD] {
+            let (code, _, err) = run_edited(case, QD, &[(arc, to)], args);
+            assert_eq!(code, 1, "{case}: {err}");
+            for says in ["qd.msh, line ", r#"of this line element of group "arc" is off the curve"#, "[curves]", "of its size"] {
+                assert!(err.contains(says), "{case}: no {says:?} in\n{err}");
+            }
+            assert!(!err.contains("non-positive area"), "{case}: {err}");
+        }
+    }
+    let (code, out, err) = run_edited("curve-ok", QD, &[("", "")], ADAPT_QD);
+    assert!(code == 0 && out.lines().filter(|l| l.trim_start().starts_with(char::is_numeric)).count() == 4, "{err}\n{out}");
+}
+
+/// Two physical groups of lines under one name in `$PhysicalNames`: refused naming both tags and
+/// lines (a problem names groups by name, so the two would silently be one part).
+#[test]
+fn a_physical_name_given_to_two_groups_is_refused() {
+    let dir = scratch("gmsh-dupname");
+    std::fs::write(dir.join("sq.msh"), fixture("square.msh").replace(r#"1 2 "sides""#, r#"1 2 "bottom""#)).unwrap();
+    std::fs::write(dir.join("v.toml"), fixture("bad_data_gmsh.toml")).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["solve", "--problem", "v.toml", "--mesh", "gmsh:sq.msh"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(r#"sq.msh, line 7: $PhysicalNames: the name "bottom" is given to groups 1 (line 6) and 2 of dimension 1"#),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A partitioned MSH 4.1 file puts its elements on partition entities: read as if it were whole,
+/// its lines would come out in no group and the problem be blamed. Refused naming the section,
+/// its line and how to write it whole.
+#[test]
+fn a_partitioned_mesh_is_refused_by_name() {
+    let dir = scratch("gmsh-partitioned");
+    std::fs::write(dir.join("v.toml"), fixture(QD)).unwrap();
+    std::fs::write(dir.join("p.msh"), fixture("gmsh_renumbered/partitioned.msh")).unwrap();
+    for args in [["solve", "--problem", "v.toml", "--mesh", "gmsh:p.msh"], ["adapt", "--problem", "v.toml", "--mesh", "gmsh:p.msh"]] {
+        let o = Command::new(env!("CARGO_BIN_EXE_signorini")).current_dir(&dir).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains("p.msh, line 21") && err.contains("a partitioned mesh ($PartitionedEntities)") && err.contains("unpartition"),
+            "{err}"
+        );
+        assert!(!err.contains("names the physical group"), "{err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// An annulus 0.5 < r < 1 of `n` sectors and `layers` rings, the hole (a closed loop, on its
+/// circle) contact, the outer circle clamped; the gap closes on x > 0 only, the normal is the
+/// body's outward one (toward the centre).
+struct Hole;
+
+impl signorini::problems::Problem for Hole {
+    fn name(&self) -> &str {
+        "hole"
+    }
+    fn description(&self) -> &str {
+        "contact on a closed loop"
+    }
+    fn material(&self) -> signorini::problems::Material {
+        signorini::problems::Material { mu: 1.0, zeta: 1.0 }
+    }
+    fn part_of(&self, _x: [f64; 2]) -> signorini::problems::Part {
+        signorini::problems::Part::Neumann
+    }
+    fn body_force(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn traction(&self, _x: [f64; 2], _n: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn dirichlet(&self, _x: [f64; 2]) -> [f64; 2] {
+        [0.0, 0.0]
+    }
+    fn contact_normal(&self, _x: [f64; 2], outward: [f64; 2]) -> [f64; 2] {
+        outward
+    }
+    fn gap(&self, x: [f64; 2]) -> f64 {
+        0.002 - 0.01 * x[0].max(0.0) / 0.5
+    }
+}
+
+/// Rings at the radii `radii` (0.5 first, 1 last), `n` sectors each.
+fn annulus(n: usize, radii: &[f64]) -> signorini::mesh::Mesh {
+    use signorini::mesh::BoundaryEdge;
+    use signorini::problems::{Curve, Part};
+    let v = |k: usize, j: usize| k * n + j % n;
+    let layers = radii.len() - 1;
+    let mut vertices = Vec::new();
+    for &r in radii {
+        for j in 0..n {
+            let t = std::f64::consts::TAU * j as f64 / n as f64;
+            vertices.push([r * t.cos(), r * t.sin()]);
+        }
+    }
+    let mut triangles = Vec::new();
+    for k in 0..layers {
+        for j in 0..n {
+            let (a, b, c, d) = (v(k, j), v(k + 1, j), v(k + 1, j + 1), v(k, j + 1));
+            triangles.extend([[a, b, c], [a, c, d]]);
+        }
+    }
+    let inner = Curve::Circle { centre: [0.0, 0.0], radius: 0.5 };
+    let mut boundary: Vec<BoundaryEdge> =
+        (0..n).map(|j| BoundaryEdge { v: [v(0, j + 1), v(0, j)], part: Part::Contact, curve: Some(inner) }).collect();
+    boundary.extend((0..n).map(|j| BoundaryEdge { v: [v(layers, j), v(layers, j + 1)], part: Part::Dirichlet, curve: None }));
+    let mesh = signorini::mesh::Mesh { vertices, triangles, boundary };
+    mesh.check().unwrap();
+    mesh
+}
+
+/// On a closed contact loop, one active arc through the loop's start is one zone
+/// [s_first, s_last + L], not two zones with zone_min/zone_max the whole loop.
+#[test]
+fn an_active_arc_through_the_start_of_a_closed_contact_loop_is_one_zone() {
+    let mesh = annulus(32, &[0.5, 0.625, 0.75, 0.875, 1.0]);
+    let sol = super::common::solve_on(&Hole, &mesh);
+    let loop_length = 32.0 * 2.0 * 0.5 * (std::f64::consts::PI / 32.0).sin();
+    let zones = sol.contact_zones();
+    assert_eq!(zones.len(), 1, "{zones:?}");
+    let z = zones[0];
+    // pressed on x > 0 only: the arc crosses the x axis at (0.5, 0), the loop's start (the hole's
+    // boundary runs clockwise, the body on its left: from above the axis to below it)
+    assert!(z.s[0] < loop_length && z.s[1] > loop_length && z.s[1] - z.s[0] < 0.5 * loop_length, "{z:?} (L = {loop_length})");
+    assert!(z.from[1] > 0.0 && z.to[1] < 0.0 && z.from[0] > 0.0 && z.to[0] > 0.0, "{z:?}");
+    // its length is that of the active nodes: (active - 1) half-edges
+    let half = 0.5 * loop_length / 32.0;
+    assert!(((z.s[1] - z.s[0]) / half - (sol.active_count() - 1) as f64).abs() < 1e-9, "{z:?}: {} active", sol.active_count());
+    assert_eq!(sol.contact_zone(), Some(z.s));
+}
+
+/// Refinement onto a concave curve (a hole's circle) turns a triangle over where the first layer
+/// is thinner than the chord's sagitta: the error names the curve, the edge, the new vertex and
+/// the remedy, not the vertex order.
+#[test]
+fn refinement_that_turns_a_triangle_over_on_a_curve_says_so() {
+    let mut mesh = annulus(16, &[0.5, 0.505, 0.6, 0.8, 1.0]);
+    let mut error = None;
+    for _ in 0..3 {
+        match signorini::mesh::refine::refine(&mesh, &vec![true; mesh.n_triangles()]) {
+            Ok(r) => mesh = r.mesh,
+            Err(e) => {
+                error = Some(e.to_string());
+                break;
+            }
+        }
+    }
+    let error = error.expect("refinement onto the hole turns a triangle over");
+    for part in [
+        "refinement put the new vertex of the contact boundary edge",
+        "the circle of centre (0, 0) and radius 0.5",
+        "turned triangle",
+        "thinner there than the curve's sagitta",
+        "mesh the body finer near the curve",
+    ] {
+        assert!(error.contains(part), "{part}: {error}");
+    }
+    assert!(!error.contains("counter-clockwise"), "{error}");
+}
+
+/// The estimator line of solving the Gmsh square with `msh` as its mesh, or the error.
+fn solve_msh(dir: &Path, msh: &str) -> Result<String, String> {
+    std::fs::write(dir.join("v.toml"), fixture("bad_data_gmsh.toml")).unwrap();
+    std::fs::write(dir.join("m.msh"), msh).unwrap();
+    let (code, out, err) = signorini_in(dir, &["solve", "--problem", "v.toml", "--mesh", "gmsh:m.msh"]);
+    match code {
+        0 => Ok(out.lines().find(|l| l.starts_with("estimator:")).unwrap_or_default().to_string()),
+        _ => Err(err),
+    }
+}
+
+#[test]
+fn lines_between_sections_are_skipped_as_gmsh_skips_them() {
+    let dir = scratch("gmsh-stray");
+    let msh = fixture("square.msh");
+    let plain = solve_msh(&dir, &msh).unwrap();
+    assert!(!plain.is_empty());
+    for (at, stray) in [("$EndElements\n", "written by hand\n1 2 3\n"), ("$EndMeshFormat\n", "x\n"), ("$EndNodes\n", "  note\n")] {
+        assert!(msh.contains(at));
+        let with = msh.replacen(at, &format!("{at}{stray}"), 1);
+        assert_eq!(solve_msh(&dir, &with).as_ref(), Ok(&plain), "{stray:?} after {at:?}");
+    }
+}
+
+#[test]
+fn a_byte_order_mark_is_named() {
+    let dir = scratch("gmsh-bom");
+    let err = solve_msh(&dir, &format!("\u{feff}{}", fixture("square.msh"))).unwrap_err();
+    assert!(err.contains("m.msh") && err.contains("starts with a byte-order mark") && err.contains("save it without one"), "{err}");
+    assert!(!err.contains("EndEndMeshFormat"), "{err}");
+}
+
+/// A Gmsh variant of tests/fixtures/square.msh: (exit code, stderr).
+fn gmsh_variant(name: &str, from: &str, to: &str) -> (i32, String) {
+    let msh = fixture("square.msh");
+    assert!(msh.contains(from), "{from}");
+    let (code, _, err) = solve_gmsh(name, &msh.replace(from, to));
+    (code, err)
+}
+
+/// `signorini solve` of bad_data_gmsh.toml on the mesh file `msh` (written as bad.msh), probed at
+/// (0.25, 0.5): (exit code, stdout without its timings, stderr).
+fn solve_gmsh(name: &str, msh: &str) -> (i32, String, String) {
+    let dir = scratch(&format!("gmsh-{name}"));
+    std::fs::write(dir.join("bad.msh"), msh).unwrap();
+    std::fs::write(dir.join("v.toml"), fixture("bad_data_gmsh.toml")).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["solve", "--problem", "v.toml", "--mesh", "gmsh:bad.msh", "--probe", "0.25,0.5"])
+        .output()
+        .unwrap();
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    let out: Vec<&str> = std::str::from_utf8(&o.stdout).unwrap().lines().filter(|l| !l.starts_with("time:")).collect();
+    (o.status.code().unwrap_or(-1), out.join("\n"), text(&o.stderr))
+}
+
+/// tests/fixtures/square.msh with a second square, its own nodes 5-8 shifted by `d`, its own
+/// boundary lines in the same groups and its triangles 11 and 12: two bodies, each a valid mesh.
+fn two_squares(d: [f64; 2]) -> String {
+    let msh = fixture("square.msh");
+    let copy: Vec<String> = ["0 0 0", "1 0 0", "1 1 0", "0 1 0"]
+        .iter()
+        .map(|p| {
+            let c: Vec<f64> = p.split(' ').map(|x| x.parse().unwrap()).collect();
+            format!("{} {} 0", c[0] + d[0], c[1] + d[1])
+        })
+        .collect();
+    let nodes = format!("0 1 0\n2 1 0 4\n5\n6\n7\n8\n{}\n$EndNodes", copy.join("\n"));
+    let elements = "6 1 4 3\n1 1 1 1\n7 5 6\n1 2 1 3\n8 6 7\n9 7 8\n10 8 5\n2 1 2 2\n11 5 6 7\n12 5 8 7\n$EndElements";
+    let out = msh
+        .replace("$Nodes\n1 4 1 4\n", "$Nodes\n2 8 1 8\n")
+        .replace("0 1 0\n$EndNodes", &nodes)
+        .replace("$Elements\n3 6 1 6\n", "$Elements\n6 12 1 12\n")
+        .replace("6 1 4 3\n$EndElements", elements);
+    assert_ne!(out, msh);
+    out
+}
+
+/// Two bodies in one place, or crossing each other, each a valid mesh of its own, are refused
+/// rather than solved (a probe would give one body's value), naming
+/// a triangle of each (tag and line) and a point inside both; squares that only touch along an
+/// edge (each its own nodes) still solve.
+#[test]
+fn overlapping_bodies_in_a_gmsh_file_are_refused_naming_two_triangles_and_a_point() {
+    let (code, _, err) = solve_gmsh("touching", &two_squares([1.0, 0.0]));
+    assert_eq!(code, 0, "squares side by side: {err}");
+    for d in [[0.0, 0.0], [0.5, 0.0], [0.5, 0.25], [-0.3, 0.6]] {
+        let msh = two_squares(d);
+        let (code, out, err) = solve_gmsh(&format!("overlap{}-{}", d[0], d[1]), &msh);
+        assert_eq!(code, 1, "shift {d:?}: {out}{err}");
+        // the first triangle of the first square overlaps the first of the second in each shift
+        let line = |tag: u32| 1 + msh.lines().position(|l| l.starts_with(&format!("{tag} "))).unwrap();
+        let said = format!("bad.msh, line {}: triangles 5 (line {}) and 11 overlap: both hold the point (", line(11), line(5));
+        assert!(err.contains(&said), "shift {d:?}: {err}");
+        // the point named lies inside both squares
+        let at = err.split("both hold the point (").nth(1).and_then(|r| r.split(')').next()).unwrap();
+        let p: Vec<f64> = at.split(", ").map(|x| x.parse().unwrap()).collect();
+        let inside = |o: [f64; 2]| p[0] > o[0] && p[0] < o[0] + 1.0 && p[1] > o[1] && p[1] < o[1] + 1.0;
+        assert!(inside([0.0, 0.0]) && inside(d), "shift {d:?}: ({at}) is not in both");
+    }
+}
+
+/// Gmsh skips the sections it does not read (`$Comments`, any unknown one) wherever they are,
+/// before `$MeshFormat` too, and so do we: a file opening with `$Comments` is no bad header.
+/// Every placement solves to the plain file's output, also when a
+/// comment holds a line a reader looks for (`$PhysicalNames`, `$MeshFormat`, `$Nodes`); a
+/// comment never closed is named at its line.
+#[test]
+fn sections_gmsh_skips_are_skipped_wherever_they_are() {
+    let plain = fixture("square.msh");
+    let (code, want, err) = solve_gmsh("plain", &plain);
+    assert_eq!(code, 0, "{err}");
+    let comment =
+        "$Comments\nwritten by hand\n$PhysicalNames\n1\n1 1 \"bottom\"\n$EndPhysicalNames\n$MeshFormat\n4.1 1 8\n$Nodes\n$EndComments";
+    for (name, from, to) in [
+        ("top", "$MeshFormat\n", format!("{comment}\n$MeshFormat\n")),
+        ("top-two", "$MeshFormat\n", format!("$Foo\n1 2 3\n$EndFoo\n\n{comment}\n$MeshFormat\n")),
+        ("between", "$Entities\n", format!("{comment}\n$Entities\n")),
+        ("before-nodes", "$Nodes\n", format!("{comment}\n$Nodes\n")),
+        ("end", "$EndElements\n", format!("$EndElements\n{comment}\n")),
+    ] {
+        assert!(plain.contains(from), "{from}");
+        let (code, out, err) = solve_gmsh(name, &plain.replacen(from, &to, 1));
+        assert_eq!((code, &out), (0, &want), "{name}: {err}");
+    }
+    let (code, _, err) = solve_gmsh("open", &plain.replace("$Entities\n", "$Comments\nno end\n$Entities\n"));
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("bad.msh, line 10: the section $Comments has no line $EndComments"), "{err}");
+}
+
+#[test]
+fn the_unmodified_gmsh_square_solves() {
+    let (code, err) = gmsh_variant("good", "$Nodes", "$Nodes");
+    assert_eq!(code, 0, "{err}");
+}
+
+#[test]
+fn malformed_gmsh_meshes_are_named() {
+    let nodes = "$Nodes\n1 4 1 4\n2 1 0 4\n1\n2\n3\n4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n$EndNodes";
+    let second_block = |header: &str| nodes.replace("$Nodes\n1 4 1 4\n", header).replace("$EndNodes", "2 1 0 1\n4\n0.5 0.5 0\n$EndNodes");
+    for (name, from, to, says) in [
+        // triangle 6 laid over triangle 5 (both on the same side of their edge)
+        (
+            "fold",
+            "6 1 4 3".to_string(),
+            "6 1 2 4".to_string(),
+            "triangles 5 and 6 overlap: their edge (0, 0)-(1, 0) has both on the same side",
+        ),
+        ("count", "$Nodes\n1 4 1 4\n".into(), "$Nodes\n1 3 1 4\n".into(), "the $Nodes header declares 3 nodes, its blocks hold 4"),
+        // a header count or range that is wrong is named as such, not blamed on a tag listed twice
+        ("count-over", "$Nodes\n1 4 1 4\n".into(), "$Nodes\n1 5 1 4\n".into(), "the $Nodes header declares 5 nodes, its blocks hold 4"),
+        ("min-tag", "$Nodes\n1 4 1 4\n".into(), "$Nodes\n1 4 2 4\n".into(), "node tag 1 is outside the range 2 to 4"),
+        ("inf", "0 1 0\n$EndNodes".into(), "1e999 1 0\n$EndNodes".into(), "node 4 has the coordinate inf"),
+        ("nan", "0 1 0\n$EndNodes".into(), "nan 1 0\n$EndNodes".into(), "node 4 has the coordinate NaN"),
+        // tags 1..4, then 4 again: mshio drops the tags of a section whose tags look contiguous
+        ("dup-dense", nodes.into(), second_block("$Nodes\n2 5 1 4\n"), "node tag 4 is listed twice, at (0, 1, 0) and at (0.5, 0.5, 0)"),
+        // sparse tags (up to 9), 4 listed again in a second block with other coordinates
+        ("dup-sparse", nodes.into(), second_block("$Nodes\n2 5 1 9\n"), "node tag 4 is listed twice, at (0, 1, 0) and at (0.5, 0.5, 0)"),
+    ] {
+        let (code, err) = gmsh_variant(name, &from, &to);
+        assert_eq!(code, 1, "{name}: {err}");
+        assert!(err.contains("bad.msh") && err.contains(says), "{name}: {err}");
+    }
+}
+
+#[test]
+fn a_predicate_problem_on_a_gmsh_mesh_says_predicates_tag_the_built_in_meshes() {
+    let dir = scratch("gmsh-predicate-gmsh");
+    std::fs::write(dir.join("sq.msh"), fixture("square.msh")).unwrap();
+    std::fs::write(dir.join("v.toml"), fixture("bad_data_square.toml")).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["solve", "--problem", "v.toml", "--mesh", "gmsh:sq.msh"]);
+    assert_eq!(code, 1, "{err}");
+    for part in ["declares its boundary parts by predicates on x and y (parts.contact = \"y < 1e-12\"", "which tag the built-in meshes"] {
+        assert!(err.contains(part), "{part}: {err}");
+    }
+    assert!(!err.contains("not named by"), "{err}");
+}
+
+#[test]
+fn a_parametric_gmsh_file_is_refused_with_the_option_that_writes_a_plain_one() {
+    let dir = scratch("gmsh-parametric");
+    std::fs::write(dir.join("v.toml"), fixture("bad_data_gmsh.toml")).unwrap();
+    let msh = fixture("square.msh");
+    assert!(msh.contains("$Nodes\n1 4 1 4\n2 1 0 4\n"));
+    std::fs::write(dir.join("m.msh"), msh.replace("$Nodes\n1 4 1 4\n2 1 0 4\n", "$Nodes\n1 4 1 4\n2 1 1 4\n")).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["solve", "--problem", "v.toml", "--mesh", "gmsh:m.msh"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("m.msh") && err.contains("Mesh.SaveParametric = 0"), "{err}");
+}
+
+/// A physical group named as the tag of another, unnamed group ("1" beside the unnamed group 1)
+/// would read as one boundary part, a problem naming "1" holding both sides: refused when the
+/// mesh is read, naming both groups.
+#[test]
+fn a_group_named_as_another_groups_tag_is_refused() {
+    let (code, out) = solve_gmsh_square("name-is-a-tag", &[], &[("3\n1 1 \"bottom\"\n1 2 \"sides\"", "2\n1 2 \"1\"")]);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("the physical group 2 is named \"1\", the tag of the unnamed group 1"), "{out}");
 }

@@ -15,8 +15,8 @@ fn kkt_holds_for_both_examples() {
 
 /// The round-off bound of a contact force holds off the active set on graded adaptive meshes
 /// of every built-in problem too (what `DiscreteSolution::positive_forces`, Lambda_h^C and eta_7
-/// rest on), and a rigid translation of the data (battery 9: 3e7 times the deformation hid
-/// every contact force from eta_7) leaves the forces counted as positive as they were.
+/// rest on), and a rigid translation of the data (by 3e7 times the deformation, which could
+/// hide every contact force from eta_7) leaves the forces counted as positive as they were.
 #[test]
 fn inactive_forces_stay_below_their_round_off_bound_on_adaptive_levels() {
     use signorini::adapt::Refine;

@@ -3,8 +3,8 @@
 //! serde's Rust type names never reach the reader.
 
 use crate::common;
+use crate::common::{fixture, one_run_manifest, scratch, signorini_in_time};
 use common::parse_err;
-
 use signorini::adapt::AdaptConfig;
 use signorini::study::manifest::Manifest;
 use std::path::Path;
@@ -16,7 +16,7 @@ fn run_with(extra: &str) -> String {
 }
 
 #[test]
-fn bad_save_levels_beyond_the_run_are_errors() {
+fn save_levels_beyond_the_run_are_errors() {
     let e = run_with("save_levels = [99]");
     assert!(e.contains("run[0].save_levels") && e.contains("99") && e.contains("0..=23"), "{e}");
     let e = run_with("levels = 3\nsave_levels = [0, 3]");
@@ -28,7 +28,7 @@ fn bad_save_levels_beyond_the_run_are_errors() {
 }
 
 #[test]
-fn bad_loop_settings_are_errors_from_the_one_validation() {
+fn invalid_loop_settings_are_errors_from_the_one_validation() {
     let e = run_with("max_ndof = 0");
     assert!(e.contains("run[0].max_ndof") && e.contains(">= 1"), "{e}");
     let e = run_with("levels = 0");
@@ -66,7 +66,7 @@ fn adapt_config_validate_rejects_what_the_loop_cannot_run() {
 }
 
 #[test]
-fn bad_keys_are_errors_everywhere() {
+fn wrong_keys_are_errors_everywhere() {
     for (text, key) in [
         (format!("{BASE}[[run]]\nid = \"a\"\nsave_level = [1]\n"), "save_level"),
         (format!("{BASE}lvels = 3\n[[run]]\nid = \"a\"\n"), "lvels"),
@@ -125,8 +125,8 @@ fn every_declared_study_still_parses() {
     }
 }
 
-/// One file spelt two ways in a manifest (`./p.toml`, `problems/../p.toml`) is one spec: the
-/// battery found `./p.toml` refused as a changed input against a run stored with `p.toml`.
+/// One file spelt two ways in a manifest (`./p.toml`, `problems/../p.toml`) is one spec:
+/// `./p.toml` is no changed input against a run stored with `p.toml`.
 #[test]
 fn a_path_spelt_another_way_is_the_same_spec() {
     use signorini::study::manifest::spelled;
@@ -143,13 +143,81 @@ fn a_path_spelt_another_way_is_the_same_spec() {
     let a = Manifest::parse(&dir.join("s.toml"), &text("p.toml")).unwrap();
     let b = Manifest::parse(&dir.join("s.toml"), &text("./p.toml")).unwrap();
     assert_eq!(a.runs[0].spec, b.runs[0].spec);
-    // the same file by its absolute path (battery 5, finding 14: "changed ... none now")
+    // the same file by its absolute path (not "changed ... none now")
     let c = Manifest::parse(&dir.join("s.toml"), &text(&dir.join("p.toml").display().to_string())).unwrap();
     assert_eq!(c.runs[0].spec, a.runs[0].spec);
-    // one mesh, one spelling (battery 5, finding 15)
+    // one mesh, one spelling
     for mesh in ["structured:02", "structured: 2", " structured:2 "] {
         let c = Manifest::parse(&dir.join("s.toml"), &text("p.toml").replace("structured:2", mesh)).unwrap();
         assert_eq!(c.runs[0].spec, a.runs[0].spec, "{mesh:?}");
     }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_run_id_that_hides_its_record_or_clashes_by_case_is_refused() {
+    for (id, says) in [
+        (".", "starts with a letter or digit"),
+        (".hidden", "starts with a letter or digit"),
+        ("-a", "starts with a letter or digit"),
+        ("A", r#""A" and "a", the same name but for case"#),
+        ("a", r#""a" twice"#),
+    ] {
+        let text = fixture("tiny.toml").replace(r#"id = "b""#, &format!("id = {id:?}"));
+        let err = common::parse_err(&text);
+        assert!(err.contains("key `run[1].id`") && err.contains(says), "{id}: {err}");
+    }
+    // what the id check still accepts
+    for id in ["b.2", "B_2-x", "0"] {
+        let text = fixture("tiny.toml").replace(r#"id = "b""#, &format!("id = {id:?}"));
+        signorini::study::manifest::Manifest::parse(std::path::Path::new("experiments/tiny.toml"), &text).unwrap();
+    }
+}
+
+#[test]
+fn a_run_id_longer_than_the_store_s_file_names_allow_is_refused_by_key() {
+    let dir = scratch("manifest-long-id");
+    let long = "x".repeat(300);
+    let file = one_run_manifest(&dir, "s", &long, "");
+    let (code, _, err) = signorini_in_time(&dir, &["run", &file, "--results", "r"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("key `run[0].id`") && err.contains("at most 128 characters") && err.contains("300 characters"), "{err}");
+    assert!(!dir.join("r").exists(), "something was written before the refusal");
+    // the longest accepted id makes every file of a run, snapshots included
+    let longest = "y".repeat(128);
+    let file = one_run_manifest(&dir, "t", &longest, "save_levels = [1]\n");
+    let (code, _, err) = signorini_in_time(&dir, &["run", &file, "--results", "r"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(dir.join("r/t/runs").join(format!("{longest}.json")).is_file());
+    assert!(dir.join("r/t/meshes").join(format!("{longest}_level1.vtu")).is_file());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn an_odd_symmetric_mesh_in_a_manifest_keeps_the_parser_s_reason() {
+    let dir = scratch("manifest-symmetric");
+    let file = one_run_manifest(&dir, "s", "a", "mesh = \"symmetric:3\"\n");
+    let (code, _, err) = signorini_in_time(&dir, &["run", &file, "--results", "r"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("key `run[0].mesh`") && err.contains("N even") && err.contains("use symmetric:2 or symmetric:4"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn two_manifests_of_one_study_with_different_runs_are_refused_before_any_run() {
+    let dir = scratch("manifest-two");
+    for sub in ["one", "two"] {
+        std::fs::create_dir(dir.join(sub)).unwrap();
+    }
+    one_run_manifest(&dir.join("one"), "s", "a", "");
+    one_run_manifest(&dir.join("two"), "s", "a", "theta = 0.3\n");
+    let (code, _, err) = signorini_in_time(&dir, &["run", "one/s.toml", "two/s.toml", "--results", "r"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("one/s.toml and two/s.toml both declare study s with different runs"), "{err}");
+    assert!(!dir.join("r").exists(), "a run was computed before the refusal");
+    // the same declaration twice is no conflict
+    std::fs::copy(dir.join("one/s.toml"), dir.join("two/s.toml")).unwrap();
+    let (code, _, err) = signorini_in_time(&dir, &["run", "one/s.toml", "two/s.toml", "--results", "r"]);
+    assert_eq!(code, 0, "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }

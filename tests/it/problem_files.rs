@@ -4,11 +4,13 @@
 //! the file, the key and the position.
 
 use crate::common;
+use crate::common::{fixture, parse_problem, scratch, signorini_in};
 use common::*;
 use signorini::adapt::{self, AdaptConfig};
 use signorini::norms;
 use signorini::problems::{self, Curve, FileProblem, Material, Part, Problem};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::process::Command;
 
 fn file(name: &str) -> FileProblem {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/problems").join(format!("{name}.toml"));
@@ -337,7 +339,7 @@ fn group_errors() {
     // a group in two parts
     let e = err(&groups.replace("neumann = [\"side\"]", "neumann = [\"top\"]"));
     assert!(e.contains("key `parts.neumann`") && e.contains("\"top\""), "{e}");
-    // outward without a circle: the straight edges' own outward normals (battery 10, F11)
+    // outward without a circle: the straight edges' own outward normals
     let p = FileProblem::parse(Path::new("g.toml"), &groups.replace("normal = [0, -1]", "normal = \"outward\"")).unwrap();
     assert_eq!(p.contact_normal([0.6, 0.2], [0.0, -1.0]), [0.0, -1.0]);
     // with a circle, the mesh gives the circle's normal on the group's edges (Curve::outward)
@@ -466,4 +468,93 @@ mod random_input {
             }
         }
     }
+}
+
+const QD: &str = "gmsh_renumbered/quarter_disc.toml";
+
+const SQUARE: &str = "bad_data_square.toml";
+
+#[test]
+fn a_pair_with_a_third_value_is_refused_not_cut_to_two() {
+    let ex71 = std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("experiments/problems/ex71.toml")).unwrap();
+    let dir = scratch("problem-files-pairs");
+    let cases = [
+        ("exact", ex71.replace(r#"u = ["y^2*(y - 1)","#, r#"u = ["y^2*(y - 1)", "x","#), "structured:4"),
+        ("vertex", fixture(SQUARE).replace("[material]", "required_vertices = [[1, 0.5, 0]]\n\n[material]"), "structured:4"),
+        ("centre", fixture(QD).replace("centre = [0, 0]", "centre = [0, 0, 0]"), "gmsh:qd.msh"),
+    ];
+    std::fs::write(dir.join("qd.msh"), fixture("gmsh_renumbered/plain.msh")).unwrap();
+    for (case, text, mesh) in cases {
+        assert!(text.contains(", \"x\",") || text.contains("0.5, 0]") || text.contains("[0, 0, 0]"), "{case}: not changed");
+        std::fs::write(dir.join("v.toml"), text).unwrap();
+        let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
+            .current_dir(&dir)
+            .args(["solve", "--problem", "v.toml", "--mesh", mesh])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{case}: {err}");
+        assert!(err.contains("v.toml:") && err.contains("invalid length 3, expected an array of exactly two values"), "{case}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The square problem with a point constraint and an exact solution added, every pair valid.
+fn with_every_pair() -> String {
+    let base = fixture(SQUARE);
+    format!(
+        "required_vertices = [[0.5, 0]]\n{base}\n[[point_constraints]]\nat = [0.5, 1]\nu = [\"free\", 0]\n\n[exact]\nu = [\"0\", \"0\"]\ngrad = [[\"0\", \"0\"], [\"0\", \"0\"]]\n"
+    )
+}
+
+#[test]
+fn every_pair_valued_key_refuses_a_third_value() {
+    let good = with_every_pair();
+    assert!(parse_problem(&good).is_ok(), "{:?}", parse_problem(&good).err());
+    let normal = good.replace("normal = \"outward\"", "normal = [0, -1]");
+    assert!(parse_problem(&normal).is_ok(), "{:?}", parse_problem(&normal).err());
+    for (key, from, to) in [
+        ("body_force", "body_force = [\"0\", \"-1\"]", "body_force = [\"0\", \"-1\", \"0\"]"),
+        ("traction", "traction = [\"0\", \"0\"]", "traction = [\"0\", \"0\", \"0\"]"),
+        ("dirichlet", "dirichlet = [\"0\", \"-0.01\"]", "dirichlet = [\"0\", \"-0.01\", 0]"),
+        ("required_vertices", "required_vertices = [[0.5, 0]]", "required_vertices = [[0.5, 0, 0]]"),
+        ("at", "at = [0.5, 1]", "at = [0.5, 1, 0]"),
+        ("u", "u = [\"free\", 0]", "u = [\"free\", 0, 7]"),
+        ("u", "u = [\"0\", \"0\"]", "u = [\"0\", \"0\", \"0\"]"),
+        ("grad", "grad = [[\"0\", \"0\"], [\"0\", \"0\"]]", "grad = [[\"0\", \"0\", \"0\"], [\"0\", \"0\"]]"),
+        ("grad", "grad = [[\"0\", \"0\"], [\"0\", \"0\"]]", "grad = [[\"0\", \"0\"], [\"0\", \"0\"], [\"0\", \"0\"]]"),
+    ] {
+        assert!(good.contains(from), "{from}");
+        let err = parse_problem(&good.replace(from, to)).map(|_| ()).expect_err(to);
+        assert!(err.contains(key) && err.contains("two"), "{to}: {err}");
+    }
+    let err = parse_problem(&normal.replace("normal = [0, -1]", "normal = [0, -1, 0]")).map(|_| ()).expect_err("normal");
+    assert!(err.contains("normal") && err.contains("two"), "{err}");
+    // a circle's centre (groups and a curve)
+    let circle = fixture("bad_data_gmsh.toml") + "\n[curves.bottom]\ncircle = { centre = [0.5, 2], radius = 2 }\n";
+    assert!(parse_problem(&circle).is_ok(), "{:?}", parse_problem(&circle).err());
+    let err = parse_problem(&circle.replace("[0.5, 2]", "[0.5, 2, 0]")).map(|_| ()).expect_err("centre");
+    assert!(err.contains("centre") && err.contains("two"), "{err}");
+}
+
+#[test]
+fn a_point_constraint_with_a_third_value_is_refused_by_the_binary() {
+    let dir = scratch("problem-files-pc");
+    let text = with_every_pair().replace("u = [\"free\", 0]", "u = [\"free\", 0, 7]");
+    std::fs::write(dir.join("p.toml"), text).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["solve", "--problem", "p.toml", "--mesh", "structured:4"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("p.toml:") && err.contains("point_constraints") && err.contains("exactly two"), "{err}");
+}
+
+#[test]
+fn a_problem_file_beside_the_manifests_is_called_one() {
+    let dir = scratch("problem-files-beside");
+    let study =
+        "description = \"one short run\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:2\"\nlevels = 2\n[[run]]\nid = \"a\"\n";
+    std::fs::write(dir.join("study.toml"), study).unwrap();
+    std::fs::write(dir.join("square.toml"), fixture("bad_data_square.toml")).unwrap();
+    let (code, _, err) = signorini_in(&dir, &["drift", "--experiments", ".", "--results", "none"]);
+    assert_ne!(code, 0, "{err}");
+    assert!(err.contains("square.toml looks like a problem file") && err.contains("keep problem files in a subfolder"), "{err}");
 }

@@ -2,6 +2,7 @@
 //! last finished level, not from level 0, and ends with the same numbers and history as a run
 //! that was never stopped; the checkpoint it resumed from is gone once the run has landed.
 
+use crate::common::{scratch, signorini_in};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -83,4 +84,69 @@ fn a_killed_run_resumes_after_its_last_finished_level_with_the_same_numbers() {
     }
     assert!(!stopped.join("resumed/.partial").exists(), "the checkpoint stays after the run landed");
     std::fs::remove_dir_all(&root).unwrap();
+}
+
+const LONG: &str = r#"description = "one run long enough to be stopped"
+[defaults]
+problem = "ex71"
+mesh = "structured:4"
+theta = 0.5
+[[run]]
+id = "long"
+levels = 22
+"#;
+
+#[test]
+fn a_checkpoint_is_resumed_only_as_written_by_this_code() {
+    let dir = scratch("resume-checkpoint-is-resumed");
+    std::fs::write(dir.join("long.toml"), LONG).unwrap();
+    let partial = dir.join("killed/long/.partial/long.json");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["run", "long.toml", "--results", "killed"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = std::time::Instant::now();
+    while checkpoint_levels(&partial) < 6 {
+        assert!(child.try_wait().unwrap().is_none(), "the run finished before it could be stopped");
+        assert!(started.elapsed().as_secs() < 300, "no checkpoint of 6 levels after 300 s");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let text = std::fs::read_to_string(&partial).unwrap();
+    let kept: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(kept["sha256"].as_str().map(str::len), Some(64), "{}", &text[..text.len().min(400)]);
+    let edited = |f: &dyn Fn(&mut serde_json::Value)| {
+        let mut v = kept.clone();
+        f(&mut v);
+        serde_json::to_string_pretty(&v).unwrap()
+    };
+    let cases = [
+        ("as-written", text.clone(), "resuming after level"),
+        ("edited", edited(&|v| v["levels"][0]["eta1"] = 0.1234.into()), "its levels are not what was written"),
+        ("truncated", text[..text.len() / 2].to_string(), "it does not parse as a checkpoint"),
+        ("other-code", edited(&|v| v["code"]["executable_sha256"] = "0".repeat(64).into()), "it was written by other code"),
+    ];
+    let mut eta1 = Vec::new();
+    for (name, checkpoint, said) in cases {
+        let results = dir.join(name);
+        std::fs::create_dir_all(results.join("long/.partial")).unwrap();
+        std::fs::write(results.join("long/.partial/long.json"), checkpoint).unwrap();
+        let (code, _, err) = signorini_in(&dir, &["run", "long.toml", "--results", name]);
+        assert_eq!(code, 0, "{name}: {err}");
+        assert!(err.contains(said), "{name}: {err}");
+        if name != "as-written" {
+            assert!(err.contains(&format!("{name}/long/.partial/long.json: not resumed from: ")), "{err}");
+            assert!(err.contains("the run starts over") && !err.contains("resuming after"), "{err}");
+        }
+        let record: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(results.join("long/runs/long.json")).unwrap()).unwrap();
+        assert_eq!(record["levels"].as_array().unwrap().len(), 22);
+        eta1.push(record["levels"][0]["eta1"].as_f64().unwrap());
+    }
+    assert!(eta1.iter().all(|&e| e == eta1[0] && e != 0.1234), "{eta1:?}");
+    std::fs::remove_dir_all(&dir).ok();
 }

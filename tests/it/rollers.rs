@@ -119,7 +119,7 @@ fn with(dirichlet: &str, points: &str) -> String {
 }
 
 #[test]
-fn bad_rollers_and_point_constraints_are_clear_errors() {
+fn malformed_rollers_and_point_constraints_are_clear_errors() {
     let e = solve_err(&with("[\"free\", \"free\"]", ""));
     assert!(e.contains("p.toml:") && e.contains("key `dirichlet`") && e.contains("at least one component prescribed"), "{e}");
     let e = solve_err(&with("[0.1, \"free\"]", "[[point_constraints]]\nat = [0, 0.5]\nu = [\"free\", \"free\"]\n"));

@@ -4,26 +4,12 @@
 //! with nothing to compare, or with records made from an edited manifest, says so.
 
 use crate::common::signorini_in;
+use crate::common::{copy_dir, scratch};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 fn repo() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("signorini-scratch-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap().flatten() {
-        let target = to.join(e.file_name());
-        if e.path().is_dir() { copy_dir(&e.path(), &target) } else { std::fs::copy(e.path(), target).map(|_| ()).unwrap() }
-    }
 }
 
 /// Every file under `dir` with its contents' hash, sorted by path.
@@ -55,7 +41,7 @@ fn tracked_state() -> Vec<(PathBuf, String)> {
 /// so it is not computed a second time here), one copy per test (tests run concurrently and
 /// write into their folder).
 fn scratch_copy(name: &str) -> PathBuf {
-    let dir = tmp(name);
+    let dir = scratch(&format!("scratch-{name}"));
     copy_dir(&repo().join("results/ex71"), &dir.join("ex71"));
     dir
 }
@@ -116,7 +102,7 @@ fn figures_of_one_study_are_drawn_into_its_scratch_folder_only() {
 fn small_store() -> &'static PathBuf {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let d = tmp("small");
+        let d = scratch("scratch-small");
         let text = std::fs::read_to_string(repo().join("tests/fixtures/cli_pair.toml")).unwrap();
         for (folder, name, body) in
             [("experiments", "one", text.clone()), ("experiments", "two", text.clone()), ("edited", "one", text + "# edited\n")]

@@ -3,6 +3,7 @@
 //! and deletes nothing, while shards compute side by side and never the same run twice; an interrupted study keeps its finished runs with summaries that
 //! describe exactly them, and `figures` refuses it.
 
+use crate::common::{fixture_path, scratch};
 use signorini::records::StudyDir;
 use signorini::study::manifest::Manifest;
 use signorini::study::store::Store;
@@ -10,13 +11,6 @@ use signorini::study::{check_complete, drift};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("signorini-store-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn signorini(args: &[&str]) -> (Option<i32>, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).output().unwrap();
@@ -28,15 +22,11 @@ fn signorini(args: &[&str]) -> (Option<i32>, String) {
 /// `signorini run` of the tiny study with --wait, in the background (stderr captured).
 fn run_waiting(res: &str) -> std::process::Child {
     Command::new(env!("CARGO_BIN_EXE_signorini"))
-        .args(["run", &fixture(), "--quick", "--wait", "--results", res])
+        .args(["run", &fixture_path("tiny.toml"), "--quick", "--wait", "--results", res])
         .stderr(Stdio::piped())
         .stdout(Stdio::null())
         .spawn()
         .unwrap()
-}
-
-fn fixture() -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny.toml").display().to_string()
 }
 
 /// A study of several runs long enough to be interrupted in the middle (about a second each).
@@ -54,12 +44,12 @@ fn long_manifest(dir: &Path) -> PathBuf {
 
 #[test]
 fn fresh_shard_removes_only_its_own_runs() {
-    let d = tmp("shard");
+    let d = scratch("store-shard");
     let res = d.to_str().unwrap();
-    assert_eq!(signorini(&["run", &fixture(), "--quick", "--shard", "2/2", "--results", res]).0, Some(0));
+    assert_eq!(signorini(&["run", &fixture_path("tiny.toml"), "--quick", "--shard", "2/2", "--results", res]).0, Some(0));
     let dir = StudyDir::new(&d, "tiny");
     assert!(dir.run_file("b").exists());
-    let (code, err) = signorini(&["run", &fixture(), "--quick", "--shard", "1/2", "--fresh", "--results", res]);
+    let (code, err) = signorini(&["run", &fixture_path("tiny.toml"), "--quick", "--shard", "1/2", "--fresh", "--results", res]);
     assert_eq!(code, Some(0), "{err}");
     let ids: Vec<String> = dir.read_runs().unwrap().iter().map(|r| r.run.id.clone()).collect();
     assert_eq!(ids, ["a", "b"], "shard 1's --fresh removed shard 2's run");
@@ -70,9 +60,9 @@ fn fresh_shard_removes_only_its_own_runs() {
 
 #[test]
 fn a_second_run_of_the_same_study_is_refused_or_waits_and_loses_nothing() {
-    let d = tmp("lock");
+    let d = scratch("store-lock");
     let res = d.to_str().unwrap();
-    assert_eq!(signorini(&["run", &fixture(), "--quick", "--shard", "2/2", "--results", res]).0, Some(0));
+    assert_eq!(signorini(&["run", &fixture_path("tiny.toml"), "--quick", "--shard", "2/2", "--results", res]).0, Some(0));
     let dir = StudyDir::new(&d, "tiny");
     let before = std::fs::read(dir.run_file("b")).unwrap();
     let store = Store::new(&d, "tiny");
@@ -80,7 +70,7 @@ fn a_second_run_of_the_same_study_is_refused_or_waits_and_loses_nothing() {
     // refused after the lock's patience (1 s here, 30 by default), naming the holder; with
     // --fresh it must not have deleted anything
     let out = Command::new(env!("CARGO_BIN_EXE_signorini"))
-        .args(["run", &fixture(), "--quick", "--fresh", "--results", res])
+        .args(["run", &fixture_path("tiny.toml"), "--quick", "--fresh", "--results", res])
         .env("SIGNORINI_LOCK_PATIENCE", "1")
         .output()
         .unwrap();
@@ -109,7 +99,7 @@ fn a_second_run_of_the_same_study_is_refused_or_waits_and_loses_nothing() {
 
 #[test]
 fn an_interrupted_study_keeps_consistent_summaries_and_figures_refuse_it() {
-    let d = tmp("interrupt");
+    let d = scratch("store-interrupt");
     let exp = d.join("experiments");
     std::fs::create_dir_all(&exp).unwrap();
     let manifest = long_manifest(&exp);
@@ -173,7 +163,7 @@ fn an_interrupted_study_keeps_consistent_summaries_and_figures_refuse_it() {
 
 #[test]
 fn shards_compute_side_by_side_and_a_run_is_computed_once() {
-    let d = tmp("runlock");
+    let d = scratch("store-runlock");
     let res = d.to_str().unwrap();
     let dir = StudyDir::new(&d, "tiny");
     // another process computes run a now: it holds a's lock and has a temporary file staged
@@ -183,12 +173,12 @@ fn shards_compute_side_by_side_and_a_run_is_computed_once() {
     std::fs::create_dir_all(staged.parent().unwrap()).unwrap();
     std::fs::write(&staged, "half written").unwrap();
     // shard 2/2 (run b) neither waits for a nor removes a's file in progress
-    let (code, err) = signorini(&["run", &fixture(), "--quick", "--shard", "2/2", "--results", res]);
+    let (code, err) = signorini(&["run", &fixture_path("tiny.toml"), "--quick", "--shard", "2/2", "--results", res]);
     assert_eq!(code, Some(0), "{err}");
     assert!(dir.run_file("b").exists() && !dir.run_file("a").exists());
     assert!(staged.exists(), "removed a file of a run in progress: {err}");
     // the whole study without --wait: refused at run a, naming the holder
-    let (code, err) = signorini(&["run", &fixture(), "--quick", "--results", res]);
+    let (code, err) = signorini(&["run", &fixture_path("tiny.toml"), "--quick", "--results", res]);
     assert_ne!(code, Some(0));
     assert!(
         err.contains("run a of") && err.contains("is being written by process") && err.contains(&std::process::id().to_string()),
@@ -213,15 +203,15 @@ fn shards_compute_side_by_side_and_a_run_is_computed_once() {
 
 #[test]
 fn a_stored_run_another_process_computes_is_not_removed_by_replace() {
-    let d = tmp("claim");
+    let d = scratch("store-claim");
     let res = d.to_str().unwrap();
-    assert_eq!(signorini(&["run", &fixture(), "--quick", "--results", res]).0, Some(0));
+    assert_eq!(signorini(&["run", &fixture_path("tiny.toml"), "--quick", "--results", res]).0, Some(0));
     let dir = StudyDir::new(&d, "tiny");
     // the stored run b is no longer declared, and another process holds b's lock (computes it
     // under an older manifest): --replace must not remove what that process is writing
     let exp = d.join("exp");
     std::fs::create_dir_all(&exp).unwrap();
-    let text = std::fs::read_to_string(fixture()).unwrap();
+    let text = std::fs::read_to_string(fixture_path("tiny.toml")).unwrap();
     let cut = text.find("[[run]]\nid = \"b\"").expect("the fixture declares run b");
     let only_a = exp.join("tiny.toml");
     std::fs::write(&only_a, &text[..cut]).unwrap();
@@ -242,9 +232,9 @@ fn a_stored_run_another_process_computes_is_not_removed_by_replace() {
 
 #[test]
 fn a_temporary_file_of_a_running_writer_is_not_a_leftover() {
-    let d = tmp("writer");
+    let d = scratch("store-writer");
     let res = d.to_str().unwrap();
-    assert_eq!(signorini(&["run", &fixture(), "--quick", "--shard", "2/2", "--results", res]).0, Some(0));
+    assert_eq!(signorini(&["run", &fixture_path("tiny.toml"), "--quick", "--shard", "2/2", "--results", res]).0, Some(0));
     let dir = StudyDir::new(&d, "tiny");
     // another process commits levels.csv now (its name is in the temporary's), and one that has
     // ended left its own
@@ -260,16 +250,16 @@ fn a_temporary_file_of_a_running_writer_is_not_a_leftover() {
 }
 
 /// The study lock is held only to set up and to commit: a run that finds it taken waits for it
-/// (up to 30 s) without --wait, so two shards started at the same moment both run (battery
-/// finding 12: the second was refused).
+/// (up to 30 s) without --wait, so two shards started at the same moment both run (the second is not
+/// refused).
 #[test]
 fn a_study_lock_held_briefly_is_waited_for_without_wait() {
-    let d = tmp("brief-lock");
+    let d = scratch("store-brief-lock");
     let res = d.to_str().unwrap();
     let store = Store::new(&d, "tiny");
     let lock = store.lock(false).unwrap();
     let child = Command::new(env!("CARGO_BIN_EXE_signorini"))
-        .args(["run", &fixture(), "--quick", "--shard", "1/2", "--results", res])
+        .args(["run", &fixture_path("tiny.toml"), "--quick", "--shard", "1/2", "--results", res])
         .stderr(Stdio::piped())
         .stdout(Stdio::null())
         .spawn()

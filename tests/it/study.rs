@@ -2,29 +2,19 @@
 //! interrupted study resumes; the quick form is an exact prefix of the full one.
 
 use crate::common;
+use crate::common::{fixture_path, scratch};
 use common::parse_err;
 
 use signorini::records::{RunRecord, StudyDir};
 use signorini::study::manifest::{Manifest, ManifestError};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("signorini-test-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn signorini(args: &[&str]) -> (bool, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_signorini")).args(args).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(!err.contains("panicked"), "{err}");
     (out.status.success(), err)
-}
-
-fn fixture() -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny.toml").display().to_string()
 }
 
 /// Records without timings (fields t_*), as JSON values.
@@ -37,7 +27,7 @@ fn numbers(r: &RunRecord) -> serde_json::Value {
 }
 
 #[test]
-fn bad_manifests_name_file_key_and_expectation() {
+fn malformed_manifests_name_file_key_and_expectation() {
     let base = "[defaults]\nproblem = \"ex71\"\nlevels = 3\n";
     let e = parse_err(&format!("{base}[[run]]\nid = \"a\"\ntheta = 1.5\n"));
     assert!(e.contains("run[0].theta") && e.contains("(0, 1]") && e.contains("1.5"), "{e}");
@@ -63,22 +53,22 @@ fn bad_manifests_name_file_key_and_expectation() {
 }
 
 #[test]
-fn bad_manifest_via_cli_is_a_clear_error() {
-    let d = tmp("badcli");
+fn a_malformed_manifest_via_cli_is_a_clear_error() {
+    let d = scratch("study-badcli");
     let f = d.join("bad_study.toml");
     std::fs::write(&f, "[[run]]\nid = \"a\"\nproblem = \"ex71\"\nlevels = 0\n").unwrap();
     let (ok, err) = signorini(&["run", f.to_str().unwrap(), "--results", d.to_str().unwrap()]);
     assert!(!ok);
     assert!(err.contains("bad_study.toml") && err.contains("run[0].levels"), "{err}");
-    let (ok, err) = signorini(&["run", &fixture(), "--shard", "3/2", "--results", d.to_str().unwrap()]);
+    let (ok, err) = signorini(&["run", &fixture_path("tiny.toml"), "--shard", "3/2", "--results", d.to_str().unwrap()]);
     assert!(!ok && err.contains("--shard"), "{err}");
 }
 
 #[test]
 fn same_numbers_on_one_and_two_threads() {
-    let (d1, d2) = (tmp("j1"), tmp("j2"));
-    assert!(signorini(&["run", &fixture(), "--jobs", "1", "--results", d1.to_str().unwrap()]).0);
-    assert!(signorini(&["run", &fixture(), "--jobs", "2", "--results", d2.to_str().unwrap()]).0);
+    let (d1, d2) = (scratch("study-j1"), scratch("study-j2"));
+    assert!(signorini(&["run", &fixture_path("tiny.toml"), "--jobs", "1", "--results", d1.to_str().unwrap()]).0);
+    assert!(signorini(&["run", &fixture_path("tiny.toml"), "--jobs", "2", "--results", d2.to_str().unwrap()]).0);
     let (r1, r2) = (StudyDir::new(&d1, "tiny").read_runs().unwrap(), StudyDir::new(&d2, "tiny").read_runs().unwrap());
     assert_eq!(r1.len(), 2);
     for (a, b) in r1.iter().zip(&r2) {
@@ -90,14 +80,14 @@ fn same_numbers_on_one_and_two_threads() {
 
 #[test]
 fn interrupted_study_resumes_and_shards_merge() {
-    let d = tmp("resume");
+    let d = scratch("study-resume");
     let res = d.to_str().unwrap();
     // the first shard stands for a study interrupted after its first run
-    assert!(signorini(&["run", &fixture(), "--shard", "1/2", "--results", res]).0);
+    assert!(signorini(&["run", &fixture_path("tiny.toml"), "--shard", "1/2", "--results", res]).0);
     let dir = StudyDir::new(&d, "tiny");
     assert_eq!(dir.read_runs().unwrap().len(), 1);
     let before = std::fs::metadata(dir.run_file("a")).unwrap().modified().unwrap();
-    let (ok, err) = signorini(&["run", &fixture(), "--results", res]);
+    let (ok, err) = signorini(&["run", &fixture_path("tiny.toml"), "--results", res]);
     assert!(ok);
     assert!(err.contains("tiny/a: finished earlier, kept"), "{err}");
     assert_eq!(std::fs::metadata(dir.run_file("a")).unwrap().modified().unwrap(), before, "finished run rewritten");
@@ -110,15 +100,15 @@ fn interrupted_study_resumes_and_shards_merge() {
         assert!(prov.get(key).is_some(), "provenance lacks {key}");
     }
     // --fresh starts over
-    let (ok, err) = signorini(&["run", &fixture(), "--fresh", "--results", res]);
+    let (ok, err) = signorini(&["run", &fixture_path("tiny.toml"), "--fresh", "--results", res]);
     assert!(ok && !err.contains("finished earlier"), "{err}");
 }
 
 #[test]
 fn quick_form_is_an_exact_prefix() {
-    let (dq, df) = (tmp("quick"), tmp("full"));
-    assert!(signorini(&["run", &fixture(), "--quick", "--results", dq.to_str().unwrap()]).0);
-    assert!(signorini(&["run", &fixture(), "--results", df.to_str().unwrap()]).0);
+    let (dq, df) = (scratch("study-quick"), scratch("study-full"));
+    assert!(signorini(&["run", &fixture_path("tiny.toml"), "--quick", "--results", dq.to_str().unwrap()]).0);
+    assert!(signorini(&["run", &fixture_path("tiny.toml"), "--results", df.to_str().unwrap()]).0);
     let (q, f) = (StudyDir::new(&dq, "tiny").read_runs().unwrap(), StudyDir::new(&df, "tiny").read_runs().unwrap());
     for (q, f) in q.iter().zip(&f) {
         let (qn, fn_) = (numbers(q), numbers(f));
@@ -137,7 +127,7 @@ fn quick_form_is_an_exact_prefix() {
 fn stored_reference_replays_to_the_computed_one() {
     use signorini::mesh::MeshSpec;
     use signorini::study::reference;
-    let m = Manifest::load(Path::new(&fixture())).unwrap();
+    let m = Manifest::load(Path::new(&fixture_path("tiny.toml"))).unwrap();
     let spec = &m.runs[0].spec;
     let reference_spec = spec.reference.as_ref().unwrap();
     let problem = signorini::problems::load(&spec.problem, &spec.constants).unwrap();

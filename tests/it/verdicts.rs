@@ -3,12 +3,12 @@
 //! centres are told from the coarse end of a grading, and the `fb` rows of CLAIMS.md read
 //! synthetic records (and say "no data" without them).
 
+use crate::common::scratch;
 use signorini::adapt::{LevelRecord, Refine};
 use signorini::claims::{self, Verdict};
 use signorini::estimate::EstimatorConfig;
 use signorini::records::{MeshSnapshot, RunRecord, RunSpec, StudyDir, write_json};
 use signorini::verdict::{self, RateReport, RateVerdict, refinement};
-use std::path::PathBuf;
 
 /// Deterministic pseudo-random numbers, roughly standard normal (sum of 12 uniforms - 6).
 struct Lcg(u64);
@@ -176,12 +176,6 @@ fn refinement_centre_is_told_from_the_coarse_end_of_a_grading() {
     assert!(!refinement::local_minimum(&prof, a, 0.15).unwrap().holds);
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("signorini-verdicts-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
-
 fn record(id: &str, refine: Refine, levels: Vec<LevelRecord>) -> RunRecord {
     let run = RunSpec {
         id: id.into(),
@@ -235,7 +229,7 @@ fn row<'a>(c: &'a [claims::Claim], id: &str) -> &'a claims::Claim {
 
 #[test]
 fn fb_rows_say_no_data_without_the_study() {
-    let d = tmp("empty");
+    let d = scratch("verdicts-empty");
     std::fs::create_dir_all(&d).unwrap();
     let c = claims::claims(&crate::common::sealed(&d), crate::common::roles()).unwrap();
     for id in ["fb-error-rate", "fb-efficiency", "fb-refinement", "fb-error-rate (without full-contact nodes)", "fb-contact-zone"] {
@@ -247,7 +241,7 @@ fn fb_rows_say_no_data_without_the_study() {
 
 #[test]
 fn fb_rows_on_synthetic_records() {
-    let d = tmp("fb");
+    let d = scratch("verdicts-fb");
     let dir = StudyDir::new(&d, "fb");
     std::fs::create_dir_all(dir.root.join("runs")).unwrap();
     std::fs::create_dir_all(dir.root.join("meshes")).unwrap();

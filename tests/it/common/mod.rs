@@ -196,3 +196,151 @@ pub fn copy_tree(from: &std::path::Path, to: &std::path::Path) {
         }
     }
 }
+
+/// The text of `tests/fixtures/BASE` with each `from` replaced by its `to` (each must be there).
+pub fn edited(base: &str, edits: &[(&str, &str)]) -> String {
+    let mut text = fixture(base);
+    for (from, to) in edits {
+        assert!(text.contains(from), "{from} not in {base}");
+        text = text.replace(from, to);
+    }
+    text
+}
+
+/// `signorini ARGS` in a fresh folder holding `v.toml` (fixture `base` with `edits`, see
+/// [`edited`]), `qd.msh` (the quarter disc) and `sq.msh` (the Gmsh square), removed afterwards:
+/// (exit code, stdout, stderr), never a panic or a signal.
+pub fn run_edited(name: &str, base: &str, edits: &[(&str, &str)], args: &[&str]) -> (i32, String, String) {
+    let dir = scratch(&format!("edited-{name}"));
+    std::fs::write(dir.join("v.toml"), edited(base, edits)).unwrap();
+    std::fs::write(dir.join("qd.msh"), fixture("gmsh_renumbered/plain.msh")).unwrap();
+    std::fs::write(dir.join("sq.msh"), fixture("square.msh")).unwrap();
+    let answer = signorini_in(&dir, args);
+    std::fs::remove_dir_all(&dir).ok();
+    answer
+}
+
+/// `signorini ARGS` in `dir` without progress lines: (exit code, stdout followed by stderr),
+/// never a panic.
+pub fn output_in(dir: &std::path::Path, args: &[&str]) -> (i32, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(dir)
+        .env("SIGNORINI_PROGRESS", "off")
+        .args(args)
+        .output()
+        .unwrap();
+    let all = String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert!(!all.contains("panicked"), "{all}");
+    (o.status.code().unwrap_or(-1), all)
+}
+
+/// `signorini solve` of the Gmsh square's problem (fixture `bad_data_gmsh.toml` with `edits`)
+/// on `tests/fixtures/square.msh` with `mesh_edits` (each replaced once): (exit code, stdout and
+/// stderr).
+pub fn solve_gmsh_square(name: &str, edits: &[(&str, &str)], mesh_edits: &[(&str, &str)]) -> (i32, String) {
+    let dir = scratch(&format!("gmsh-square-{name}"));
+    for (file, fixture_name, edits) in [("v.toml", "bad_data_gmsh.toml", edits), ("sq.msh", "square.msh", mesh_edits)] {
+        let mut text = fixture(fixture_name);
+        for (from, to) in edits {
+            assert!(text.contains(from), "{from} not in {fixture_name}");
+            text = text.replacen(from, to, 1);
+        }
+        std::fs::write(dir.join(file), text).unwrap();
+    }
+    let out = output_in(&dir, &["solve", "--problem", "v.toml", "--mesh", "gmsh:sq.msh"]);
+    std::fs::remove_dir_all(&dir).ok();
+    out
+}
+
+/// `signorini ARGS` run in the repository's root: (exit code, stdout, stderr), as [`signorini_in`].
+pub fn signorini_in_repo(args: &[&str]) -> (i32, String, String) {
+    signorini_in(std::path::Path::new(env!("CARGO_MANIFEST_DIR")), args)
+}
+
+/// The path of `tests/fixtures/NAME`, as a string for an argument list.
+pub fn fixture_path(name: &str) -> String {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(name).display().to_string()
+}
+
+/// `signorini ARGS` in `dir` without progress lines, killed after 20 s (a hang is a failure, not
+/// a wait): (exit code, stdout, stderr); never a panic or a signal.
+pub fn signorini_in_time(dir: &std::path::Path, args: &[&str]) -> (i32, String, String) {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(dir)
+        .args(args)
+        .env("SIGNORINI_PROGRESS", "off")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(20) {
+            child.kill().unwrap();
+            panic!("signorini {args:?} hung (killed after 20 s)");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let o = child.wait_with_output().unwrap();
+    let (out, err) = (String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned());
+    assert!(!err.contains("panicked"), "{err}");
+    (o.status.code().unwrap_or_else(|| panic!("killed by a signal: {err}")), out, err)
+}
+
+/// Write a study `NAME.toml` in `dir` of ex71 on structured:2 with one run `id` (2 levels, quick
+/// form 1) and `extra` appended; its file name.
+pub fn one_run_manifest(dir: &std::path::Path, name: &str, id: &str, extra: &str) -> String {
+    let file = format!("{name}.toml");
+    let text = format!(
+        "description = \"t\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:2\"\nlevels = 2\nquick_levels = 1\n[[run]]\nid = \"{id}\"\n{extra}"
+    );
+    std::fs::write(dir.join(&file), text).unwrap();
+    file
+}
+
+/// Copy the folder `from` to `to` (made), following symlinks.
+pub fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let target = to.join(e.file_name());
+        if e.path().is_dir() { copy_dir(&e.path(), &target) } else { std::fs::copy(e.path(), target).map(|_| ()).unwrap() }
+    }
+}
+
+/// The `estimator:` line of a solve's output.
+pub fn estimator_line(out: &str) -> String {
+    out.lines().find(|l| l.starts_with("estimator:")).unwrap_or_default().to_string()
+}
+
+/// Wait for `child` (its output piped): (exit code, stdout followed by stderr).
+pub fn finish(child: std::process::Child) -> (i32, String) {
+    let o = child.wait_with_output().unwrap();
+    (o.status.code().unwrap_or(-1), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
+}
+
+/// The problem text parsed, or its error's message.
+pub fn parse_problem(text: &str) -> Result<signorini::problems::FileProblem, String> {
+    signorini::problems::FileProblem::parse(std::path::Path::new("p.toml"), text).map_err(|e| e.to_string())
+}
+
+/// Level rows of `adapt`'s table.
+pub fn level_rows(out: &str) -> usize {
+    out.lines().filter(|l| l.trim_start().starts_with(|c: char| c.is_ascii_digit())).count()
+}
+
+/// A scratch folder with the study of two runs ([`TWO_RUNS`]) stored into `res` and `fresh`.
+pub fn stored_two_runs(name: &str) -> std::path::PathBuf {
+    let dir = scratch(name);
+    std::fs::create_dir_all(dir.join("experiments")).unwrap();
+    std::fs::write(dir.join("experiments/s.toml"), TWO_RUNS).unwrap();
+    for results in ["res", "fresh"] {
+        let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", results]);
+        assert_eq!(code, 0, "{out}{err}");
+    }
+    dir
+}
+
+/// A stored study of two runs, one adaptive, one uniform.
+const TWO_RUNS: &str = "description = \"s\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\ntheta = 0.5\nlevels = 4\nquick_levels = 2\n[[run]]\nid = \"a\"\nrefine = \"adaptive\"\n[[run]]\nid = \"c\"\nrefine = \"uniform\"\n";

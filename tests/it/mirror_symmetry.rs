@@ -1,13 +1,7 @@
-//! Battery 13, finding F2 [silent]: Example 7.1 mirrored about y = x (x and y swapped, and the
-//! components; contact on x = 0), on `structured:N`, a mesh the mirror maps onto itself, gave the
-//! mirrored u_h to the last digit, yet err_quadrature (the efficiency index's denominator) 20-25%
-//! smaller, eta_1 6% smaller and other adaptive meshes from level 1. The "quadrature" maxima were
-//! taken over the collapsed Gauss rule's points, which only the reflection fixing one vertex keeps;
-//! a mirror reverses each triangle and sampled other points. They are now taken over Radon's
-//! 7-point degree-5 rule, which every symmetry of the triangle keeps: the mirrored problem's
-//! errors, estimates and adaptive meshes are the original's, line for line.
+//! A problem mirrored about y = x reports the same errors, estimates and adaptive meshes as the
+//! original: the error maxima are taken over points that a reflection maps onto themselves.
 
-use super::common::{scratch, signorini_in};
+use crate::common::{scratch, signorini_in};
 
 const MIRRORED: &str = r#"description = "Example 7.1 mirrored about y = x"
 body_force = ["3*x*(y - 2)*(x + 3)*exp(x)", "2*exp(x)*(x^2 + x - 1) - 6*x + 2"]
@@ -40,7 +34,7 @@ fn numbers(out: &str) -> Vec<String> {
 
 #[test]
 fn a_mirrored_problem_reports_the_same_errors_estimates_and_meshes() {
-    let dir = scratch("b13-f2");
+    let dir = scratch("mirror-symmetry-mirrored-problem-reports");
     std::fs::write(dir.join("sw71.toml"), MIRRORED).unwrap();
     let run = |args: &[&str]| {
         let (code, out, err) = signorini_in(&dir, args);

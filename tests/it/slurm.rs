@@ -2,15 +2,9 @@
 //! a bad call exits non-zero with a message naming what is wrong, creates nothing and submits
 //! nothing. The script runs with a fake `sbatch` first on PATH that records each call.
 
+use crate::common::scratch;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("signorini-slurm-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 /// Every path under `dir`, sorted.
 fn listing(dir: &Path) -> Vec<PathBuf> {
@@ -36,7 +30,7 @@ struct Setup {
 impl Setup {
     fn new(name: &str) -> Self {
         use std::os::unix::fs::PermissionsExt;
-        let root = tmp(name);
+        let root = scratch(&format!("slurm-{name}"));
         let (work, tools) = (root.join("work"), root.join("tools"));
         std::fs::create_dir_all(&work).unwrap();
         std::fs::create_dir_all(&tools).unwrap();
@@ -64,7 +58,7 @@ impl Setup {
 }
 
 #[test]
-fn bad_submit_arguments_are_refused_before_anything_is_created_or_submitted() {
+fn invalid_submit_arguments_are_refused_before_anything_is_created_or_submitted() {
     for (args, expected) in [
         (&["--tasks", "0", "m.toml"][..], "--tasks 0: expected a whole number >= 1"),
         (&["--tasks", "abc", "m.toml"][..], "--tasks abc: expected a whole number >= 1"),
@@ -92,7 +86,7 @@ fn bad_submit_arguments_are_refused_before_anything_is_created_or_submitted() {
 }
 
 #[test]
-fn good_submit_calls_sbatch_for_the_array_and_the_finish_job() {
+fn a_valid_submit_calls_sbatch_for_the_array_and_the_finish_job() {
     let s = Setup::new("good");
     let (code, err) = s.submit(&["--tasks", "3", "--results", "res", "--bin", "fake-bin", "m.toml"]);
     assert_eq!(code, 0, "{err}");
@@ -102,8 +96,8 @@ fn good_submit_calls_sbatch_for_the_array_and_the_finish_job() {
     assert!(s.work.join("res/slurm-logs").is_dir());
 }
 
-/// Battery 10, F2: `--tasks 5` for a study of 3 runs was submitted; tasks 4 and 5 failed ("this
-/// shard holds no run") and the finish job (afterok) never ran. The script now asks the binary
+/// `--tasks 5` for a study of 3 runs is not submitted (tasks 4 and 5 would fail, "this shard
+/// holds no run", and the finish job, afterok, never run): the script asks the binary
 /// (`run --plan --shard N/N`, which runs nothing) before it creates or submits anything.
 #[test]
 fn more_tasks_than_runs_are_refused_before_anything_is_submitted() {

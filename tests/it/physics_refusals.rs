@@ -4,24 +4,14 @@
 //! the body's size; and a material without elastic sense (Young's modulus <= 0, Poisson's ratio
 //! outside (-1, 0.5) in plane strain and plane stress alike, Lamé constants that are not coercive).
 
+use crate::common::{fixture, scratch};
 use std::path::PathBuf;
 use std::process::Command;
-
-fn fixture(name: &str) -> String {
-    std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures").join(name)).unwrap()
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("signorini-bad-physics-{name}-{}", std::process::id()));
-    std::fs::remove_dir_all(&dir).ok();
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// `signorini ARGS` in a folder holding `v.toml` (`base` with `from` replaced by `to`) and
 /// `sq.msh` (the Gmsh square): (exit code, stderr).
 fn run(name: &str, base: &str, from: &str, to: &str, args: &[&str]) -> (i32, String) {
-    let dir = tmp(name);
+    let dir = scratch(&format!("physics-refusals-{name}"));
     let text = fixture(base);
     assert!(text.contains(from), "{from} not in {base}");
     std::fs::write(dir.join("v.toml"), text.replace(from, to)).unwrap();
@@ -33,7 +23,9 @@ fn run(name: &str, base: &str, from: &str, to: &str, args: &[&str]) -> (i32, Str
 }
 
 const SOLVE: &[&str] = &["solve", "--problem", "v.toml", "--mesh", "structured:4"];
+
 const SQUARE: &str = "bad_data_square.toml";
+
 const OUTWARD: &str = r#"normal = "outward""#;
 
 #[test]
@@ -82,9 +74,9 @@ fn the_adaptive_loop_and_a_study_refuse_it_too() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("reversed against the edge's outward normal"), "{err}");
     // a study: the manifest's run is refused before any record is written
-    let dir = tmp("study");
+    let dir = scratch("physics-refusals-study");
     std::fs::write(dir.join("v.toml"), fixture(SQUARE).replace(OUTWARD, "normal = [1, 0]")).unwrap();
-    let manifest = "description = \"tests/it/bad_physics.rs\"\n[defaults]\nproblem = \"v.toml\"\nmesh = \"structured:4\"\nlevels = 2\n[[run]]\nid = \"a\"\n";
+    let manifest = "description = \"a study of a refused problem\"\n[defaults]\nproblem = \"v.toml\"\nmesh = \"structured:4\"\nlevels = 2\n[[run]]\nid = \"a\"\n";
     std::fs::write(dir.join("physics.toml"), manifest).unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
         .current_dir(&dir)
@@ -98,8 +90,8 @@ fn the_adaptive_loop_and_a_study_refuse_it_too() {
 
 #[test]
 fn a_gap_deeper_than_the_body_is_refused() {
-    // the unit square is 1 thick along its contact side's normal (battery 11, N2: the bound was
-    // the bounding box's diameter, sqrt(2) = 1.414..., which let -1.4 through)
+    // the unit square is 1 thick along its contact side's normal (not the bounding box's
+    // diameter, sqrt(2) = 1.414..., which would let -1.4 through)
     let (code, err) = run("deep", SQUARE, r#"chi = "0.001""#, r#"chi = "-1.4""#, SOLVE);
     assert_eq!(code, 1, "{err}");
     assert!(
@@ -123,7 +115,7 @@ fn a_material_without_elastic_sense_is_refused_naming_the_key() {
         ("numinus1", "E = 1\nnu = -1\nmodel = \"plane_strain\"", "a Poisson ratio in (-1, 0.5) in plane strain, got -1"),
         ("nustress", "E = 1\nnu = 1\nmodel = \"plane_stress\"", "a Poisson ratio in (-1, 0.5) in plane stress, got 1"),
         // plane stress is a thin plate of a 3-D material: 0.5 <= nu < 1 keeps the 2-D operator
-        // coercive but has no material behind it (battery 5, finding 9: nu = 0.7 solved)
+        // coercive but has no material behind it (nu = 0.7 is refused)
         (
             "nustress07",
             "E = 1\nnu = 0.7\nmodel = \"plane_stress\"",
@@ -143,7 +135,7 @@ fn a_material_without_elastic_sense_is_refused_naming_the_key() {
 /// `signorini ARGS` in a folder holding `v.toml`: experiments/problems/`base` with `from`
 /// replaced by `to`: (exit code, stderr).
 fn run_experiment(name: &str, base: &str, from: &str, to: &str, args: &[&str]) -> (i32, String) {
-    let dir = tmp(name);
+    let dir = scratch(&format!("physics-refusals-{name}"));
     let text = std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("experiments/problems").join(base)).unwrap();
     assert!(text.contains(from), "{from} not in {base}");
     std::fs::write(dir.join("v.toml"), text.replace(from, to)).unwrap();
@@ -205,16 +197,16 @@ fn a_body_force_that_the_exact_solution_does_not_satisfy_is_refused() {
 }
 
 /// Prescribed displacements at the ends of the contact part that start the body inside the
-/// obstacle (battery: a Dirichlet side pushed 0.5 into the foundation at its corners, a point
-/// constraint past the gap) were solved and certified "penetration 0": the constraint is not
-/// imposed at a prescribed node. Refused, naming the node, the source, u . n and the gap; the same
+/// obstacle (a Dirichlet side pushed 0.5 into the foundation at its corners, a point constraint
+/// past the gap) are not solved and certified "penetration 0" (the constraint is not imposed at
+/// a prescribed node): refused, naming the node, the source, u . n and the gap; the same
 /// data touching the obstacle (u . n = chi) pass.
 #[test]
 fn prescribed_displacements_that_start_the_body_inside_the_obstacle_are_refused() {
     let sides = r#"dirichlet = "x < 1e-12 || x > 1 - 1e-12""#;
     let pushed = format!("{sides}\n");
     let variant = |name: &str, dirichlet: &str| {
-        let dir = tmp(name);
+        let dir = scratch(&format!("physics-refusals-{name}"));
         let text = fixture(SQUARE).replace(r#"dirichlet = "y > 1 - 1e-12""#, &pushed).replace(r#"dirichlet = ["0", "-0.01"]"#, dirichlet);
         std::fs::write(dir.join("v.toml"), text).unwrap();
         let o = Command::new(env!("CARGO_BIN_EXE_signorini")).current_dir(&dir).args(SOLVE).output().unwrap();
@@ -234,9 +226,9 @@ fn prescribed_displacements_that_start_the_body_inside_the_obstacle_are_refused(
 }
 
 /// An exact solution that does not satisfy the problem's boundary or contact conditions
-/// (battery: a mistyped gap or traction in Example 7.1; battery 5: a contact normal the solution
-/// is not pressed along, rollers where its traction is not zero) measured errors that never converge,
-/// certified: refused naming the condition, the point and the values. The file as it is passes.
+/// (a mistyped gap or traction in Example 7.1, a contact normal the solution is not pressed
+/// along, rollers where its traction is not zero) would measure errors that never converge:
+/// refused naming the condition, the point and the values. The file as it is passes.
 #[test]
 fn an_exact_solution_that_breaks_a_boundary_or_contact_condition_is_refused() {
     let solve = &["solve", "--problem", "v.toml", "--mesh", "structured:8"];
@@ -244,7 +236,7 @@ fn an_exact_solution_that_breaks_a_boundary_or_contact_condition_is_refused() {
         ("chi-below", "chi = 0\n", "chi = -0.05\n", "u . n <= chi"),
         ("chi-above", "chi = 0\n", "chi = 0.05\n", "complementarity"),
         ("traction", r#"traction = "exact""#, r#"traction = ["0", "0"]"#, "the traction on Gamma_N"),
-        // battery 5: a declared contact normal other than the one the exact solution is pressed
+        // a declared contact normal other than the one the exact solution is pressed
         // along (its traction has a part across it: friction), and a top edge on rollers where
         // the exact solution's traction is not zero (the point constraints hold it vertically)
         ("oblique-normal", r#"normal = "outward""#, "normal = [0.3, -1]", "no tangential traction on Gamma_C"),
@@ -264,11 +256,10 @@ fn an_exact_solution_that_breaks_a_boundary_or_contact_condition_is_refused() {
     assert_eq!(code, 0, "{err}");
 }
 
-/// Battery 7, finding 8: a contact part that is a narrow band inside one edge (y in (0.6113,
-/// 0.6133) on the right side of Example 7.2, between the 16 samples of structured:4 and 8) was
-/// silently dropped on those meshes and refused on 16 and 64. Every sign change of a comparison
-/// is now located by bisection and the parts tested on both sides of it: refused on every mesh,
-/// naming a point of the band; the file without the band passes.
+/// A contact part that is a narrow band inside one edge (y in (0.6113, 0.6133) on the right side
+/// of Example 7.2, between the 16 samples of structured:4 and 8) is refused on every mesh, naming
+/// a point of the band (every sign change of a comparison is located by bisection and the parts
+/// tested on both sides of it); the file without the band passes.
 #[test]
 fn a_contact_band_inside_one_edge_is_refused_on_every_mesh() {
     let whole = r#"contact = "x > 1 - 1e-12""#;
@@ -288,8 +279,8 @@ fn a_contact_band_inside_one_edge_is_refused_on_every_mesh() {
     }
 }
 
-/// Battery 7, finding 11: a `[curves]` circle with a centre that is not a number was blamed on
-/// its radius ("got radius 1"): the message names the centre.
+/// A `[curves]` circle with a centre that is not a number is named by its centre, not blamed on
+/// its radius ("got radius 1").
 #[test]
 fn a_circle_with_a_centre_that_is_not_finite_names_the_centre() {
     let mesh = format!("gmsh:{}", PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("experiments/meshes/hertz.msh").display());

@@ -1,29 +1,60 @@
-//! Battery 14, the leftovers of issue 38 (its "Minor notes" and the rollers case of F3):
-//! * A point constraint on Gamma_D with a value on a component `dirichlet` also prescribes
-//!   (ex72_rollers with `u = [0.25, 0]` at its point (0, 0.5), where `dirichlet = [0.1, "free"]`
-//!   sets u_1 = 0.1) was accepted, exit 0, one of the two values silently dropped. The solve now
-//!   checks, once per mesh before assembling (`contact::point::check_on_dirichlet`), that such a
-//!   value equals Gamma_D's there (to 1e-12 of the prescribed displacements' scale) and refuses
-//!   it otherwise, naming the point, the component, both values and the part; an equal value
-//!   (redundant) is still accepted and solves the same problem. A contact node sets no value
-//!   (a point there leaves the contact nodes; `contact::plausible` and the reaction check judge
-//!   it), and rollers or a symmetry hold are Dirichlet components: no other case exists.
-//! * `export` / `adapt --save` with standard output on /dev/full said only "writing standard
-//!   output: No space left on device" (exit 1) though the files were written. The error now
-//!   names the files written and says only the printed report was lost; exit 1 stays.
-//! * A point constraint at a non-vertex (`at = [1, 0.3]` on structured:4) said only "is not a
-//!   vertex of the mesh". It now says that a required vertex must be one of the mesh given (none
-//!   is inserted) and names the smallest structured:N (and symmetric:N) with a vertex there.
-//! * `adapt | head -c 10` dying by SIGPIPE (141 under pipefail) is the deliberate policy of
-//!   `main` (a closed stdout ends the program as `ls | head` does), kept and tested by
-//!   `bad_input::closed_stdout_ends_quietly`.
+//! Point constraints (`[[point_constraints]]`): a point value that takes a force, or that Gamma_D
+//! sets otherwise, is refused; the rollers' point with zero reaction and an equal value on Gamma_D
+//! are accepted; a point off the vertices names the mesh that lacks it.
 
-use super::common::{scratch, signorini_in};
+use crate::common::{scratch, signorini_in};
 use std::path::Path;
-use std::process::Command;
+
+/// Example 7.2 with `u = (0.3, 0)` prescribed at its centre.
+const INTERIOR_POINT: &str = "dirichlet = [0.1, 0]\nrequired_vertices = [[1, 0.5]]\n[material]\nE = 500\nnu = 0.3\nmodel = \"plane_strain\"\n[parts]\ncontact = \"x > 1 - 1e-12\"\ndirichlet = \"x < 1e-12\"\n[contact]\nnormal = \"outward\"\nchi = \"-0.2 + 0.5*abs(y - 0.5)\"\n[[point_constraints]]\nat = [0.5, 0.5]\nu = [0.3, 0]\n";
 
 fn rollers() -> String {
     std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/experiments/problems/ex72_rollers.toml")).unwrap()
+}
+
+fn solve(dir: &Path, problem: &str, mesh: &str) -> (i32, String, String) {
+    std::fs::write(dir.join("p.toml"), problem).unwrap();
+    signorini_in(dir, &["solve", "--problem", "p.toml", "--mesh", mesh])
+}
+
+#[test]
+fn a_point_constraint_that_takes_a_force_is_refused() {
+    let dir = scratch("point-constraints-point-constraint-that");
+    for mesh in ["structured:4", "structured:16"] {
+        let (code, out, err) = solve(&dir, INTERIOR_POINT, mesh);
+        assert_eq!(code, 1, "{mesh}: {out}{err}");
+        assert!(!out.contains("estimator:"), "{mesh}: {out}");
+        for part in [
+            "the point constraint at (0.5, 0.5) prescribes u_1 = 0.3",
+            "takes a force of",
+            "removing a rigid motion",
+            "zero H^1 capacity",
+            "on a part",
+        ] {
+            assert!(err.contains(part), "{mesh}: {part:?} not in {err}");
+        }
+    }
+    // the adaptive loop gets the same refusal from its first solve
+    let (code, _, err) = signorini_in(&dir, &["adapt", "--problem", "p.toml", "--levels", "3"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("removing a rigid motion"), "{err}");
+}
+
+#[test]
+fn the_rollers_point_with_zero_reaction_is_accepted() {
+    let dir = scratch("point-constraints-rollers");
+    for mesh in ["structured:4", "structured:16", "symmetric:24"] {
+        let (code, out, err) = solve(&dir, &rollers(), mesh);
+        assert_eq!(code, 0, "{mesh}: {err}");
+        assert!(out.contains("estimator:"), "{mesh}: {out}");
+        assert!(!err.contains("point constraint"), "{mesh}: {err}");
+    }
+    // u_2 = 0.05 at the point still only fixes the vertical rigid motion (here, a translation
+    // by 0.05), which takes no force: accepted too; it is the force, not the value, that counts
+    let moved = rollers().replace("u = [\"free\", 0] ", "u = [\"free\", 0.05] ");
+    assert_ne!(moved, rollers());
+    let (code, _, err) = solve(&dir, &moved, "structured:8");
+    assert_eq!(code, 0, "{err}");
 }
 
 /// ex72_rollers without its required vertex (the wedge's tip) and with its point constraint at
@@ -39,11 +70,6 @@ fn rollers_with(u: &str) -> String {
     text.replace("u = [\"free\", 0]", u)
 }
 
-fn solve(dir: &Path, problem: &str, mesh: &str) -> (i32, String, String) {
-    std::fs::write(dir.join("p.toml"), problem).unwrap();
-    signorini_in(dir, &["solve", "--problem", "p.toml", "--mesh", mesh])
-}
-
 /// The summary's lines that describe the solution (not the timings).
 fn solution_lines(out: &str) -> Vec<&str> {
     out.lines().filter(|l| l.starts_with("contact:") || l.contains("estimate")).collect()
@@ -51,7 +77,7 @@ fn solution_lines(out: &str) -> Vec<&str> {
 
 #[test]
 fn a_point_value_that_gamma_d_sets_otherwise_is_refused() {
-    let dir = scratch("b14b-dirichlet");
+    let dir = scratch("point-constraints-dirichlet");
     for mesh in ["structured:4", "structured:16"] {
         let (code, out, err) = solve(&dir, &rollers_with("u = [0.25, 0]"), mesh);
         assert_eq!(code, 1, "{mesh}: {out}{err}");
@@ -73,7 +99,7 @@ fn a_point_value_that_gamma_d_sets_otherwise_is_refused() {
 
 #[test]
 fn an_equal_point_value_on_gamma_d_is_accepted_and_changes_nothing() {
-    let dir = scratch("b14b-dirichlet-equal");
+    let dir = scratch("point-constraints-dirichlet-equal");
     let (code, plain, err) = solve(&dir, &rollers(), "structured:8");
     assert_eq!(code, 0, "{err}");
     // 0.3 - 0.2 is 0.1 less 2.8e-17: the same value to round-off
@@ -90,36 +116,8 @@ fn an_equal_point_value_on_gamma_d_is_accepted_and_changes_nothing() {
 }
 
 #[test]
-fn a_failed_stdout_names_the_files_already_written() {
-    let dir = scratch("b14b-devfull");
-    let full = || std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
-    let run = |args: &[&str]| {
-        let o = Command::new(env!("CARGO_BIN_EXE_signorini")).current_dir(&dir).args(args).stdout(full()).output().unwrap();
-        (o.status.code(), String::from_utf8_lossy(&o.stderr).into_owned())
-    };
-    let (code, err) = run(&["export", "--problem", "ex72", "--mesh", "structured:4", "--out", "case"]);
-    assert_eq!(code, Some(1), "{err}");
-    assert!(err.contains("error: writing standard output: No space left on device"), "{err}");
-    assert!(err.contains("Only the printed report was lost"), "{err}");
-    for f in ["mesh.vtu", "case.json"] {
-        let path = dir.join("case").join(f);
-        assert!(err.contains(&Path::new("case").join(f).display().to_string()), "{f} not named: {err}");
-        assert!(std::fs::metadata(&path).unwrap().len() > 0, "{f} empty");
-    }
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("case/case.json")).unwrap()).unwrap();
-    assert!(json.is_object());
-    let (code, err) = run(&["adapt", "--problem", "ex72", "--levels", "2", "--save", "last.vtu"]);
-    assert_eq!(code, Some(1), "{err}");
-    assert!(
-        err.contains("No space left on device") && err.contains("Only the printed report was lost: ") && err.contains("last.vtu"),
-        "{err}"
-    );
-    assert!(std::fs::read_to_string(dir.join("last.vtu")).unwrap().trim_end().ends_with("</VTKFile>"));
-}
-
-#[test]
 fn a_point_constraint_off_the_vertices_says_which_mesh_has_one() {
-    let dir = scratch("b14b-vertex");
+    let dir = scratch("point-constraints-vertex");
     let text = format!("{}\n[[point_constraints]]\nat = [1, 0.3]\nu = [\"free\", 0]\n", rollers());
     let (code, _, err) = solve(&dir, &text, "structured:4");
     assert_eq!(code, 1, "{err}");

@@ -1,25 +1,93 @@
-//! What the eighth battery of hostile inputs found in the file types of a results folder and of
-//! output paths, each fixed in the one function its path goes through:
-//!
-//! * a file of a results folder that is a named pipe (every reader hung) or a symlink to
-//!   `/dev/zero` (every reader grew to 24 GB): every reader of a results folder goes through
-//!   `records::read_bytes`/`read_text`, the bounded reader of `base::input`, which refuses by
-//!   name what is not a regular file, or is larger than `RESULTS_LIMIT`, before opening it;
-//! * an atomic write renamed its file over a named pipe or a device (`adapt --save /dev/null`
-//!   as root replaced /dev/null): `base::input::check_target`, in `records::Batch` and in the
-//!   command line's early checks of `--save` and `--report`, refuses such a target;
-//! * a mesh snapshot no record names: named as a leftover by every reader and removed by `run`,
-//!   now also when it is a named pipe or a symlink (which the folder walk skipped);
-//! * a lock file that is a named pipe or a symlink to a device: refused naming it;
-//! * a named pipe among the manifests of `--experiments`: refused by name (the word on a problem
-//!   file put beside the manifests read it again, past the reader, and hung).
-//!
-//! No test here touches a real device: device nodes are made in a scratch folder, and only as root.
+//! Files that are not what they should be: a named pipe, a device or a link where a regular file is
+//! expected (a manifest, problem, mesh, record, snapshot, summary or lock), or a file where a folder
+//! must be, is refused naming it, at once and without reading it; no write replaces one.
 
+use crate::common::{fixture, one_run_manifest, scratch, signorini_in, signorini_in_time, stored_study, stored_two_runs};
 use std::path::{Path, PathBuf};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
-const STUDY: &str = r#"description = "battery 8 file types: two short runs of Example 7.1, the second saving a mesh"
+/// A named pipe as a lock file (`.lock` or `.locks/RUN.lock`) does not block `report`, `figures`
+/// and `drift` looking at the locks: a lock file that is not a regular file is refused by its
+/// metadata, naming it, as writers refuse it.
+#[test]
+fn a_reader_refuses_a_lock_file_that_is_a_pipe_without_hanging() {
+    let dir = scratch("special-files-fifo-reader-refuses-lock");
+    stored_study(
+        &dir,
+        "experiments/s.toml",
+        "description = \"fifo\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\n[[run]]\nid = \"a\"\nlevels = 3\n",
+        "res",
+    );
+    for lock in ["res/s/.lock", "res/s/.locks/a.lock"] {
+        let path = dir.join(lock);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::remove_file(&path).ok();
+        let made = std::process::Command::new("mkfifo").arg(&path).status().unwrap();
+        assert!(made.success());
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
+            .current_dir(&dir)
+            .args(["report", "--results", "res", "--out", "page"])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = std::time::Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if start.elapsed().as_secs() > 60 {
+                child.kill().ok();
+                panic!("report hung on the named pipe {lock}");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let o = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{lock}: {err}");
+        assert!(err.contains(&format!("the lock file res/s/{}", lock.trim_start_matches("res/s/"))) && err.contains("named pipe"), "{err}");
+        std::fs::remove_file(&path).unwrap();
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+const TWO_RUNS_OF_TWO_AND_THREE_LEVELS: &str = "description = \"two runs\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:2\"\n[[run]]\nid = \"a\"\nlevels = 2\n[[run]]\nid = \"b\"\nlevels = 3\n";
+
+#[test]
+fn a_lock_folder_that_is_a_file_is_named_also_when_every_run_is_finished() {
+    let dir = scratch("special-files-locks");
+    stored_study(&dir, "exp/s.toml", TWO_RUNS_OF_TWO_AND_THREE_LEVELS, "res");
+    let locks = dir.join("res/s/.locks");
+    std::fs::remove_dir_all(&locks).unwrap();
+    std::fs::write(&locks, "").unwrap();
+    for args in [&["run", "exp/s.toml", "--results", "res"][..], &["figures", "--results", "res", "--experiments", "exp"]] {
+        let (code, _, err) = signorini_in(&dir, args);
+        assert_eq!(code, 1, "{args:?}: {err}");
+        assert!(err.contains(".locks is a regular file, not a folder: move it away"), "{args:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_record_that_links_to_another_file_is_removed_and_its_target_kept() {
+    let dir = stored_two_runs("special-files-link");
+    let target = dir.join("elsewhere.txt");
+    std::fs::write(&target, "root:x:0:0:root:/root:/bin/bash\n").unwrap();
+    let record = dir.join("res/s/runs/c.json");
+    std::fs::remove_file(&record).unwrap();
+    std::os::unix::fs::symlink(&target, &record).unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "res"]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(err.contains("runs/c.json") && err.contains("is not a run record") && err.contains("--replace"), "{err}");
+    let (code, out, err) = signorini_in(&dir, &["run", "experiments/s.toml", "--results", "res", "--replace"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "root:x:0:0:root:/root:/bin/bash\n", "the link's target untouched");
+    assert!(!std::fs::symlink_metadata(&record).unwrap().file_type().is_symlink(), "the link replaced by the record");
+    let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "experiments", "--results", "res", "--against", "fresh"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("drift: none"), "{out}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+const TWO_RUNS_ONE_SAVING: &str = r#"description = "two short runs of Example 7.1, the second saving a mesh"
 
 [defaults]
 problem = "ex71"
@@ -72,8 +140,8 @@ fn within(dir: &Path, args: &[&str]) -> (i32, String) {
 
 /// A scratch folder holding the study's manifest and its results (`results/study`), computed.
 fn stored(name: &str) -> PathBuf {
-    let dir = crate::common::scratch(&format!("battery8-files-{name}"));
-    std::fs::write(dir.join("study.toml"), STUDY).unwrap();
+    let dir = crate::common::scratch(&format!("special-files-{name}"));
+    std::fs::write(dir.join("study.toml"), TWO_RUNS_ONE_SAVING).unwrap();
     let (code, out) = within(&dir, &["run", "study.toml", "--results", "results"]);
     assert_eq!(code, 0, "{out}");
     dir
@@ -227,10 +295,103 @@ fn a_lock_file_that_is_a_pipe_or_a_link_to_a_device_is_refused_naming_it() {
 
 #[test]
 fn a_named_pipe_among_the_manifests_is_refused_naming_it() {
-    let dir = crate::common::scratch("battery8-files-manifests");
+    let dir = crate::common::scratch("special-files-files-manifests");
     std::fs::create_dir_all(dir.join("e")).unwrap();
     fifo(&dir.join("e/x.toml"));
     let (code, out) = within(&dir, &["figures", "--experiments", "e", "--results", "results"]);
     assert_eq!(code, 1, "{out}");
     assert!(out.contains("x.toml") && out.contains("not a regular file (a named pipe)"), "{out}");
+}
+
+const SHORT_RUN_STUDY: &str = r#"description = "one run of a few seconds"
+[defaults]
+problem = "ex71"
+mesh = "structured:8"
+[[run]]
+id = "a"
+levels = 16
+theta = 0.5
+"#;
+
+#[test]
+fn a_file_where_a_folder_must_be_is_named() {
+    let dir = scratch("special-files-file-where-folder");
+    std::fs::create_dir_all(dir.join("exp")).unwrap();
+    std::fs::write(dir.join("exp/s.toml"), SHORT_RUN_STUDY.replace("levels = 16", "levels = 2")).unwrap();
+    // the study's folder is a file
+    std::fs::create_dir_all(dir.join("results")).unwrap();
+    std::fs::write(dir.join("results/s"), "not a folder").unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "exp/s.toml", "--results", "results"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(err.contains("results/s is a regular file, not a folder"), "{err}");
+    assert!(!err.contains("os error 17"), "{err}");
+    // the study's .locks is a file
+    std::fs::remove_file(dir.join("results/s")).unwrap();
+    std::fs::create_dir_all(dir.join("results/s")).unwrap();
+    std::fs::write(dir.join("results/s/.locks"), "not a folder").unwrap();
+    let (code, out, err) = signorini_in(&dir, &["run", "exp/s.toml", "--results", "results"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(err.contains("results/s/.locks is a regular file, not a folder"), "{err}");
+    // --save under a file
+    std::fs::write(dir.join("plain"), "a file").unwrap();
+    let (code, out, err) =
+        signorini_in(&dir, &["adapt", "--problem", "ex72", "--mesh", "structured:4", "--levels", "1", "--save", "plain/u.vtu"]);
+    assert_ne!(code, 0, "{out}");
+    assert!(err.contains("plain is a file, not a folder"), "{err}");
+    assert!(!err.contains("does not exist"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_mesh_that_is_not_a_regular_file_is_refused_at_once() {
+    let dir = scratch("special-files-devzero");
+    std::fs::write(dir.join("v.toml"), fixture("bad_data_gmsh.toml")).unwrap();
+    let start = std::time::Instant::now();
+    let o = Command::new(env!("CARGO_BIN_EXE_signorini"))
+        .current_dir(&dir)
+        .args(["solve", "--problem", "v.toml", "--mesh", "gmsh:/dev/zero"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("/dev/zero: not a regular file"), "{err}");
+    assert!(start.elapsed().as_secs() < 5, "it read on: {:?}", start.elapsed());
+}
+
+fn mkfifo(path: &Path) {
+    let c = std::ffi::CString::new(path.to_str().unwrap()).unwrap();
+    // SAFETY: mkfifo reads the NUL-terminated path it is given
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0, "mkfifo {}", path.display());
+}
+
+#[test]
+fn input_files_that_are_not_regular_files_are_refused_at_once() {
+    let dir = scratch("special-files-fifo");
+    mkfifo(&dir.join("pipe.toml"));
+    mkfifo(&dir.join("pipe.msh"));
+    std::fs::create_dir(dir.join("folder.toml")).unwrap();
+    let problem = fixture("bad_data_square.toml");
+    std::fs::write(dir.join("p.toml"), &problem).unwrap();
+    let uses_pipe_mesh = one_run_manifest(&dir, "m", "a", "mesh = \"gmsh:pipe.msh\"\n");
+    let uses_pipe_problem = one_run_manifest(&dir, "q", "a", "problem = \"pipe.toml\"\n");
+    for (args, file, found) in [
+        (vec!["run", "pipe.toml"], "pipe.toml", "a named pipe"),
+        (vec!["run", "folder.toml"], "folder.toml", "a directory"),
+        (vec!["run", &uses_pipe_mesh], "pipe.msh", "a named pipe"),
+        (vec!["run", &uses_pipe_problem], "pipe.toml", "a named pipe"),
+        (vec!["solve", "--problem", "pipe.toml", "--mesh", "structured:2"], "pipe.toml", "a named pipe"),
+        (vec!["solve", "--problem", "folder.toml", "--mesh", "structured:2"], "folder.toml", "a directory"),
+        (vec!["solve", "--problem", "p.toml", "--mesh", "gmsh:pipe.msh"], "pipe.msh", "a named pipe"),
+        (vec!["solve", "--problem", "p.toml", "--mesh", "gmsh:/dev/zero"], "/dev/zero", "a character device"),
+    ] {
+        let (code, _, err) = signorini_in_time(&dir, &args);
+        assert_eq!(code, 1, "{args:?}: {err}");
+        assert!(err.contains(file) && err.contains(&format!("not a regular file ({found})")), "{args:?}: {err}");
+    }
+    // a problem file beyond the stated limit is refused before it is read
+    std::fs::write(dir.join("big.toml"), format!("{problem}\n# {}\n", "x".repeat(17 << 20))).unwrap();
+    let (code, _, err) = signorini_in_time(&dir, &["solve", "--problem", "big.toml", "--mesh", "structured:2"]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("big.toml: the problem file has 17.0 MiB, more than the 16.0 MiB"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -4,7 +4,7 @@
 //! what needs it; a role declared twice in a study is refused; the repository's manifests declare
 //! every role needed; and a role is not part of what the provenance hashes.
 
-use crate::common::{parse_err, signorini_in};
+use crate::common::{copy_dir, parse_err, scratch, signorini_in};
 use signorini::analysis::roles::{self, NEEDED};
 use signorini::study::manifest::{self, Manifest};
 use std::path::{Path, PathBuf};
@@ -13,25 +13,10 @@ fn repo() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("signorini-roles-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap().flatten() {
-        let target = to.join(e.file_name());
-        if e.path().is_dir() { copy_dir(&e.path(), &target) } else { std::fs::copy(e.path(), target).map(|_| ()).unwrap() }
-    }
-}
-
 /// A scratch copy of `experiments/` with `ex71.toml`'s run `adaptive` renamed and its role
 /// line dropped (the run table rewritten by hand, as a maintainer might).
 fn renamed_without_role(name: &str) -> PathBuf {
-    let d = tmp(name);
+    let d = scratch(&format!("roles-{name}"));
     copy_dir(&repo().join("experiments"), &d.join("experiments"));
     let file = d.join("experiments/ex71.toml");
     let text = std::fs::read_to_string(&file).unwrap();
