@@ -1,5 +1,5 @@
 //! The integration tests, built as one test binary (one link instead of one per file): each
-//! module is one file of what was `tests/NAME.rs`. `tests/ordering_forced.rs` stays a binary of
+//! module is one file, named for the behaviour its tests check. `tests/ordering_forced.rs` stays a binary of
 //! its own, since it sets an environment variable that every solve in its process reads.
 
 mod common;

@@ -1,5 +1,5 @@
 //! The record of one solve, as `signorini solve --json` prints it ([`SolveReport`]: its fields
-//! are the JSON keys; `tests/it/bad_input.rs` checks the ones scripts rely on), and the export of a
+//! are the JSON keys; `tests/it/cli_refusals.rs` checks the ones scripts rely on), and the export of a
 //! case for the NGSolve cross-check.
 
 use crate::records;

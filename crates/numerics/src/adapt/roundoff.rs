@@ -43,7 +43,7 @@ pub const ROUNDOFF_ESTIMATE: f64 = 1e3;
 /// active node and eta_7, by 1e16 every active node, all certified). Not 1e-3:
 /// Example 7.2 translated by 5e10 keeps its estimate to 1e-2 with a measured round-off of 2.6e-3
 /// to 4.9e-3 of the deformation (`structured:8`, and level 1 from `structured:4`), and
-/// `tests/it/bad_battery8_contact.rs` holds it accepted; the stored studies stay below 1e-9 of it.
+/// `tests/it/resolution.rs` holds it accepted; the stored studies stay below 1e-9 of it.
 pub const RESOLVED_DEFORMATION: f64 = 1e-2;
 
 /// u_h has no deformation above its round-off when the deformation's size ([`deformation`]) is
