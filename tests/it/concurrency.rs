@@ -2,7 +2,7 @@
 //! verdict, readers given `--wait` wait for the writer through all its runs, and two drift checks
 //! in one checkout take turns.
 
-use crate::common::{finish, scratch, signorini_in, stored_study};
+use crate::common::{SHORT_RUN_STUDY, finish, scratch, signorini_in, stored_study};
 use std::process::{Command, Stdio};
 
 /// A study of one run that takes a few seconds (Example 7.1, 19 adaptive levels from
@@ -107,16 +107,6 @@ fn readers_given_wait_wait_for_the_writer_through_all_its_runs() {
     assert!(!page.contains("(missing)"), "the page was drawn from a study still being computed");
     std::fs::remove_dir_all(&dir).ok();
 }
-
-const SHORT_RUN_STUDY: &str = r#"description = "one run of a few seconds"
-[defaults]
-problem = "ex71"
-mesh = "structured:8"
-[[run]]
-id = "a"
-levels = 16
-theta = 0.5
-"#;
 
 fn drift(dir: &std::path::Path) -> std::process::Child {
     Command::new(env!("CARGO_BIN_EXE_signorini"))

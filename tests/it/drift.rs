@@ -1,6 +1,6 @@
 //! The drift check reports what moved, with the right row, and passes an unperturbed copy.
 
-use crate::common::{output_in, scratch, signorini_in, stored_study};
+use crate::common::{LONG, TWO_SHORT_RUNS, checkpoint_levels, output_in, scratch, signorini_in, stored_study};
 use signorini::records::{RunRecord, StudyDir};
 use signorini::study::drift::{DECADES, ORDER_OF_MAGNITUDE, compare_study, observed_rate};
 use signorini::study::manifest::Manifest;
@@ -382,34 +382,6 @@ fn roundoff_floor_is_compared_by_its_order_of_magnitude() {
         assert_eq!(caught, visible, "level {level}: factor 20 ({rows:?})");
     }
 }
-
-const TWO_SHORT_RUNS: &str = r#"description = "two short runs"
-[defaults]
-problem = "ex71"
-mesh = "structured:4"
-levels = 3
-save_levels = [1]
-[[run]]
-id = "a"
-[[run]]
-id = "b"
-theta = 0.3
-"#;
-
-fn checkpoint_levels(file: &std::path::Path) -> usize {
-    let Ok(text) = std::fs::read_to_string(file) else { return 0 };
-    serde_json::from_str::<serde_json::Value>(&text).ok().and_then(|v| v["levels"].as_array().map(|l| l.len())).unwrap_or(0)
-}
-
-const LONG: &str = r#"description = "one run long enough to be stopped"
-[defaults]
-problem = "ex71"
-mesh = "structured:4"
-theta = 0.5
-[[run]]
-id = "long"
-levels = 22
-"#;
 
 /// The text of the Drift section of a study page.
 fn drift_section(page: &std::path::Path) -> String {

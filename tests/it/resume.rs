@@ -2,7 +2,7 @@
 //! last finished level, not from level 0, and ends with the same numbers and history as a run
 //! that was never stopped; the checkpoint it resumed from is gone once the run has landed.
 
-use crate::common::{scratch, signorini_in};
+use crate::common::{LONG, checkpoint_levels, scratch, signorini_in};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -24,12 +24,6 @@ fn bin() -> &'static str {
 
 fn run(results: &Path, manifest: &Path) -> std::process::Output {
     Command::new(bin()).args(["run", manifest.to_str().unwrap(), "--results", results.to_str().unwrap()]).output().unwrap()
-}
-
-fn checkpoint_levels(file: &Path) -> usize {
-    let Ok(text) = std::fs::read_to_string(file) else { return 0 };
-    let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else { return 0 };
-    v["levels"].as_array().map_or(0, |l| l.len())
 }
 
 fn without_measurements(file: PathBuf) -> serde_json::Value {
@@ -85,16 +79,6 @@ fn a_killed_run_resumes_after_its_last_finished_level_with_the_same_numbers() {
     assert!(!stopped.join("resumed/.partial").exists(), "the checkpoint stays after the run landed");
     std::fs::remove_dir_all(&root).unwrap();
 }
-
-const LONG: &str = r#"description = "one run long enough to be stopped"
-[defaults]
-problem = "ex71"
-mesh = "structured:4"
-theta = 0.5
-[[run]]
-id = "long"
-levels = 22
-"#;
 
 #[test]
 fn a_checkpoint_is_resumed_only_as_written_by_this_code() {

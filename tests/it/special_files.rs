@@ -2,7 +2,7 @@
 //! expected (a manifest, problem, mesh, record, snapshot, summary or lock), or a file where a folder
 //! must be, is refused naming it, at once and without reading it; no write replaces one.
 
-use crate::common::{fixture, one_run_manifest, scratch, signorini_in, signorini_in_time, stored_study, stored_two_runs};
+use crate::common::{SHORT_RUN_STUDY, fixture, one_run_manifest, scratch, signorini_in, signorini_in_time, stored_study, stored_two_runs};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -302,16 +302,6 @@ fn a_named_pipe_among_the_manifests_is_refused_naming_it() {
     assert_eq!(code, 1, "{out}");
     assert!(out.contains("x.toml") && out.contains("not a regular file (a named pipe)"), "{out}");
 }
-
-const SHORT_RUN_STUDY: &str = r#"description = "one run of a few seconds"
-[defaults]
-problem = "ex71"
-mesh = "structured:8"
-[[run]]
-id = "a"
-levels = 16
-theta = 0.5
-"#;
 
 #[test]
 fn a_file_where_a_folder_must_be_is_named() {

@@ -3,7 +3,7 @@
 //! (`--fresh` refuses, naming it), a manifest's file name that cannot name a study is refused,
 //! and a results root inside a study folder is refused.
 
-use crate::common::{scratch, signorini_in, stored_study};
+use crate::common::{scratch, signorini_in, stored_study, stored_two_short_runs as stored};
 
 const STUDY: &str = "description = \"two runs\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:2\"\n\
 [[run]]\nid = \"a\"\nlevels = 2\nsave_levels = [1]\n[[run]]\nid = \"b\"\nlevels = 2\n";
@@ -114,26 +114,6 @@ fn a_default_output_folder_inside_a_study_folder_is_named_as_the_default_not_as_
         assert!(err.contains(default) && err.contains("is inside the study folder"), "{args:?}: {err}");
     }
     std::fs::remove_dir_all(&dir).ok();
-}
-
-const TWO_SHORT_RUNS: &str = r#"description = "two short runs"
-[defaults]
-problem = "ex71"
-mesh = "structured:4"
-levels = 3
-save_levels = [1]
-[[run]]
-id = "a"
-[[run]]
-id = "b"
-theta = 0.3
-"#;
-
-/// A scratch folder with `exp/st.toml` ([`TWO_SHORT_RUNS`]) run into `res/`.
-fn stored(name: &str) -> std::path::PathBuf {
-    let dir = scratch(name);
-    stored_study(&dir, "exp/st.toml", TWO_SHORT_RUNS, "res");
-    dir
 }
 
 #[test]

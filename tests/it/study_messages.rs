@@ -2,27 +2,9 @@
 //! removes and lists each run once; the run table tells runs apart; messages say what is true in
 //! the command's own terms.
 
-use crate::common::{one_run_manifest, scratch, signorini_in, signorini_in_time, stored_study};
-
-const TWO_SHORT_RUNS: &str = r#"description = "two short runs"
-[defaults]
-problem = "ex71"
-mesh = "structured:4"
-levels = 3
-save_levels = [1]
-[[run]]
-id = "a"
-[[run]]
-id = "b"
-theta = 0.3
-"#;
-
-/// A scratch folder with `exp/st.toml` ([`TWO_SHORT_RUNS`]) run into `res/`.
-fn stored(name: &str) -> std::path::PathBuf {
-    let dir = scratch(name);
-    stored_study(&dir, "exp/st.toml", TWO_SHORT_RUNS, "res");
-    dir
-}
+use crate::common::{
+    TWO_SHORT_RUNS, one_run_manifest, scratch, signorini_in, signorini_in_time, stored_study, stored_two_short_runs as stored,
+};
 
 #[test]
 fn messages_say_what_is_true_in_the_command_s_own_terms() {

@@ -344,3 +344,53 @@ pub fn stored_two_runs(name: &str) -> std::path::PathBuf {
 
 /// A stored study of two runs, one adaptive, one uniform.
 const TWO_RUNS: &str = "description = \"s\"\n[defaults]\nproblem = \"ex71\"\nmesh = \"structured:4\"\ntheta = 0.5\nlevels = 4\nquick_levels = 2\n[[run]]\nid = \"a\"\nrefine = \"adaptive\"\n[[run]]\nid = \"c\"\nrefine = \"uniform\"\n";
+
+/// A study of two short runs of Example 7.1 (`a`, and `b` with theta 0.3), three levels each.
+pub const TWO_SHORT_RUNS: &str = r#"description = "two short runs"
+[defaults]
+problem = "ex71"
+mesh = "structured:4"
+levels = 3
+save_levels = [1]
+[[run]]
+id = "a"
+[[run]]
+id = "b"
+theta = 0.3
+"#;
+
+/// A scratch folder named `name` with `exp/st.toml` ([`TWO_SHORT_RUNS`]) run into `res/`.
+pub fn stored_two_short_runs(name: &str) -> std::path::PathBuf {
+    let dir = scratch(name);
+    stored_study(&dir, "exp/st.toml", TWO_SHORT_RUNS, "res");
+    dir
+}
+
+/// A study of one run of 22 levels: long enough to be stopped part way.
+pub const LONG: &str = r#"description = "one run long enough to be stopped"
+[defaults]
+problem = "ex71"
+mesh = "structured:4"
+theta = 0.5
+[[run]]
+id = "long"
+levels = 22
+"#;
+
+/// The levels a run's checkpoint file holds (0 where there is none yet, or it does not parse).
+pub fn checkpoint_levels(file: &std::path::Path) -> usize {
+    let Ok(text) = std::fs::read_to_string(file) else { return 0 };
+    let Ok(v) = serde_json::from_str::<serde_json::Value>(&text) else { return 0 };
+    v["levels"].as_array().map_or(0, |l| l.len())
+}
+
+/// A study of one run of a few seconds (16 levels of Example 7.1 from `structured:8`).
+pub const SHORT_RUN_STUDY: &str = r#"description = "one run of a few seconds"
+[defaults]
+problem = "ex71"
+mesh = "structured:8"
+[[run]]
+id = "a"
+levels = 16
+theta = 0.5
+"#;
