@@ -415,7 +415,7 @@ class Discretisation:
     def errors(self, U, lattice=6):
         """L-infinity errors, |u - u_h| measured as the larger component (crates/numerics/src/contact/norms.rs convention):
         nodal = max over P2 nodes; dense = max over a barycentric lattice with `lattice`
-        subdivisions per triangle (order 6 = 28 points, as LATTICE_ORDER in crates/numerics/src/contact/sampling.rs),
+        subdivisions per triangle (order 6 = 28 points, as LATTICE_ORDER in crates/model/src/settings/sampling.rs),
         evaluated element by element through NGSolve."""
         exact = self.prob.exact
         ue = eval_points(self.mesh, exact, self.case.points)

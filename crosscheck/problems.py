@@ -1,5 +1,5 @@
 """Problem data of Examples 7.1 and 7.2, transcribed from the paper's Section 7, of the
-free-boundary problem `fb` (beyond the paper), transcribed from its definition (the doc comment of `Fb` in crates/numerics/src/problems/builtin.rs),
+free-boundary problem `fb` (beyond the paper), transcribed from its definition (the doc comment of `Fb` in crates/model/src/problems/builtin.rs),
 and of Hertz contact `hertz` and Example 7.2 on rollers `ex72_rollers` (beyond the paper), transcribed
 from experiments/problems/hertz.toml and ex72_rollers.toml.
 

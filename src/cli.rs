@@ -113,25 +113,7 @@ pub enum Command {
     /// with --results DIR (a study rerun into a scratch folder), the figures of the declared
     /// studies DIR holds into DIR/figures/ and DIR/CLAIMS.md. Refuses if a study's runs do not
     /// match its manifest (interrupted, sharded or partial), naming what is missing.
-    Figures {
-        /// Results root to read; CLAIMS.md is written there [default: results, where every
-        /// declared study must be complete].
-        #[arg(long)]
-        results: Option<std::path::PathBuf>,
-        /// The declared studies the results must match.
-        #[arg(long, default_value = "experiments")]
-        experiments: std::path::PathBuf,
-        /// Folder the figures are written to [default: figures, or DIR/figures with --results DIR].
-        #[arg(long, visible_alias = "out")]
-        figures: Option<std::path::PathBuf>,
-        /// Draw only these studies' figures (repeatable) [default: every study the results hold].
-        #[arg(long, value_name = "STUDY")]
-        study: Vec<String>,
-        /// If another process is writing a study of the results folder, wait for it to finish
-        /// instead of refusing (what the Slurm finish job does).
-        #[arg(long)]
-        wait: bool,
-    },
+    Figures(signorini::commands::figures::FiguresArgs),
     /// Write one self-contained HTML page per study for a browser (OUT/STUDY.html): its figures
     /// embedded, its CLAIMS rows, the drift status from the last drift report, the run table and
     /// the provenance. Reads only files (records, PNGs, the drift report): run `figures` and
@@ -181,7 +163,7 @@ impl Command {
             Command::Solve { .. } => false,
             Command::Adapt(args) => args.save.is_some(),
             Command::Run { plan, .. } => !plan,
-            Command::Drift { .. } | Command::Figures { .. } | Command::Export { .. } | Command::Report { .. } => true,
+            Command::Drift { .. } | Command::Figures(_) | Command::Export { .. } | Command::Report { .. } => true,
         }
     }
 }

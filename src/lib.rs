@@ -7,9 +7,12 @@
 //!
 //! ```text
 //!   signorini            main.rs, bin/: the command line, the benchmark; this prelude
-//!   signorini-claims     plot/, analysis/: figures, study pages, verdict rules, Section 7's claims
-//!   signorini-harness    study/, records/: manifests, runner, store, drift; records, atomic writes
-//!   signorini-numerics   adapt/, estimator/, contact/, fem/, sparse/, mesh/, problems/, base/
+//!   signorini-harness    study/, report/: the runner, references, drift; the solve report
+//!   signorini-claims     commands/, plot/, analysis/: figures (also as `signorini-figures`, built
+//!                        without the solver), study pages, verdict rules, Section 7's claims
+//!   signorini-numerics   adapt/, estimator/, contact/, fem/, sparse/: the solver
+//!   signorini-store      study/, records/: manifests, the results folder's store; run records
+//!   signorini-model      level/, settings/, mesh/, problems/, base/
 //! ```
 //!
 //! Three entry points: [`solve::solve`] (one discrete solution on a mesh, certified by its KKT
@@ -23,8 +26,9 @@
 pub mod commands;
 
 pub use signorini_claims::{analysis, plot};
-pub use signorini_harness::{records, study};
-pub use signorini_numerics::{adapt, base, contact, estimator, fem, mesh, problems, sparse};
+pub use signorini_harness::{records, report, study};
+pub use signorini_model::{base, level, mesh, problems, settings};
+pub use signorini_numerics::{adapt, contact, estimator, fem, sparse};
 
 pub use analysis::{claims, hertz, verdict};
 pub use base::{element, memory};
@@ -32,5 +36,4 @@ pub use contact::{certify, norms, solve};
 pub use estimator::estimate;
 pub use fem::assembly;
 pub use plot::page;
-pub use records::report;
 pub use sparse::{cholesky, ordering, symbolic};

@@ -4,55 +4,20 @@
 mod cli;
 
 use anyhow::Result;
-use clap::Parser;
 use cli::{Cli, Command, flag_of};
 use signorini::adapt::{Caveat, LevelRecord};
 use signorini::commands::adapt::{self, AdaptInterrupted, AdaptObserver};
 use signorini::commands::drift::{self, Drift, DriftInterrupted, DriftRequest};
+use signorini::commands::output::{self, stdout_write, wrote, wrote_all};
 use signorini::commands::places::{again_while_written, results_place};
 use signorini::commands::run::{self, RunFlags};
 use signorini::commands::threads::start_threads;
 use signorini::commands::workspace::Workspace;
 use signorini::commands::{figures, report, solve};
 use signorini::study;
-use std::path::{Path, PathBuf};
+use signorini_claims::say;
+use std::path::Path;
 use std::process::ExitCode;
-
-/// `eprintln!` that cannot panic: a message whose write to stderr fails (a full device, a
-/// file-size limit, a closed stderr) is dropped, and the exit status still says what happened.
-macro_rules! say {
-    ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stderr(), $($arg)*);
-    }};
-}
-
-/// The first error writing standard output, if one happened (a full device, a file-size limit).
-static STDOUT_ERROR: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-
-/// Write to standard output without panicking: std's `println!` panics when the write fails
-/// (`> /dev/full` would end in exit 101). The first error is kept, later output dropped, and [`main`]
-/// exits with the error status naming it. Every `print!`/`println!` of this file comes here (the
-/// two macros below shadow std's).
-fn stdout_write(args: std::fmt::Arguments, newline: bool) {
-    use std::io::Write as _;
-    if STDOUT_ERROR.get().is_some() {
-        return;
-    }
-    let mut out = std::io::stdout().lock();
-    if let Err(e) = out.write_fmt(args).and_then(|_| if newline { out.write_all(b"\n") } else { Ok(()) }) {
-        let _ = STDOUT_ERROR.set(e.to_string());
-    }
-}
-
-/// Flush standard output (its last lines are buffered) and report the first write error.
-fn stdout_result() -> std::result::Result<(), String> {
-    use std::io::Write as _;
-    if let Err(e) = std::io::stdout().flush() {
-        let _ = STDOUT_ERROR.set(e.to_string());
-    }
-    STDOUT_ERROR.get().map_or(Ok(()), |e| Err(e.clone()))
-}
 
 macro_rules! println {
     () => { stdout_write(format_args!(""), true) };
@@ -61,35 +26,6 @@ macro_rules! println {
 
 macro_rules! print {
     ($($arg:tt)*) => { stdout_write(format_args!($($arg)*), false) };
-}
-
-/// The files this command wrote, in order, each complete (written to a temporary name and
-/// renamed). A failed standard output then names them: they are kept and valid, and only the
-/// printed report was lost (`export > /dev/full` says which files it wrote, not only "No space left on device").
-static WRITTEN: std::sync::Mutex<Vec<std::path::PathBuf>> = std::sync::Mutex::new(Vec::new());
-
-/// Print `line` for the file `path` just written, and remember the file ([`WRITTEN`]). Every
-/// "wrote" line of this file comes here.
-fn wrote(path: &std::path::Path, line: std::fmt::Arguments) {
-    let mut written = WRITTEN.lock().unwrap_or_else(|e| e.into_inner());
-    if !written.iter().any(|w| w == path) {
-        written.push(path.to_path_buf());
-    }
-    drop(written);
-    println!("{line}");
-}
-
-/// The error of a failed standard output (`e`): with the files written, which it did not touch.
-fn stdout_error(e: &str) -> anyhow::Error {
-    let written = WRITTEN.lock().unwrap_or_else(|e| e.into_inner());
-    if written.is_empty() {
-        return anyhow::anyhow!("writing standard output: {e}");
-    }
-    let files: Vec<String> = written.iter().map(|f| f.display().to_string()).collect();
-    anyhow::anyhow!(
-        "writing standard output: {e}. Only the printed report was lost: the files were written before, complete and valid: {}",
-        files.join(", ")
-    )
 }
 
 /// The `adapt` table: a header, one row per level, notes and the saved file.
@@ -145,13 +81,6 @@ impl AdaptObserver for AdaptTable {
     }
 }
 
-/// Print a "wrote" line for each file written.
-fn wrote_all(files: &[PathBuf]) {
-    for f in files {
-        wrote(f, format_args!("wrote {}", f.display()));
-    }
-}
-
 /// Run the command parsed.
 fn dispatch(command: &Command) -> Result<()> {
     match command {
@@ -190,13 +119,7 @@ fn dispatch(command: &Command) -> Result<()> {
             wrote(file, format_args!("report: {}", file.display()));
             checked.outcome().map(|lines| lines.iter().for_each(|l| println!("{l}")))
         }
-        Command::Figures { results, figures, experiments, study, wait } => {
-            results_place("--results", results.as_deref())?;
-            let workspace = Workspace::load(experiments)?;
-            again_while_written(*wait, || {
-                figures::draw(results.as_deref(), figures.as_deref(), &workspace, study, *wait).map(|f| wrote_all(&f))
-            })
-        }
+        Command::Figures(args) => figures::run(args).map(|f| wrote_all(&f)),
         Command::Report { results, figures, out, study, drift_report, experiments, wait } => {
             results_place("--results", results.as_deref())?;
             let workspace = Workspace::load(experiments)?;
@@ -224,37 +147,9 @@ fn install_interrupt_handler() {
     }
 }
 
-/// The command line, or the exit status of what parsing printed instead: help and version go
-/// through [`stdout_write`], so that a standard output that fails is an error there too (clap's
-/// own printing ignores the failure, and `--help > /dev/full` would exit 0); a usage
-/// error goes to standard error with clap's status.
-fn parse() -> std::result::Result<Cli, ExitCode> {
-    let e = match Cli::try_parse() {
-        Ok(cli) => return Ok(cli),
-        Err(e) => e,
-    };
-    if e.use_stderr() {
-        let _ = e.print();
-        return Err(ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2)));
-    }
-    print!("{}", e.render());
-    match stdout_result() {
-        Ok(()) => Err(ExitCode::SUCCESS),
-        Err(msg) => {
-            say!("error: writing standard output: {msg}");
-            Err(ExitCode::FAILURE)
-        }
-    }
-}
-
 fn main() -> ExitCode {
-    // A file-size limit (`ulimit -f`, a quota) makes a write fail with EFBIG instead of killing
-    // the process, so the store can clean up and say which file it was writing.
-    // SAFETY: setting a signal's disposition, before any thread is started.
-    unsafe {
-        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
-    }
-    let cli = match parse() {
+    output::ignore_file_size_signal();
+    let cli: Cli = match output::parse() {
         Ok(cli) => cli,
         Err(code) => return code,
     };
@@ -281,22 +176,10 @@ fn main() -> ExitCode {
         _ => None,
     };
     let result = start_threads(jobs).and_then(|()| dispatch(&cli.command));
-    // what was computed and kept stays; output that could not be written is an error
-    let result = result.and_then(|()| stdout_result().map_err(|e| stdout_error(&e)));
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e)
-            if e.downcast_ref::<study::Interrupted>().is_some()
-                || e.downcast_ref::<AdaptInterrupted>().is_some()
-                || e.downcast_ref::<DriftInterrupted>().is_some()
-                || e.downcast_ref::<study::accept::AcceptInterrupted>().is_some() =>
-        {
-            say!("{e:#}");
-            ExitCode::from(130)
-        }
-        Err(e) => {
-            say!("error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
+    output::exit_status(result, |e| {
+        e.downcast_ref::<study::Interrupted>().is_some()
+            || e.downcast_ref::<AdaptInterrupted>().is_some()
+            || e.downcast_ref::<DriftInterrupted>().is_some()
+            || e.downcast_ref::<study::accept::AcceptInterrupted>().is_some()
+    })
 }

@@ -50,10 +50,11 @@ macro_rules! note {
 
 pub mod adapt;
 pub mod drift;
-pub mod figures;
-pub mod places;
 pub mod report;
 pub mod run;
 pub mod solve;
 pub mod threads;
-pub mod workspace;
+
+// the commands that read stored results only, from the claims crate (`signorini-figures` is built
+// from them without the solver)
+pub use signorini_claims::commands::{figures, output, places, workspace};

@@ -299,7 +299,7 @@ fn every_listed_function_is_accepted_and_the_docs_list_exactly_them() {
             .filter(|f| f.starts_with(|c: char| c.is_ascii_alphabetic()) && f.chars().all(|c| c.is_ascii_alphanumeric())),
     );
     let listed: BTreeSet<&str> = EXPRESSION_FUNCTIONS.into_iter().collect();
-    assert_eq!(documented, listed, "experiments/problems/README.md against crates/numerics/src/problems/file/names.rs");
+    assert_eq!(documented, listed, "experiments/problems/README.md against crates/model/src/problems/file/names.rs");
     for c in EXPRESSION_CONSTANTS {
         assert!(spans.contains(&c), "constant {c} not documented");
     }

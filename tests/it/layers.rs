@@ -15,9 +15,11 @@ use std::path::{Path, PathBuf};
 /// The member crates (folder under the repository) and their floors, bottom first, as their
 /// lib.rs's docs draw them.
 const CRATES: &[(&str, &[&str])] = &[
-    ("crates/numerics", &["base", "problems", "mesh", "sparse", "fem", "contact", "estimator", "adapt"]),
-    ("crates/harness", &["records", "study"]),
-    ("crates/claims", &["analysis", "plot"]),
+    ("crates/model", &["base", "problems", "mesh", "settings", "level"]),
+    ("crates/numerics", &["sparse", "fem", "contact", "estimator", "adapt"]),
+    ("crates/store", &["records", "study"]),
+    ("crates/harness", &["report", "study"]),
+    ("crates/claims", &["analysis", "plot", "commands", "bin"]),
 ];
 
 fn repo() -> &'static Path {
@@ -170,8 +172,9 @@ fn scan(src: &Path, children_too: bool) -> Scan {
     out
 }
 
+/// The floor of a file: the floor folder it is in, or the floor that is this one file.
 fn floor_of(floors: &[&str], rel: &str) -> Option<usize> {
-    floors.iter().position(|f| rel.starts_with(&format!("{f}/")))
+    floors.iter().position(|f| rel.starts_with(&format!("{f}/")) || rel == format!("{f}.rs"))
 }
 
 #[test]
@@ -346,4 +349,30 @@ fn claims_and_figures_read_results_only_through_the_shelf() {
         }
     }
     assert!(bad.is_empty(), "read past the store's integrity check (take a store::Shelf):\n{}", bad.join("\n"));
+}
+
+/// The dependencies a crate's Cargo.toml names, with the package each one is (a renamed path
+/// dependency `store = { package = "signorini-store" }` is signorini-store).
+fn dependencies_of(dir: &str) -> Vec<String> {
+    let text = std::fs::read_to_string(repo().join(dir).join("Cargo.toml")).unwrap();
+    let table: toml::Table = text.parse().unwrap();
+    let deps = table.get("dependencies").and_then(|d| d.as_table()).cloned().unwrap_or_default();
+    deps.iter().map(|(k, v)| v.get("package").and_then(|p| p.as_str()).unwrap_or(k).to_string()).collect()
+}
+
+/// `make figures` compiles no solver: the figures binary's crate and every crate it stands on
+/// name neither the solver crates nor faer, only each other and crates outside the workspace.
+#[test]
+fn the_figures_crates_stand_on_no_solver() {
+    let light = ["crates/claims", "crates/store", "crates/model"];
+    for dir in light {
+        let deps = dependencies_of(dir);
+        let solver: Vec<&String> =
+            deps.iter().filter(|d| ["faer", "signorini-numerics", "signorini-harness", "signorini"].contains(&d.as_str())).collect();
+        assert!(solver.is_empty(), "{dir} depends on {solver:?}: `make figures` would compile the solver");
+        for d in deps.iter().filter(|d| d.starts_with("signorini")) {
+            assert!(light.iter().any(|l| l.trim_start_matches("crates/") == d.trim_start_matches("signorini-")), "{dir} depends on {d}");
+        }
+    }
+    assert!(dependencies_of("crates/numerics").contains(&"faer".to_string()), "the check reads dependencies as the solver's names faer");
 }

@@ -92,7 +92,7 @@ fn no_reference_drops_the_defaults_reference() {
     assert!(m.runs[0].spec.reference.is_some());
     assert!(m.runs[1].spec.reference.is_none());
     // and the format documentation says so
-    let doc = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/harness/src/study/manifest.rs")).unwrap();
+    let doc = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/store/src/study/manifest.rs")).unwrap();
     assert!(doc.contains("no_reference = true") && !doc.contains("`reference = false`"));
 }
 

@@ -4,6 +4,8 @@
 //! Floors, top first (`tests/it/layers.rs` checks them):
 //!
 //! ```text
+//!   bin/              signorini-figures: the figures command without the solver
+//!   commands/         the figures command, the places a command may use, printing
 //!   plot/             figures and study pages, from records only
 //!   analysis/         rates, verdict rules, the claims of Section 7, Hertz
 //! ```
@@ -12,4 +14,5 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod analysis;
+pub mod commands;
 pub mod plot;

@@ -1,13 +1,14 @@
-//! The harness above the numerics: what a run and a solve report hold and how they are written
-//! (atomically, journaled), the store of a results folder, studies declared in manifests, their
-//! runner, reference solutions, provenance and the drift check.
+//! The harness above the solver and the store: the runner of declared studies, their reference
+//! solutions, the drift check, and what a solve reports. The records, manifests and the results
+//! folder's store are the store crate's (`signorini-store`), re-exported here under the paths
+//! this crate uses for them (`records`, `study::manifest`, `study::store`).
 //!
-//! Floors, top first; code uses only its own floor and the floors below, and the numerics crate
+//! Floors, top first; code uses only its own floor and the floors below, and the crates below
 //! (`tests/it/layers.rs` checks the floors inside this crate, the compiler the crates):
 //!
 //! ```text
-//!   study/            manifests, runner, store, references, provenance, drift
-//!   records/          run and solve records; atomic writes, the journal
+//!   study/            runner, references, drift, accepting a rerun
+//!   report/           the solve report (`signorini solve --json`, VTU files)
 //! ```
 //!
 //! Entry point: [`study::run_study`] (a declared study into its results folder).
@@ -15,5 +16,8 @@
 // `!(x > 0.0)` is how this crate rejects NaN together with the out-of-range values, on purpose.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod records;
+pub mod report;
 pub mod study;
+
+// the records of runs, from the store crate, under the path this crate uses for them
+pub use ::store::records;

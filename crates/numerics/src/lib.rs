@@ -2,6 +2,9 @@
 //! elasticity with frictionless unilateral contact, solved by a primal–dual active set method,
 //! the supremum-norm a posteriori estimator of Khandelwal, Porwal and Wadhawan, and the adaptive
 //! loop SOLVE -> ESTIMATE -> MARK -> REFINE. Nothing here knows of studies or results folders.
+//! Problems, meshes, settings and level records are the model crate's (`signorini-model`); the
+//! settings and level records are re-exported where the loop, the contact solve and the
+//! estimator had them (`adapt::LevelRecord`, `contact::PdasOptions`, `estimate::EstimatorConfig`).
 //!
 //! Floors, one folder each, top first; code uses only its own floor and the floors below
 //! (`tests/it/layers.rs` checks it, and that no two files use each other):
@@ -12,9 +15,7 @@
 //!   contact/          active-set method, the SOLVE step, KKT certificate, error norms
 //!   fem/              P2 unknowns, element stiffness, assembly
 //!   sparse/           symmetric CSC, orderings, symbolic and numeric Cholesky
-//!   mesh/             triangulations, refinement, Gmsh, point location
-//!   problems/         the Problem trait, boundary parts, built-ins, problem files
-//!   base/             reference element, statistics, memory
+//!   (signorini-model) base, problems, mesh, settings, level records
 //! ```
 //!
 //! Two entry points: [`contact::solve::solve`] (one discrete solution on a mesh, certified by its
@@ -24,10 +25,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod adapt;
-pub mod base;
 pub mod contact;
 pub mod estimator;
 pub mod fem;
-pub mod mesh;
-pub mod problems;
 pub mod sparse;

@@ -26,11 +26,11 @@ use crate::analysis::{problem_names, studies};
 // the paper's C_0 (Section 7, the estimator's default): a reliability row holds when the
 // smallest reliable C_0 of its runs is at most this
 pub use criterion::{Criterion, Evidence, Kind};
-use harness::records::{MeshSnapshot, RunRecord};
-use harness::study::store::Shelf;
-use numerics::estimator::estimate::{C0_PAPER, ContactTerm, LogFactor, c0_paper};
+use model::settings::estimator::{C0_PAPER, ContactTerm, LogFactor, c0_paper};
 use std::fmt::Write as _;
 use std::path::Path;
+use store::records::{MeshSnapshot, RunRecord};
+use store::study::store::Shelf;
 
 /// The paper's optimal rate in NDF: NDF^(-3/2).
 pub const OPTIMAL: f64 = 1.5;
@@ -65,7 +65,7 @@ pub enum ClaimsError {
     Io(#[from] std::io::Error),
     /// A checked study folder cannot hand out what a row asks for.
     #[error(transparent)]
-    Shelf(#[from] harness::study::store::ShelfError),
+    Shelf(#[from] store::study::store::ShelfError),
     /// The problem of a stored run cannot be loaded (the row `hertz` needs its geometry): the
     /// error says which run and why.
     #[error("{0:#}")]
@@ -453,7 +453,7 @@ impl Ctx<'_> {
         let (spec, ndof) = (r.run.reference.as_ref()?, r.reference_ndof?);
         let runs = self.shelf.runs(&r.study).ok()?;
         let adaptive =
-            |x: &&RunRecord| x.run.refine == numerics::adapt::Refine::Adaptive && x.run.estimator.log_factor == LogFactor::Squared;
+            |x: &&RunRecord| x.run.refine == model::settings::adapt::Refine::Adaptive && x.run.estimator.log_factor == LogFactor::Squared;
         let along = runs
             .iter()
             .filter(adaptive)
@@ -537,7 +537,7 @@ pub const PEAK_NEAR: f64 = 0.05;
 /// "the largest element indicator lies within 0.05 of the wedge tip (1, 0.5) at 8 of 12 levels
 /// (the last at (0.996, 0.499))": where the marking sees the error, from the records alone.
 fn peak_text(r: &RunRecord, name: &str, at: [f64; 2]) -> String {
-    let near = r.levels.iter().filter(|l| numerics::mesh::dist(at, [l.max_indicator_x, l.max_indicator_y]) <= PEAK_NEAR).count();
+    let near = r.levels.iter().filter(|l| model::mesh::dist(at, [l.max_indicator_x, l.max_indicator_y]) <= PEAK_NEAR).count();
     let last = r.levels.last().map_or(String::new(), |l| format!(" (the last at ({:.3}, {:.3}))", l.max_indicator_x, l.max_indicator_y));
     format!(
         "the largest element indicator lies within {PEAK_NEAR} of {name} ({}, {}) at {near} of {} levels{last}",
@@ -694,7 +694,7 @@ fn theta_claim(ctx: &Ctx, out: &mut Vec<Claim>) -> std::io::Result<()> {
             last.map_or(0, |l| l.ndof),
             ctx.values(r, Q::Error).last().copied().flatten().map_or("n/a".into(), |e| format!("{e:.2e}"))
         ));
-        if r.run.refine == numerics::adapt::Refine::Adaptive {
+        if r.run.refine == model::settings::adapt::Refine::Adaptive {
             let short = |p: &RateReport| if p.main.spans_enough() { String::new() } else { " (under two decades: no verdict)".into() };
             let text = format!("θ = {}: {}", r.run.theta, rep.map_or("n/a".into(), |p| format!("{}{}", p.main.text(), short(&p))));
             match headline.iter_mut().find(|(p, _)| *p == r.run.problem) {
@@ -1040,5 +1040,5 @@ pub fn markdown_for(claims: &[Claim], results: &Path) -> String {
 pub fn write(shelf: &Shelf, roles: &Roles) -> Result<(), ClaimsError> {
     let c = claims(shelf, roles)?;
     let results = shelf.root();
-    Ok(harness::records::write_atomic(&results.join("CLAIMS.md"), markdown_for(&c, results).as_bytes())?)
+    Ok(store::records::write_atomic(&results.join("CLAIMS.md"), markdown_for(&c, results).as_bytes())?)
 }

@@ -11,8 +11,8 @@
 //! its flat side) deviates from them by terms that vanish as a / R -> 0, which a second, smaller
 //! load measures.
 
-use numerics::contact::solve::ContactSample;
-use numerics::problems::{Curve, Material, Problem};
+use model::level::sample::ContactSample;
+use model::problems::{Curve, Material, Problem};
 
 /// The closed-form solution for a cylinder of radius `radius` with the plane-strain modulus
 /// `e_star` = E / (1 - nu^2).

@@ -7,10 +7,10 @@
 //! row without data.
 
 use crate::analysis::studies::{self, Study};
-use harness::records::RunRecord;
-use harness::study::manifest::Manifest;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use store::records::RunRecord;
+use store::study::manifest::Manifest;
 
 /// A role a CLAIMS row or a figure needs: in study `study`, the run that declares `name`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -147,5 +147,5 @@ pub fn check(manifests: &[Manifest]) -> Result<Roles, RoleError> {
 
 /// The roles declared by every manifest in `experiments`, checked ([`check`]).
 pub fn read(experiments: &Path) -> anyhow::Result<Roles> {
-    Ok(check(&harness::study::manifest::declared(experiments, &[])?)?)
+    Ok(check(&store::study::manifest::declared(experiments, &[])?)?)
 }

@@ -40,7 +40,7 @@
 //! wide interval), and so is a window shorter than two decades.
 //! The method: `docs/method.md`, section "From rates to verdicts".
 
-use harness::records::RunRecord;
+use store::records::RunRecord;
 
 /// A claimed rate counts as met when the interval lies within claim ± RATE_BAND (or contains it).
 pub const RATE_BAND: f64 = 0.1;
@@ -60,7 +60,7 @@ pub const WINDOW_SHIFT: usize = 2;
 /// round-off floor (`LevelRecord::roundoff_floor`): below, it measures round-off ([`floor_hit`]).
 pub const FLOOR_MARGIN: f64 = 10.0;
 
-use numerics::base::stats::{LineFit, fit_line};
+use model::base::stats::{LineFit, fit_line};
 
 /// The variable a rate is fitted against.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -293,8 +293,8 @@ impl RateVerdict {
 /// The variable the theory speaks of for this run: h_min under uniform refinement, NDF otherwise.
 pub fn abscissa_of(run: &RunRecord) -> Abscissa {
     match run.run.refine {
-        numerics::adapt::Refine::Uniform => Abscissa::InverseHMin,
-        numerics::adapt::Refine::Adaptive => Abscissa::Ndof,
+        model::settings::adapt::Refine::Uniform => Abscissa::InverseHMin,
+        model::settings::adapt::Refine::Adaptive => Abscissa::Ndof,
     }
 }
 
@@ -405,7 +405,7 @@ pub fn clamped_free_corner_exponent(nu: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use numerics::base::stats::t_quantile_975;
+    use model::base::stats::t_quantile_975;
 
     #[test]
     fn t_quantiles_match_tables() {
@@ -514,7 +514,7 @@ mod tests {
 /// Refinement locations, tested as what they are: a claimed location is a refinement centre when
 /// the local mesh size h has a local minimum (or a plateau of its own) there.
 pub mod refinement {
-    use harness::records::MeshSnapshot;
+    use store::records::MeshSnapshot;
 
     /// One mesh edge on a boundary segment: parameter range [s0, s1] along the segment and length.
     #[derive(Clone, Copy, Debug, PartialEq)]
@@ -599,8 +599,8 @@ pub mod refinement {
         for t in &m.triangles {
             let v = t.map(|i| m.vertices[i]);
             let c = [(v[0][0] + v[1][0] + v[2][0]) / 3.0, (v[0][1] + v[1][1] + v[2][1]) / 3.0];
-            let d = (0..3).map(|i| numerics::mesh::dist(v[i], v[(i + 1) % 3])).fold(0.0, f64::max);
-            let dc = numerics::mesh::dist(c, p);
+            let d = (0..3).map(|i| model::mesh::dist(v[i], v[(i + 1) % 3])).fold(0.0, f64::max);
+            let dc = model::mesh::dist(c, p);
             if dc <= r {
                 inner = inner.min(d);
             } else if dc <= reach {

@@ -10,7 +10,7 @@ use super::{Built, ERR, ESTIMATE, Figure, NDF_DESC, PALETTE, Style, runs, series
 use crate::analysis::problem_names;
 use crate::analysis::roles::{self, Roles};
 use crate::analysis::verdict::FLOOR_MARGIN;
-use harness::study::store::Shelf;
+use store::study::store::Shelf;
 
 const STUDY: &str = roles::DEEP_EX71_AS_WRITTEN.study;
 
@@ -69,7 +69,7 @@ pub(super) fn deep_floor(shelf: &Shelf, roles: &Roles) -> anyhow::Result<Built> 
                 large: false,
             };
             p.series.push(series(r, format!("{label}: error {ERR}"), style(0, false, true), |l| l.err_quadrature));
-            if r.run.refine != numerics::adapt::Refine::Uniform {
+            if r.run.refine != model::settings::adapt::Refine::Uniform {
                 p.series.push(series(r, format!("{label}: {ESTIMATE}"), style(1, false, false), |l| Some(l.terms.estimate)));
             }
             p.series.push(series(r, format!("{label}: {FLOOR_MARGIN} × round-off floor"), style(2, true, false), |l| {

@@ -10,7 +10,7 @@
 use super::render::{LineFigure, MARKERS, Panel};
 use super::{Built, ERR, Figure, NDF_DESC, PALETTE, Style, runs, series, slope};
 use crate::analysis::studies::{self, Study};
-use harness::study::store::Shelf;
+use store::study::store::Shelf;
 
 /// One Example 7.2 study's error figure: its study, the problem's name in the panels and the title.
 struct Labels {
@@ -50,7 +50,7 @@ fn error_figure(shelf: &Shelf, labels: Labels) -> anyhow::Result<Built> {
         Ok(r) => r,
         Err(why) => return Ok(Err(why)),
     };
-    type Field = fn(&numerics::adapt::LevelRecord) -> Option<f64>;
+    type Field = fn(&model::level::record::LevelRecord) -> Option<f64>;
     let panels_of: [(&str, &str, Field); 2] =
         [("the whole square", "", |l| l.err_quadrature), (labels.contact, " on Γ_{C}", |l| l.err_contact)];
     let mut panels = Vec::new();

@@ -11,8 +11,8 @@ use super::{
 };
 use crate::analysis::roles::{self, Roles};
 use anyhow::Context;
-use harness::study::store::Shelf;
-use numerics::problems::Fb;
+use model::problems::Fb;
+use store::study::store::Shelf;
 
 const STUDY: &str = roles::FB_AS_WRITTEN.study;
 

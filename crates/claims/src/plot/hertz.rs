@@ -11,9 +11,9 @@ use super::{Built, Figure, Marker, PALETTE, Panel, Style, YScale, mesh_figure, r
 use crate::analysis::hertz::{self, Hertz};
 use crate::analysis::roles::{self, Roles};
 use anyhow::Context;
-use harness::records::{MeshSnapshot, RunRecord};
-use harness::study::store::Shelf;
 use plotters::style::RGBColor;
+use store::records::{MeshSnapshot, RunRecord};
+use store::study::store::Shelf;
 
 const STUDY: &str = roles::HERTZ_AS_WRITTEN.study;
 
@@ -64,7 +64,7 @@ pub(super) fn hertz_pressure(shelf: &Shelf) -> anyhow::Result<Built> {
         nodes.sort_by(|u, v| u.x[0].total_cmp(&v.x[0]));
         // thousands of nodes: a line, no markers
         let style = Style { color: PALETTE[k % PALETTE.len()], marker: Marker::None, dashed: false, filled: true, large: false };
-        let s = |n: &&numerics::contact::solve::ContactSample| (n.x[0] - c.centre) / a;
+        let s = |n: &&model::level::sample::ContactSample| (n.x[0] - c.centre) / a;
         profile.series.push(Series {
             label: format!(
                 "{}, NDF {}: F = {:.4}, a_{{h}} = {:.5} ({}), p_{{0,h}} = {:.3} ({})",

@@ -81,14 +81,15 @@ use crate::analysis::problem_names;
 use crate::analysis::roles::{self, Role, Roles};
 use crate::analysis::studies::{self, Study};
 use anyhow::Context;
-use harness::records::{MeshSnapshot, RunRecord};
-use harness::study::store::Shelf;
-use numerics::adapt::{LevelRecord, Refine};
-use numerics::estimator::estimate::{C0_PAPER, ContactTerm, LogFactor, c0_paper};
+use model::level::record::LevelRecord;
+use model::settings::adapt::Refine;
+use model::settings::estimator::{C0_PAPER, ContactTerm, LogFactor, c0_paper};
 use plotters::prelude::*;
 use render::{Figure, HLine, LineFigure, Marker, MeshFigure, PALETTE, Panel, Series, Slope, SlopeAnchor, Style, YScale};
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
+use store::records::{MeshSnapshot, RunRecord};
+use store::study::store::Shelf;
 
 /// A figure: its name (the file stem under `figures/`), the study it is drawn from, and its
 /// caption on the study page (what it shows: the quantities, the runs, the axes).
@@ -275,7 +276,7 @@ pub fn draw_studies(shelf: &Shelf, figures: &Path, roles: &Roles, studies: Optio
     let keep = |figure: &str| studies.is_none_or(|s| study_of(figure).is_some_and(|st| s.iter().any(|x| x == st)));
     let outcome = draw_figures_where(shelf, figures, roles, &keep)?;
     for (name, why) in &outcome.skipped {
-        numerics::base::note::line(format_args!("figures: skipped {name}: {why}"));
+        model::base::note::line(format_args!("figures: skipped {name}: {why}"));
     }
     Ok(outcome.written)
 }
@@ -290,7 +291,7 @@ pub fn draw_figures(shelf: &Shelf, figures: &Path, roles: &Roles) -> anyhow::Res
 /// [`draw_figures`] for the figures `keep` accepts.
 pub fn draw_figures_where(shelf: &Shelf, figures: &Path, roles: &Roles, keep: &dyn Fn(&str) -> bool) -> anyhow::Result<Outcome> {
     register_font()?;
-    numerics::base::input::create_folder(figures)?;
+    model::base::input::create_folder(figures)?;
     let mut outcome = Outcome::default();
     let mut errors = Vec::new();
     for name in FIGURES.into_iter().filter(|f| keep(f)) {
@@ -326,17 +327,17 @@ fn write_figure(fig: &Figure, dir: &Path, name: &str) -> anyhow::Result<Vec<Path
         let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
         fig.render(&root, rich::SVG)?;
     }
-    harness::records::write_atomic(&svg, text.as_bytes()).with_context(|| format!("writing {}", svg.display()))?;
+    store::records::write_atomic(&svg, text.as_bytes()).with_context(|| format!("writing {}", svg.display()))?;
 
     let png = dir.join(format!("{name}.png"));
     let tmp = dir.join(format!(".{name}.tmp{}.png", std::process::id()));
-    numerics::base::failpoint::step("write", &tmp);
+    model::base::failpoint::step("write", &tmp);
     let drawn = {
         // the backend saves the file when presented (or dropped), before the rename below
         glyphs::Glyphs::new(BitMapBackend::new(&tmp, size), FONT_BYTES)
             .and_then(|backend| fig.render(&backend.into_drawing_area(), rich::BITMAP).map(|_| ()))
     };
-    numerics::base::failpoint::step("rename", &png);
+    model::base::failpoint::step("rename", &png);
     if let Err(e) = drawn.and_then(|()| std::fs::rename(&tmp, &png).with_context(|| format!("writing {}", png.display()))) {
         std::fs::remove_file(&tmp).ok();
         return Err(e);

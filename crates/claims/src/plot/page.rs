@@ -11,10 +11,10 @@
 use crate::analysis::claims::Claim;
 use crate::analysis::studies::{self, Study};
 use base64::Engine;
-use harness::records::RunRecord;
-use harness::study::store::Shelf;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
+use store::records::RunRecord;
+use store::study::store::Shelf;
 
 /// The figures of [`crate::plot::FIGURES`] drawn from `study` ([`crate::plot::study_of`]), in
 /// the order drawn.
@@ -78,7 +78,7 @@ impl DriftReports {
         use anyhow::Context;
         let mut reports = Vec::new();
         for file in files {
-            match harness::records::read_text(file) {
+            match store::records::read_text(file) {
                 Ok(t) => reports.push(serde_json::from_str(&t).with_context(|| {
                     format!(
                         "reading the drift report {} (drift writes it whole, so it was cut or edited since): run `signorini drift` to write it again, or remove it and the pages say \"not checked\"",
@@ -140,7 +140,7 @@ fn drift_status(reports: &DriftReports, study: &str, runs: &[RunRecord]) -> Stri
         Some(_) if r["self_comparison"].as_bool() == Some(true) => {
             format!("not checked: the drift report of {date}{against} compared this folder with itself (nothing was rerun)")
         }
-        Some(e) if harness::study::drift::compared_a_copy(e) => format!(
+        Some(e) if store::study::compared_a_copy(e) => format!(
             "not checked: the drift report of {date}{against} compared these records with byte-identical ones, timings included: a copy of this folder, not a rerun"
         ),
         None => format!("not checked in the drift report of {date}{against} (it did not include this study; {advice})"),
@@ -167,7 +167,7 @@ fn records_not_compared(entry: &serde_json::Value, runs: &[RunRecord]) -> Option
     let differences = |side: &serde_json::Map<String, serde_json::Value>| {
         let changed: Vec<&str> = runs
             .iter()
-            .filter(|r| side.get(&r.run.id).and_then(|v| v.as_str()) != Some(harness::records::record_sha256(r).as_str()))
+            .filter(|r| side.get(&r.run.id).and_then(|v| v.as_str()) != Some(store::records::record_sha256(r).as_str()))
             .map(|r| r.run.id.as_str())
             .collect();
         let gone: Vec<String> = side.keys().filter(|id| !runs.iter().any(|r| r.run.id == **id)).cloned().collect();
@@ -249,7 +249,11 @@ fn run_table(runs: &[RunRecord]) -> String {
             escape(&r.run.id),
             escape(&r.run.problem),
             r.run.refine,
-            if matches!(r.run.refine, numerics::adapt::Refine::Adaptive) { format!(", θ = {}", r.run.theta) } else { String::new() },
+            if matches!(r.run.refine, model::settings::adapt::Refine::Adaptive) {
+                format!(", θ = {}", r.run.theta)
+            } else {
+                String::new()
+            },
             escape(&estimator_settings(&r.run.estimator)),
             r.levels.len(),
             last.map_or("–".into(), |l| l.ndof.to_string()),
@@ -264,9 +268,9 @@ fn run_table(runs: &[RunRecord]) -> String {
 /// The estimator settings of a run that differ from the defaults (`contact_term = as_written;
 /// c0 = 1`), as the manifest's `[estimator]` keys; "default" where none do. Runs that differ
 /// only there share their refinement cell: this cell tells them apart.
-fn estimator_settings(config: &numerics::estimator::estimate::EstimatorConfig) -> String {
+fn estimator_settings(config: &model::settings::estimator::EstimatorConfig) -> String {
     let (Ok(serde_json::Value::Object(set)), Ok(serde_json::Value::Object(default))) =
-        (serde_json::to_value(config), serde_json::to_value(numerics::estimator::estimate::EstimatorConfig::default()))
+        (serde_json::to_value(config), serde_json::to_value(model::settings::estimator::EstimatorConfig::default()))
     else {
         return "–".into();
     };
@@ -358,7 +362,7 @@ fn figures_html(figures: &Path, study: &str) -> std::io::Result<String> {
     );
     for name in figures_of(study) {
         let png = figures.join(format!("{name}.png"));
-        match harness::records::read_bytes(&png) {
+        match store::records::read_bytes(&png) {
             Ok(bytes) if !bytes.starts_with(PNG_SIGNATURE) => {
                 return Err(std::io::Error::new(
                     std::io::ErrorKind::InvalidData,
@@ -474,12 +478,12 @@ pub fn write_pages(
     // integrity check when the shelf was opened
     let claims =
         crate::analysis::claims::claims(shelf, roles).with_context(|| format!("computing the CLAIMS rows from {}", results.display()))?;
-    numerics::base::input::create_folder(out)?;
+    model::base::input::create_folder(out)?;
     let mut written = Vec::new();
     for study in &chosen {
         let incomplete = shelf.not_as_declared(study);
         if !incomplete.is_empty() {
-            numerics::base::note::line(format_args!(
+            model::base::note::line(format_args!(
                 "report: {study} is incomplete in {} (its page says so): {}",
                 results.display(),
                 incomplete.join(", ")
@@ -487,12 +491,12 @@ pub fn write_pages(
         }
         let page = study_page(shelf, figures, study, &claims, drift)?;
         let path = out.join(format!("{study}.html"));
-        harness::records::write_atomic(&path, page.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+        store::records::write_atomic(&path, page.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
         written.push(path);
     }
     if studies.is_empty() {
         let path = out.join("index.html");
-        harness::records::write_atomic(&path, index_page(results, &chosen, &claims).as_bytes())
+        store::records::write_atomic(&path, index_page(results, &chosen, &claims).as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
         written.push(path);
     }

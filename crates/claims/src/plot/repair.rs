@@ -10,8 +10,8 @@ use super::{Built, ERR, ESTIMATE, Figure, NDF_DESC, PALETTE, Style, problem_titl
 use crate::analysis::claims::repair::{Fitted, PROBLEMS, Stored};
 use crate::analysis::roles::Roles;
 use anyhow::Context;
-use harness::records::RunRecord;
-use harness::study::store::Shelf;
+use store::records::RunRecord;
+use store::study::store::Shelf;
 
 /// "deep/ex71_repaired"
 fn name(r: &RunRecord) -> String {

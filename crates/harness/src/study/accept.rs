@@ -2,18 +2,18 @@
 //! without a moment at which a stored run is lost. The rerun goes into a staging folder beside
 //! the results (`RESULTS/.accept/STUDY`, a folder no study can be named after); only when every
 //! run of it has finished is the study swapped, as one change through the study's journal
-//! ([`crate::records::journal`]): every file of the rerun renamed into place and every old file
+//! ([`::store::records::journal`]): every file of the rerun renamed into place and every old file
 //! it does not replace removed. Stopped before the swap (an interrupt, a kill, a failed run) the
 //! stored study is as it was; stopped during it, the next writer of the study completes it.
 
 use super::store::{Store, owned};
 use super::{Manifest, RunOptions};
-use crate::records::{StudyDir, journal::Journal};
+use ::store::records::{StudyDir, journal::Journal};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 
 /// The folder the reruns of `drift --accept` are staged in, inside the results root.
-pub const STAGING: &str = crate::records::journal::STAGING;
+pub const STAGING: &str = ::store::records::journal::STAGING;
 
 /// `drift --accept` stopped by an interrupt before the swap (exit status 130): the stored study
 /// is unchanged.
@@ -76,8 +76,8 @@ pub fn accept(manifest: &Manifest, results: &Path, progress: bool) -> Result<()>
 }
 
 /// The stored runs as (id, SHA-256 of the record file), to tell whether they changed.
-fn fingerprint(runs: &[crate::records::RunRecord]) -> Vec<(String, String)> {
-    runs.iter().map(|r| (r.run.id.clone(), crate::records::record_sha256(r))).collect()
+fn fingerprint(runs: &[::store::records::RunRecord]) -> Vec<(String, String)> {
+    runs.iter().map(|r| (r.run.id.clone(), ::store::records::record_sha256(r))).collect()
 }
 
 /// Every data file of `staged` renamed onto its place in `live`, every data file of `live` it
@@ -92,7 +92,7 @@ fn swap(live: &StudyDir, staged: &StudyDir) -> Result<()> {
     let names: Vec<PathBuf> = new
         .data
         .iter()
-        .filter(|p| !p.file_name().is_some_and(|n| crate::records::is_temporary(&n.to_string_lossy())))
+        .filter(|p| !p.file_name().is_some_and(|n| ::store::records::is_temporary(&n.to_string_lossy())))
         .map(|p| relative(staged, p))
         .collect();
     let journal = Journal {
@@ -105,7 +105,7 @@ fn swap(live: &StudyDir, staged: &StudyDir) -> Result<()> {
 /// The staging folder of a study, once swapped (what is left is only its locks).
 fn remove_staging(staging: &Path, study: &str) {
     let folder = staging.join(study);
-    numerics::base::failpoint::step("remove folder", &folder);
+    model::base::failpoint::step("remove folder", &folder);
     let _ = std::fs::remove_dir_all(&folder);
     let _ = std::fs::remove_dir(staging);
 }

@@ -34,7 +34,7 @@
 use super::manifest::DERIVED;
 use super::manifest::{DriftSpec, Manifest, Tolerance};
 use super::store::Store;
-use crate::records::RunRecord;
+use ::store::records::RunRecord;
 use numerics::adapt::LevelRecord;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -260,7 +260,7 @@ pub fn observed_rate(run: &RunRecord, field: &str, last: usize) -> Option<f64> {
         .iter()
         .map(|l| Some(((l["ndof"].as_f64()?).ln(), l[field].as_f64().filter(|v| *v > 0.0)?.ln())))
         .collect::<Option<_>>()?;
-    numerics::base::stats::fit_line(&pts).map(|f| -f.slope)
+    model::base::stats::fit_line(&pts).map(|f| -f.slope)
 }
 
 /// Compare a study's fresh runs with its stored runs. `quick`: fresh runs are the quick forms
@@ -415,8 +415,8 @@ fn first_history_difference(s: &numerics::adapt::History, f: &numerics::adapt::H
 /// final active set exactly (a hand-edited `last.eta_h` there is a drift, never "none").
 fn compare_references(study: &str, stored: &Store, fresh: &Store, runs: &[RunRecord], spec: &DriftSpec, against: bool) -> Vec<DriftRow> {
     let mut out = Vec::new();
-    let keys: std::collections::BTreeSet<String> = runs.iter().filter_map(|r| crate::records::ReferenceRecord::key_of(&r.run)).collect();
-    let describe = |r: &Option<crate::records::ReferenceRecord>| {
+    let keys: std::collections::BTreeSet<String> = runs.iter().filter_map(|r| ::store::records::ReferenceRecord::key_of(&r.run)).collect();
+    let describe = |r: &Option<::store::records::ReferenceRecord>| {
         r.as_ref().map_or("(missing)".to_string(), |r| format!("NDF {} after {} levels", r.rebuild.ndof, r.rebuild.history.levels.len()))
     };
     for key in keys {
@@ -455,7 +455,7 @@ fn replay_tier(manifest: &Manifest, stored: &[RunRecord], progress: bool, c: &mu
         let Some(s) = stored.iter().find(|r| &r.run.id == id) else { continue }; // a missing run is a row already
         let Some(level) = s.levels.iter().rposition(|l| tier.replay_max_ndof.is_none_or(|m| l.ndof <= m)) else { continue };
         if progress {
-            numerics::base::note::line(format_args!(
+            model::base::note::line(format_args!(
                 "{study}/{id}: replaying level {level} (NDF {}) from the stored refinement history",
                 s.levels[level].ndof
             ));
@@ -578,19 +578,9 @@ pub struct DriftReport {
     #[serde(default)]
     pub self_comparison: bool,
     /// With `against`: the studies whose records there are byte-identical to the stored ones,
-    /// timings (`t_*`) included ([`compared_a_copy`]): a copy of the stored folder, not a rerun.
+    /// timings (`t_*`) included ([`compared_a_copy`](super::compared_a_copy)): a copy of the stored folder, not a rerun.
     #[serde(default)]
     pub copies: Vec<String>,
-}
-
-/// Whether a drift report's study entry compared the stored records with records byte-identical
-/// to them (their hashes, `records` and `against_records`), timings (`t_*`) included: no rerun
-/// reproduces a run's timings, so the other folder is a copy of the stored one, or the folder
-/// itself. That checks that the copy reads back, not the numbers, and a study page never quotes
-/// it as a rerun (`drift --against` a `cp -r` copy is never "rerun and compared"). The folder itself ([`same_folder`]) is the case where every record is its own copy.
-pub fn compared_a_copy(entry: &Value) -> bool {
-    let stored = entry.get("records").and_then(Value::as_object);
-    stored.is_some_and(|s| !s.is_empty() && entry.get("against_records").and_then(Value::as_object) == Some(s))
 }
 
 /// Whether `against` and `results` are one folder (after resolving symlinks and `.`/`..`).
@@ -643,27 +633,6 @@ impl DriftReport {
     }
 }
 
-/// The declared studies a results folder holds (a folder `DIR/STUDY`), those it does not, and
-/// its other folders (not declared studies).
-#[derive(Clone, Debug)]
-pub struct Held {
-    pub present: Vec<Manifest>,
-    pub absent: Vec<String>,
-    pub undeclared: Vec<String>,
-}
-
-/// Which of `manifests`' studies `dir` holds. A `dir` that is not a readable folder is an error.
-pub fn held_by(dir: &Path, manifests: &[Manifest]) -> std::io::Result<Held> {
-    let entries =
-        std::fs::read_dir(dir).map_err(|e| std::io::Error::new(e.kind(), format!("reading the folder {}: {e}", dir.display())))?;
-    let mut folders: Vec<String> =
-        entries.flatten().filter(|e| e.path().is_dir()).map(|e| e.file_name().to_string_lossy().into_owned()).collect();
-    folders.sort();
-    let (present, absent): (Vec<&Manifest>, Vec<&Manifest>) = manifests.iter().partition(|m| folders.contains(&m.study));
-    let undeclared = folders.into_iter().filter(|f| !manifests.iter().any(|m| &m.study == f)).collect();
-    Ok(Held { present: present.into_iter().cloned().collect(), absent: absent.iter().map(|m| m.study.clone()).collect(), undeclared })
-}
-
 /// "a, b" or "none".
 fn listed(names: &[String]) -> String {
     if names.is_empty() { "none".into() } else { names.join(", ") }
@@ -673,7 +642,7 @@ fn listed(names: &[String]) -> String {
 /// (with `named`, the studies were named one by one and each must be there), and the names of
 /// those it does not. A folder holding none of them is an error: there is nothing to compare.
 pub fn select_against(dir: &Path, manifests: &[Manifest], named: bool) -> anyhow::Result<(Vec<Manifest>, Vec<String>)> {
-    let held = held_by(dir, manifests).map_err(|e| anyhow::anyhow!("--against {}: {e}", dir.display()))?;
+    let held = super::held_by(dir, manifests).map_err(|e| anyhow::anyhow!("--against {}: {e}", dir.display()))?;
     if named && !held.absent.is_empty() {
         anyhow::bail!(
             "--against {}: the folder does not hold {} (it holds: {}); nothing of {} to compare",
@@ -819,7 +788,7 @@ pub fn check(
             c.rows.extend(compare_provenance(&m.study, &stored_store, &fresh_store));
         }
         if opts.progress {
-            numerics::base::note::line(format_args!(
+            model::base::note::line(format_args!(
                 "{}: {}",
                 m.study,
                 if c.rows.is_empty() { "no drift".to_string() } else { format!("{} field(s) moved", c.rows.len()) }
@@ -827,13 +796,13 @@ pub fn check(
         }
         // the records compared, by hash: a page quoting this report checks that it shows them
         let hashes = |runs: &[RunRecord]| -> BTreeMap<String, String> {
-            runs.iter().map(|r| (r.run.id.clone(), crate::records::record_sha256(r))).collect()
+            runs.iter().map(|r| (r.run.id.clone(), ::store::records::record_sha256(r))).collect()
         };
         let mut entry =
             serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": c.rows.len(), "quick": quick, "records": hashes(&stored) });
         if opts.against.is_some() {
             entry["against_records"] = serde_json::to_value(hashes(&fresh))?;
-            if compared_a_copy(&entry) {
+            if super::compared_a_copy(&entry) {
                 report.copies.push(m.study.clone());
             }
         }
@@ -844,7 +813,7 @@ pub fn check(
     if all_studies && opts.against.is_none() {
         let file = opts.results.join("CLAIMS.md");
         // through the results folder's one reader: a pipe or a device there is named, not read
-        let stored = match crate::records::read_text(&file) {
+        let stored = match ::store::records::read_text(&file) {
             Ok(text) => text,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
             Err(e) => format!("(unreadable: {e})"),
@@ -917,7 +886,7 @@ fn rerun(m: &Manifest, quick: bool, opts: &DriftOptions) -> anyhow::Result<()> {
         if !replay.is_empty() {
             tiers.push(format!("the last level of {replay} replayed from its history"));
         }
-        numerics::base::note::line(format_args!("{}: a deep study: {} (all to the end: drift --deep)", m.study, tiers.join(", ")));
+        model::base::note::line(format_args!("{}: a deep study: {} (all to the end: drift --deep)", m.study, tiers.join(", ")));
     }
     let options = super::RunOptions {
         quick,

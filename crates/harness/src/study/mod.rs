@@ -18,18 +18,18 @@
 
 pub mod accept;
 pub mod drift;
-pub mod manifest;
 pub mod progress;
-pub mod provenance;
 pub mod reference;
-pub mod store;
 
-use crate::records::{Batch, MeshSnapshot, RunRecord, RunSpec};
+// the declared studies as stored, from the store crate, under the paths this crate uses for them
+pub use ::store::study::{Held, check_complete, compared_a_copy, held_by, manifest, provenance, store, stored_problem};
+
+use ::store::records::{Batch, MeshSnapshot, RunRecord, RunSpec};
 use anyhow::{Context, Result, bail};
 use manifest::Manifest;
+use model::mesh::MeshSpec;
+use model::problems;
 use numerics::adapt::{self, AdaptConfig, Level};
-use numerics::mesh::MeshSpec;
-use numerics::problems;
 use progress::Progress;
 use reference::ReferenceField;
 use std::collections::HashMap;
@@ -222,7 +222,7 @@ pub fn plan(manifest: &Manifest, opts: &RunOptions) -> Result<Plan> {
         Ok(checked) => checked,
         Err(e) => match e.downcast_ref::<store::BeingWritten>() {
             Some(w) => {
-                numerics::base::note::line(format_args!("{}: {w}", manifest.study));
+                model::base::note::line(format_args!("{}: {w}", manifest.study));
                 return Ok(computed(planned));
             }
             None => return Err(e),
@@ -263,11 +263,11 @@ pub fn plan(manifest: &Manifest, opts: &RunOptions) -> Result<Plan> {
 
 /// The run a file of a study folder belongs to: `runs/RUN.json`, `.partial/RUN.json` (its
 /// checkpoint), `meshes/RUN_levelL.*`; `None` for the study's shared files.
-fn run_of_file(dir: &crate::records::StudyDir, file: &std::path::Path) -> Option<String> {
+fn run_of_file(dir: &::store::records::StudyDir, file: &std::path::Path) -> Option<String> {
     let name = file.file_name()?.to_string_lossy().into_owned();
     let folder = file.parent()?.strip_prefix(&dir.root).ok()?.to_str()?.to_string();
     match folder.as_str() {
-        "meshes" => crate::records::StudyDir::parse_mesh_name(&name).map(|(r, _)| r.to_string()),
+        "meshes" => ::store::records::StudyDir::parse_mesh_name(&name).map(|(r, _)| r.to_string()),
         "runs" | ".partial" => name.strip_suffix(".json").map(str::to_string),
         _ => None,
     }
@@ -310,14 +310,14 @@ fn set_up(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &RunOpt
                 // a summary is rendered again below; a reference at fault is computed again
                 if file.starts_with(store.dir().root.join("references")) {
                     let key = file.file_stem().map(|k| k.to_string_lossy().into_owned()).unwrap_or_default();
-                    numerics::base::note::line(format_args!("{}: removing {} (at fault; computed again)", manifest.study, file.display()));
+                    model::base::note::line(format_args!("{}: removing {} (at fault; computed again)", manifest.study, file.display()));
                     writer.remove_reference(&key)?;
                 }
                 continue;
             }
             store::Stale::Differs { .. } => continue,
         };
-        numerics::base::note::line(format_args!("{}/{id}: removing the stored run and its snapshots ({why})", manifest.study));
+        model::base::note::line(format_args!("{}/{id}: removing the stored run and its snapshots ({why})", manifest.study));
         writer.remove_run(&writer.claim_run(id)?)?;
         runs = store.records()?;
     }
@@ -352,7 +352,7 @@ fn run_planned(manifest: &Manifest, store: &Store, planned: &[RunSpec], opts: &R
                 store.dir().root.display(),
                 store::stale::spec_differences(&r.run, spec).join("; ")
             ),
-            Some(r) => numerics::base::note::line(format_args!(
+            Some(r) => model::base::note::line(format_args!(
                 "{}/{}: replacing the stored run when the new one has finished ({})",
                 manifest.study,
                 spec.id,
@@ -383,7 +383,7 @@ fn keep(manifest: &Manifest, store: &Store, spec: &RunSpec, opts: &RunOptions) -
         } else {
             "finished earlier, kept (use --fresh to start over)"
         };
-        numerics::base::note::line(format_args!("{}/{}: {how}", manifest.study, spec.id));
+        model::base::note::line(format_args!("{}/{}: {how}", manifest.study, spec.id));
     }
     store_missing_reference(manifest, store, spec, opts)
 }
@@ -393,11 +393,11 @@ fn keep(manifest: &Manifest, store: &Store, spec: &RunSpec, opts: &RunOptions) -
 /// with its history, after checking that it is the reference the run was measured against
 /// (the same NDF; the errors the drift check compares tell the rest).
 fn store_missing_reference(manifest: &Manifest, store: &Store, spec: &RunSpec, opts: &RunOptions) -> Result<()> {
-    let Some(key) = crate::records::ReferenceRecord::key_of(spec) else { return Ok(()) };
+    let Some(key) = ::store::records::ReferenceRecord::key_of(spec) else { return Ok(()) };
     if matches!(store.reference(&key), Ok(Some(_))) {
         return Ok(());
     }
-    numerics::base::note::line(format_args!(
+    model::base::note::line(format_args!(
         "{}/{}: the history of its reference solution is not stored in {}; computing it once",
         manifest.study,
         spec.id,
@@ -417,7 +417,7 @@ fn store_missing_reference(manifest: &Manifest, store: &Store, spec: &RunSpec, o
             stored.map_or("none".to_string(), |n| n.to_string())
         );
     }
-    store.lock(true)?.commit_reference(&crate::records::ReferenceRecord::new(spec, &reference.spec, reference.rebuild.clone()))
+    store.lock(true)?.commit_reference(&::store::records::ReferenceRecord::new(spec, &reference.spec, reference.rebuild.clone()))
 }
 
 /// The error of an interrupted study: the runs kept, those missing, the command that resumes.
@@ -439,62 +439,6 @@ fn interruption(manifest: &Manifest, store: &Store, opts: &RunOptions) -> anyhow
     }
     Interrupted { study: manifest.study.clone(), resume, kept, missing }.into()
 }
-
-/// Every declared run is stored with exactly its declared (full) spec, and nothing else is:
-/// what figures and claims need before they draw from a study. The error names what is missing
-/// or different and how to complete the study.
-pub fn check_complete(manifest: &Manifest, results: &std::path::Path) -> Result<()> {
-    let store = Store::of(results, manifest);
-    let runs = store.read()?;
-    let dir = store.dir();
-    let mut problems = Vec::new();
-    for planned in &manifest.runs {
-        match runs.iter().find(|r| r.run.id == planned.spec.id) {
-            None => problems.push(format!("run {} is missing", planned.spec.id)),
-            Some(r) if r.run != planned.spec => problems.push(format!(
-                "run {} was computed with another spec ({})",
-                planned.spec.id,
-                store::stale::spec_differences(&r.run, &planned.spec).join("; ")
-            )),
-            Some(_) => {}
-        }
-    }
-    for r in &runs {
-        if !manifest.runs.iter().any(|p| p.spec.id == r.run.id) {
-            problems.push(format!("run {} is not declared in {}", r.run.id, manifest.file.display()));
-        }
-    }
-    if !problems.is_empty() {
-        // the advice writes into the folder being checked, never into results/ unless that is it
-        let into = if results == std::path::Path::new("results") { String::new() } else { format!(" --results {}", results.display()) };
-        // runs stored with another spec or not declared are refused by a plain run: the advice
-        // that works replaces them
-        let replace = if runs.iter().any(|r| manifest.runs.iter().all(|p| p.spec != r.run)) { " --replace" } else { "" };
-        bail!(
-            "{} does not match {}: {}. Complete it with `signorini run {}{into}{replace}` (or start over with --fresh) before drawing from it",
-            dir.root.display(),
-            manifest.file.display(),
-            problems.join("; "),
-            manifest.file.display()
-        );
-    }
-    Ok(())
-}
-
-/// The problem a stored run of `study` solved: its spec's problem resolved against the manifest
-/// the provenance names, with the run's constants (for figures and claims that need the problem's
-/// data, such as Hertz's radius and material). A problem file not found there (the study was
-/// run from another folder) is looked for beside `experiments/STUDY.toml`, so a study rerun
-/// into a scratch folder is drawn without copying its manifest and problem files.
-pub fn stored_problem(results: &std::path::Path, study: &str, spec: &RunSpec) -> Result<Box<dyn problems::Problem>> {
-    let prov = Store::new(results, study).provenance()?;
-    let recorded = manifest::resolve_problem(std::path::Path::new(&prov.manifest), &spec.problem);
-    let declared = manifest::resolve_problem(&PathBuf::from("experiments").join(format!("{study}.toml")), &spec.problem);
-    let found = |p: &String| !problems::is_file(p) || std::path::Path::new(p).exists();
-    let path = [recorded.clone(), declared].into_iter().find(found).unwrap_or(recorded);
-    problems::load(&path, &spec.constants).with_context(|| format!("the problem of {study}/{}", spec.id))
-}
-
 /// The key of a run's reference solution in the cache: problem and mesh as resolved (two
 /// manifests may name different files by the same relative path).
 fn reference_key(spec: &RunSpec, problem: &str, mesh: &str) -> Option<String> {
@@ -510,7 +454,7 @@ pub struct Prepared {
     /// The run's input files pinned to the bytes its spec holds the hashes of, for as long as
     /// the run computes ([`manifest::pin_inputs`]): every later read (the initial mesh built
     /// again on resuming, a replay) is of those bytes too.
-    pub pins: numerics::base::pin::Pins,
+    pub pins: model::base::pin::Pins,
     /// The code that computes the run: its checkpoint holds it, and only its own is resumed.
     pub code: provenance::CodeVersion,
 }
@@ -528,7 +472,7 @@ impl Prepared {
         }
     }
 
-    pub fn initial_mesh(&self) -> Result<numerics::mesh::Mesh> {
+    pub fn initial_mesh(&self) -> Result<model::mesh::Mesh> {
         Ok(self.mesh_spec.build(self.problem.as_ref())?)
     }
 }
@@ -541,7 +485,7 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
     let mesh_path = manifest::resolve_mesh(manifest_file, &spec.mesh);
     let problem = problems::load(&problem_path, &spec.constants)?;
     let mesh_spec = MeshSpec::parse(&mesh_path)?;
-    numerics::base::memory::check_memory(&format!("{study}/{}: the initial mesh {}", spec.id, spec.mesh), mesh_spec.ndof()?)?;
+    model::base::memory::check_memory(&format!("{study}/{}: the initial mesh {}", spec.id, spec.mesh), mesh_spec.ndof()?)?;
     if spec.reference.is_some() && problem.exact().is_some() {
         bail!("{study}/{}: problem {} has an exact solution; a reference solution is not needed", spec.id, spec.problem);
     }
@@ -559,7 +503,7 @@ pub fn prepare(study: &str, spec: &RunSpec, manifest_file: &std::path::Path, pro
                 spinner.finish();
                 let field = field.ok_or_else(|| anyhow::anyhow!("interrupted"))?;
                 if progress {
-                    numerics::base::note::line(format_args!("{label}: NDF {} in {:.1} s", field.ndof, started.elapsed().as_secs_f64()));
+                    model::base::note::line(format_args!("{label}: NDF {} in {:.1} s", field.ndof, started.elapsed().as_secs_f64()));
                 }
                 Ok(field)
             });
@@ -585,7 +529,7 @@ pub fn preload_references(manifest: &Manifest, stored: &Store, progress: bool) -
         let spec = &planned.spec;
         let problem_path = manifest::resolve_problem(&manifest.file, &spec.problem);
         let mesh_path = manifest::resolve_mesh(&manifest.file, &spec.mesh);
-        let (Some(key), Some(file_key)) = (reference_key(spec, &problem_path, &mesh_path), crate::records::ReferenceRecord::key_of(spec))
+        let (Some(key), Some(file_key)) = (reference_key(spec, &problem_path, &mesh_path), ::store::records::ReferenceRecord::key_of(spec))
         else {
             continue;
         };
@@ -609,7 +553,7 @@ pub fn preload_references(manifest: &Manifest, stored: &Store, progress: bool) -
                 })?;
             spinner.finish();
             if progress {
-                numerics::base::note::line(format_args!("{label}: rebuilt in {:.1} s", started.elapsed().as_secs_f64()));
+                model::base::note::line(format_args!("{label}: rebuilt in {:.1} s", started.elapsed().as_secs_f64()));
             }
             Ok(field)
         })?;
@@ -646,7 +590,7 @@ fn run_one(
     let (levels, history) = (result.records, result.history);
     if progress {
         let last = levels.last().expect("at least one level");
-        numerics::base::note::line(format_args!(
+        model::base::note::line(format_args!(
             "{study}/{}: {} levels, final NDF {}, estimate {:.3e}{stopped}",
             spec.id,
             levels.len(),
@@ -656,7 +600,7 @@ fn run_one(
     }
     let reference_ndof = prepared.reference.as_ref().map(|r| r.ndof);
     if let Some(r) = &prepared.reference {
-        run.stage_reference(&crate::records::ReferenceRecord::new(spec, &r.spec, r.rebuild.clone()), meshes)?;
+        run.stage_reference(&::store::records::ReferenceRecord::new(spec, &r.spec, r.rebuild.clone()), meshes)?;
     }
     Ok(Some(RunRecord {
         study: study.to_string(),
@@ -682,7 +626,7 @@ fn start_of(
     let mesh0 = prepared.initial_mesh()?;
     let Some(c) = run.checkpoint(spec, &prepared.code) else { return Ok(adapt::Start::new(mesh0)) };
     let done = c.levels.len();
-    numerics::base::note::line(format_args!(
+    model::base::note::line(format_args!(
         "{study}/{}: resuming after level {} (from {})",
         spec.id,
         done - 1,
@@ -709,7 +653,7 @@ fn start_of(
         c.next_active.as_ref().map(|f| f.decode()).transpose().with_context(|| format!("{study}/{}: the checkpoint", spec.id))?;
     let start = adapt::replay::resume(mesh0, c.levels, c.history, next_active).with_context(|| format!("{study}/{}: resuming", spec.id))?;
     if progress {
-        numerics::base::note::line(format_args!("{study}/{}: level {} rebuilt from the stored marks", spec.id, start.level));
+        model::base::note::line(format_args!("{study}/{}: level {} rebuilt from the stored marks", spec.id, start.level));
     }
     Ok(start)
 }
@@ -754,7 +698,7 @@ fn loop_of(
             ));
             pb.inc(1);
             for c in level.caveats {
-                numerics::base::note::line(format_args!("warning: {study}/{}: level {}: {c}", spec.id, r.level));
+                model::base::note::line(format_args!("warning: {study}/{}: level {}: {c}", spec.id, r.level));
             }
             if level.caveats.iter().any(|c| matches!(c, adapt::Caveat::AtRoundoff)) {
                 at_roundoff.push(r.level);
@@ -810,7 +754,7 @@ pub fn replay_stored_level(manifest: &Manifest, stored: &RunRecord, level: usize
 /// run saves it. Every level a run computes comes through here.
 fn keep_level(study: &str, spec: &RunSpec, run: &RunWriter, meshes: &mut Batch, level: &Level, prepared: &Prepared) -> Result<()> {
     let r = level.record;
-    if let Some(bad) = crate::records::first_non_finite(r) {
+    if let Some(bad) = ::store::records::first_non_finite(r) {
         bail!("{study}/{}: level {}: {bad}; a record cannot hold it, so the run stops here and nothing of it is stored", spec.id, r.level);
     }
     if let (Some(reference), Some(rs)) = (&prepared.reference, &spec.reference)
@@ -847,7 +791,7 @@ fn save_level(
     problem: &dyn problems::Problem,
 ) -> Result<()> {
     let (mesh, sol) = (level.mesh, level.solution);
-    let doc = crate::records::report::solution_vtu(mesh, sol, &level.estimate.element);
+    let doc = crate::report::solution_vtu(mesh, sol, &level.estimate.element);
     let l = level.record.level;
     meshes.add(&run.snapshot_file(l, "vtu"), doc.as_bytes())?;
     let snapshot = MeshSnapshot {

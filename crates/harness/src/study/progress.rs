@@ -93,7 +93,7 @@ impl Progress {
         bar.set_style(style);
         bar.set_prefix(prefix.to_string());
         // drawn through the process's one display: a bar of another study's run takes its own line
-        let bar = numerics::base::note::bars().add(bar);
+        let bar = model::base::note::bars().add(bar);
         bar.enable_steady_tick(Duration::from_millis(200));
         Progress { bar, plain: None, heartbeat: Mutex::new(None) }
     }
@@ -122,7 +122,7 @@ impl Progress {
     pub fn finish(&self) {
         drop(self.heartbeat.lock().unwrap_or_else(|e| e.into_inner()).take());
         self.bar.finish_and_clear();
-        numerics::base::note::bars().remove(&self.bar);
+        model::base::note::bars().remove(&self.bar);
     }
 }
 

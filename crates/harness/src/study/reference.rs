@@ -3,16 +3,16 @@
 //! the adaptive loop ([`compute`]) or rebuilt from its stored refinement history in one solve
 //! ([`replay`]), to the same numbers.
 
-use crate::records::{Rebuild, ReferenceSpec};
-use numerics::adapt::{self, AdaptConfig};
-use numerics::adapt::{Flags, Refine};
-use numerics::base::element::{self, N_NODES};
-use numerics::contact::norms::Displacement;
-use numerics::mesh::{
+use ::store::records::{Rebuild, ReferenceSpec};
+use model::base::element::{self, N_NODES};
+use model::mesh::{
     Mesh, MeshSpec,
     locate::{Hit, Locator},
 };
-use numerics::problems::Problem;
+use model::problems::Problem;
+use numerics::adapt::{self, AdaptConfig};
+use numerics::adapt::{Flags, Refine};
+use numerics::contact::norms::Displacement;
 
 /// A P2 field on a mesh with an R*-tree for point location ([`Locator`]).
 pub struct ReferenceField {

@@ -6,48 +6,27 @@
 //! interrupted deep run resumes.
 //! The method: `docs/method.md`, sections "MARK: the maximum strategy" and "The loop and its stops".
 
-pub mod history;
-mod level;
 pub mod replay;
 mod roundoff;
 
-pub use history::{BadFlags, Flags, History, LevelHistory};
-pub use level::{LevelRecord, Refine, float_fields, is_measurement};
+pub use model::level::history::{self, BadFlags, Flags, History, LevelHistory};
+pub use model::level::record::{LevelRecord, float_fields, is_measurement};
+pub use model::settings::adapt::{AdaptConfig, Refine};
 
 pub use roundoff::{
     Cause, Caveat, Conditioned, Drowned, NO_DEFORMATION, RESOLVED_DEFORMATION, RESOLVED_FORCES, ROUNDOFF_ESTIMATE, Resolution, TRANSLATED,
     Unresolved, WARNED_FORCES, WARNED_SHAPE, deformation, force_roundoff, resolution,
 };
 
-use crate::contact::PdasOptions;
 use crate::contact::norms::{self, Reference};
 use crate::contact::solve::{self, DiscreteSolution, SolveError};
-use crate::estimator::estimate::{self, ConfigError, Estimate, EstimatorConfig};
-use crate::mesh::Mesh;
-use crate::mesh::refine::{self, Refinement};
-use crate::problems::Problem;
+use crate::estimator::estimate::{self, ConfigError, Estimate};
+use model::mesh::Mesh;
+use model::mesh::refine::{self, Refinement};
+use model::problems::Problem;
 use std::ops::ControlFlow;
 use std::time::Instant;
 
-/// Settings of the loop; [`AdaptConfig::validate`] checks them.
-#[derive(Clone, Debug)]
-pub struct AdaptConfig {
-    /// Number of levels solved (level 0 is the initial mesh).
-    pub levels: usize,
-    /// Stop before solving a level with more unknowns than this.
-    pub max_ndof: Option<usize>,
-    /// Stop after solving the first level with at least this many unknowns (it is not refined).
-    pub stop_ndof: Option<usize>,
-    pub refine: Refine,
-    pub theta: f64,
-    pub estimator: EstimatorConfig,
-    pub pdas: PdasOptions,
-    /// Start each level's active-set method from the previous level's active set.
-    pub warm_start: bool,
-}
-
-/// Why the loop could not run: settings out of range (checked before anything is solved) or a
-/// level whose solve failed.
 #[derive(Debug, thiserror::Error)]
 pub enum AdaptError {
     /// A setting of the loop outside its range ([`ConfigError`], the estimator's error type: one
@@ -67,7 +46,7 @@ pub enum AdaptError {
     /// The next level would not fit in memory: levels `0..level` were solved (and seen by the
     /// observer), level `level` was not.
     #[error("stopped before level {level} ({}): {error}", if *level == 0 { "no level was solved".to_string() } else { format!("levels 0 to {} were solved", level - 1) })]
-    Memory { level: usize, error: crate::base::memory::MemoryError },
+    Memory { level: usize, error: model::base::memory::MemoryError },
     /// A start at or beyond the last level: nothing is left to solve.
     #[error("nothing to solve: the loop starts at level {start} and has {levels} levels")]
     NothingToSolve { start: usize, levels: usize },
@@ -80,77 +59,11 @@ pub enum AdaptError {
     /// Refining level `level` into the next failed (levels `0..=level` were solved and seen by
     /// the observer).
     #[error("refining level {level} (levels 0 to {level} were solved): {error}")]
-    Refine { level: usize, error: crate::mesh::MeshError },
+    Refine { level: usize, error: model::mesh::MeshError },
     /// Level `level`'s u_h does not resolve its deformation, or its contact forces are at their
     /// round-off ([`resolution`]).
     #[error("level {level}: {error}")]
     Unresolved { level: usize, error: Unresolved },
-}
-
-impl AdaptConfig {
-    /// Check every setting: the one validation behind the command line and the manifests.
-    /// With theta > 1 the maximum strategy marks nothing and the loop solves one mesh over and
-    /// over; with `levels = 0` or `max_ndof = 0` it solves nothing.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        let bad = |key, expected: &str, got: String| Err(ConfigError { key, expected: expected.into(), got });
-        if self.levels == 0 {
-            return bad("levels", "a number of levels >= 1", "0".into());
-        }
-        if self.max_ndof == Some(0) {
-            return bad("max_ndof", "a number of unknowns >= 1", "0".into());
-        }
-        if self.stop_ndof == Some(0) {
-            return bad("stop_ndof", "a number of unknowns >= 1", "0".into());
-        }
-        if let (Some(stop), Some(max)) = (self.stop_ndof, self.max_ndof)
-            && stop > max
-        {
-            // the loop stops before a level above max_ndof, so no level could reach stop_ndof
-            return bad(
-                "stop_ndof",
-                &format!("a number of unknowns <= max_ndof = {max} (no level above max_ndof is solved, so this stop is never reached)"),
-                stop.to_string(),
-            );
-        }
-        if !(self.theta > 0.0 && self.theta <= 1.0) {
-            return bad("theta", "a number in (0, 1]", ConfigError::number(self.theta));
-        }
-        self.estimator.validate()?;
-        if self.pdas.max_iterations == 0 {
-            return bad("pdas.max_iterations", "a number of iterations >= 1", "0".into());
-        }
-        Ok(())
-    }
-
-    /// Check `max_ndof` against the initial mesh `mesh` of `ndof` unknowns: level 0 is always
-    /// solved, so a `max_ndof` below it would contradict itself (refused, not a silent level 0).
-    pub fn check_initial(&self, ndof: f64, mesh: &str) -> Result<(), ConfigError> {
-        match self.max_ndof {
-            Some(max) if (max as f64) < ndof => Err(ConfigError {
-                key: "max_ndof",
-                expected: format!(
-                    "a number of unknowns >= {ndof:.0} (the initial mesh {mesh} has {ndof:.0}, and level 0 is always solved)"
-                ),
-                got: max.to_string(),
-            }),
-            _ => Ok(()),
-        }
-    }
-}
-
-impl Default for AdaptConfig {
-    fn default() -> Self {
-        AdaptConfig {
-            levels: 20,
-            max_ndof: None,
-            stop_ndof: None,
-            refine: Refine::Adaptive,
-            theta: 0.5,
-            estimator: EstimatorConfig::default(),
-            pdas: PdasOptions::default(),
-            warm_start: true,
-        }
-    }
 }
 
 /// What the observer sees at each level.
@@ -198,10 +111,10 @@ pub fn free_boundary_edge(mesh: &Mesh, sol: &DiscreteSolution) -> Option<f64> {
     mesh.boundary
         .iter()
         .zip(&sol.nodes.boundary_nodes)
-        .filter(|(e, _)| e.part == crate::problems::Part::Contact)
+        .filter(|(e, _)| e.part == model::problems::Part::Contact)
         .filter_map(|(e, nodes)| {
             let active: Vec<bool> = nodes.iter().map(|&n| sol.dofs.contact_index[n].is_some_and(|k| sol.active[k])).collect();
-            (active.contains(&true) && active.contains(&false)).then(|| crate::mesh::dist(mesh.vertices[e.v[0]], mesh.vertices[e.v[1]]))
+            (active.contains(&true) && active.contains(&false)).then(|| model::mesh::dist(mesh.vertices[e.v[0]], mesh.vertices[e.v[1]]))
         })
         .reduce(f64::max)
 }
@@ -209,7 +122,7 @@ pub fn free_boundary_edge(mesh: &Mesh, sol: &DiscreteSolution) -> Option<f64> {
 /// Active set for the refined mesh: a new contact node starts active where the previous level's
 /// discrete solution (transferred exactly, P2 in P2) touches the obstacle.
 fn transfer_active_set(old_mesh: &Mesh, old: &DiscreteSolution, refinement: &Refinement, problem: &dyn Problem) -> Vec<bool> {
-    let new_nodes = crate::mesh::P2Nodes::new(&refinement.mesh);
+    let new_nodes = model::mesh::P2Nodes::new(&refinement.mesh);
     let u = refine::transfer_p2(old_mesh, &old.nodes, &old.u, refinement, &new_nodes);
     let dofs = crate::fem::assembly::DofMap::new(&new_nodes, problem);
     let scale = u.iter().fold(0.0f64, |a, v| a.max(v[0].abs()).max(v[1].abs())).max(f64::MIN_POSITIVE);
@@ -243,7 +156,7 @@ pub enum AdaptTermination {
     /// from the origin refined deep); levels `0..level` were solved and seen by
     /// the observer, that one was not. A stop, not an error of the loop, so that a study keeps
     /// the levels solved; the command line exits 1 as for the memory stop ([`Self::is_error`]).
-    FarFromOrigin { level: usize, ndof: usize, worst: crate::mesh::precision::ShapeRoundoff },
+    FarFromOrigin { level: usize, ndof: usize, worst: model::mesh::precision::ShapeRoundoff },
 }
 
 impl AdaptTermination {
@@ -264,7 +177,7 @@ impl AdaptTermination {
             AdaptTermination::FarFromOrigin { level, ndof, worst } => Some(format!(
                 "stopped before level {level} (levels 0 to {} were solved): its refined mesh ({ndof} unknowns) is too fine for its coordinates: {}; or stop the loop before this level: at most {level} levels (levels = {level}, --levels {level}) or at most {} unknowns (max_ndof, --max-ndof)",
                 level - 1,
-                crate::mesh::MeshError::from(worst),
+                model::mesh::MeshError::from(worst),
                 ndof - 1
             )),
         }
@@ -337,7 +250,7 @@ pub fn solve_level(
     // before every level, not only the first: an adaptive loop grows until it does not fit;
     // `measured`: unknowns and peak resident bytes of a measured solve, if known (the previous
     // level's in the loop, the level's own stored one in a replay)
-    crate::base::memory::check_memory_measured(&format!("level {level} of the adaptive loop"), ndof as f64, measured)
+    model::base::memory::check_memory_measured(&format!("level {level} of the adaptive loop"), ndof as f64, measured)
         .map_err(|error| AdaptError::Memory { level, error })?;
     let mut options = config.pdas.clone();
     if config.warm_start {
@@ -420,8 +333,8 @@ pub fn solve_level(
 ///
 /// ```rust
 /// use signorini_numerics::adapt::{self, AdaptConfig, AdaptTermination};
-/// use signorini_numerics::mesh::MeshSpec;
-/// use signorini_numerics::problems::{self, Problem};
+/// use model::mesh::MeshSpec;
+/// use model::problems::{self, Problem};
 /// use std::ops::ControlFlow;
 ///
 /// let problem = problems::by_name("ex71").unwrap();
@@ -525,7 +438,7 @@ impl AdaptState {
         drop(self.last.take());
         let t_level = Instant::now();
         let previous = self.records.last().and_then(LevelRecord::measured_peak);
-        let measured = crate::base::memory::reset_peak_resident();
+        let measured = model::base::memory::reset_peak_resident();
         let started_from = self.initial_active.take().filter(|_| config.warm_start);
         let Solved { mut record, solution: sol, estimate: est, marks, caveats } =
             solve_level(problem, &mesh, level, config, reference, started_from.clone(), previous)?;
@@ -566,7 +479,7 @@ impl AdaptState {
         };
         let next = if far.is_some() || over { None } else { next };
         record.t_level = t_level.elapsed().as_secs_f64();
-        record.mem_peak_mib = crate::base::memory::peak_resident().filter(|_| measured).map(|b| b / (1024.0 * 1024.0));
+        record.mem_peak_mib = model::base::memory::peak_resident().filter(|_| measured).map(|b| b / (1024.0 * 1024.0));
         let flow = observer(Level {
             record: &record,
             mesh: &mesh,

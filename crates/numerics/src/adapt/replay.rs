@@ -7,8 +7,8 @@
 use super::BadFlags;
 use super::{AdaptConfig, AdaptError, History, LevelRecord, Solved, Start};
 use crate::contact::norms::Reference;
-use crate::mesh::{Mesh, refine};
-use crate::problems::Problem;
+use model::mesh::{Mesh, refine};
+use model::problems::Problem;
 
 /// A history that does not rebuild the run it belongs to.
 #[derive(Debug, thiserror::Error)]
@@ -25,7 +25,7 @@ pub enum ReplayError {
     Length { level: usize, what: &'static str, got: usize, want: usize, of: &'static str },
     /// Refining level `level` into the next failed ([`refine::refine`]).
     #[error("refining level {level}: {error}")]
-    Refine { level: usize, error: crate::mesh::MeshError },
+    Refine { level: usize, error: model::mesh::MeshError },
 }
 
 /// The mesh of level `level`: `mesh0` refined by the marks of levels 0..level, every mesh on the

@@ -3,12 +3,12 @@
 //! discretisation error, is round-off of an exact discrete solution, or comes from a u_h, a set
 //! of contact forces or an element geometry that round-off has eaten into.
 
-use crate::base::number::shown;
 use crate::contact::solve::DiscreteSolution;
 use crate::estimator::estimate::Estimate;
-use crate::mesh::Mesh;
-use crate::mesh::precision::ShapeRoundoff;
-use crate::problems::{Material, Problem};
+use model::base::number::shown;
+use model::mesh::Mesh;
+use model::mesh::precision::ShapeRoundoff;
+use model::problems::{Material, Problem};
 
 /// The estimate is at round-off when eta_h is at most this many times what u_h's round-off can do
 /// to it ([`Body::estimate_roundoff`]): the smaller of two scales of the stress an error of u_h
@@ -115,7 +115,7 @@ pub const RESOLVED_FORCES: f64 = 1e-2;
 pub const WARNED_FORCES: f64 = 1e-6;
 
 /// Above this relative round-off of the element shapes (and up to
-/// [`crate::mesh::precision::SHAPE_ROUNDOFF_REFUSED`], which the mesh check refuses) a warning
+/// [`model::mesh::precision::SHAPE_ROUNDOFF_REFUSED`], which the mesh check refuses) a warning
 /// ([`Caveat::Shape`]). Example 7.2 on an 8x8 grid of the unit square translated by t (mesh and
 /// data; delta = 2.5e-16 t): eta_6 (the most sensitive term) moved by 1e-4 at 1e9 (2.5e-6), 3e-3
 /// at 1e11 (2.5e-4), 1% at 3e11, 4% at 1e12 (2.5e-3), 35% at 1e13; eta_1 to eta_5 by less than
@@ -489,7 +489,7 @@ pub enum Resolution {
 /// alone; by 1e11 its round-off passes that bound and it is refused, named, as it would be
 /// alone). Then, for a resolved solve, the contact forces ([`RESOLVED_FORCES`],
 /// [`WARNED_FORCES`]) and the element shapes ([`WARNED_SHAPE`]; beyond
-/// [`crate::mesh::precision::SHAPE_ROUNDOFF_REFUSED`] the mesh check has refused the mesh). The
+/// [`model::mesh::precision::SHAPE_ROUNDOFF_REFUSED`] the mesh check has refused the mesh). The
 /// forces are not asked of a solve at round-off: an exact solution that touches the obstacle
 /// without pressing on it has forces at their own round-off (u = 0.5 - 1e-9 x on
 /// `structured:32`: 2e-11 against bounds of 1e-2 of it), and its eta_7 is declared round-off

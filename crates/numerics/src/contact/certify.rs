@@ -27,8 +27,8 @@
 //! study and a wrong answer.
 
 use crate::fem::assembly::DofMap;
-use crate::mesh::{Mesh, P2Nodes};
-use crate::problems::{Part, Problem};
+use model::mesh::{Mesh, P2Nodes};
+use model::problems::{Part, Problem};
 
 /// The relative tolerance of every KKT condition ([`certify`]). Measured on all 769 solves of
 /// every level of every study (`signorini drift`, 2026-11-24, up to 1.1M unknowns): the

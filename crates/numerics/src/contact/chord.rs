@@ -23,11 +23,11 @@
 //! held at +0.05 has room 0.15, so chi = -0.12 is accepted). So a gap that is not negative is checked too where the
 //! Dirichlet data move a held end (`[0, -0.2]` on a 0.1 plate's top with chi = 0.01 turned the
 //! plate inside out). The boundary edges are in an R*-tree ([`rstar`], as in
-//! [`mesh::locate`](crate::mesh::locate)), built at the first negative gap, so that a point
+//! [`mesh::locate`](model::mesh::locate)), built at the first negative gap, so that a point
 //! costs the edges near its line, not all of them: near linear at 1e7 unknowns.
 
-use crate::mesh::{Mesh, P2Nodes};
-use crate::problems::{Part, Problem};
+use model::mesh::{Mesh, P2Nodes};
+use model::problems::{Part, Problem};
 use rstar::primitives::{GeomWithData, Rectangle};
 use rstar::{AABB, RTree, RTreeObject, SelectionFunction};
 

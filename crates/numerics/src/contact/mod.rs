@@ -12,8 +12,9 @@ pub mod consistent;
 pub mod norms;
 pub mod plausible;
 pub mod point;
-pub mod sampling;
 pub mod solve;
+
+pub use model::settings::sampling;
 
 pub use active_set::{
     ContactError, ContactSolver, NormalIterate, Pair, PdasIteration, PdasOptions, PdasOutput, PdasTermination, SCHUR_MAX_CONTACT, Strategy,

@@ -5,7 +5,7 @@
 
 use crate::contact::sampling::Sampling;
 use crate::contact::solve::DiscreteSolution;
-use crate::mesh::Mesh;
+use model::mesh::Mesh;
 use rayon::prelude::*;
 
 /// ||u - u_h||_Linf three ways (max over both components).
@@ -91,7 +91,7 @@ pub fn linf_error_contact(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference)
             let mut refs = Vec::new();
             for b in sol.nodes.element_boundary[t].iter().flatten() {
                 let e = &mesh.boundary[*b];
-                if e.part != crate::problems::Part::Contact {
+                if e.part != model::problems::Part::Contact {
                     continue;
                 }
                 let (i, j) = (tri.iter().position(|&v| v == e.v[0])?, tri.iter().position(|&v| v == e.v[1])?);

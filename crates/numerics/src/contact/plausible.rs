@@ -59,10 +59,10 @@
 //! problem file is read (`problems::file`).
 
 use super::chord::Chords;
-use crate::base::number::{point, shown};
 use crate::fem::assembly::DofMap;
-use crate::mesh::{Mesh, P2Nodes};
-use crate::problems::{Part, Problem};
+use model::base::number::{point, shown};
+use model::mesh::{Mesh, P2Nodes};
+use model::problems::{Part, Problem};
 
 /// The largest angle, in degrees, a declared contact normal may make with the outward normal.
 pub const MAX_NORMAL_ANGLE_DEGREES: f64 = 80.0;
@@ -112,7 +112,7 @@ pub enum ContactDataError {
     Prescribed { problem: String, part: String, by: String, at: [f64; 2], u: [String; 2], normal: [f64; 2], un: f64, chi: f64 },
     /// The gap or the normal is not a finite number at a sampled point of the contact part.
     #[error(transparent)]
-    Datum(crate::problems::BadDatum),
+    Datum(model::problems::BadDatum),
 }
 
 /// The problem as errors name it: its file, or its built-in name.
@@ -137,7 +137,7 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
     if problem.bad_datum().is_some() {
         return Ok(());
     }
-    let outward: Vec<Option<[f64; 2]>> = crate::mesh::outward_normals(mesh, nodes)
+    let outward: Vec<Option<[f64; 2]>> = model::mesh::outward_normals(mesh, nodes)
         .into_iter()
         .zip(&mesh.boundary)
         .map(|(n, e)| (e.part == Part::Contact).then_some(n))
@@ -154,7 +154,7 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
 
 /// The largest angle (radians, 0.057 degrees) between a contact vertex's normal and the normal
 /// on one of its contact edges next to it ([`check_corners`]). A real angle, not round-off: a
-/// smooth normal reaches it over [`PART_END`](crate::mesh::PART_END) of the body's size only by
+/// smooth normal reaches it over [`PART_END`](model::mesh::PART_END) of the body's size only by
 /// turning 1e6 radians per body size (a jump for every purpose), and a normal evaluated from
 /// expressions at far translated coordinates keeps its direction to about 1e-9
 /// (`["x - 0.5", "-1e-3"]` turns by 1e-6 over 1e-9 of the size, which a bound of 1e-6 would call
@@ -163,7 +163,7 @@ pub fn check_contact_data(mesh: &Mesh, nodes: &P2Nodes, dofs: &DofMap, problem: 
 pub const CORNER_ANGLE: f64 = 1e-3;
 
 /// Every contact vertex against the normal on each of its contact edges, at the vertex (with
-/// that edge's outward normal) and next to it ([`PART_END`](crate::mesh::PART_END) of the body's
+/// that edge's outward normal) and next to it ([`PART_END`](model::mesh::PART_END) of the body's
 /// size inside the edge, as the part check takes a vertex): where they differ by more than
 /// [`CORNER_ANGLE`] the vertex is a corner of the normal (two contact sides of the square with
 /// `normal = "outward"`, two circles meeting at an angle, a declared normal that jumps there),
@@ -175,7 +175,7 @@ fn check_corners(mesh: &Mesh, dofs: &DofMap, problem: &dyn Problem, diameter: f6
     for (b, e) in mesh.boundary.iter().enumerate().filter(|(_, e)| e.part == Part::Contact) {
         let [p, q] = e.v.map(|v| mesh.vertices[v]);
         let len = (q[0] - p[0]).hypot(q[1] - p[1]);
-        let t = (crate::mesh::PART_END * diameter / len).min(0.25);
+        let t = (model::mesh::PART_END * diameter / len).min(0.25);
         for (v, at, far) in [(e.v[0], p, q), (e.v[1], q, p)] {
             let Some(k) = dofs.contact_index[v] else { continue };
             let node = dofs.contact[k].normal;

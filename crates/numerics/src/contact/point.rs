@@ -8,20 +8,20 @@
 //! its round-off, and everything that solves (solve, adapt, studies) gets the refusal.
 
 use crate::fem::assembly::DofMap;
-use crate::mesh::P2Nodes;
-use crate::problems::{Part, Problem};
+use model::mesh::P2Nodes;
+use model::problems::{Part, Problem};
 
 /// A point constraint whose reaction is above its round-off.
 #[derive(Debug, thiserror::Error)]
 #[error(
     "{problem}: the point constraint at {at} prescribes u_{component} = {value}, and holding it there takes a force of {reaction} ({relative} of the nodal forces' scale {scale}, {ratio} times its round-off {bound}): a point constraint is for removing a rigid motion (rollers: u_2 = 0 at one point), which takes no force; a displacement prescribed at a single point is no constraint of the continuous problem (a point has zero H^1 capacity), so each mesh would solve another problem. Give the prescribed displacement on a part (`[parts] dirichlet` with `dirichlet`) instead",
-    at = crate::base::number::point(*.at),
-    value = crate::base::number::shown(*.value),
-    reaction = crate::base::number::shown(*.reaction),
-    relative = crate::base::number::shown(.reaction.abs() / .scale),
-    scale = crate::base::number::shown(*.scale),
+    at = model::base::number::point(*.at),
+    value = model::base::number::shown(*.value),
+    reaction = model::base::number::shown(*.reaction),
+    relative = model::base::number::shown(.reaction.abs() / .scale),
+    scale = model::base::number::shown(*.scale),
     ratio = format!("{:.1e}", .reaction.abs() / .bound),
-    bound = crate::base::number::shown(*.bound)
+    bound = model::base::number::shown(*.bound)
 )]
 pub struct PointReactionError {
     pub problem: String,
@@ -84,9 +84,9 @@ pub fn check_reactions(
 #[derive(Debug, thiserror::Error)]
 #[error(
     "{problem}: the point constraint at {at} prescribes u_{component} = {value}, but the point is on the Dirichlet part ({part}), which already sets u_{component} = {dirichlet} there: one node cannot take both values. The point value is redundant there: drop it, or write \"free\" for u_{component} in `u` (a point constraint on Gamma_D can only prescribe a component `dirichlet` leaves \"free\")",
-    at = crate::base::number::point(*.at),
-    value = crate::base::number::shown(*.value),
-    dirichlet = crate::base::number::shown(*.dirichlet)
+    at = model::base::number::point(*.at),
+    value = model::base::number::shown(*.value),
+    dirichlet = model::base::number::shown(*.dirichlet)
 )]
 pub struct PointOnDirichletError {
     pub problem: String,

@@ -2,14 +2,16 @@
 //! discrete contact force (eq. 4.5) and its KKT report.
 //! The method: `docs/method.md`, sections "The discrete contact force" and "The certificate a solve passes before it reports".
 
-use crate::base::element::{self, Affine};
 use crate::contact::certify::{self, Certificate, KktError, KktInput, RigidMotionError};
 use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, PdasTermination, Strategy, Timings};
 use crate::fem::assembly::{self, DofMap, System};
-use crate::mesh::locate::Locator;
-use crate::mesh::{Mesh, MeshError, P2Nodes};
-use crate::problems::Problem;
+use model::base::element::{self, Affine};
+use model::mesh::locate::Locator;
+use model::mesh::{Mesh, MeshError, P2Nodes};
+use model::problems::Problem;
 use std::time::Instant;
+
+pub use model::level::sample::ContactSample;
 
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {
@@ -22,7 +24,7 @@ pub enum SolveError {
     #[error(transparent)]
     NotCertified(#[from] KktError),
     #[error(transparent)]
-    Data(#[from] crate::problems::BadDatum),
+    Data(#[from] model::problems::BadDatum),
     #[error(transparent)]
     ContactData(#[from] Box<super::plausible::ContactDataError>),
     #[error(transparent)]
@@ -35,21 +37,21 @@ pub enum SolveError {
     #[error("the problem's contact part matches no boundary edge of the mesh: there is nothing to be in contact (the problem declares: {})", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") })]
     NoContact { declared: Vec<String> },
     /// A non-zero traction where no boundary edge of the mesh is Neumann: it would be ignored.
-    #[error("{problem}: the traction (`traction`) is ({tx}, {ty}) at ({x}, {y}), but no boundary edge of the mesh is in the Neumann part (the problem declares: {}): a traction acts only on Gamma_N and would be ignored; remove `traction` or leave part of the boundary to Neumann", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") }, tx = crate::base::number::shown(.value[0]), ty = crate::base::number::shown(.value[1]), x = crate::base::number::shown(.at[0]), y = crate::base::number::shown(.at[1]))]
+    #[error("{problem}: the traction (`traction`) is ({tx}, {ty}) at ({x}, {y}), but no boundary edge of the mesh is in the Neumann part (the problem declares: {}): a traction acts only on Gamma_N and would be ignored; remove `traction` or leave part of the boundary to Neumann", if .declared.is_empty() { "no parts by name".to_string() } else { .declared.join("; ") }, tx = model::base::number::shown(.value[0]), ty = model::base::number::shown(.value[1]), x = model::base::number::shown(.at[0]), y = model::base::number::shown(.at[1]))]
     UnusedTraction { problem: String, at: [f64; 2], value: [f64; 2], declared: Vec<String> },
     /// An entry of the assembled stiffness matrix or load vector overflowed f64's range while
     /// the data themselves are finite: the problem's scale, not its data, is at fault.
-    #[error("{problem}: the assembled {what} has an entry that is not a finite number (overflow beyond f64's range, about 1.8e308) although every datum is finite: the material (mu = {mu}, zeta = {zeta}) or the loads are too large for this mesh; give them in other units (for example E in GPa instead of Pa) so that the stiffness entries, about mu times a mesh-independent factor, stay well inside the range", mu = crate::base::number::shown(*.mu), zeta = crate::base::number::shown(*.zeta))]
+    #[error("{problem}: the assembled {what} has an entry that is not a finite number (overflow beyond f64's range, about 1.8e308) although every datum is finite: the material (mu = {mu}, zeta = {zeta}) or the loads are too large for this mesh; give them in other units (for example E in GPa instead of Pa) so that the stiffness entries, about mu times a mesh-independent factor, stay well inside the range", mu = model::base::number::shown(*.mu), zeta = model::base::number::shown(*.zeta))]
     Overflow { problem: String, what: &'static str, mu: f64, zeta: f64 },
     /// The assembled stiffness matrix is zero or has entries below f64's normal range
     /// (subnormal: they keep fewer digits, and products of them vanish): the material is too
     /// small in these units.
-    #[error("{problem}: the assembled stiffness matrix has entries below f64's normal range (about 2.2e-308: subnormal numbers, which keep fewer digits and whose products vanish; the largest entry is {largest}): the material (mu = {mu}, zeta = {zeta}) is too small in these units for the factorisation to be trusted; give them in other units (for example E in MPa instead of Pa, or lengths in mm instead of m) so that the stiffness entries, about mu times a mesh-independent factor, stay well inside the range", largest = crate::base::number::shown(*.largest), mu = crate::base::number::shown(*.mu), zeta = crate::base::number::shown(*.zeta))]
+    #[error("{problem}: the assembled stiffness matrix has entries below f64's normal range (about 2.2e-308: subnormal numbers, which keep fewer digits and whose products vanish; the largest entry is {largest}): the material (mu = {mu}, zeta = {zeta}) is too small in these units for the factorisation to be trusted; give them in other units (for example E in MPa instead of Pa, or lengths in mm instead of m) so that the stiffness entries, about mu times a mesh-independent factor, stay well inside the range", largest = model::base::number::shown(*.largest), mu = model::base::number::shown(*.mu), zeta = model::base::number::shown(*.zeta))]
     Underflow { problem: String, largest: f64, mu: f64, zeta: f64 },
     /// The solve of a finite system gave a displacement, a product K u_h, or a product of forces
     /// and displacements (the scale complementarity is measured on) beyond f64's range: the
     /// loads are too large for the stiffness in these units.
-    #[error("{problem}: {what} is not a finite number (overflow beyond f64's range, about 1.8e308) although the assembled system is finite: the loads (largest load-vector entry {load}) and the displacements they cause (largest |u_h| {u}, with the stiffness mu = {mu}) are too large for f64; give the data in other units (for example loads in kN instead of N, or E in Pa instead of GPa) so that the loads, the displacements and their products stay well inside the range", load = crate::base::number::shown(*.load), u = crate::base::number::shown(*.u), mu = crate::base::number::shown(*.mu))]
+    #[error("{problem}: {what} is not a finite number (overflow beyond f64's range, about 1.8e308) although the assembled system is finite: the loads (largest load-vector entry {load}) and the displacements they cause (largest |u_h| {u}, with the stiffness mu = {mu}) are too large for f64; give the data in other units (for example loads in kN instead of N, or E in Pa instead of GPa) so that the loads, the displacements and their products stay well inside the range", load = model::base::number::shown(*.load), u = model::base::number::shown(*.u), mu = model::base::number::shown(*.mu))]
     SolutionOverflow { problem: String, what: &'static str, load: f64, u: f64, mu: f64 },
 }
 
@@ -103,11 +105,11 @@ fn check_solution(u: &[f64], ku: &[f64], rhs: &[f64], gap: &[f64], problem: &dyn
 /// evaluated at the three P2 nodes of every boundary edge with the edge's outward normal, and
 /// any non-zero value is an error naming `traction` (the default zero traction passes).
 fn unused_traction(mesh: &Mesh, nodes: &P2Nodes, problem: &dyn Problem) -> Result<(), SolveError> {
-    use crate::problems::Part;
+    use model::problems::Part;
     if mesh.boundary.iter().any(|e| e.part == Part::Neumann) {
         return Ok(());
     }
-    let outward = crate::mesh::outward_normals(mesh, nodes);
+    let outward = model::mesh::outward_normals(mesh, nodes);
     for (three, n) in nodes.boundary_nodes.iter().zip(outward) {
         for &p in three {
             let at = nodes.coords[p];
@@ -203,8 +205,8 @@ pub struct Kkt {
 ///
 /// ```rust
 /// use signorini_numerics::contact::PdasOptions;
-/// use signorini_numerics::mesh::MeshSpec;
-/// use signorini_numerics::problems::{Ex72, Problem};
+/// use model::mesh::MeshSpec;
+/// use model::problems::{Ex72, Problem};
 ///
 /// let mesh = MeshSpec::parse("structured:8").unwrap().build(&Ex72).unwrap();
 /// let sol = signorini_numerics::contact::solve::solve(&mesh, &Ex72, &PdasOptions::default(), &mut |_| {}).unwrap();
@@ -455,7 +457,7 @@ impl DiscreteSolution {
             while !walked[e] {
                 walked[e] = true;
                 let [a, b, m] = edges[e];
-                let len = crate::mesh::dist(self.nodes.coords[a], self.nodes.coords[b]);
+                let len = model::mesh::dist(self.nodes.coords[a], self.nodes.coords[b]);
                 visit(m, s + 0.5 * len, &mut zones);
                 s += len;
                 visit(b, s, &mut zones);
@@ -533,10 +535,10 @@ pub fn contact_density(mesh: &Mesh, sol: &DiscreteSolution) -> Vec<f64> {
 fn contact_weights(mesh: &Mesh, sol: &DiscreteSolution, share: impl Fn(bool, f64) -> f64) -> Vec<f64> {
     let mut weight = vec![0.0; sol.dofs.contact.len()];
     for (be, bn) in mesh.boundary.iter().zip(&sol.nodes.boundary_nodes) {
-        if be.part != crate::problems::Part::Contact {
+        if be.part != model::problems::Part::Contact {
             continue;
         }
-        let len = crate::mesh::dist(mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
+        let len = model::mesh::dist(mesh.vertices[be.v[0]], mesh.vertices[be.v[1]]);
         for (i, &p) in bn.iter().enumerate() {
             if let Some(k) = sol.dofs.contact_index[p] {
                 weight[k] += share(i < 2, len);
@@ -545,18 +547,6 @@ fn contact_weights(mesh: &Mesh, sol: &DiscreteSolution, share: impl Fn(bool, f64
     }
     weight
 }
-
-/// A contact node of a discrete solution: its position, the nodal contact force lambda_p (paper
-/// eq. 3.6, in the constraint direction), the pressure lambda_p / int_{Gamma_C} psi_p ds (psi_p the
-/// P2 basis function of the node; see `solve::contact_samples`) and whether it is active.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct ContactSample {
-    pub x: [f64; 2],
-    pub lambda: f64,
-    pub pressure: f64,
-    pub active: bool,
-}
-
 /// The contact nodes with their nodal forces and the pressure p_h(p) = lambda_p / int psi_p ds, psi_p
 /// the node's P2 basis function on Gamma_C (a sixth of each adjacent contact edge's length for a
 /// vertex, two thirds of its edge for an edge midpoint): the weights for which a constant or

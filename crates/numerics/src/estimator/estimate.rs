@@ -30,228 +30,18 @@
 mod local;
 pub mod repair;
 
-use crate::base::element::EDGE_VERTICES;
-use crate::contact::sampling::Sampling;
 use crate::contact::solve::DiscreteSolution;
-use crate::mesh::{Mesh, dist};
-use crate::problems::{Part, Problem};
+use model::base::element::EDGE_VERTICES;
+use model::mesh::{Mesh, dist};
+use model::problems::{Part, Problem};
 use rayon::prelude::*;
 
 /// Gauss points per edge for the "quadrature" sampling of edge terms.
+pub use model::c0_paper;
+pub use model::level::terms::{NotFinite, Terms};
+pub use model::settings::estimator::{C0_PAPER, ConfigError, ContactTerm, EstimatorConfig, LogFactor, StressFrame};
+
 pub const EDGE_GAUSS: usize = crate::contact::sampling::EDGE_GAUSS;
-
-/// Which contact nodes eta_5 is taken over. Manifests spell the values in snake_case
-/// (`as_written`), the command line in kebab-case (`--contact-term as-written`). The variants'
-/// docs are for readers of the code (`help = None`): the flag's help describes the values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "snake_case")]
-pub enum ContactTerm {
-    /// All contact nodes, as the paper writes eta_5.
-    #[value(help = None::<&str>)]
-    AsWritten,
-    /// Without full-contact nodes N_h^FC (u_h.n = chi_h on all of Gamma_{p,C}), as in
-    /// Krause–Veeser–Walloth. At a node in full contact the exact normal stress is a compressive
-    /// contact pressure, not an error: taken over all contact nodes, eta_5 measures that pressure
-    /// and decays only like h (measured: the `contact_term_ablation` study).
-    #[value(help = None::<&str>)]
-    WithoutFullContact,
-    /// The repaired contact terms (beyond the paper): at a full-contact node eta_5 takes only the
-    /// tensile part (n . sigma(u_h) n)^+ of the normal stress, at other contact nodes it is as
-    /// written; eta_7 is taken over a narrower Lambda_h^C, the full-contact edges (all three
-    /// nodes active) and the edges through an active node with positive contact force that lies
-    /// on no full-contact edge (an isolated active node). See [`repair`] for why, and for the
-    /// step of the proof that is open.
-    #[value(help = None::<&str>)]
-    TensileOnFullContact,
-}
-
-/// The log factor l_h multiplying the residual terms (`--log-factor`, `estimator.log_factor`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "snake_case")]
-pub enum LogFactor {
-    /// 1 + |log h_min|^2 (eq. 6.3)
-    #[value(help = None::<&str>)]
-    Squared,
-    /// 1 + |log h_min|
-    #[value(help = None::<&str>)]
-    Linear,
-    /// 1
-    #[value(help = None::<&str>)]
-    One,
-}
-
-impl LogFactor {
-    pub fn value(self, h_min: f64) -> f64 {
-        let l = h_min.ln().abs();
-        match self {
-            LogFactor::Squared => 1.0 + l * l,
-            LogFactor::Linear => 1.0 + l,
-            LogFactor::One => 1.0,
-        }
-    }
-}
-
-/// How the paper's sigma-hat_1, sigma-hat_2 (the components of sigma(u_h) n in eta_5 and eta_4)
-/// are read. The paper defines sigma-hat_1 as the first component of sigma n "in a frame where
-/// e_1 is the normal"; read literally as the first Cartesian component it is -sigma_12 on the
-/// bottom edge of Example 7.1 (n = (0, -1)) and the normal stress sigma_11 on Example 7.2's
-/// right edge (n = (1, 0)).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum StressFrame {
-    /// sigma-hat_1 = n . sigma n (normal stress, eta_5), sigma-hat_2 = t . sigma n (eta_4).
-    #[default]
-    Normal,
-    /// sigma-hat_1 = (sigma n)_1 (eta_5), sigma-hat_2 = (sigma n)_2 (eta_4): the Cartesian components.
-    Cartesian,
-}
-
-/// A declared estimator variant.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct EstimatorConfig {
-    pub contact_term: ContactTerm,
-    pub log_factor: LogFactor,
-    /// The constant replacing the hidden one of Theorem 6.1 (Section 7: [`C0_PAPER`]).
-    pub c0: f64,
-    pub sampling: Sampling,
-    /// Reading of sigma-hat_1, sigma-hat_2 in eta_4, eta_5 (absent in older records: normal).
-    #[serde(default)]
-    pub stress_frame: StressFrame,
-}
-
-/// The constant C_0 of Section 7 as a literal, for text that quotes it (`concat!`): its one
-/// definition, which [`C0_PAPER`] reads.
-#[macro_export]
-macro_rules! c0_paper {
-    () => {
-        0.45
-    };
-}
-pub use crate::c0_paper;
-
-/// The constant C_0 of Section 7, the estimator's default.
-pub const C0_PAPER: f64 = c0_paper!();
-
-impl Default for EstimatorConfig {
-    fn default() -> Self {
-        EstimatorConfig {
-            contact_term: ContactTerm::AsWritten,
-            log_factor: LogFactor::Squared,
-            c0: C0_PAPER,
-            sampling: Sampling::Quadrature,
-            stress_frame: StressFrame::Normal,
-        }
-    }
-}
-
-/// A setting outside its range: `key` is the field (as manifests spell it: `estimator.c0`,
-/// `theta`), `expected` the admissible values, `got` the value given. The one error of the
-/// settings' validation, whether they come from a manifest or the command line (which names
-/// the flag of `key` instead).
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{key}: expected {expected}, got {got}")]
-pub struct ConfigError {
-    pub key: &'static str,
-    pub expected: String,
-    pub got: String,
-}
-
-impl ConfigError {
-    /// A number as an error shows it: as Rust prints it while that is short (0.5, -1, NaN),
-    /// else in exponent form (1e-320 and 1e308, not hundreds of digits).
-    pub fn number(x: f64) -> String {
-        let plain = x.to_string();
-        if plain.len() <= 24 { plain } else { format!("{x:e}") }
-    }
-}
-
-impl EstimatorConfig {
-    /// Check the settings: C_0 must be a positive normal number (not zero, NaN, infinite or
-    /// subnormal, where C_0 eta_h loses its digits). Whether C_0 eta_h is finite depends on
-    /// eta_h too: [`Terms::check_finite`] checks that once the estimate is computed.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        if !(self.c0 > 0.0 && self.c0.is_normal()) {
-            let expected = if self.c0 > 0.0 && self.c0.is_finite() {
-                format!("a positive number of at least {:e} (a subnormal C_0 leaves C_0 eta_h few digits)", f64::MIN_POSITIVE)
-            } else {
-                "a positive number".into()
-            };
-            return Err(ConfigError { key: "estimator.c0", expected, got: ConfigError::number(self.c0) });
-        }
-        Ok(())
-    }
-}
-
-/// An estimate that is not a finite number: C_0 eta_h overflowed (a C_0 too large for this
-/// eta_h) or eta_h itself is not finite (`overflowed` names the term: the problem's data are
-/// beyond double precision, which no C_0 mends). Nothing can be compared with it or stored.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("the estimate C_0 eta_h = {c0:e} x {eta_h:e} is {estimate}, not a finite number ({})", blame(overflowed))]
-pub struct NotFinite {
-    pub c0: f64,
-    pub eta_h: f64,
-    pub estimate: f64,
-    /// The first of eta_1 .. eta_7, l_h and their sum eta_h that is not finite, in words, with
-    /// its value; None when eta_h is finite (then C_0 is too large for it).
-    pub overflowed: Option<(&'static str, f64)>,
-}
-
-/// Whom a [`NotFinite`] estimate is due to: C_0, or the term that overflowed.
-fn blame(overflowed: &Option<(&'static str, f64)>) -> String {
-    match overflowed {
-        None => "estimator.c0, --c0: a C_0 for which it is finite".into(),
-        Some((term, value)) => format!(
-            "{term} is {value}, so no C_0 makes it finite: the problem's data are too large for double precision; \
-             rescale its units (body force, loads, Dirichlet data, obstacle)"
-        ),
-    }
-}
-
-/// The estimator's terms (the `estimator` object of `signorini solve --json`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Terms {
-    pub eta1: f64,
-    pub eta2: f64,
-    pub eta3: f64,
-    pub eta4: f64,
-    pub eta5: f64,
-    pub eta6: f64,
-    pub eta7: f64,
-    pub l_h: f64,
-    /// Psi = eta_1 + ... + eta_5
-    pub psi: f64,
-    pub eta_h: f64,
-    pub c0: f64,
-    /// C_0 eta_h, the quantity compared with the error
-    pub estimate: f64,
-}
-
-impl Terms {
-    pub fn eta(&self) -> [f64; 7] {
-        [self.eta1, self.eta2, self.eta3, self.eta4, self.eta5, self.eta6, self.eta7]
-    }
-
-    /// The estimate is a finite number: what every path that reports or stores one checks
-    /// (the adaptive loop at every level, `signorini solve`).
-    pub fn check_finite(&self) -> Result<(), NotFinite> {
-        if self.estimate.is_finite() {
-            return Ok(());
-        }
-        let named = [
-            ("eta_1, the element residual h^2 |f + div sigma(u_h)| (the body force)", self.eta1),
-            ("eta_2, the stress jumps across edges", self.eta2),
-            ("eta_3, the Neumann residual (the surface load)", self.eta3),
-            ("eta_4, the tangential contact stress", self.eta4),
-            ("eta_5, the normal contact stress", self.eta5),
-            ("eta_6, the penetration (u_h.n - chi)^+", self.eta6),
-            ("eta_7, the gap (chi - u_h.n)^+ where the contact force is positive", self.eta7),
-            ("the log factor l_h", self.l_h),
-            ("eta_h = l_h (eta_1 + ... + eta_5) + eta_6 + eta_7", self.eta_h),
-        ];
-        let overflowed = named.into_iter().find(|(_, v)| !v.is_finite());
-        Err(NotFinite { c0: self.c0, eta_h: self.eta_h, estimate: self.estimate, overflowed })
-    }
-}
 
 /// The estimate and the per-element indicators used for marking.
 #[derive(Clone, Debug)]
@@ -275,8 +65,8 @@ pub struct Estimate {
 /// ```rust
 /// use signorini_numerics::contact::PdasOptions;
 /// use signorini_numerics::estimator::estimate::{self, EstimatorConfig};
-/// use signorini_numerics::mesh::MeshSpec;
-/// use signorini_numerics::problems::{Ex71, Problem};
+/// use model::mesh::MeshSpec;
+/// use model::problems::{Ex71, Problem};
 ///
 /// let mesh = MeshSpec::parse("structured:4").unwrap().build(&Ex71).unwrap();
 /// let sol = signorini_numerics::contact::solve::solve(&mesh, &Ex71, &PdasOptions::default(), &mut |_| {}).unwrap();

@@ -7,9 +7,9 @@
 //! the contact solver relies on that to work on a small Schur complement.
 //! The method: `docs/method.md`, section "The discretisation".
 
-use crate::base::element::{self, Affine, EDGE_VERTICES, N_NODES};
-use crate::mesh::{Mesh, P2Nodes};
-use crate::problems::{Material, Part, Problem};
+use model::base::element::{self, Affine, EDGE_VERTICES, N_NODES};
+use model::mesh::{Mesh, P2Nodes};
+use model::problems::{Material, Part, Problem};
 use rayon::prelude::*;
 
 use crate::sparse::csc::{SymCsc, offsets, par_fill};
@@ -70,7 +70,7 @@ impl DofMap {
             .point_constraints()
             .iter()
             .filter_map(|c| {
-                let p = (0..nodes.n_vertices).find(|&p| crate::mesh::dist(nodes.coords[p], c.at) < POINT_TOLERANCE)?;
+                let p = (0..nodes.n_vertices).find(|&p| model::mesh::dist(nodes.coords[p], c.at) < POINT_TOLERANCE)?;
                 Some((p, c.u))
             })
             .collect();
@@ -828,9 +828,9 @@ mod tests {
     /// in element order, to the bit, on one thread and on two.
     /// A patch test on structured:100 with oblique contact normals (the local frames are
     /// exercised; 20000 triangles: several element chunks).
-    fn oblique_patch() -> (crate::problems::Patch, Mesh, P2Nodes, DofMap) {
-        let problem = crate::problems::Patch { normal: [0.8, -0.6], ..Default::default() };
-        let mesh = crate::mesh::MeshSpec::parse("structured:100").unwrap().build(&problem).unwrap();
+    fn oblique_patch() -> (model::problems::Patch, Mesh, P2Nodes, DofMap) {
+        let problem = model::problems::Patch { normal: [0.8, -0.6], ..Default::default() };
+        let mesh = model::mesh::MeshSpec::parse("structured:100").unwrap().build(&problem).unwrap();
         let nodes = P2Nodes::new(&mesh);
         let dofs = DofMap::new(&nodes, &problem);
         (problem, mesh, nodes, dofs)

@@ -177,34 +177,7 @@ impl OrderingChoice {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Method {
-    NestedDissection,
-    MinimumDegree,
-}
-
-/// The environment variable that forces one ordering for every factorisation in the process:
-/// `nested-dissection` or `minimum-degree` (unset or `auto`: the one with fewer flops). A
-/// diagnostic, not a setting: the drift check's tolerances are measured by rerunning every study
-/// with each ordering forced, since the ordering changes the summation order of the
-/// factorisation and so the results at round-off (`results/roundoff/`).
-pub const FORCE_ENV: &str = "SIGNORINI_ORDERING";
-
-/// The ordering forced by [`FORCE_ENV`], read once per process; an unknown value is an error
-/// (the command line checks it at start-up, so a measurement never silently runs with the
-/// automatic choice).
-pub fn forced() -> Result<Option<Method>, String> {
-    static FORCED: std::sync::OnceLock<Result<Option<Method>, String>> = std::sync::OnceLock::new();
-    FORCED
-        .get_or_init(|| match std::env::var(FORCE_ENV).as_deref() {
-            Err(_) | Ok("") | Ok("auto") => Ok(None),
-            Ok("nested-dissection") => Ok(Some(Method::NestedDissection)),
-            Ok("minimum-degree") => Ok(Some(Method::MinimumDegree)),
-            Ok(other) => Err(format!("{FORCE_ENV}={other:?}: expected auto, nested-dissection or minimum-degree")),
-        })
-        .clone()
-}
+pub use model::settings::ordering::{FORCE_ENV, Method, forced};
 
 thread_local! {
     /// Set while [`automatic`] runs: [`FORCE_ENV`] does not apply on this thread.
@@ -530,8 +503,8 @@ pub(crate) fn ordered_counts(graph: &Graph, order: &[usize]) -> super::etree::Co
 mod tests {
     use super::*;
     use crate::fem::assembly::{self, DofMap};
-    use crate::mesh::{MeshSpec, P2Nodes};
-    use crate::problems::Ex72;
+    use model::mesh::{MeshSpec, P2Nodes};
+    use model::problems::Ex72;
 
     fn system(n: usize) -> (SymCsc, Vec<[f64; 2]>) {
         let p = Ex72;
@@ -573,11 +546,11 @@ mod tests {
         assert!((choice.grading - 2.0).abs() < 1e-9, "{choice:?}");
         // graded towards the contact boundary y = 0 as Example 7.1's adaptive meshes: AMD is
         // computed and needs several times fewer flops than nested dissection
-        let p = crate::problems::Ex71;
+        let p = model::problems::Ex71;
         let mut mesh = MeshSpec::Structured(8).build(&p).expect("the unit square");
         for _ in 0..12 {
             let marked: Vec<bool> = (0..mesh.n_triangles()).map(|t| mesh.corners(t).iter().any(|c| c[1] == 0.0)).collect();
-            mesh = crate::mesh::refine::refine(&mesh, &marked).unwrap().mesh;
+            mesh = model::mesh::refine::refine(&mesh, &marked).unwrap().mesh;
         }
         let nodes = P2Nodes::new(&mesh);
         let dofs = DofMap::new(&nodes, &p);
@@ -587,7 +560,7 @@ mod tests {
         assert_eq!(choice.method, Method::MinimumDegree, "{choice:?}");
         let amd = choice.flops_minimum_degree.expect("computed on a graded mesh");
         assert!(amd < 0.5 * choice.flops_nested_dissection, "{choice:?}");
-        crate::base::note::line(format_args!("graded: {} unknowns, {choice:?}", sys.matrix.n()));
+        model::base::note::line(format_args!("graded: {} unknowns, {choice:?}", sys.matrix.n()));
     }
 
     #[test]

@@ -357,7 +357,7 @@ impl Criterion {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use numerics::base::stats::LineFit;
+    use model::base::stats::LineFit;
 
     fn fit(slope: f64, half_width: f64, decades: f64, abscissa: Abscissa) -> RateFit {
         RateFit {

@@ -9,8 +9,8 @@ use super::{Claim, Criterion, Ctx, Evidence, Kind, OPTIMAL, Q, RowKind, Summary,
 use crate::analysis::problem_names;
 use crate::analysis::roles;
 use crate::analysis::verdict;
-use harness::records::RunRecord;
-use numerics::estimator::estimate::{C0_PAPER, ContactTerm};
+use model::settings::estimator::{C0_PAPER, ContactTerm};
+use store::records::RunRecord;
 
 const SUBJECT: Subject = Subject { prefix: "7.1", kind: Kind::Paper };
 

@@ -14,7 +14,7 @@ use crate::analysis::problem_names;
 use crate::analysis::roles;
 use crate::analysis::studies;
 use crate::analysis::verdict::{self, Abscissa, refinement};
-use harness::records::RunRecord;
+use store::records::RunRecord;
 
 /// A corner is a refinement centre when its smallest element within this distance of it ...
 const CORNER_NEAR: f64 = 0.02;
@@ -210,8 +210,8 @@ fn corners(ctx: &Ctx, a72: Option<&RunRecord>, errors: &Errors) -> Claim {
     let peaks = a72
         .filter(|r| r.levels.iter().any(|l| l.max_indicator_x != 0.0 || l.max_indicator_y != 0.0))
         .map(|r| {
-            let near = |l: &numerics::adapt::LevelRecord| {
-                [[0.0, 0.0], [0.0, 1.0]].iter().any(|c| numerics::mesh::dist(*c, [l.max_indicator_x, l.max_indicator_y]) <= 0.05)
+            let near = |l: &model::level::record::LevelRecord| {
+                [[0.0, 0.0], [0.0, 1.0]].iter().any(|c| model::mesh::dist(*c, [l.max_indicator_x, l.max_indicator_y]) <= 0.05)
             };
             let n = r.levels.iter().filter(|l| near(l)).count();
             let at = |k: usize| {
@@ -278,10 +278,10 @@ fn eta6_eta7(a72: Option<&RunRecord>) -> Claim {
                 _ => plateaus.push((h, i, i)),
             }
         }
-        let fit = |f: fn(&numerics::adapt::LevelRecord) -> f64| {
+        let fit = |f: fn(&model::level::record::LevelRecord) -> f64| {
             let pts: Vec<(f64, f64)> =
                 plateaus.iter().map(|p| (p.0, f(&r.levels[p.2]))).filter(|p| p.1 > 1e-14).map(|p| (p.0.ln(), p.1.ln())).collect();
-            numerics::base::stats::fit_line(&pts)
+            model::base::stats::fit_line(&pts)
         };
         // largest change of eta_6 + eta_7 within a plateau of at least two levels
         let within = plateaus

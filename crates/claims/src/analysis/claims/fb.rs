@@ -9,8 +9,8 @@ use super::rows::{self, Loaded, Subject, Words};
 use super::{Claim, Criterion, Ctx, Evidence, Kind, Q, RowKind, Summary, fb_free_boundary, rate_text, repair, short_range, source};
 use crate::analysis::problem_names;
 use crate::analysis::verdict;
-use harness::records::RunRecord;
-use numerics::estimator::estimate::ContactTerm;
+use model::settings::estimator::ContactTerm;
+use store::records::RunRecord;
 
 const SUBJECT: Subject = Subject { prefix: problem_names::FB, kind: Kind::Beyond };
 

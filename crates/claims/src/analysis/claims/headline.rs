@@ -4,7 +4,7 @@
 //! levels or the dense sampling changes it) is counted as undecided, a pass or a failure alike.
 
 use super::{Claim, Kind, RowKind, Verdict, terms};
-use numerics::estimator::estimate::ContactTerm;
+use model::settings::estimator::ContactTerm;
 
 /// How a row counts in the headline.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -29,9 +29,9 @@ use super::{
 use crate::analysis::roles::{self, Role, Roles};
 use crate::analysis::verdict::{self, Abscissa};
 use crate::analysis::{problem_names, studies};
-use harness::records::RunRecord;
-use numerics::base::stats::line_value_at;
-use numerics::estimator::estimate::c0_paper;
+use model::base::stats::line_value_at;
+use model::settings::estimator::c0_paper;
+use store::records::RunRecord;
 
 /// (ln NDF, ln error) at the levels of `r`'s error-rate fit (every other level of its window).
 fn fit_points(ctx: &Ctx, r: &RunRecord) -> Option<Vec<(f64, f64)>> {
@@ -242,7 +242,7 @@ fn problem_roles(problem: &str) -> ProblemRoles {
 }
 
 impl Stored {
-    pub fn read(shelf: &harness::study::store::Shelf, roles: &Roles) -> std::io::Result<Stored> {
+    pub fn read(shelf: &store::study::store::Shelf, roles: &Roles) -> std::io::Result<Stored> {
         let load = |s: &str| shelf.runs(s);
         Ok(Stored {
             estimator_repair: load(studies::ESTIMATOR_REPAIR)?,

@@ -16,7 +16,7 @@ use super::{
 use crate::analysis::problem_names;
 use crate::analysis::roles;
 use crate::analysis::verdict::{self, Abscissa};
-use harness::records::RunRecord;
+use store::records::RunRecord;
 
 /// The study.
 const STUDY: &str = roles::ROLLERS_AS_WRITTEN.study;

@@ -11,8 +11,8 @@ use super::{
 use crate::analysis::problem_names;
 use crate::analysis::roles::{self, Role};
 use crate::analysis::verdict::{self, Abscissa, RateReport};
-use harness::records::RunRecord;
 use std::collections::BTreeMap;
+use store::records::RunRecord;
 
 /// A problem's runs per contact term (eta_5 as written, without full-contact nodes, repaired)
 /// and its uniform run, each in the study that runs it deepest, with the smaller study's run

@@ -7,8 +7,8 @@
 //! part, each term has its own row and the row says at which level they part.
 
 use super::{Ctx, Q, source};
-use harness::records::RunRecord;
-use numerics::estimator::estimate::ContactTerm;
+use model::settings::estimator::ContactTerm;
+use store::records::RunRecord;
 
 /// Two runs coincide when their errors agree to this relative difference at every common level
 /// (and their NDF exactly).

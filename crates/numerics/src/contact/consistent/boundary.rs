@@ -32,8 +32,8 @@
 
 use super::{CONSISTENT, ExactError};
 use crate::fem::assembly::edge_points;
-use crate::mesh::{Mesh, P2Nodes};
-use crate::problems::{Curve, Exact, Part, Problem};
+use model::mesh::{Mesh, P2Nodes};
+use model::problems::{Curve, Exact, Part, Problem};
 
 /// A checked point of a boundary edge: where, the body's outward normal there, the part, and
 /// which edge (by index into `mesh.boundary`) at which parameter `t` (0 and 1: its vertices).
@@ -85,7 +85,7 @@ fn parameters(p: [f64; 2], q: [f64; 2], part: Part, spacing: f64) -> Vec<f64> {
 /// checked on it.
 pub(in crate::contact) fn sample(mesh: &Mesh, nodes: &P2Nodes, only: Option<Part>) -> Vec<(Point, f64)> {
     use rayon::prelude::*;
-    let normals = crate::mesh::outward_normals(mesh, nodes);
+    let normals = model::mesh::outward_normals(mesh, nodes);
     let spacing = super::diameter(mesh) / CONTACT_DENSITY as f64;
     // in the edges' order, whatever the number of threads
     let edges = mesh.boundary.par_iter().enumerate().filter(|(_, e)| only.is_none_or(|p| e.part == p));

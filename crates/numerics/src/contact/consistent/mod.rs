@@ -26,8 +26,8 @@
 
 pub(in crate::contact) mod boundary;
 
-use crate::mesh::{Mesh, P2Nodes};
-use crate::problems::{Exact, Material, Problem};
+use model::mesh::{Mesh, P2Nodes};
+use model::problems::{Exact, Material, Problem};
 
 /// Triangles sampled (spread evenly over the mesh's numbering).
 pub const SAMPLES: usize = 97;
@@ -43,7 +43,7 @@ pub const BEYOND: f64 = 100.0;
 pub enum ExactError {
     #[error(
         "{problem}: the exact solution's gradient contradicts its displacement: at {x} {what} is {declared:.6e}, while central differences of `exact.u[{i}]` give {differenced:.6e} (steps {step:.1e} and half that agree to {spread:.1e}), at {count} of {sampled} sampled points; {advice}",
-        x = crate::base::number::point(*.at),
+        x = model::base::number::point(*.at),
         what = gradient_entry(*.written, *.i, *.j),
         advice = if *.written { "write the derivative of u there, or leave `exact.grad` out and it is differentiated from u" } else { "u is not differentiable there as written (a kink or a jump near the point?); write `exact.grad` by hand where the derivative is known" }
     )]
@@ -63,7 +63,7 @@ pub enum ExactError {
     },
     #[error(
         "{problem}: the body force is not -div sigma(u) of the exact solution: at {x} `body_force[{i}]` is {declared:.6e}, while -div sigma(u) is {differenced:.6e} by central differences of sigma(exact.grad) (steps {step:.1e} and half that agree to {spread:.1e}), at {count} of {sampled} sampled points; an exact solution must solve the equations, -div sigma(u) = f (paper eq. 1.1)",
-        x = crate::base::number::point(*.at)
+        x = model::base::number::point(*.at)
     )]
     BodyForce {
         problem: String,
@@ -78,7 +78,7 @@ pub enum ExactError {
     },
     #[error(
         "{problem}: the exact solution does not satisfy {what}: at {x} {detail}, at {count} of {sampled} checked boundary points; an exact solution must satisfy the problem's boundary and contact conditions (paper eq. 1.1-1.8), or the errors are measured against the solution of another problem",
-        x = crate::base::number::point(*.at)
+        x = model::base::number::point(*.at)
     )]
     Boundary { problem: String, what: String, at: [f64; 2], detail: String, count: usize, sampled: usize },
 }
@@ -432,10 +432,10 @@ mod tests {
 
     #[test]
     fn the_built_in_exact_solutions_are_consistent() {
-        for problem in crate::problems::KNOWN {
-            let p = crate::problems::by_name(problem).unwrap();
+        for problem in model::problems::KNOWN {
+            let p = model::problems::by_name(problem).unwrap();
             for n in [4, 16] {
-                let mesh = crate::mesh::MeshSpec::parse(&format!("structured:{n}")).unwrap().build(p.as_ref()).unwrap();
+                let mesh = model::mesh::MeshSpec::parse(&format!("structured:{n}")).unwrap().build(p.as_ref()).unwrap();
                 assert_eq!(check_exact(p.as_ref(), &mesh, &P2Nodes::new(&mesh)), Ok(()), "{problem} on structured:{n}");
             }
         }

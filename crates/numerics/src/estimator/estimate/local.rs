@@ -4,12 +4,12 @@
 //! (eta_3, eta_4, eta_5, eta_6, eta_7) and the interior traction jumps (eta_2).
 
 use super::{EstimatorConfig, StressFrame};
-use crate::base::element::{self, Affine, EDGE_VERTICES, N_NODES};
 use crate::contact::sampling::Sampling;
 use crate::contact::solve::DiscreteSolution;
 use crate::fem::assembly::edge_basis;
-use crate::mesh::Mesh;
-use crate::problems::{Material, Part, Problem};
+use model::base::element::{self, Affine, EDGE_VERTICES, N_NODES};
+use model::mesh::Mesh;
+use model::problems::{Material, Part, Problem};
 use rayon::prelude::*;
 
 /// Local (per element) quantities before they are gathered on patches.

@@ -33,8 +33,8 @@
 //! force; the studies test it numerically (`estimator_repair`), they do not prove it.
 
 use crate::contact::solve::DiscreteSolution;
-use crate::mesh::Mesh;
-use crate::problems::Part;
+use model::mesh::Mesh;
+use model::problems::Part;
 
 /// Lambda_h^C,r per boundary edge of `mesh` (in `Mesh::boundary` order): a contact edge whose
 /// three nodes are all active (a full-contact edge), or one through a node with positive

@@ -1,7 +1,7 @@
 //! Provenance of a study's results (`results/STUDY/provenance.json`): git commit and dirty flag, Cargo.lock hash,
 //! rustc version, the manifest's hash, machine, threads, date.
 
-use numerics::base::digest::sha256_hex;
+use model::base::digest::sha256_hex;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::process::Command;
@@ -48,7 +48,7 @@ impl ProblemFile {
     pub fn of(path: &Path) -> Self {
         ProblemFile {
             path: path.display().to_string(),
-            sha256: numerics::base::input::read(path, numerics::problems::file::PROBLEM_FILE).ok().map(|b| sha256_hex(&b)),
+            sha256: model::base::input::read(path, model::problems::file::PROBLEM_FILE).ok().map(|b| sha256_hex(&b)),
         }
     }
 }
@@ -206,7 +206,7 @@ pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: 
         signorini_version: env!("CARGO_PKG_VERSION").to_string(),
         machine: machine(),
         threads: rayon::current_num_threads(),
-        ordering: match numerics::sparse::ordering::forced() {
+        ordering: match model::settings::ordering::forced() {
             Ok(Some(m)) => serde_json::to_value(m).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
             _ => "auto".into(),
         },
@@ -216,7 +216,7 @@ pub fn collect(study: &str, manifest_path: &Path, manifest_bytes: &[u8], quick: 
             .map(|m| {
                 (
                     m.display().to_string(),
-                    numerics::base::input::read(m, numerics::mesh::gmsh::MESH_FILE)
+                    model::base::input::read(m, model::mesh::gmsh::MESH_FILE)
                         .map(|b| sha256_hex(&b))
                         .unwrap_or_else(|e| format!("(cannot read: {e})")),
                 )

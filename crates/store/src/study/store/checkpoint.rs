@@ -8,7 +8,8 @@
 use crate::records::{RunSpec, StudyDir};
 use crate::study::provenance::CodeVersion;
 use anyhow::{Context, Result};
-use numerics::adapt::{Flags, History, LevelRecord};
+use model::level::history::{Flags, History};
+use model::level::record::LevelRecord;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -35,7 +36,7 @@ impl Checkpoint {
     /// read back exactly: serde_json's `float_roundtrip`).
     pub fn content_sha256(&self) -> String {
         let json = serde_json::to_vec(&(&self.levels, &self.history, &self.next_active)).expect("a checkpoint serialises");
-        numerics::base::digest::sha256_hex(&json)
+        model::base::digest::sha256_hex(&json)
     }
 
     /// Why this checkpoint, read back for `spec`'s run by `code`, is not resumed, if it is not.
@@ -88,7 +89,7 @@ pub(super) fn read(dir: &StudyDir, spec: &RunSpec, code: &CodeVersion) -> Option
     match why {
         None => parsed.ok(),
         Some(why) => {
-            numerics::base::note::line(format_args!("{}: not resumed from: {why}; the run starts over", path.display()));
+            model::base::note::line(format_args!("{}: not resumed from: {why}; the run starts over", path.display()));
             None
         }
     }
@@ -117,13 +118,13 @@ pub(super) fn remove(dir: &StudyDir, run: &str) -> Result<()> {
         for e in entries.flatten() {
             let name = e.file_name().to_string_lossy().into_owned();
             if name.starts_with(&own_temporary) && crate::records::is_temporary(&name) {
-                numerics::base::failpoint::step("remove", &e.path());
+                model::base::failpoint::step("remove", &e.path());
                 let _ = std::fs::remove_file(e.path());
             }
         }
     }
     if path.exists() {
-        numerics::base::failpoint::step("remove", &path);
+        model::base::failpoint::step("remove", &path);
     }
     match std::fs::remove_file(&path) {
         Ok(()) => {}
@@ -132,7 +133,7 @@ pub(super) fn remove(dir: &StudyDir, run: &str) -> Result<()> {
     }
     // fails while another run's checkpoint is there: then it stays
     if partial.is_dir() {
-        numerics::base::failpoint::step("remove folder", &partial);
+        model::base::failpoint::step("remove folder", &partial);
         let _ = std::fs::remove_dir(&partial);
     }
     Ok(())

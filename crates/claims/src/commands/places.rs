@@ -2,14 +2,14 @@
 //! computation (never inside a study folder, never a pipe, a device or a folder where a file
 //! goes), results roots outside study folders, and readers that wait for writers.
 
-use crate::study;
 use anyhow::{Context, Result, bail};
+use store::study;
 
 /// Refuse an output path whose folder does not exist, or that is not a file a write may replace
 /// (a named pipe, a device such as /dev/null: the write renames a new file over it), before
 /// hours of work are spent, not after.
 pub fn check_writable(flag: &str, path: &std::path::Path) -> Result<()> {
-    let dir = crate::base::input::folder_of(path);
+    let dir = model::base::input::folder_of(path);
     if let Some(blocking) = dir.ancestors().find(|a| a.exists() && !a.is_dir()) {
         bail!("{flag} {}: {} is a file, not a folder", path.display(), blocking.display());
     }
@@ -28,11 +28,11 @@ pub fn check_writable(flag: &str, path: &std::path::Path) -> Result<()> {
 }
 
 /// Refuse an output path a write may not replace (a named pipe, a device, a folder), naming the
-/// flag; the same check every atomic write makes ([`crate::base::input::check_target`]), made
+/// flag; the same check every atomic write makes ([`model::base::input::check_target`]), made
 /// here before any computation.
 pub fn check_target(flag: &str, path: &std::path::Path) -> Result<()> {
     outside_study(flag, path)?;
-    crate::base::input::check_target(path).map_err(|e| anyhow::anyhow!("{flag} {}: {e}", path.display()))
+    model::base::input::check_target(path).map_err(|e| anyhow::anyhow!("{flag} {}: {e}", path.display()))
 }
 
 /// Refuse an output path inside a results study folder (`STUDY/` holding `runs/`, `.lock` or

@@ -220,7 +220,7 @@ impl Shelf {
     }
 
     /// The problem a stored run of `study` solved ([`crate::study::stored_problem`]).
-    pub fn problem(&self, study: &str, spec: &RunSpec) -> anyhow::Result<Box<dyn numerics::problems::Problem>> {
+    pub fn problem(&self, study: &str, spec: &RunSpec) -> anyhow::Result<Box<dyn model::problems::Problem>> {
         if self.shelved(study)?.is_none() {
             return Err(ShelfError::NoRun { study: study.to_string(), run: spec.id.clone() }.into());
         }

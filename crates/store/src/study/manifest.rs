@@ -48,24 +48,24 @@
 //! ```
 //!
 //! Every error names the file, the key and what was expected; unknown keys are errors. The run's
-//! loop settings are checked by [`AdaptConfig::validate`](numerics::adapt::AdaptConfig::validate),
+//! loop settings are checked by [`AdaptConfig::validate`](model::settings::adapt::AdaptConfig::validate),
 //! as on the command line. `save_levels` may not repeat a level. What needs the runs' files
 //! and this machine (the meshes built with their problems, memory for the initial mesh and the
 //! reference, `max_ndof` against the initial mesh) is checked by [`Manifest::check_runs`] for
 //! every run before any is solved.
 
 use crate::records::{ReferenceSpec, RunSpec};
-use numerics::adapt::AdaptConfig;
-use numerics::adapt::Refine;
-use numerics::contact::sampling::Sampling;
-use numerics::estimator::estimate::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
-use numerics::mesh::MeshSpec;
+use model::mesh::MeshSpec;
+use model::settings::adapt::AdaptConfig;
+use model::settings::adapt::Refine;
+use model::settings::estimator::{ContactTerm, EstimatorConfig, LogFactor, StressFrame};
+use model::settings::sampling::Sampling;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// A derived field's value as a function of its record.
-pub type Definition = fn(&numerics::adapt::LevelRecord) -> Option<f64>;
+pub type Definition = fn(&model::level::record::LevelRecord) -> Option<f64>;
 
 /// Fields that are functions of other fields of the same record, checked as such (the stored
 /// and the fresh value each equal the function of the record's own fields, to the bit) rather
@@ -74,18 +74,18 @@ pub type Definition = fn(&numerics::adapt::LevelRecord) -> Option<f64>;
 /// tolerance on the index itself could be honest about while still seeing a change of 1e-5.
 pub const DERIVED: [(&str, Definition); 1] = [("efficiency", |l| l.err_quadrature.map(|e| l.terms.estimate / e))];
 
-/// A manifest as [`numerics::base::input::read`] reads it: a regular file of at most
-/// [`TEXT_LIMIT`](numerics::base::input::TEXT_LIMIT) bytes.
-const MANIFEST: numerics::base::input::Kind =
-    numerics::base::input::Kind { what: "the manifest", limit: numerics::base::input::Limit::Bytes(numerics::base::input::TEXT_LIMIT) };
+/// A manifest as [`model::base::input::read`] reads it: a regular file of at most
+/// [`TEXT_LIMIT`](model::base::input::TEXT_LIMIT) bytes.
+const MANIFEST: model::base::input::Kind =
+    model::base::input::Kind { what: "the manifest", limit: model::base::input::Limit::Bytes(model::base::input::TEXT_LIMIT) };
 
 #[derive(Debug, thiserror::Error)]
 pub enum ManifestError {
     #[error("{file}: {error}")]
-    Read { file: PathBuf, error: numerics::base::input::InputError },
-    #[error("{file}: {}", numerics::base::input::excerpt(message))]
+    Read { file: PathBuf, error: model::base::input::InputError },
+    #[error("{file}: {}", model::base::input::excerpt(message))]
     Syntax { file: PathBuf, message: String },
-    #[error("{file}: key `{key}`: expected {expected}, got {}", numerics::base::input::excerpt(got))]
+    #[error("{file}: key `{key}`: expected {expected}, got {}", model::base::input::excerpt(got))]
     Invalid { file: PathBuf, key: String, expected: String, got: String },
     /// The file's name cannot name a study ([`crate::records::study_name_fault`]).
     #[error(
@@ -264,7 +264,7 @@ impl Manifest {
     }
 
     pub fn load(path: &Path) -> Result<Self, ManifestError> {
-        let bytes = numerics::base::input::read(path, MANIFEST).map_err(|error| ManifestError::Read { file: path.to_path_buf(), error })?;
+        let bytes = model::base::input::read(path, MANIFEST).map_err(|error| ManifestError::Read { file: path.to_path_buf(), error })?;
         let text = String::from_utf8_lossy(&bytes);
         Self::parse(path, &text).map(|mut m| {
             m.bytes = without_roles(&bytes);
@@ -274,10 +274,8 @@ impl Manifest {
 
     pub fn parse(path: &Path, text: &str) -> Result<Self, ManifestError> {
         let file = path.to_path_buf();
-        let raw: ManifestToml = toml::from_str(text).map_err(|e| ManifestError::Syntax {
-            file: file.clone(),
-            message: numerics::base::toml_text::plain(e.to_string().trim_end()),
-        })?;
+        let raw: ManifestToml = toml::from_str(text)
+            .map_err(|e| ManifestError::Syntax { file: file.clone(), message: model::base::toml_text::plain(e.to_string().trim_end()) })?;
         let study = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         if let Some(why) = crate::records::study_name_fault(&study) {
             return Err(ManifestError::Name { file, study, why });
@@ -441,17 +439,17 @@ fn parse_run(
         check_role(role, &id, roles).map_err(|(expected, got)| invalid.at(key("role"), &expected, got))?;
     }
     let problem = r.problem.clone().or(d.problem.clone()).ok_or_else(|| invalid.at(key("problem"), "a problem name", "nothing".into()))?;
-    let problem = if numerics::problems::is_file(&problem) { spelled_for(path, &problem) } else { problem };
+    let problem = if model::problems::is_file(&problem) { spelled_for(path, &problem) } else { problem };
     let mut constants = d.constants.clone().unwrap_or_default();
     constants.extend(r.constants.clone().unwrap_or_default());
-    if let Err(e) = numerics::problems::load(&resolve_problem(path, &problem), &constants) {
+    if let Err(e) = model::problems::load(&resolve_problem(path, &problem), &constants) {
         let expected = match e {
-            numerics::problems::ProblemError::Unknown(_) => format!(
+            model::problems::ProblemError::Unknown(_) => format!(
                 "a built-in problem ({}) or the path of a problem file (NAME.toml, relative to the manifest)",
-                numerics::problems::KNOWN.join(", ")
+                model::problems::KNOWN.join(", ")
             ),
-            numerics::problems::ProblemError::File(e) => format!("a valid problem file ({e})"),
-            numerics::problems::ProblemError::Constants(_) => {
+            model::problems::ProblemError::File(e) => format!("a valid problem file ({e})"),
+            model::problems::ProblemError::Constants(_) => {
                 return Err(invalid.at(
                     key("constants"),
                     "no constants: the problem is built in",
@@ -485,7 +483,7 @@ fn parse_run(
     if let Some(rf) = &reference
         && !(rf.theta > 0.0 && rf.theta <= 1.0)
     {
-        return Err(invalid.at(key("reference.theta"), "a number in (0, 1]", numerics::estimator::estimate::ConfigError::number(rf.theta)));
+        return Err(invalid.at(key("reference.theta"), "a number in (0, 1]", model::settings::estimator::ConfigError::number(rf.theta)));
     }
     let inputs = input_hashes(path, &problem, &mesh).map_err(|(k, e)| invalid.at(key(k), "a readable file", e))?;
     let spec = RunSpec {
@@ -547,7 +545,7 @@ fn check_drift(drift: &DriftSpec, runs: &[PlannedRun], invalid: &Invalid) -> Res
             }
         }
     }
-    let floats = numerics::adapt::float_fields();
+    let floats = model::level::record::float_fields();
     for (key, tol) in
         std::iter::once(("default".to_string(), &drift.default)).chain(drift.fields.iter().map(|(k, t)| (format!("fields.{k}"), t)))
     {
@@ -586,7 +584,7 @@ fn check_drift(drift: &DriftSpec, runs: &[PlannedRun], invalid: &Invalid) -> Res
             ));
         }
         if !r.min.is_finite() {
-            return Err(invalid.at(key("min"), "a finite rate", numerics::estimator::estimate::ConfigError::number(r.min)));
+            return Err(invalid.at(key("min"), "a finite rate", model::settings::estimator::ConfigError::number(r.min)));
         }
         if r.last < 2 || r.last > run.spec.levels {
             return Err(invalid.at(
@@ -633,7 +631,7 @@ fn first_repeated(values: &[usize]) -> Option<usize> {
 /// a problem file relative to the manifest's folder (an absolute path as it is). The run's spec
 /// (and so its record) keeps `problem` as written; the provenance records the file and its hash.
 pub fn resolve_problem(manifest: &Path, problem: &str) -> String {
-    if !numerics::problems::is_file(problem) || Path::new(problem).is_absolute() {
+    if !model::problems::is_file(problem) || Path::new(problem).is_absolute() {
         return problem.to_string();
     }
     manifest.parent().unwrap_or(Path::new("")).join(problem).display().to_string()
@@ -699,7 +697,7 @@ pub fn spelled_for(manifest: &Path, path: &str) -> String {
 /// (the key of [`RunSpec::inputs`]) and the path resolved against the manifest's folder.
 pub fn input_files(manifest: &Path, problem: &str, mesh: &str) -> Vec<(&'static str, String, PathBuf)> {
     let mut out = Vec::new();
-    if numerics::problems::is_file(problem) {
+    if model::problems::is_file(problem) {
         out.push(("problem", problem.to_string(), PathBuf::from(resolve_problem(manifest, problem))));
     }
     if let Ok(spec) = MeshSpec::parse(&resolve_mesh(manifest, mesh))
@@ -716,20 +714,20 @@ pub fn input_files(manifest: &Path, problem: &str, mesh: &str) -> Vec<(&'static 
 pub fn input_hashes(manifest: &Path, problem: &str, mesh: &str) -> Result<BTreeMap<String, String>, (&'static str, String)> {
     let mut out = BTreeMap::new();
     for (key, written, resolved) in input_files(manifest, problem, mesh) {
-        let kind = if key == "mesh" { numerics::mesh::gmsh::MESH_FILE } else { numerics::problems::file::PROBLEM_FILE };
-        let bytes = numerics::base::input::read(&resolved, kind).map_err(|e| (key, format!("{}: {e}", resolved.display())))?;
-        out.insert(written, numerics::base::digest::sha256_hex(&bytes));
+        let kind = if key == "mesh" { model::mesh::gmsh::MESH_FILE } else { model::problems::file::PROBLEM_FILE };
+        let bytes = model::base::input::read(&resolved, kind).map_err(|e| (key, format!("{}: {e}", resolved.display())))?;
+        out.insert(written, model::base::digest::sha256_hex(&bytes));
     }
     Ok(out)
 }
 
 /// Pin the input files of a run with `spec` (of the manifest at `manifest`) to the bytes its
-/// spec holds the hashes of ([`numerics::base::pin`]): until the guard is dropped, a read of one
+/// spec holds the hashes of ([`model::base::pin`]): until the guard is dropped, a read of one
 /// of them with other bytes is an error naming it, so the record's `inputs` are the hashes of
 /// what the run parsed. (A file the spec holds no hash of, a record of an older format, is not
 /// pinned.)
-pub fn pin_inputs(manifest: &Path, spec: &RunSpec) -> numerics::base::pin::Pins {
-    numerics::base::pin::pin(
+pub fn pin_inputs(manifest: &Path, spec: &RunSpec) -> model::base::pin::Pins {
+    model::base::pin::pin(
         input_files(manifest, &spec.problem, &spec.mesh)
             .into_iter()
             .filter_map(|(_, written, resolved)| spec.inputs.get(&written).map(|h| (resolved, h.clone()))),
@@ -769,7 +767,7 @@ impl Manifest {
         let mut files: Vec<PathBuf> = self
             .runs
             .iter()
-            .filter(|r| numerics::problems::is_file(&r.spec.problem))
+            .filter(|r| model::problems::is_file(&r.spec.problem))
             .map(|r| PathBuf::from(resolve_problem(&self.file, &r.spec.problem)))
             .collect();
         files.dedup();
@@ -796,7 +794,7 @@ impl Manifest {
     /// solved (a mistake in the last run must not cost the first one's): the mesh is read and
     /// built with the run's problem (a missing or malformed mesh file, a boundary group the
     /// problem does not name, a kink that is not a vertex), the initial mesh and the reference
-    /// solution's `min_ndof` fit in this machine's memory ([`check_memory`](numerics::base::memory::check_memory)),
+    /// solution's `min_ndof` fit in this machine's memory ([`check_memory`](model::base::memory::check_memory)),
     /// `max_ndof` is at least the initial mesh's unknowns (level 0 is always solved), and a
     /// reference is declared only for a problem without an exact solution.
     pub fn check_runs(&self) -> Result<(), ManifestError> {
@@ -813,12 +811,12 @@ impl Manifest {
             expected,
             got: format!("{got} (run {})", spec.id),
         };
-        let problem = numerics::problems::load(&resolve_problem(&self.file, &spec.problem), &spec.constants)
+        let problem = model::problems::load(&resolve_problem(&self.file, &spec.problem), &spec.constants)
             .map_err(|e| invalid("problem", "a problem that loads".into(), format!("{:?}: {e}", spec.problem)))?;
         let mesh_spec = MeshSpec::parse(&resolve_mesh(&self.file, &spec.mesh))
             .map_err(|e| invalid("mesh", e.expected(), format!("{:?}", spec.mesh)))?;
         let ndof = mesh_spec.ndof().map_err(|e| invalid("mesh", "a readable mesh file".into(), format!("{:?}: {e}", spec.mesh)))?;
-        numerics::base::memory::check_memory(&format!("the initial mesh {}", spec.mesh), ndof)
+        model::base::memory::check_memory(&format!("the initial mesh {}", spec.mesh), ndof)
             .map_err(|e| invalid("mesh", "an initial mesh that fits in this machine's memory".into(), e.to_string()))?;
         mesh_spec
             .build(problem.as_ref())
@@ -846,10 +844,9 @@ impl Manifest {
                     rf.min_ndof.to_string(),
                 ));
             }
-            numerics::base::memory::check_memory(&format!("the reference solution (min_ndof {})", rf.min_ndof), rf.min_ndof as f64)
-                .map_err(|e| {
-                    invalid("reference.min_ndof", "a reference solution that fits in this machine's memory".into(), e.to_string())
-                })?;
+            model::base::memory::check_memory(&format!("the reference solution (min_ndof {})", rf.min_ndof), rf.min_ndof as f64).map_err(
+                |e| invalid("reference.min_ndof", "a reference solution that fits in this machine's memory".into(), e.to_string()),
+            )?;
         }
         Ok(())
     }
@@ -892,7 +889,7 @@ pub fn declared(dir: &Path, only: &[String]) -> anyhow::Result<Vec<Manifest>> {
 /// (its tables are a problem's, not a study's).
 fn not_a_manifest(file: &Path, error: ManifestError) -> anyhow::Error {
     // through the one reader: a named pipe (refused by `load`) must not be read here either
-    let tables = numerics::base::input::read_text(file, MANIFEST).ok().and_then(|t| t.parse::<toml::Table>().ok()).unwrap_or_default();
+    let tables = model::base::input::read_text(file, MANIFEST).ok().and_then(|t| t.parse::<toml::Table>().ok()).unwrap_or_default();
     let problem_like = ["material", "contact", "parts", "body_force", "dirichlet"].iter().any(|k| tables.contains_key(*k));
     if problem_like && !tables.contains_key("run") {
         anyhow::anyhow!(

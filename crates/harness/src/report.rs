@@ -2,14 +2,14 @@
 //! are the JSON keys; `tests/it/cli_refusals.rs` checks the ones scripts rely on), and the export of a
 //! case for the NGSolve cross-check.
 
-use crate::records;
+use ::store::records;
 use anyhow::Result;
+use model::mesh::locate::Locator;
+use model::mesh::{Mesh, io};
 use numerics::contact::PdasIteration;
 use numerics::contact::norms::LinfError;
 use numerics::contact::solve::{ContactInterval, DiscreteSolution, Kkt, SolveTimings};
 use numerics::estimator::estimate::{Estimate, EstimatorConfig, Terms};
-use numerics::mesh::locate::Locator;
-use numerics::mesh::{Mesh, io};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -27,7 +27,7 @@ pub struct Probe {
 pub enum ProbeError {
     #[error("malformed --probe '{0}': expected X,Y with two finite numbers, e.g. 0.5,0.25")]
     Malformed(String),
-    #[error("--probe {},{}: the point is outside the mesh (no triangle of the mesh contains it; u_h is defined on the triangles only, and where the boundary is curved the straight-sided triangles leave out the thin part between each boundary edge and the curve)", numerics::base::number::shown(*x), numerics::base::number::shown(*y))]
+    #[error("--probe {},{}: the point is outside the mesh (no triangle of the mesh contains it; u_h is defined on the triangles only, and where the boundary is curved the straight-sided triangles leave out the thin part between each boundary edge and the curve)", model::base::number::shown(*x), model::base::number::shown(*y))]
     Outside { x: f64, y: f64 },
 }
 
@@ -210,7 +210,7 @@ impl SolveReport {
 
 /// `v` to 6 significant digits without trailing zeros (0.1875, 0.254745): an arc length in the
 /// summary, not the 17 digits of a point on a curved Gmsh boundary (`--json` keeps those). In
-/// scientific notation (1.25e150) where [`numerics::base::number::shown`] would be.
+/// scientific notation (1.25e150) where [`model::base::number::shown`] would be.
 fn significant(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         return v.to_string();

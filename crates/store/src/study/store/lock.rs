@@ -28,7 +28,7 @@ fn patience() -> std::time::Duration {
         match text.trim().parse::<f64>() {
             Ok(s) if (0.0..=3600.0).contains(&s) => std::time::Duration::from_secs_f64(s),
             _ => {
-                numerics::base::note::line(format_args!(
+                model::base::note::line(format_args!(
                     "SIGNORINI_LOCK_PATIENCE={text:?} is not a number of seconds in 0 ..= 3600; waiting the default {} s",
                     STUDY_LOCK_PATIENCE.as_secs()
                 ));
@@ -114,14 +114,14 @@ pub fn scratch_folder(folder: &Path) -> Result<Lock> {
 /// The lock file at `path`, made if missing; one that is not a regular file (a named pipe, a
 /// symlink to a device: its holder's text would be read without end) is refused, naming it.
 fn open(path: &Path) -> Result<std::fs::File> {
-    if let Err(e) = numerics::base::input::check_target(path) {
+    if let Err(e) = model::base::input::check_target(path) {
         bail!("the lock file {} is {}, not a file: remove it", path.display(), e.found);
     }
     if let Some(parent) = path.parent() {
-        numerics::base::input::create_folder(parent)?;
+        model::base::input::create_folder(parent)?;
     }
     if !path.exists() {
-        numerics::base::failpoint::step("create", path);
+        model::base::failpoint::step("create", path);
     }
     std::fs::OpenOptions::new()
         .read(true)
@@ -153,7 +153,7 @@ fn claim(mut file: std::fs::File, path: &Path, what: &str, wait: bool) -> Result
             if !wait {
                 return Err(Held { what: what.to_string(), holder, lock: path.to_path_buf() }.into());
             }
-            numerics::base::note::line(format_args!("{what} is being written by {holder}; waiting for it to finish"));
+            model::base::note::line(format_args!("{what} is being written by {holder}; waiting for it to finish"));
             file.lock().with_context(|| format!("waiting for the lock {}", path.display()))?;
         }
         Err(std::fs::TryLockError::Error(e)) => return Err(e).with_context(|| format!("locking {}", path.display())),
@@ -252,7 +252,7 @@ pub(super) fn writer_of(dir: &StudyDir) -> Result<Option<BeingWritten>> {
     // a lock file that is not a regular file (a named pipe would block the open itself) is
     // refused by its metadata, never opened, as a writer refuses it ([`open`])
     let shared = |path: &Path| -> Result<Option<std::result::Result<std::fs::File, std::fs::File>>> {
-        if let Err(e) = numerics::base::input::check_target(path) {
+        if let Err(e) = model::base::input::check_target(path) {
             bail!("the lock file {} is {}, not a file: remove it", path.display(), e.found);
         }
         let Ok(file) = std::fs::File::open(path) else { return Ok(None) };
@@ -300,10 +300,7 @@ pub(super) fn wait_for_writers(dir: &StudyDir) -> Result<()> {
             Some(pid) if seen.contains(&pid) => {}
             pid => {
                 seen.extend(pid);
-                numerics::base::note::line(format_args!(
-                    "{} is being written by {}; waiting for it to finish",
-                    written.what, written.holder
-                ));
+                model::base::note::line(format_args!("{} is being written by {}; waiting for it to finish", written.what, written.holder));
             }
         }
         let file = std::fs::File::open(&written.lock).with_context(|| format!("opening the lock file {}", written.lock.display()))?;

@@ -55,7 +55,7 @@ impl Journal {
                 ),
             )
         })?;
-        numerics::base::failpoint::step("remove", &file);
+        model::base::failpoint::step("remove", &file);
         std::fs::remove_file(&file).map_err(super::step("removing the finished journal", &file))
     }
 
@@ -91,14 +91,14 @@ impl Journal {
                 continue;
             }
             if let Some(parent) = to.parent() {
-                numerics::base::input::create_folder(parent)?;
+                model::base::input::create_folder(parent)?;
             }
-            numerics::base::failpoint::step("rename", &to);
+            model::base::failpoint::step("rename", &to);
             std::fs::rename(&from, &to).map_err(super::step("renaming into place", &to))?;
         }
         for gone in &self.removals {
             let gone = folder.join(gone);
-            numerics::base::failpoint::step("remove", &gone);
+            model::base::failpoint::step("remove", &gone);
             match std::fs::remove_file(&gone) {
                 Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(super::step("removing", &gone)(e)),
                 _ => {}
@@ -140,7 +140,7 @@ pub fn roll_forward(folder: &Path) -> std::io::Result<Option<Journal>> {
     let Some(journal) = pending(folder)? else { return Ok(None) };
     journal.carry_out(folder)?;
     let file = folder.join(FILE);
-    numerics::base::failpoint::step("remove", &file);
+    model::base::failpoint::step("remove", &file);
     std::fs::remove_file(&file).map_err(super::step("removing the finished journal", &file))?;
     Ok(Some(journal))
 }

@@ -128,7 +128,7 @@ impl Store {
         let rolled = crate::records::journal::roll_forward(&self.dir.root)
             .with_context(|| format!("completing the change a stopped process left in {}", self.dir.root.display()))?;
         if let Some(journal) = rolled {
-            numerics::base::note::line(format_args!(
+            model::base::note::line(format_args!(
                 "{}: completed a change a stopped process left part-way ({} file(s) put into place, {} removed)",
                 self.study,
                 journal.renames.len(),
@@ -327,7 +327,7 @@ impl Store {
     /// Name the leftovers of an unfinished run a reader ignores, in one line.
     pub fn note_leftovers(&self, leftovers: &[PathBuf]) {
         if !leftovers.is_empty() {
-            numerics::base::note::line(format_args!(
+            model::base::note::line(format_args!(
                 "{}: ignoring {} file(s) of an unfinished run in {} (`signorini run` removes them): {}",
                 self.study,
                 leftovers.len(),

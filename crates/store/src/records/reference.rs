@@ -37,7 +37,7 @@ pub struct Rebuild {
     /// iteration there: the first iteration solves the converged iteration's system, the same
     /// solution in one numeric factorisation where the loop's warm start took several.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub final_active: Option<numerics::adapt::Flags>,
+    pub final_active: Option<model::level::history::Flags>,
 }
 
 /// What identifies a run's reference solution: everything it is computed from.

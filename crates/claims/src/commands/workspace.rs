@@ -4,9 +4,9 @@
 //! [`Workspace`] and read no manifest themselves.
 
 use crate::analysis::roles::{self, Roles};
-use crate::study::manifest::{self, Manifest};
 use anyhow::{Result, bail};
 use std::path::{Path, PathBuf};
+use store::study::manifest::{self, Manifest};
 
 /// The experiments folder as read: its manifests and the roles of their runs.
 pub struct Workspace {

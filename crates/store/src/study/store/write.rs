@@ -113,7 +113,7 @@ impl Writer<'_> {
         for sub in ["runs", "meshes", "references", ".partial"] {
             let folder = dir.root.join(sub);
             if folder.is_dir() {
-                numerics::base::failpoint::step("remove folder", &folder);
+                model::base::failpoint::step("remove folder", &folder);
                 std::fs::remove_dir(&folder).with_context(|| format!("removing the emptied folder {}", folder.display()))?;
             }
         }
@@ -129,10 +129,10 @@ impl Writer<'_> {
             return Ok(());
         }
         for f in &found {
-            numerics::base::failpoint::step("remove", f);
+            model::base::failpoint::step("remove", f);
             std::fs::remove_file(f).with_context(|| format!("removing {}", f.display()))?;
         }
-        numerics::base::note::line(format_args!(
+        model::base::note::line(format_args!(
             "{}: removed {} file(s) of an unfinished run (no finished run accounts for them): {}",
             self.store.study,
             found.len(),
@@ -229,7 +229,7 @@ impl Writer<'_> {
     /// against it store it again, computed anew ([`Writer::commit_reference`]).
     pub fn remove_reference(&self, key: &str) -> Result<()> {
         let file = self.store.dir.reference_file(key);
-        numerics::base::failpoint::step("remove", &file);
+        model::base::failpoint::step("remove", &file);
         match std::fs::remove_file(&file) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e).with_context(|| format!("removing {}", file.display())),
             _ => Ok(()),

@@ -1,18 +1,8 @@
 //! What the loop reports about one level ([`LevelRecord`]: the one record type a study stores
-//! per level, behind JSON, CSV, drift and plots) and how the mesh is refined between levels.
+//! per level, behind JSON, CSV, drift and plots).
 
-use crate::estimator::estimate::Terms;
+use super::terms::Terms;
 use serde::{Deserialize, Serialize};
-
-/// How the mesh is refined from level to level.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Refine {
-    /// Maximum strategy: mark T if eta_T >= theta max eta_T (Section 7, ref. \[35\]).
-    Adaptive,
-    /// Mark every element (one newest-vertex bisection each, so NDF about doubles per level).
-    Uniform,
-}
 
 /// Everything a study stores about one level: the one record type behind JSON, CSV, drift and
 /// plots. Flat, so that it is also one CSV row. Fields starting with `t_` (timings, seconds) and

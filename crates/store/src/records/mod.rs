@@ -13,11 +13,10 @@ mod error;
 mod finite;
 pub mod journal;
 pub mod reference;
-pub mod report;
 
 pub use error::RecordError;
 pub use finite::{NonFinite, first_non_finite};
-use numerics::contact::solve::ContactSample;
+use model::level::sample::ContactSample;
 pub use reference::{Rebuild, ReferenceRecord};
 
 use std::io::Write;
@@ -52,11 +51,11 @@ fn temporary_for(path: &Path) -> std::path::PathBuf {
     path.with_file_name(format!(".{name}.tmp{}.{n}", std::process::id()))
 }
 
-/// `path` may be replaced by a renamed file ([`numerics::base::input::check_target`]): the rename
+/// `path` may be replaced by a renamed file ([`model::base::input::check_target`]): the rename
 /// would replace whatever is there, so a named pipe, a device or a folder is refused, naming it.
 /// Checked when a file is staged and again just before its rename.
 fn replaceable(path: &Path) -> std::io::Result<()> {
-    numerics::base::input::check_target(path)
+    model::base::input::check_target(path)
         .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, format!("{}: {e}", path.display())))
 }
 
@@ -92,9 +91,9 @@ impl Batch {
     /// the temporary file is removed and the error names the path and the step.
     pub fn add(&mut self, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         replaceable(path)?;
-        numerics::base::input::create_folder(numerics::base::input::folder_of(path))?;
+        model::base::input::create_folder(model::base::input::folder_of(path))?;
         let tmp = temporary_for(path);
-        numerics::base::failpoint::step("write", &tmp);
+        model::base::failpoint::step("write", &tmp);
         let written = std::fs::File::create(&tmp).and_then(|mut f| {
             f.write_all(bytes)?;
             f.sync_all()
@@ -110,7 +109,7 @@ impl Batch {
             );
             return Err(std::io::Error::new(e.kind(), format!("writing {what}: {e}{}", size_limit_note(&e, bytes.len()))));
         }
-        self.staged.push((tmp, path.to_path_buf(), numerics::base::digest::sha256_hex(bytes)));
+        self.staged.push((tmp, path.to_path_buf(), model::base::digest::sha256_hex(bytes)));
         Ok(())
     }
 
@@ -135,7 +134,7 @@ impl Batch {
         let staged = std::mem::take(&mut self.staged);
         let mut rest = staged.iter();
         for (tmp, path, _) in rest.by_ref() {
-            numerics::base::failpoint::step("rename", path);
+            model::base::failpoint::step("rename", path);
             let renamed = replaceable(path).and_then(|()| std::fs::rename(tmp, path).map_err(step("renaming the temporary file to", path)));
             if let Err(e) = renamed {
                 let _ = std::fs::remove_file(tmp);
@@ -186,24 +185,24 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 
 /// The bytes of a file of a results folder (a record, `levels.csv`, `provenance.json`, a
 /// reference, a mesh snapshot, a checkpoint, a drift report, a figure), through the one bounded
-/// reader [`numerics::base::input::read`]: a path that is not a regular file after following
+/// reader [`model::base::input::read`]: a path that is not a regular file after following
 /// symlinks (a named pipe, `/dev/zero`, a folder) or is larger than
-/// [`RESULTS_LIMIT`](numerics::base::input::RESULTS_LIMIT) is refused before it is opened (kind
+/// [`RESULTS_LIMIT`](model::base::input::RESULTS_LIMIT) is refused before it is opened (kind
 /// `InvalidData`); a missing file keeps its kind (`NotFound`). An error names the path.
 pub fn read_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
-    numerics::base::input::read(path, numerics::base::input::RESULTS_FILE).map_err(|e| step("reading", path)(input_error(e)))
+    model::base::input::read(path, model::base::input::RESULTS_FILE).map_err(|e| step("reading", path)(input_error(e)))
 }
 
 /// Read a text file of a results folder ([`read_bytes`], then UTF-8); an error names the path.
 pub fn read_text(path: &Path) -> std::io::Result<String> {
-    numerics::base::input::read_text(path, numerics::base::input::RESULTS_FILE).map_err(|e| step("reading", path)(input_error(e)))
+    model::base::input::read_text(path, model::base::input::RESULTS_FILE).map_err(|e| step("reading", path)(input_error(e)))
 }
 
 /// The reader's error as an `io::Error`: a failed file operation keeps its own (and kind),
 /// a file refused for its type or size is `InvalidData`.
-fn input_error(e: numerics::base::input::InputError) -> std::io::Error {
+fn input_error(e: model::base::input::InputError) -> std::io::Error {
     match e {
-        numerics::base::input::InputError::Io { error, .. } => error,
+        model::base::input::InputError::Io { error, .. } => error,
         other => std::io::Error::new(std::io::ErrorKind::InvalidData, other.to_string()),
     }
 }
@@ -223,7 +222,7 @@ pub fn json_bytes<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Resul
 /// record is checked to be exactly that): what a drift report keeps of each record it compared,
 /// and what the study page compares with the records it shows.
 pub fn record_sha256(record: &RunRecord) -> String {
-    json_bytes(Path::new("runs"), record).map(|b| numerics::base::digest::sha256_hex(&b)).unwrap_or_else(|e| format!("(not written: {e})"))
+    json_bytes(Path::new("runs"), record).map(|b| model::base::digest::sha256_hex(&b)).unwrap_or_else(|e| format!("(not written: {e})"))
 }
 
 /// Serialise as pretty JSON (checked by [`json_bytes`]) and write atomically.
@@ -231,8 +230,10 @@ pub fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> std::io::Resul
     write_atomic(path, &json_bytes(path, value)?)
 }
 
-use numerics::adapt::{AdaptConfig, History, LevelRecord, Refine};
-use numerics::estimator::estimate::{ContactTerm, EstimatorConfig};
+use model::level::history::History;
+use model::level::record::LevelRecord;
+use model::settings::adapt::{AdaptConfig, Refine};
+use model::settings::estimator::{ContactTerm, EstimatorConfig};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -488,7 +489,7 @@ impl StudyDir {
         let file = self.mesh_file(&record.run.id, level, ext);
         let bytes = read_bytes(&file)?;
         let name = file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let found = numerics::base::digest::sha256_hex(&bytes);
+        let found = model::base::digest::sha256_hex(&bytes);
         match record.snapshots.get(&name) {
             Some(held) if *held == found => Ok(bytes),
             held => Err(RecordError::Snapshot { path: file, run: record.run.id.clone(), held: held.cloned(), found }.into()),
