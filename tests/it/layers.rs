@@ -376,3 +376,37 @@ fn the_figures_crates_stand_on_no_solver() {
     }
     assert!(dependencies_of("crates/numerics").contains(&"faer".to_string()), "the check reads dependencies as the solver's names faer");
 }
+
+/// The source files of the targets whose Cargo.toml says `test = false` (a library: its `src/`
+/// but `src/bin/`; a binary: its file): `cargo test` does not compile their unit tests.
+fn untested_sources() -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for dir in std::iter::once(".").chain(CRATES.iter().map(|(d, _)| *d)) {
+        let table: toml::Table = std::fs::read_to_string(repo().join(dir).join("Cargo.toml")).unwrap().parse().unwrap();
+        let untested = |t: &toml::Value| t.get("test").and_then(|v| v.as_bool()) == Some(false);
+        if table.get("lib").is_some_and(untested) {
+            let mut files = Vec::new();
+            rust_files(&repo().join(dir).join("src"), &mut files);
+            out.extend(files.into_iter().filter(|f| !f.starts_with(repo().join(dir).join("src/bin"))));
+        }
+        for bin in table.get("bin").and_then(|b| b.as_array()).into_iter().flatten().filter(|b| untested(b)) {
+            out.push(repo().join(dir).join(bin["path"].as_str().expect("a [[bin]] with test = false names its path")));
+        }
+    }
+    out
+}
+
+/// A `#[test]` in a target whose unit tests `cargo test` does not compile would never run.
+#[test]
+fn no_test_is_left_where_it_would_not_run() {
+    let files = untested_sources();
+    assert!(files.iter().any(|f| f.ends_with("src/main.rs")), "the command line's unit tests are not compiled: {files:?}");
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        assert!(
+            !text.contains("#[test]") && !text.contains("#[cfg(test)]"),
+            "{}: a unit test in a target with test = false never runs",
+            f.display()
+        );
+    }
+}

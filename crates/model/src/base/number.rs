@@ -14,6 +14,24 @@ pub fn point(p: [f64; 2]) -> String {
     format!("({}, {})", shown(p[0]), shown(p[1]))
 }
 
+/// `v` to 6 significant digits without trailing zeros (0.1875, 0.254745): an arc length in the
+/// summary, not the 17 digits of a point on a curved Gmsh boundary (`--json` keeps those). In
+/// scientific notation (1.25e150) where [`shown`] would be.
+pub fn significant(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return v.to_string();
+    }
+    if !(1e-4..1e9).contains(&v.abs()) {
+        let s = format!("{v:.5e}");
+        let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = if mantissa.contains('.') { mantissa.trim_end_matches('0').trim_end_matches('.') } else { mantissa };
+        return format!("{mantissa}e{exponent}");
+    }
+    let decimals = (5 - v.abs().log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
+}
+
 #[cfg(test)]
 mod tests {
     use super::shown;
@@ -37,6 +55,13 @@ mod tests {
         for v in [1e-300, 3.3e200, 7e-5, 2.5e12] {
             assert_eq!(shown(v).parse::<f64>().unwrap(), v, "reads back");
             assert!(shown(v).len() < 12, "{}", shown(v));
+        }
+    }
+
+    #[test]
+    fn arc_lengths_of_any_size_print_in_a_few_characters() {
+        for (v, s) in [(0.1875, "0.1875"), (0.2547452048856056, "0.254745"), (1.0, "1"), (1.25e150, "1.25e150"), (-2.5e-150, "-2.5e-150")] {
+            assert_eq!(super::significant(v), s);
         }
     }
 }
