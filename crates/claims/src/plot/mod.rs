@@ -317,8 +317,8 @@ fn register_font() -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Render as SVG (into a string, written atomically) and PNG (into a temporary file in the same
-/// directory, then renamed: the `image` encoder behind plotters writes only to paths).
+/// Render as SVG (into a string, written atomically) and PNG (drawn into memory, encoded, written
+/// to a temporary file in the same directory, then renamed).
 fn write_figure(fig: &Figure, dir: &Path, name: &str) -> anyhow::Result<Vec<PathBuf>> {
     let size = fig.size();
     let svg = dir.join(format!("{name}.svg"));
@@ -332,17 +332,33 @@ fn write_figure(fig: &Figure, dir: &Path, name: &str) -> anyhow::Result<Vec<Path
     let png = dir.join(format!("{name}.png"));
     let tmp = dir.join(format!(".{name}.tmp{}.png", std::process::id()));
     model::base::failpoint::step("write", &tmp);
-    let drawn = {
-        // the backend saves the file when presented (or dropped), before the rename below
-        glyphs::Glyphs::new(BitMapBackend::new(&tmp, size), FONT_BYTES)
-            .and_then(|backend| fig.render(&backend.into_drawing_area(), rich::BITMAP).map(|_| ()))
-    };
+    let drawn = png_bytes(fig, size).and_then(|bytes| std::fs::write(&tmp, bytes).with_context(|| format!("writing {}", tmp.display())));
     model::base::failpoint::step("rename", &png);
     if let Err(e) = drawn.and_then(|()| std::fs::rename(&tmp, &png).with_context(|| format!("writing {}", png.display()))) {
         std::fs::remove_file(&tmp).ok();
         return Err(e);
     }
     Ok(vec![svg, png])
+}
+
+/// The bytes of a PNG file of `fig` drawn at `(w, h)`: 8-bit RGB, the pixels plotters' bitmap
+/// backend draws (on black, where nothing is drawn, as its file-backed form starts).
+fn png_bytes(fig: &Figure, (w, h): (u32, u32)) -> anyhow::Result<Vec<u8>> {
+    let mut rgb = vec![0u8; 3 * w as usize * h as usize];
+    {
+        let backend = glyphs::Glyphs::new(BitMapBackend::with_buffer(&mut rgb, (w, h)), FONT_BYTES)?;
+        fig.render(&backend.into_drawing_area(), rich::BITMAP)?;
+    }
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, w, h);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    // deflate at zlib's default level, each row's filter chosen adaptively
+    encoder.set_compression(png::Compression::Balanced);
+    let mut writer = encoder.write_header()?;
+    writer.write_image_data(&rgb)?;
+    writer.finish()?;
+    Ok(bytes)
 }
 
 /// The y range of every line panel of figure `name` drawn from `results` against the range of
