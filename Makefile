@@ -72,10 +72,11 @@ cluster-test: build
 
 # Redraw figures/ and results/CLAIMS.md from the stored results (no study is rerun). Builds only
 # what redrawing needs (signorini-figures: records, claims, plots; no solver), which `signorini
-# figures` also is; the records are checked as `signorini figures` checks them.
-FIGURES_BIN := $(or $(CARGO_TARGET_DIR),target)/release/signorini-figures
+# figures` also is, in the `figures` profile (Cargo.toml: unoptimised but for the crates drawing
+# spends its time in); the records are checked as `signorini figures` checks them.
+FIGURES_BIN := $(or $(CARGO_TARGET_DIR),target)/figures/signorini-figures
 figures:
-	$(CARGO) build --release --locked -p signorini-claims --bin signorini-figures
+	$(CARGO) build --profile figures --locked -p signorini-claims --bin signorini-figures
 	$(FIGURES_BIN)
 
 # Rerun every declared study from scratch, rewrite results/, redraw.

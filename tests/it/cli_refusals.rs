@@ -430,14 +430,14 @@ fn makefile_binary_follows_cargo_target_dir() {
         .output()
         .expect("make is a prerequisite");
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success() && text.contains("/tmp/elsewhere/release/signorini-figures"), "{text}");
+    assert!(out.status.success() && text.contains("/tmp/elsewhere/figures/signorini-figures"), "{text}");
     let out = Command::new("make")
         .args(["-n", "figures"])
         .env_remove("CARGO_TARGET_DIR")
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .unwrap();
-    assert!(String::from_utf8_lossy(&out.stdout).contains("target/release/signorini-figures"));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("target/figures/signorini-figures"));
 }
 
 /// `cargo run -- ARGS` runs the command line although the crate has a second binary (bench).
