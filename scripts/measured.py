@@ -133,6 +133,17 @@ def cmd_drift(a):
     save(data)
 
 
+def cmd_figures(a):
+    wall, peak = time_log(a.time_log)
+    data = load()
+    data["make_figures"] = {"date": a.date, "commit": a.commit, "load": a.load,
+                            "command": "make figures (signorini-figures built in the figures profile, then run)",
+                            "wall_s": wall, "peak_kib": peak}
+    if a.build_s is not None:
+        data["make_figures"]["build_s"] = a.build_s
+    save(data)
+
+
 def du(path):
     return int(subprocess.run(["du", "-s", "--block-size=1", path], capture_output=True, text=True, check=True).stdout.split()[0])
 
@@ -177,6 +188,14 @@ def render(d):
                 "| what | measured |", "| --- | --- |",
                 f"| wall | {mmss(r['wall_s'])} |",
                 f"| peak resident set (largest process) | {kib(r['peak_kib'])} = {gib(r['peak_kib'])} = {gb(r['peak_kib'] * 1024)} |", ""]
+    f = d.get("make_figures")
+    if f:
+        out += ["## make figures", "",
+                f"{f['date']}, commit {f['commit']}, machine {f['load']}, on a fresh clone (nothing compiled): `{f['command']}`.", "",
+                "| what | measured |", "| --- | --- |",
+                f"| wall, clone to figures | {mmss(f['wall_s'])} |",
+                *([f"| of which compiling (cargo build's Finished line) | {f['build_s']} s |"] if "build_s" in f else []),
+                f"| peak resident set (largest process) | {kib(f['peak_kib'])} = {gib(f['peak_kib'])} = {gb(f['peak_kib'] * 1024)} |", ""]
     k = d.get("disk")
     if k:
         out += ["## Disk", "",
@@ -201,6 +220,12 @@ def main():
     r.add_argument("--load", required=True, choices=["idle", "nearly idle", "under load"])
     r.add_argument("--commit", required=True)
     r.add_argument("--date", required=True)
+    g = sub.add_parser("figures", help="/usr/bin/time -v make figures on a fresh clone")
+    g.add_argument("--time-log", required=True)
+    g.add_argument("--load", required=True, choices=["idle", "nearly idle", "under load"])
+    g.add_argument("--commit", required=True)
+    g.add_argument("--date", required=True)
+    g.add_argument("--build-s", type=int, help="cargo build's own seconds (its Finished line)")
     k = sub.add_parser("disk")
     k.add_argument("--date", required=True)
     k.add_argument("--commit", required=True)
@@ -212,6 +237,8 @@ def main():
         cmd_test(a)
     elif a.cmd == "drift":
         cmd_drift(a)
+    elif a.cmd == "figures":
+        cmd_figures(a)
     elif a.cmd == "disk":
         cmd_disk(a)
     elif a.check:

@@ -170,6 +170,7 @@ fn readme_and_workflow_quote_measured_json_as_it_is() {
     let t = &m["make_test"];
     let d = &m["make_drift"];
     let k = &m["disk"];
+    let f = &m["make_figures"];
     let step = |name: &str| int(t, &format!("steps_s.{name}"));
     let (tk, dk) = (int(t, "peak_kib"), int(d, "peak_kib"));
     let (target, venv) = (int(k, "target_bytes"), int(k, "venv_bytes"));
@@ -209,6 +210,14 @@ fn readme_and_workflow_quote_measured_json_as_it_is() {
         format!("the study pages {} s and the NGSolve cross-check (solutions and estimator) {} s", step("report"), step("crosscheck")),
         format!("about {:.1} GB of disk** (`target/` {}, `crosscheck/.venv` {}", (target + venv) as f64 / 1e9, gb(target), gb(venv)),
         format!("({} when last measured", mmss(int(d, "wall_s"))),
+        format!(
+            "`make figures` took {} from `git clone` to the last figure ({}, commit {}, the machine {}), {} s of it compiling",
+            mmss(int(f, "wall_s")),
+            text(f, "date"),
+            text(f, "commit"),
+            text(f, "load"),
+            int(f, "build_s")
+        ),
     ];
     require("README.md", &prose("README.md"), &readme);
     let workflow = vec![
@@ -270,7 +279,7 @@ fn memory_figures(body: &str) -> Vec<String> {
 fn every_memory_figure_and_dated_commit_in_readme_and_workflow_comes_from_a_measurement() {
     let m = measured();
     let mut known: Vec<String> = Vec::new();
-    for section in ["make_test", "make_drift"] {
+    for section in ["make_test", "make_drift", "make_figures"] {
         let p = int(&m[section], "peak_kib");
         known.extend([kib(p), gib(p), gb(p * 1024)]);
     }
@@ -280,7 +289,7 @@ fn every_memory_figure_and_dated_commit_in_readme_and_workflow_comes_from_a_meas
     // not measured here: GitHub's runner sizes (its documentation) and the memory of the machine
     // docs/performance.md names
     known.extend(["16 GB", "7 GB", "32 GB", "24 GiB"].map(String::from));
-    let commits: Vec<&str> = ["make_test", "make_drift", "disk"].iter().map(|s| text(&m[*s], "commit")).collect();
+    let commits: Vec<&str> = ["make_test", "make_drift", "make_figures", "disk"].iter().map(|s| text(&m[*s], "commit")).collect();
     for rel in ["README.md", ".github/workflows/ci.yml"] {
         let body = prose(rel);
         let stray: Vec<String> = memory_figures(&body).into_iter().filter(|f| !known.contains(f)).collect();
