@@ -21,9 +21,10 @@ build:
 # provenance and CLAIMS.md against the records), and the NGSolve cross-check.
 # Test-time outputs (drift report, cross-check tables with timings) go under target/; the last
 # step fails if the run changed any file git sees.
-# The first steps only install and compile (the test binaries and the example; the dependencies as
-# clippy reads them, which `cargo check` and clippy share; the cross-check's Python environment):
-# the last line gives their time apart from the checks' own. The last line starts with
+# The first steps only install and compile (the test binaries and the example; the cross-check's
+# Python environment): the last line gives their time apart from the checks' own. The clippy step
+# includes the check build of the dependencies as clippy reads them (a `cargo check` of its own
+# before it would check the workspace's crates once more for nothing: clippy checks them again). The last line starts with
 # "N passed, N failed, N skipped" over every test binary and the doc tests of the cargo test step
 # (for CI tools), then the timing; make test writes only under target/ (its numbers there are what
 # `make measured` copies into docs/measured.json).
@@ -32,7 +33,6 @@ test: build
 	@(git rev-parse --short HEAD 2>/dev/null || echo unknown) > target/test-commit
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-before-test
 	$(TIMED) build-tests $(CARGO) build --release --locked --all-targets
-	$(TIMED) check $(CARGO) check --release --locked --all-targets
 	$(TIMED) venv crosscheck/setup.sh
 	@date +%s > target/test-compiled
 	$(TIMED) fmt $(CARGO) fmt --all --check
@@ -51,7 +51,7 @@ test: build
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-after-test
 	@diff target/status-before-test target/status-after-test >/dev/null || { echo "make test changed files git sees (before/after below); test outputs belong under target/"; diff target/status-before-test target/status-after-test; exit 1; }
 	@date +%s > target/test-finished
-	@echo "$$(cat target/test-summary); make test: PASSED in $$(( $$(cat target/test-finished) - $$(cat target/test-started) )) s after make build: $$(( $$(cat target/test-compiled) - $$(cat target/test-started) )) s compiling the tests, the example and clippy's dependencies and installing the cross-check's Python environment, then $$(( $$(cat target/test-finished) - $$(cat target/test-compiled) )) s of checks (fmt, clippy, cargo test, the example, drift: none, study pages, NGSolve cross-check; the tree unchanged). Seconds per step: $$(tr '\n' ' ' < target/test-steps)"
+	@echo "$$(cat target/test-summary); make test: PASSED in $$(( $$(cat target/test-finished) - $$(cat target/test-started) )) s after make build: $$(( $$(cat target/test-compiled) - $$(cat target/test-started) )) s compiling the tests and the example and installing the cross-check's Python environment, then $$(( $$(cat target/test-finished) - $$(cat target/test-compiled) )) s of checks (fmt, clippy with its dependencies' check build, cargo test, the example, drift: none, study pages, NGSolve cross-check; the tree unchanged). Seconds per step: $$(tr '\n' ' ' < target/test-steps)"
 
 # Copy the numbers of the last make test (what it left in target/) and of its /usr/bin/time -v log
 # into docs/measured.json and docs/measured.md, deliberately (make test itself writes only under
