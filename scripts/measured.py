@@ -155,6 +155,11 @@ def cmd_disk(a):
     save(data)
 
 
+def peak_row(peak_kib, what="peak resident set (largest process)"):
+    """A table row of a peak resident set in KiB, GiB and GB."""
+    return f"| {what} | {kib(peak_kib)} = {gib(peak_kib)} = {gb(peak_kib * 1024)} |"
+
+
 def render(d):
     out = ["# Measured numbers", "",
            "Generated from [`measured.json`](measured.json) by `scripts/measured.py` (`make measured` after a",
@@ -177,7 +182,7 @@ def render(d):
             out.append(f"| cargo test's last line | {n['passed']} passed, {n['failed']} failed, {n['skipped']} skipped |")
         out.append(f"| tests run | {n['integration']} integration, {n['unit']} unit, {n['doc']} doc |")
         out.append(f"| `{t['command']}` in all | {mmss(t['wall_s'])} wall |")
-        out.append(f"| its peak resident set (largest process) | {kib(t['peak_kib'])} = {gib(t['peak_kib'])} = {gb(t['peak_kib'] * 1024)} |")
+        out.append(peak_row(t['peak_kib'], "its peak resident set (largest process)"))
         if "missing" in t:
             out += ["", "Not measured in this run: " + t["missing"] + "."]
         out.append("")
@@ -187,7 +192,7 @@ def render(d):
                 f"{r['date']}, commit {r['commit']}, machine {r['load']}: `{r['command']}`.", "",
                 "| what | measured |", "| --- | --- |",
                 f"| wall | {mmss(r['wall_s'])} |",
-                f"| peak resident set (largest process) | {kib(r['peak_kib'])} = {gib(r['peak_kib'])} = {gb(r['peak_kib'] * 1024)} |", ""]
+                peak_row(r['peak_kib']), ""]
     f = d.get("make_figures")
     if f:
         out += ["## make figures", "",
@@ -195,7 +200,7 @@ def render(d):
                 "| what | measured |", "| --- | --- |",
                 f"| wall, clone to figures | {mmss(f['wall_s'])} |",
                 *([f"| of which compiling (cargo build's Finished line) | {f['build_s']} s |"] if "build_s" in f else []),
-                f"| peak resident set (largest process) | {kib(f['peak_kib'])} = {gib(f['peak_kib'])} = {gb(f['peak_kib'] * 1024)} |", ""]
+                peak_row(f['peak_kib']), ""]
     k = d.get("disk")
     if k:
         out += ["## Disk", "",

@@ -7,16 +7,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-const MANIFEST: &str = r#"description = "one run long enough to be stopped"
-[defaults]
-problem = "ex71"
-mesh = "structured:4"
-theta = 0.5
-[[run]]
-id = "long"
-levels = 22
-save_levels = [3, 21]
-"#;
+/// [`LONG`] with two of its levels' meshes saved.
+fn long_with_saved_meshes() -> String {
+    format!("{LONG}save_levels = [3, 21]\n")
+}
 
 fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_signorini")
@@ -40,7 +34,7 @@ fn a_killed_run_resumes_after_its_last_finished_level_with_the_same_numbers() {
     let _ = std::fs::remove_dir_all(&root);
     std::fs::create_dir_all(&root).unwrap();
     let manifest = root.join("resumed.toml");
-    std::fs::write(&manifest, MANIFEST).unwrap();
+    std::fs::write(&manifest, long_with_saved_meshes()).unwrap();
     // the reference: never stopped
     let whole = root.join("whole");
     assert!(run(&whole, &manifest).status.success());
