@@ -6,6 +6,10 @@
 //! large against its variation, are accepted.
 
 use crate::common::{scratch, signorini_in};
+use signorini::contact::consistent::{BodyForceFindings, check_exact};
+use signorini::mesh::refine::{Refinement, refine};
+use signorini::mesh::{Mesh, P2Nodes};
+use signorini::problems::{Ex71, Fb, Problem};
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -256,4 +260,74 @@ fn an_exact_solution_large_against_its_variation_is_accepted_and_a_wrong_gradien
     assert_ne!(code, 0);
     assert!(err.contains("gradient contradicts its displacement") && err.contains("`exact.grad[0][0]`"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Refine `mesh` where `near` is, and every seventh triangle elsewhere.
+fn refine_near(mesh: &Mesh, near: [f64; 2], radius: f64) -> Refinement {
+    let marks: Vec<bool> = (0..mesh.n_triangles())
+        .map(|t| {
+            let c = mesh.corners(t);
+            let centroid = [(c[0][0] + c[1][0] + c[2][0]) / 3.0, (c[0][1] + c[1][1] + c[2][1]) / 3.0];
+            signorini::mesh::dist(centroid, near) < radius || t % 7 == 0
+        })
+        .collect();
+    refine(mesh, &marks).unwrap()
+}
+
+/// On a refined mesh the body-force check takes the findings of the triangles the refinement
+/// left as they were and evaluates only the new ones: level by level, its verdict and findings
+/// are those of checking every point again, on Example 7.1, on fb (a kink of f inside some
+/// stencils, a load break) and on a file whose body force has a bump of radius 1e-3 that the
+/// load points reach only once the triangles around it are refined (refused at the same level,
+/// with the same message); every triangle the refinement left as it was is taken from the level
+/// before.
+#[test]
+fn a_refined_mesh_keeps_the_body_force_verdict_of_its_unchanged_triangles() {
+    let dir = scratch("consistent-exact-inherited");
+    let f = r#"2*exp(y)*(y^2 + y - 1) - 6*y + 2""#;
+    std::fs::write(dir.join("bump.toml"), ex71(f, r#"2*exp(y)*(y^2 + y - 1) - 6*y + 2 + 1e6*max(0, 1e-6 - (x-0.37)^2 - (y-0.61)^2)""#))
+        .unwrap();
+    let bump = signorini::problems::load(dir.join("bump.toml").to_str().unwrap(), &Default::default()).unwrap();
+    let problems: [(Box<dyn Problem>, [f64; 2]); 3] = [(Box::new(Ex71), [0.5, 0.0]), (Box::new(Fb), [0.5, 0.0]), (bump, [0.37, 0.61])];
+    for (problem, near) in problems {
+        let name = problem.name();
+        let mut mesh = crate::common::mesh(problem.as_ref(), "structured:8");
+        let mut before: Option<BodyForceFindings> = None;
+        // the triangles of this level that are their parent unchanged (a parent of one child)
+        let mut unchanged = 0;
+        let mut refused_at = None;
+        for level in 0..9 {
+            let nodes = P2Nodes::new(&mesh);
+            let every = check_exact(problem.as_ref(), &mesh, &nodes, None);
+            let kept = check_exact(problem.as_ref(), &mesh, &nodes, before.as_ref());
+            assert_eq!(kept, every, "{name}, level {level}");
+            let Ok(Some(findings)) = kept else {
+                refused_at = Some(level);
+                break;
+            };
+            assert_eq!(findings.inherited(), unchanged, "{name}, level {level} of {} triangles", mesh.n_triangles());
+            let refinement = refine_near(&mesh, near, 0.1);
+            let mut children = vec![0; mesh.n_triangles()];
+            refinement.parent.iter().for_each(|&p| children[p] += 1);
+            unchanged = refinement.parent.iter().filter(|&&p| children[p] == 1).count();
+            assert!(unchanged > 0, "{name}, level {level}");
+            before = Some(findings.inherit(&mesh, &refinement));
+            mesh = refinement.mesh;
+        }
+        match name {
+            "bump.toml" | "bump" => assert!(refused_at.is_some_and(|l| l > 0), "{name}: refused at {refused_at:?}"),
+            _ => assert_eq!(refused_at, None, "{name}"),
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The adaptive loop hands each level the findings of the one before.
+#[test]
+fn the_adaptive_loop_inherits_the_body_force_findings() {
+    let mesh = crate::common::mesh(&Ex71, "structured:8");
+    let config = signorini::adapt::AdaptConfig { levels: 4, ..Default::default() };
+    let out = signorini::adapt::run(&Ex71, mesh, &config, None, &mut |_| std::ops::ControlFlow::Continue(())).unwrap();
+    let findings = out.solution.body_force.expect("Example 7.1 has an exact solution");
+    assert!(4 * findings.inherited() > out.mesh.n_triangles(), "{} of {}", findings.inherited(), out.mesh.n_triangles());
 }

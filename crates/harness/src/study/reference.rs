@@ -158,7 +158,9 @@ pub fn replay(
     let start =
         start.map(|f| f.decode()).transpose().map_err(|source| adapt::AdaptError::from(ReplayError::Flags { level: last, source }))?;
     let measured = record.last.measured_peak();
-    let solved = numerics::sparse::ordering::automatic(|| adapt::solve_level(problem, &mesh, last, &config, None, start, measured))?;
+    let solved = numerics::sparse::ordering::automatic(|| {
+        adapt::solve_level(problem, &mesh, last, &config, None, adapt::LevelStart { active: start, body_force: None }, measured)
+    })?;
     if solved.record.ndof != record.ndof {
         return Err(ReferenceError::Replayed { stored: record.ndof, replayed: solved.record.ndof });
     }

@@ -18,6 +18,7 @@ pub use roundoff::{
     Unresolved, WARNED_FORCES, WARNED_SHAPE, deformation, force_roundoff, resolution,
 };
 
+use crate::contact::consistent::BodyForceFindings;
 use crate::contact::norms::{self, Reference};
 use crate::contact::solve::{self, DiscreteSolution, SolveError};
 use crate::estimator::estimate::{self, ConfigError, Estimate};
@@ -234,16 +235,27 @@ pub struct Solved {
     pub caveats: Vec<Caveat>,
 }
 
+/// What the solve of a level starts from besides its mesh: what the level before leaves it.
+#[derive(Clone, Debug, Default)]
+pub struct LevelStart {
+    /// The contact solve's active set (taken if `config.warm_start`).
+    pub active: Option<Vec<bool>>,
+    /// The body-force findings of the triangles the refinement left as they were
+    /// ([`BodyForceFindings::inherit`]): the data checks evaluate only the new ones, to the
+    /// same verdict.
+    pub body_force: Option<BodyForceFindings>,
+}
+
 /// SOLVE, ESTIMATE and MARK on the mesh of level `level`, the contact solve started from
-/// `initial_active` (if `config.warm_start`): everything of a level but the refinement. Its
-/// record's `t_refine` and `t_level` are zero (the loop sets them).
+/// `start` (its active set if `config.warm_start`): everything of a level but the refinement.
+/// Its record's `t_refine` and `t_level` are zero (the loop sets them).
 pub fn solve_level(
     problem: &dyn Problem,
     mesh: &Mesh,
     level: usize,
     config: &AdaptConfig,
     reference: Option<Reference>,
-    initial_active: Option<Vec<bool>>,
+    start: LevelStart,
     measured: Option<(f64, f64)>,
 ) -> Result<Solved, AdaptError> {
     let ndof = mesh.p2_ndof();
@@ -254,11 +266,14 @@ pub fn solve_level(
         .map_err(|error| AdaptError::Memory { level, error })?;
     let mut options = config.pdas.clone();
     if config.warm_start {
-        options.initial_active = initial_active;
+        options.initial_active = start.active;
     }
     let t0 = Instant::now();
-    let sol =
-        solve::solve(mesh, problem, &options, &mut |_| {}).map_err(|error| AdaptError::SolveAt { level, ndof, error: Box::new(error) })?;
+    let sol = solve::solve_from(mesh, problem, &options, start.body_force, &mut |_| {}).map_err(|error| AdaptError::SolveAt {
+        level,
+        ndof,
+        error: Box::new(error),
+    })?;
     let t_solve = t0.elapsed().as_secs_f64();
     let t0 = Instant::now();
     let est = estimate::estimate(mesh, problem, &sol, &config.estimator);
@@ -390,6 +405,8 @@ pub struct AdaptState {
     /// The mesh of level `level` (None once a step has ended the loop).
     mesh: Option<Mesh>,
     initial_active: Option<Vec<bool>>,
+    /// The body-force findings the next level inherits ([`LevelStart::body_force`]).
+    body_force: Option<BodyForceFindings>,
     /// The record of every level solved, from level 0.
     pub records: Vec<LevelRecord>,
     /// The refinement history of every level in `records`.
@@ -409,7 +426,7 @@ impl AdaptState {
             config.check_initial(start.mesh.p2_ndof() as f64, "of level 0")?;
         }
         let Start { mesh, level, initial_active, records, history } = start;
-        Ok(AdaptState { level, first: level, mesh: Some(mesh), initial_active, records, history, last: None })
+        Ok(AdaptState { level, first: level, mesh: Some(mesh), initial_active, body_force: None, records, history, last: None })
     }
 
     /// SOLVE, ESTIMATE and MARK the next level, show it to `observer`, REFINE its mesh into the
@@ -440,8 +457,15 @@ impl AdaptState {
         let previous = self.records.last().and_then(LevelRecord::measured_peak);
         let measured = model::base::memory::reset_peak_resident();
         let started_from = self.initial_active.take().filter(|_| config.warm_start);
-        let Solved { mut record, solution: sol, estimate: est, marks, caveats } =
-            solve_level(problem, &mesh, level, config, reference, started_from.clone(), previous)?;
+        let Solved { mut record, solution: sol, estimate: est, marks, caveats } = solve_level(
+            problem,
+            &mesh,
+            level,
+            config,
+            reference,
+            LevelStart { active: started_from.clone(), body_force: self.body_force.take() },
+            previous,
+        )?;
         let entry = LevelHistory {
             level,
             n_elements: mesh.n_triangles(),
@@ -457,7 +481,8 @@ impl AdaptState {
             let t0 = Instant::now();
             let refined = refine::refine(&mesh, &marks).map(|refinement| {
                 let active = config.warm_start.then(|| transfer_active_set(&mesh, &sol, &refinement, problem));
-                (refinement.mesh, active)
+                let body_force = sol.body_force.as_ref().map(|findings| findings.inherit(&mesh, &refinement));
+                (refinement.mesh, active, body_force)
             });
             record.t_refine = t0.elapsed().as_secs_f64();
             Some(refined)
@@ -465,7 +490,7 @@ impl AdaptState {
         // a refined mesh whose element shapes f64 does not resolve ends the loop before its
         // level, as the memory check does, not as an error of its solve (Mesh::check)
         let far = match &next {
-            Some(Ok((m, _))) => {
+            Some(Ok((m, ..))) => {
                 m.shape_roundoff_refused().map(|worst| AdaptTermination::FarFromOrigin { level: level + 1, ndof: m.p2_ndof(), worst })
             }
             _ => None,
@@ -474,7 +499,7 @@ impl AdaptState {
         // it does not continue, so a run interrupted now keeps no checkpoint of a level it
         // would never solve (resuming from one would solve nothing)
         let over = match (&next, config.max_ndof) {
-            (Some(Ok((m, _))), Some(max)) => m.p2_ndof() > max,
+            (Some(Ok((m, ..))), Some(max)) => m.p2_ndof() > max,
             _ => false,
         };
         let next = if far.is_some() || over { None } else { next };
@@ -487,7 +512,7 @@ impl AdaptState {
             estimate: &est,
             history: &entry,
             continues: next.is_some(),
-            next_active: next.as_ref().and_then(|n| n.as_ref().ok()).and_then(|(_, a)| a.as_deref()),
+            next_active: next.as_ref().and_then(|n| n.as_ref().ok()).and_then(|(_, a, _)| a.as_deref()),
             caveats: &caveats,
         });
         self.records.push(record);
@@ -508,9 +533,10 @@ impl AdaptState {
             AdaptTermination::LevelsReached
         };
         match next {
-            Some(Ok((m, active))) => {
+            Some(Ok((m, active, body_force))) => {
                 self.mesh = Some(m);
                 self.initial_active = active;
+                self.body_force = body_force;
                 self.level += 1;
                 Ok(None)
             }

@@ -76,7 +76,8 @@ pub fn solve_stored_level(
     let mesh = mesh_at(mesh0, history, level)?;
     let start = initial_active(history, level)?;
     let measured = stored.and_then(LevelRecord::measured_peak);
-    let solved = super::solve_level(problem, &mesh, level, config, reference, start, measured)?;
+    let solved =
+        super::solve_level(problem, &mesh, level, config, reference, super::LevelStart { active: start, body_force: None }, measured)?;
     Ok((mesh, solved))
 }
 

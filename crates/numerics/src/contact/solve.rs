@@ -3,6 +3,7 @@
 //! The method: `docs/method.md`, sections "The discrete contact force" and "The certificate a solve passes before it reports".
 
 use crate::contact::certify::{self, Certificate, KktError, KktInput, RigidMotionError};
+use crate::contact::consistent::BodyForceFindings;
 use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, PdasTermination, Strategy, Timings};
 use crate::fem::assembly::{self, DofMap, System};
 use model::base::element::{self, Affine};
@@ -167,6 +168,9 @@ pub struct DiscreteSolution {
     /// The KKT conditions' relative values, each within [`certify::TOLERANCE`].
     pub certificate: Certificate,
     pub timings: SolveTimings,
+    /// What the body-force check found on each triangle (None without an exact solution), for
+    /// the next level's check ([`solve_from`]).
+    pub body_force: Option<BodyForceFindings>,
 }
 
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -223,6 +227,19 @@ pub fn solve(
     options: &PdasOptions,
     observe: &mut dyn FnMut(&PdasIteration),
 ) -> Result<DiscreteSolution, SolveError> {
+    solve_from(mesh, problem, options, None, observe)
+}
+
+/// [`solve`] on a refined mesh, its exact solution's body-force check taking the findings of the
+/// triangles the refinement left as they were (`before`: [`BodyForceFindings::inherit`], released
+/// once the check is done); the same verdict as checking every point.
+pub fn solve_from(
+    mesh: &Mesh,
+    problem: &dyn Problem,
+    options: &PdasOptions,
+    before: Option<BodyForceFindings>,
+    observe: &mut dyn FnMut(&PdasIteration),
+) -> Result<DiscreteSolution, SolveError> {
     mesh.check()?;
     mesh.check_vertices(&problem.required_vertices())?;
     let t_all = Instant::now();
@@ -233,7 +250,8 @@ pub fn solve(
     super::point::check_on_dirichlet(&nodes, &dofs, problem)?;
     certify::check_held(mesh, &nodes, &dofs, problem)?;
     super::plausible::check_contact_data(mesh, &nodes, &dofs, problem)?;
-    super::consistent::check_exact(problem, mesh, &nodes)?;
+    let body_force = super::consistent::check_exact(problem, mesh, &nodes, before.as_ref())?;
+    drop(before);
     if dofs.contact.is_empty() {
         return Err(SolveError::NoContact { declared: problem.declared_parts() });
     }
@@ -333,6 +351,7 @@ pub fn solve(
         strategy,
         certificate,
         timings,
+        body_force,
     })
 }
 

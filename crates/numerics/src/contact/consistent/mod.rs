@@ -12,8 +12,9 @@
 //! sigma(grad) n is read (`boundary::gradient_points`: the P2 nodes, the traction's Gauss points,
 //! the estimator's edge points; a band in a hand-written grad, divergence-free, between the centroids
 //! would otherwise be certified on structured:4 to 32); the body force also at every point where the assembly
-//! evaluates it on this mesh (`fem::assembly::load_points`: whatever f the discrete problem
-//! sees is checked). The steps are `s` and `s / 2`, `s` a thousandth of the
+//! evaluates it on this mesh (module `body_force`: whatever f the discrete problem sees is
+//! checked; on a refined mesh the triangles the refinement left as they were keep the verdict
+//! of their points from the level before). The steps are `s` and `s / 2`, `s` a thousandth of the
 //! triangle's (or boundary edge's) longest edge. A central difference is second-order, so the two steps differ by
 //! about 3/4 of the larger one's error; a mismatch is reported only where it exceeds
 //! [`CONSISTENT`] times the data's scale and [`BEYOND`] times that difference. Where a kink of
@@ -24,7 +25,10 @@
 //! The boundary and contact conditions are checked too (module `boundary`): an exact solution must
 //! satisfy them as well as the equations.
 
+pub(in crate::contact) mod body_force;
 pub(in crate::contact) mod boundary;
+
+pub use body_force::BodyForceFindings;
 
 use model::mesh::{Mesh, P2Nodes};
 use model::problems::{Exact, Material, Problem};
@@ -254,90 +258,18 @@ fn minus_div(material: &Material, exact: &dyn Exact, x: [f64; 2], s: f64) -> [Qu
     minus
 }
 
-/// Triangles whose load points [`body_force_mismatch`] compares at once.
-const CHUNK: usize = 4096;
-
-/// The body force `f` at a point and -div sigma(u) there with the finer step (half `step`).
-struct Evaluated {
-    at: [f64; 2],
-    step: f64,
-    f: [f64; 2],
-    fine: [Quotient; 2],
-}
-
-/// A point whose finer quotient is off ([`judge`]'s first test against the scale so far), kept
-/// for the final test against the scale over every point.
-struct Kept {
-    at: [f64; 2],
-    step: f64,
-    declared: f64,
-    fine: Quotient,
-}
-
-/// The body force against -div sigma(u) (each component, as [`judge`] does for one): at the
-/// sampled centroids, and at every point where the assembly evaluates f on this mesh
-/// ([`crate::fem::assembly::LoadPoints`]), each with the step of its triangle. Whatever value of f
-/// the discrete problem sees is checked, so a file is not accepted on one mesh and refused on
-/// another for a mismatch between samples. Returns the first mismatch with its
-/// component, and the number of points compared.
-///
-/// The points (about 36 a triangle) are streamed, [`CHUNK`] triangles at a time, and only those
-/// off by more than [`CONSISTENT`] times the scale so far are kept: the scale over every point is
-/// no smaller, so the points it finds off are among them, and the answer is [`judge`]'s over
-/// all the points at once, in the same order, without holding them.
-fn body_force_mismatch(
-    problem: &dyn Problem,
-    exact: &dyn Exact,
-    mesh: &Mesh,
-    centroids: &[([f64; 2], f64)],
-    steps: &[f64],
-    floor: f64,
-) -> (Option<(usize, Mismatch)>, usize) {
-    use rayon::prelude::*;
-    let material = problem.material();
-    let loads = crate::fem::assembly::LoadPoints::new(problem.load_breaks());
-    let evaluate = |&(at, step): &([f64; 2], f64)| Evaluated {
-        at,
-        step,
-        f: problem.body_force(at),
-        fine: minus_div(&material, exact, at, step / 2.0),
-    };
-    let mut scale = [floor; 2];
-    let mut kept: [Vec<Kept>; 2] = [Vec::new(), Vec::new()];
-    let mut count = 0;
-    let mut take = |values: Vec<Evaluated>| {
-        for i in 0..2 {
-            let finite = values.par_iter().flat_map_iter(|v| [v.f[i].abs(), v.fine[i].value.abs()]).filter(|v| v.is_finite());
-            let so_far = scale[i];
-            scale[i] = finite.reduce(|| so_far, f64::max);
-            let so_far = scale[i];
-            let off = values.par_iter().filter(|v| (v.fine[i].value - v.f[i]).abs() > CONSISTENT * so_far);
-            let off: Vec<Kept> = off.map(|v| Kept { at: v.at, step: v.step, declared: v.f[i], fine: v.fine[i] }).collect();
-            kept[i].extend(off);
-        }
-        count += values.len();
-    };
-    take(centroids.par_iter().map(evaluate).collect());
-    for start in (0..mesh.n_triangles()).step_by(CHUNK) {
-        let end = (start + CHUNK).min(mesh.n_triangles());
-        let points = (start..end).into_par_iter().flat_map_iter(|t| loads.of(mesh, t).into_iter().map(move |x| (x, steps[t])));
-        take(points.map(|p| evaluate(&p)).collect());
-    }
-    for (i, kept) in kept.iter().enumerate() {
-        let pts: Vec<([f64; 2], f64)> = kept.iter().map(|k| (k.at, k.step)).collect();
-        let first: Vec<(f64, Quotient)> = kept.iter().map(|k| (k.declared, k.fine)).collect();
-        let differenced = |at, s| minus_div(&material, exact, at, s)[i];
-        // the scale over every point, fixed: judge's own fold over the kept ones cannot exceed it
-        if let Some(m) = judge(&pts, &first, &differenced, scale[i]) {
-            return (Some((i, m)), count);
-        }
-    }
-    (None, count)
-}
-
 /// Check `problem`'s exact solution, if it has one, on `mesh` (see the module docs).
-pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Result<(), ExactError> {
-    let Some(exact) = problem.exact() else { return Ok(()) };
+///
+/// The body force is compared at every load point (module `body_force`), taking the findings of
+/// the triangles `before` holds (the level before's, [`BodyForceFindings::inherit`]); the
+/// findings of this mesh are returned for the next level (None without an exact solution).
+pub fn check_exact(
+    problem: &dyn Problem,
+    mesh: &Mesh,
+    nodes: &P2Nodes,
+    before: Option<&BodyForceFindings>,
+) -> Result<Option<BodyForceFindings>, ExactError> {
+    let Some(exact) = problem.exact() else { return Ok(None) };
     let problem_name = || match problem.source() {
         Some(file) => format!("problem file {}", file.display()),
         None => format!("problem {}", problem.name()),
@@ -379,11 +311,13 @@ pub fn check_exact(problem: &dyn Problem, mesh: &Mesh, nodes: &P2Nodes) -> Resul
         .filter(|v| v.is_finite())
         .fold(0.0f64, |a, v| a.max(v.abs()));
     let floor = (2.0 * material.mu + material.zeta.abs()) * gradient / diameter(mesh);
-    if let (Some((i, m)), sampled) = body_force_mismatch(problem, exact, mesh, &pts, &steps, floor) {
+    let (mismatch, sampled, findings) = body_force::mismatch(problem, exact, mesh, &pts, &steps, floor, before);
+    if let Some((i, m)) = mismatch {
         let Mismatch { at, declared, differenced, step, spread, count } = m;
         return Err(ExactError::BodyForce { problem: problem_name(), at, i, declared, differenced, step, spread, count, sampled });
     }
-    boundary::check_boundary(problem, exact, mesh, nodes, &problem_name())
+    boundary::check_boundary(problem, exact, mesh, nodes, &problem_name())?;
+    Ok(Some(findings))
 }
 
 #[cfg(test)]
@@ -436,7 +370,7 @@ mod tests {
             let p = model::problems::by_name(problem).unwrap();
             for n in [4, 16] {
                 let mesh = model::mesh::MeshSpec::parse(&format!("structured:{n}")).unwrap().build(p.as_ref()).unwrap();
-                assert_eq!(check_exact(p.as_ref(), &mesh, &P2Nodes::new(&mesh)), Ok(()), "{problem} on structured:{n}");
+                assert!(check_exact(p.as_ref(), &mesh, &P2Nodes::new(&mesh), None).is_ok(), "{problem} on structured:{n}");
             }
         }
     }
