@@ -443,28 +443,49 @@ fn compare_references(study: &str, stored: &Store, fresh: &Store, runs: &[RunRec
     out
 }
 
-/// The replay tier of a deep study in its tiers: the last level of every run in
-/// `[drift.deep] replay` (the last with at most `replay_max_ndof` unknowns where that is given), rebuilt from its stored history and solved once more
-/// ([`super::replay_stored_level`]), against its stored record (rows under run `ID (replayed)`).
-/// A history that does not rebuild its meshes is a row of field `history`.
-fn replay_tier(manifest: &Manifest, stored: &[RunRecord], progress: bool, c: &mut DriftComparison) -> anyhow::Result<()> {
-    let Some(tier) = &manifest.drift.deep else { return Ok(()) };
-    let study = &manifest.study;
+/// The last level of a run of a deep study's replay tier, solved again from its stored history
+/// (by the worker that reruns the study, [`rerun_all`]) for [`replay_tier`] to compare.
+struct Replayed {
+    id: String,
+    level: usize,
+    solved: anyhow::Result<LevelRecord>,
+}
+
+/// The replay tier's solves of a deep study in its tiers: the last level of every run in
+/// `[drift.deep] replay` (the last with at most `replay_max_ndof` unknowns where that is given),
+/// rebuilt from its stored history and solved once more ([`super::replay_stored_level`]).
+fn replay_solves(manifest: &Manifest, results: &Path, progress: bool) -> anyhow::Result<Vec<Replayed>> {
+    let Some(tier) = &manifest.drift.deep else { return Ok(Vec::new()) };
+    let stored = Store::of(results, manifest).check()?.runs;
+    let mut out = Vec::new();
     for id in &tier.replay {
-        let label = format!("{id} (replayed)");
         let Some(s) = stored.iter().find(|r| &r.run.id == id) else { continue }; // a missing run is a row already
         let Some(level) = s.levels.iter().rposition(|l| tier.replay_max_ndof.is_none_or(|m| l.ndof <= m)) else { continue };
         if progress {
             model::base::note::line(format_args!(
-                "{study}/{id}: replaying level {level} (NDF {}) from the stored refinement history",
-                s.levels[level].ndof
+                "{}/{id}: replaying level {level} (NDF {}) from the stored refinement history",
+                manifest.study, s.levels[level].ndof
             ));
         }
-        match super::replay_stored_level(manifest, s, level, progress) {
-            Ok(solved) => {
+        let solved = super::replay_stored_level(manifest, s, level, progress).map(|solved| solved.record);
+        out.push(Replayed { id: id.clone(), level, solved });
+    }
+    Ok(out)
+}
+
+/// The replay tier of a deep study in its tiers: each level [`replay_solves`] solved again,
+/// against its stored record (rows under run `ID (replayed)`). A history that does not rebuild
+/// its meshes is a row of field `history`.
+fn replay_tier(manifest: &Manifest, stored: &[RunRecord], replayed: Vec<Replayed>, c: &mut DriftComparison) -> anyhow::Result<()> {
+    let study = &manifest.study;
+    for Replayed { id, level, solved } in replayed {
+        let label = format!("{id} (replayed)");
+        let Some(s) = stored.iter().find(|r| r.run.id == id) else { continue };
+        match solved {
+            Ok(record) => {
                 let stored_levels: Vec<Value> = s.levels.iter().map(|l| serde_json::to_value(l).expect("records serialise")).collect();
                 let scales = field_scales(&stored_levels);
-                let fresh = serde_json::to_value(&solved.record).expect("records serialise");
+                let fresh = serde_json::to_value(&record).expect("records serialise");
                 compare_level(study, &label, level, &stored_levels[level], &fresh, &scales, &manifest.drift, &mut c.rows, &mut c.changes);
             }
             Err(e) => {
@@ -763,10 +784,9 @@ pub fn check(
             );
         }
     }
-    if opts.against.is_none() {
-        rerun_all(&planned, opts)?;
-    }
-    for (m, quick) in &planned {
+    let mut replayed = if opts.against.is_none() { rerun_all(&planned, opts)? } else { Vec::new() };
+    replayed.resize_with(planned.len(), Vec::new);
+    for ((m, quick), replayed) in planned.iter().zip(replayed) {
         let fresh_root = opts.against.clone().unwrap_or_else(|| opts.scratch.clone());
         let stored_store = Store::of(&opts.results, m);
         let fresh_store = Store::of(&fresh_root, m);
@@ -779,9 +799,7 @@ pub fn check(
             None => fresh_store.records().with_context(|| format!("reading the fresh runs of {} in {}", m.study, fresh_root.display()))?,
         };
         let mut c = compare(m, &stored, &fresh, *quick);
-        if *quick && !opts.quick && opts.against.is_none() {
-            replay_tier(m, &stored, opts.progress, &mut c)?;
-        }
+        replay_tier(m, &stored, replayed, &mut c)?;
         c.rows.extend(checked.faults.iter().map(|f| fault_row(&stored_store, f)));
         c.rows.extend(compare_references(&m.study, &stored_store, &fresh_store, &stored, &m.drift, opts.against.is_some()));
         if opts.against.is_some() {
@@ -827,46 +845,109 @@ pub fn check(
     Ok(report)
 }
 
-/// Rerun every planned study (each with its quick flag) into the scratch folder: first the
-/// stored reference solutions replayed, one at a time (the largest solves of a drift run, each
-/// alone in memory; `--deep` computes them anew in their runs instead), then the studies' runs,
-/// [`RERUN_AT_ONCE`] studies at a time. Each study has its own folder and locks, and a run's
-/// numbers do not depend on the threads that compute it (the round-off measurement of one
-/// thread against all finds no change), so the records are the same as one study at a time;
-/// the comparisons and the replayed levels follow, one study at a time, in the manifests'
-/// order. The first error in that order is returned, after the studies under way have ended.
-fn rerun_all(planned: &[(Manifest, bool)], opts: &DriftOptions) -> anyhow::Result<()> {
-    if !opts.deep {
-        for (m, _) in planned {
-            super::preload_references(m, &Store::new(&opts.results, &m.study), opts.progress)?;
-        }
-    }
+/// Rerun every planned study (each with its quick flag) into the scratch folder, [`RERUN_AT_ONCE`]
+/// studies at a time, and solve the replay tiers' levels again (returned per study, for
+/// [`replay_tier`]). The large solves, the stored reference solutions replayed (`--deep`
+/// computes them anew in their runs instead) and the replay tiers' levels, are the first
+/// worker's tasks before it takes studies, one at a time ([`super::one_large_solve`]: each
+/// alone among the large ones in memory), while the other worker reruns the studies that need
+/// no reference. Each study has its own folder and locks, and a run's numbers do not depend on
+/// the threads that compute it (the round-off measurement of one thread against all finds no
+/// change), so the records are the same as one study at a time; the comparisons follow, one
+/// study at a time, in the manifests' order. The first error in that order is returned, after
+/// the tasks under way have ended.
+fn rerun_all(planned: &[(Manifest, bool)], opts: &DriftOptions) -> anyhow::Result<Vec<Vec<Replayed>>> {
+    use std::sync::Mutex;
     let workers = if rayon::current_num_threads() >= 2 { RERUN_AT_ONCE } else { 1 };
-    let next = std::sync::atomic::AtomicUsize::new(0);
     let failed = std::sync::atomic::AtomicBool::new(false);
-    let outcomes: Vec<std::sync::Mutex<Option<anyhow::Result<()>>>> = planned.iter().map(|_| std::sync::Mutex::new(None)).collect();
+    let with_reference = |i: &usize| planned[*i].0.runs.iter().any(|r| r.spec.reference.is_some());
+    // the large solves, one at a time (the lock in `super::one_large_solve`), by the first worker
+    // before it takes studies: the stored references, then the replay tiers' levels
+    let mut large: Vec<Task> = (0..planned.len()).filter(|i| !opts.deep && with_reference(i)).map(Task::References).collect();
+    large.extend((0..planned.len()).filter(|&i| planned[i].1 && !opts.quick && planned[i].0.drift.deep.is_some()).map(Task::Replay));
+    // the studies whose runs need no reference first, while the references are rebuilt
+    let (mut studies, needing): (Vec<usize>, Vec<usize>) = (0..planned.len()).partition(|i| !with_reference(i));
+    studies.extend(needing);
+    let studies = Mutex::new(studies.into_iter().map(Task::Study).collect::<std::collections::VecDeque<Task>>());
+    let large = Mutex::new(std::collections::VecDeque::from(large));
+    type Outcome = Mutex<Option<anyhow::Result<Vec<Replayed>>>>;
+    let outcomes: Vec<Outcome> = planned.iter().map(|_| Mutex::new(Some(Ok(Vec::new())))).collect();
+    let run = |task: Task| -> anyhow::Result<()> {
+        match task {
+            Task::References(i) => super::preload_references(&planned[i].0, &Store::new(&opts.results, &planned[i].0.study), opts.progress),
+            Task::Study(i) => {
+                let m = &planned[i].0;
+                if !opts.deep {
+                    super::preload_references(m, &Store::new(&opts.results, &m.study), opts.progress)?;
+                }
+                rerun(m, planned[i].1, opts)
+            }
+            Task::Replay(i) => {
+                let m = &planned[i].0;
+                // its references first (from the cache), so the replay does not wait for itself
+                super::preload_references(m, &Store::new(&opts.results, &m.study), opts.progress)?;
+                let replayed = {
+                    let _large = super::one_large_solve();
+                    replay_solves(m, &opts.results, opts.progress)?
+                };
+                let mut slot = outcomes[i].lock().unwrap_or_else(|e| e.into_inner());
+                if let Some(Ok(r)) = slot.as_mut() {
+                    r.extend(replayed);
+                }
+                Ok(())
+            }
+        }
+    };
     std::thread::scope(|scope| {
-        for _ in 0..workers {
-            scope.spawn(|| {
+        for worker in 0..workers {
+            let (run, failed, large, studies, outcomes) = (&run, &failed, &large, &studies, &outcomes);
+            scope.spawn(move || {
                 use std::sync::atomic::Ordering::SeqCst;
-                loop {
-                    let i = next.fetch_add(1, SeqCst);
-                    if i >= planned.len() || failed.load(SeqCst) {
+                let next = || {
+                    let from_large = if worker == 0 { large.lock().unwrap_or_else(|e| e.into_inner()).pop_front() } else { None };
+                    from_large.or_else(|| studies.lock().unwrap_or_else(|e| e.into_inner()).pop_front())
+                };
+                while let Some(task) = next() {
+                    if failed.load(SeqCst) {
                         return;
                     }
-                    let outcome = rerun(&planned[i].0, planned[i].1, opts);
-                    failed.fetch_or(outcome.is_err(), SeqCst);
-                    *outcomes[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(outcome);
+                    let i = task.study();
+                    if let Err(e) = run(task) {
+                        failed.store(true, SeqCst);
+                        *outcomes[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(Err(e));
+                    }
                 }
             });
         }
     });
+    let mut replayed = Vec::new();
     for o in outcomes {
-        if let Some(Err(e)) = o.into_inner().unwrap_or_else(|e| e.into_inner()) {
-            return Err(e);
+        match o.into_inner().unwrap_or_else(|e| e.into_inner()) {
+            Some(Err(e)) => return Err(e),
+            Some(Ok(r)) => replayed.push(r),
+            None => replayed.push(Vec::new()),
         }
     }
-    Ok(())
+    Ok(replayed)
+}
+
+/// A piece of a drift run's reruns, of the study at an index of the planned ones.
+#[derive(Clone, Copy)]
+enum Task {
+    /// Its stored reference solutions rebuilt into the process's cache.
+    References(usize),
+    /// Its runs rerun into the scratch folder (its references taken from the cache, or rebuilt).
+    Study(usize),
+    /// The levels of its replay tier solved again.
+    Replay(usize),
+}
+
+impl Task {
+    fn study(self) -> usize {
+        match self {
+            Task::References(i) | Task::Study(i) | Task::Replay(i) => i,
+        }
+    }
 }
 
 /// How many studies a drift run reruns at once on a machine with two threads or more. On the

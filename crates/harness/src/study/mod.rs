@@ -43,9 +43,25 @@ use store::{RunWriter, Store};
 /// the same one (they are deterministic, so sharing changes no number).
 static REFERENCES: Mutex<Option<HashMap<String, Arc<ReferenceField>>>> = Mutex::new(None);
 
+/// Held by the largest solves of a process (a reference solution computed or rebuilt, a deep
+/// level replayed: up to 4.5e6 unknowns), so that they run one at a time whatever else runs
+/// beside them: the peak memory of one of them, not of two.
+static LARGE: Mutex<()> = Mutex::new(());
+
+/// Wait for the other large solves of this process to end, and hold them off ([`LARGE`]).
+pub fn one_large_solve() -> std::sync::MutexGuard<'static, ()> {
+    LARGE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn reference_for(key: &str, compute: impl FnOnce() -> Result<ReferenceField>) -> Result<Arc<ReferenceField>> {
-    if let Some(r) = REFERENCES.lock().expect("reference cache").get_or_insert_default().get(key) {
-        return Ok(r.clone());
+    let cached = || REFERENCES.lock().expect("reference cache").get_or_insert_default().get(key).cloned();
+    if let Some(r) = cached() {
+        return Ok(r);
+    }
+    // one at a time; a thread that waited here for the same reference takes it from the cache
+    let _large = one_large_solve();
+    if let Some(r) = cached() {
+        return Ok(r);
     }
     let r = Arc::new(compute()?);
     REFERENCES.lock().expect("reference cache").get_or_insert_default().insert(key.to_string(), r.clone());
