@@ -180,7 +180,7 @@ def cmd_rates(args):
            cols, all_rows,
            {"tolerance_rate": TOL_RATE,
             "norm": "max over points and both components of |u - u_h|; "
-                    "dense = barycentric lattice of order 6 per triangle (as crates/numerics/src/contact/sampling.rs)"},
+                    "dense = barycentric lattice of order 6 per triangle (as crates/model/src/settings/sampling.rs)"},
            args.out_dir)
     return ok
 
