@@ -136,12 +136,13 @@ pub(super) fn mismatch(
             _ => Finding::of(&of_triangle(t)),
         })
         .collect();
-    let inherited = (0..mesh.n_triangles()).filter(|&t| known(t).points > 0).count();
+    let inherited = before.map_or(0, |b| b.triangles.iter().filter(|f| f.points > 0).count());
     let at_centroids: Vec<Evaluated> = centroids.par_iter().map(|&(at, step)| evaluate(at, step)).collect();
+    let centroid_scale = Finding::of(&at_centroids).scale;
     let count = centroids.len() + triangles.iter().map(|f| f.points as usize).sum::<usize>();
     let findings = BodyForceFindings { diameter, triangles, inherited };
-    for i in 0..2 {
-        let scale = findings.triangles.iter().map(|f| f.scale[i]).chain([Finding::of(&at_centroids).scale[i]]).fold(floor, f64::max);
+    for (i, &at_centroid) in centroid_scale.iter().enumerate() {
+        let scale = findings.triangles.iter().map(|f| f.scale[i]).chain([at_centroid]).fold(floor, f64::max);
         let threshold = CONSISTENT * scale;
         let off = |v: &&Evaluated| (v.fine[i].value - v.f[i]).abs() > threshold;
         // the points off, in the order of every point at once: the centroids, then the
