@@ -4,6 +4,8 @@ CARGO ?= cargo
 # cargo builds into $(CARGO_TARGET_DIR) when it is set, target/ otherwise
 BIN := $(or $(CARGO_TARGET_DIR),target)/release/signorini
 SCRATCH := $(or $(CARGO_TARGET_DIR),target)/test-scratch
+# clippy's check build, beside the release build of the tests (make test)
+CLIPPY_TARGET := $(abspath $(or $(CARGO_TARGET_DIR),target)/clippy)
 # each step of make test timed into target/test-steps (its last line lists them)
 TIMED := scripts/timed.sh
 
@@ -21,10 +23,12 @@ build:
 # provenance and CLAIMS.md against the records), and the NGSolve cross-check.
 # Test-time outputs (drift report, cross-check tables with timings) go under target/; the last
 # step fails if the run changed any file git sees.
-# The first steps only install and compile (the test binaries and the example; the cross-check's
-# Python environment): the last line gives their time apart from the checks' own. The clippy step
-# includes the check build of the dependencies as clippy reads them (a `cargo check` of its own
-# before it would check the workspace's crates once more for nothing: clippy checks them again). The last line starts with
+# After the formatting check, the first steps compile and install, side by side (scripts/beside.sh:
+# the release build of the test binaries leaves a core idle much of the time): the test binaries and
+# the example; clippy, with the check build of the dependencies it reads, in a target folder of
+# its own (cargo builds one thing at a time in a folder, and a check build shares nothing with a
+# release build); the cross-check's Python environment. The last line gives their time apart
+# from the checks' own. The last line starts with
 # "N passed, N failed, N skipped" over every test binary and the doc tests of the cargo test step
 # (for CI tools), then the timing; make test writes only under target/ (its numbers there are what
 # `make measured` copies into docs/measured.json).
@@ -32,11 +36,11 @@ test: build
 	@mkdir -p target && date +%s > target/test-started && rm -f target/test-steps target/test-summary target/test-counts target/test-finished
 	@(git rev-parse --short HEAD 2>/dev/null || echo unknown) > target/test-commit
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-before-test
-	$(TIMED) build-tests $(CARGO) build --release --locked --all-targets
-	$(TIMED) venv crosscheck/setup.sh
-	@date +%s > target/test-compiled
 	$(TIMED) fmt $(CARGO) fmt --all --check
-	$(TIMED) clippy $(CARGO) clippy --release --locked --all-targets -- -D warnings
+	scripts/beside.sh build-tests '$(CARGO) build --release --locked --all-targets' \
+		clippy 'CARGO_TARGET_DIR=$(CLIPPY_TARGET) $(CARGO) clippy --release --locked --all-targets -- -D warnings' \
+		venv crosscheck/setup.sh
+	@date +%s > target/test-compiled
 	@scripts/chromium.sh >/dev/null || echo "NOTE: no chromium on this machine: the browser check of the study pages (tests/it/report_page.rs) is SKIPPED, and counted as skipped (apt-get install chromium; CI installs it)"
 	@# the tests' scratch folders (std::env::temp_dir) under target/, emptied first, not left in /tmp
 	@rm -rf $(SCRATCH) && mkdir -p $(SCRATCH)
@@ -51,7 +55,7 @@ test: build
 	@(git status --porcelain --untracked-files=all 2>/dev/null || true) > target/status-after-test
 	@diff target/status-before-test target/status-after-test >/dev/null || { echo "make test changed files git sees (before/after below); test outputs belong under target/"; diff target/status-before-test target/status-after-test; exit 1; }
 	@date +%s > target/test-finished
-	@echo "$$(cat target/test-summary); make test: PASSED in $$(( $$(cat target/test-finished) - $$(cat target/test-started) )) s after make build: $$(( $$(cat target/test-compiled) - $$(cat target/test-started) )) s compiling the tests and the example and installing the cross-check's Python environment, then $$(( $$(cat target/test-finished) - $$(cat target/test-compiled) )) s of checks (fmt, clippy with its dependencies' check build, cargo test, the example, drift: none, study pages, NGSolve cross-check; the tree unchanged). Seconds per step: $$(tr '\n' ' ' < target/test-steps)"
+	@echo "$$(cat target/test-summary); make test: PASSED in $$(( $$(cat target/test-finished) - $$(cat target/test-started) )) s after make build: $$(( $$(cat target/test-compiled) - $$(cat target/test-started) )) s the formatting check, then compiling the tests and the example beside clippy (with its dependencies' check build) and installing the cross-check's Python environment, then $$(( $$(cat target/test-finished) - $$(cat target/test-compiled) )) s of checks (cargo test, the example, drift: none, study pages, NGSolve cross-check; the tree unchanged). Seconds per step: $$(tr '\n' ' ' < target/test-steps)"
 
 # Copy the numbers of the last make test (what it left in target/) and of its /usr/bin/time -v log
 # into docs/measured.json and docs/measured.md, deliberately (make test itself writes only under

@@ -5,7 +5,7 @@ tests/it/measured_numbers.rs fails when a quote no longer agrees with docs/measu
 
   scripts/measured.py test --time-log FILE --load LOAD [--command CMD]
       make test's numbers from what it leaves in target/ (test-started, test-compiled,
-      test-finished, test-commit, test-steps, test-counts, test-summary) and the wall time and peak
+      test-finished, test-commit, test-steps, test-beside, test-counts, test-summary) and the wall time and peak
       resident set of the whole command as `/usr/bin/time -v -o FILE CMD` reports them (run it
       on a fresh clone: `mkdir -p target && /usr/bin/time -v -o target/time.txt .ci/run`);
       --build-time-log FILE: `/usr/bin/time -v -o FILE make build`, run first, for make build's
@@ -113,6 +113,8 @@ def cmd_test(a):
         "compiling_s": compiled - started,
         "checks_s": finished - compiled,
         "steps_s": pairs(target_file("test-steps")),
+        # the steps scripts/beside.sh ran side by side (compiling_s is their longest, not their sum)
+        "beside": target_file("test-beside").split() if os.path.exists(os.path.join(TARGET, "test-beside")) else [],
         "tests": {"passed": int(m.group(1)), "failed": int(m.group(2)), "skipped": int(m.group(3)),
                   "integration": counts["integration"], "unit": counts["unit"], "doc": counts["doc"]},
         "wall_s": wall,
@@ -176,7 +178,8 @@ def render(d):
                 f"| make test, after make build | {t['result']} in {t['after_build_s']} s |",
                 f"| compiling and installing | {t['compiling_s']} s |",
                 f"| checks | {t['checks_s']} s |",
-                "| seconds per step | " + ", ".join(f"{k} {v}" for k, v in s.items()) + " |"]
+                "| seconds per step | " + ", ".join(f"{k} {v}" for k, v in s.items())
+                + (f" ({', '.join(t['beside'])} side by side)" if t.get("beside") else "") + " |"]
         n = t["tests"]
         if n.get("passed") is not None:
             out.append(f"| cargo test's last line | {n['passed']} passed, {n['failed']} failed, {n['skipped']} skipped |")
