@@ -24,7 +24,7 @@ build:
 # Test-time outputs (drift report, cross-check tables with timings) go under target/; the last
 # step fails if the run changed any file git sees.
 # After the formatting check, the first steps compile and install, side by side (scripts/beside.sh:
-# the release build of the test binaries leaves a core idle much of the time): the test binaries and
+# each leaves a core idle at times, at the ends of its builds or waiting on PyPI): the test binaries and
 # the example; clippy, with the check build of the dependencies it reads, in a target folder of
 # its own (cargo builds one thing at a time in a folder, and a check build shares nothing with a
 # release build); the cross-check's Python environment. The last line gives their time apart

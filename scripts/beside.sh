@@ -5,9 +5,9 @@
 # printed, step by step, once every step has finished. The exit status is 0 only if every step's
 # is; the failed steps are named.
 #
-# make test uses it for steps that leave a core idle when run alone: the compile of the test
-# binaries (release code generation) beside clippy's check build and the cross-check's Python
-# environment (mostly waiting on PyPI).
+# make test uses it for steps that each leave a core idle at times when run alone: the compile of
+# the test binaries beside clippy's check build and the cross-check's Python environment (mostly
+# waiting on PyPI).
 set -uo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 if [ $# -lt 2 ] || [ $(($# % 2)) -ne 0 ]; then
@@ -18,7 +18,10 @@ mkdir -p target
 first_step=$1 first_command=$2
 shift 2
 # the names of the steps run side by side, for scripts/measured.py (make test's numbers)
-for ((i = 1; i <= $#; i += 2)); do echo "${!i}"; done | sed "1i $first_step" >target/test-beside
+{
+    echo "$first_step"
+    for ((i = 1; i <= $#; i += 2)); do echo "${!i}"; done
+} >target/test-beside
 steps=() pids=()
 while [ $# -gt 0 ]; do
     echo "$1: running beside $first_step (its output: target/$1.log)"

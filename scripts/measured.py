@@ -113,7 +113,7 @@ def cmd_test(a):
         "compiling_s": compiled - started,
         "checks_s": finished - compiled,
         "steps_s": pairs(target_file("test-steps")),
-        # the steps scripts/beside.sh ran side by side (compiling_s is their longest, not their sum)
+        # the steps scripts/beside.sh ran side by side (compiling_s holds the longest of them, not their sum)
         "beside": target_file("test-beside").split() if os.path.exists(os.path.join(TARGET, "test-beside")) else [],
         "tests": {"passed": int(m.group(1)), "failed": int(m.group(2)), "skipped": int(m.group(3)),
                   "integration": counts["integration"], "unit": counts["unit"], "doc": counts["doc"]},
