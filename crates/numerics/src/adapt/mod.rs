@@ -288,7 +288,8 @@ pub fn solve_level(
         Resolution::AtRoundoff => (true, vec![Caveat::AtRoundoff]),
         Resolution::Resolved(caveats) => (false, caveats),
     };
-    let error = reference.map(|r| norms::linf_error(mesh, &sol, r));
+    // err_right_half from the same evaluations as the dense norm (the record says why x >= 1/2)
+    let (error, right_half) = reference.map(|r| norms::linf_error_with(mesh, &sol, r, &|x| x[0] >= 0.5)).unzip();
     let marks = match config.refine {
         Refine::Adaptive if at_roundoff => vec![false; mesh.n_triangles()],
         Refine::Adaptive => mark_maximum(&est.element, config.theta),
@@ -319,8 +320,7 @@ pub fn solve_level(
         err_nodal: error.map(|e| e.linf_nodal),
         efficiency: error.map(|e| t.estimate / e.linf_quadrature),
         err_contact: reference.and_then(|r| norms::linf_error_contact(mesh, &sol, r)),
-        err_right_half: reference
-            .and_then(|r| norms::linf_error_where(mesh, &sol, r, crate::contact::sampling::Sampling::Dense, &|x| x[0] >= 0.5)),
+        err_right_half: right_half.flatten(),
         roundoff_floor: sol.roundoff,
         h_free_boundary: free_boundary_edge(mesh, &sol),
         max_indicator_x: peak[0],

@@ -16,7 +16,6 @@ pub struct LinfError {
     pub linf_nodal: f64,
 }
 
-/// max over the sampling points of |u - u_h| (componentwise maximum).
 /// The displacement the error is measured against: an exact solution or a reference solution.
 pub type Reference<'a> = &'a dyn Displacement;
 
@@ -40,16 +39,29 @@ impl<F: Fn([f64; 2]) -> [f64; 2] + Sync> Displacement for F {
     }
 }
 
-/// The largest of |u - u_h| (componentwise maximum) at the points `at` (with u_h there), u
-/// taken from `exact` for all of them at once.
-fn largest_error(exact: Reference, at: &[([f64; 2], [f64; 2])]) -> Option<f64> {
+/// |u - u_h| (componentwise maximum) at each of the points `at` (with u_h there), u taken from
+/// `exact` for all of them at once.
+fn errors(exact: Reference, at: &[([f64; 2], [f64; 2])]) -> Vec<f64> {
     let xs: Vec<[f64; 2]> = at.iter().map(|(x, _)| *x).collect();
     let u = exact.at_each(&xs);
-    u.iter().zip(at).map(|(u, (_, uh))| (u[0] - uh[0]).abs().max((u[1] - uh[1]).abs())).reduce(f64::max)
+    u.iter().zip(at).map(|(u, (_, uh))| (u[0] - uh[0]).abs().max((u[1] - uh[1]).abs())).collect()
+}
+
+/// The largest of |u - u_h| at the points `at`; None without points.
+fn largest_error(exact: Reference, at: &[([f64; 2], [f64; 2])]) -> Option<f64> {
+    errors(exact, at).into_iter().reduce(f64::max)
+}
+
+/// The larger of two maxima, either of which may be missing.
+fn larger(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.max(b)),
+        (a, b) => a.or(b),
+    }
 }
 
 pub fn linf_error_on(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference, sampling: Sampling) -> f64 {
-    linf_error_where(mesh, sol, exact, sampling, &|_| true).unwrap_or(0.0)
+    maxima(mesh, sol, exact, sampling, &|_| true).0.unwrap_or(0.0)
 }
 
 /// max |u - u_h| over the sampling points x with `keep(x)`; None if no point is kept.
@@ -60,21 +72,29 @@ pub fn linf_error_where(
     sampling: Sampling,
     keep: &(dyn Fn([f64; 2]) -> bool + Sync),
 ) -> Option<f64> {
+    maxima(mesh, sol, exact, sampling, keep).1
+}
+
+/// max |u - u_h| over every sampling point and over those x with `keep(x)` (None where there
+/// are none), from one evaluation of u and u_h per point: the maximum of the same values either
+/// way, so the same numbers as [`linf_error_on`] and [`linf_error_where`] one by one.
+fn maxima(
+    mesh: &Mesh,
+    sol: &DiscreteSolution,
+    exact: Reference,
+    sampling: Sampling,
+    keep: &(dyn Fn([f64; 2]) -> bool + Sync),
+) -> (Option<f64>, Option<f64>) {
     let refs = sampling.points();
     (0..mesh.n_triangles())
         .into_par_iter()
         .map(|t| {
-            let mut at = sol.eval_element(mesh, t, &refs);
-            at.retain(|(x, _)| keep(*x));
-            largest_error(exact, &at)
+            let at = sol.eval_element(mesh, t, &refs);
+            let e = errors(exact, &at);
+            let kept = at.iter().zip(&e).filter(|((x, _), _)| keep(*x)).map(|(_, e)| *e).reduce(f64::max);
+            (e.into_iter().reduce(f64::max), kept)
         })
-        .reduce(
-            || None,
-            |a, b| match (a, b) {
-                (Some(a), Some(b)) => Some(a.max(b)),
-                (a, b) => a.or(b),
-            },
-        )
+        .reduce(|| (None, None), |a, b| (larger(a.0, b.0), larger(a.1, b.1)))
 }
 
 /// Points per edge of the contact-edge sampling (end points included).
@@ -106,6 +126,17 @@ pub fn linf_error_contact(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference)
 }
 
 pub fn linf_error(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference) -> LinfError {
+    linf_error_with(mesh, sol, exact, &|_| true).0
+}
+
+/// [`linf_error`], and the dense lattice's maximum over the points x with `keep(x)` (None if
+/// none is kept: [`linf_error_where`] with [`Sampling::Dense`]) from the same evaluations.
+pub fn linf_error_with(
+    mesh: &Mesh,
+    sol: &DiscreteSolution,
+    exact: Reference,
+    keep: &(dyn Fn([f64; 2]) -> bool + Sync),
+) -> (LinfError, Option<f64>) {
     let nodal = sol
         .nodes
         .coords
@@ -116,9 +147,11 @@ pub fn linf_error(mesh: &Mesh, sol: &DiscreteSolution, exact: Reference) -> Linf
             (u[0] - uh[0]).abs().max((u[1] - uh[1]).abs())
         })
         .fold(0.0, f64::max);
-    LinfError {
+    let (dense, kept) = maxima(mesh, sol, exact, Sampling::Dense, keep);
+    let error = LinfError {
         linf_quadrature: linf_error_on(mesh, sol, exact, Sampling::Quadrature),
-        linf_dense: linf_error_on(mesh, sol, exact, Sampling::Dense),
+        linf_dense: dense.unwrap_or(0.0),
         linf_nodal: nodal,
-    }
+    };
+    (error, kept)
 }
