@@ -2,18 +2,52 @@
 //! last finished level, not from level 0, and ends with the same numbers and history as a run
 //! that was never stopped; the checkpoint it resumed from is gone once the run has landed.
 
-use crate::common::{LONG, checkpoint_levels, scratch, signorini_in};
+use crate::common::{checkpoint_levels, scratch, signorini_in};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// [`LONG`] with two of its levels' meshes saved.
-fn long_with_saved_meshes() -> String {
-    format!("{LONG}save_levels = [3, 21]\n")
+/// A study of one run of 12 small levels, stopped part way: started with [`stopped_at`], which
+/// makes every change to its files wait 50 ms, so it is still in progress when it is killed,
+/// at the cost in computing of a run of a second.
+const SMALL: &str = r#"description = "one run to be stopped part way"
+[defaults]
+problem = "ex71"
+mesh = "structured:4"
+theta = 0.5
+[[run]]
+id = "long"
+levels = 12
+"#;
+
+/// [`SMALL`] with two of its levels' meshes saved.
+fn small_with_saved_meshes() -> String {
+    format!("{SMALL}save_levels = [3, 11]\n")
 }
 
 fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_signorini")
+}
+
+/// `signorini args` in `dir`, every change to its files paused ([`signorini::base::failpoint`]),
+/// killed (SIGKILL: no handler runs) once its checkpoint `partial` holds `levels` levels.
+fn stopped_at(dir: &Path, args: &[&str], partial: &Path, levels: usize) {
+    let mut child = Command::new(bin())
+        .current_dir(dir)
+        .args(args)
+        .env(signorini::base::failpoint::PAUSE_ENV, "50")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    while checkpoint_levels(partial) < levels {
+        assert!(child.try_wait().unwrap().is_none(), "the run finished before it could be stopped");
+        assert!(started.elapsed() < Duration::from_secs(300), "no checkpoint of {levels} levels after 300 s");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
 }
 
 fn run(results: &Path, manifest: &Path) -> std::process::Output {
@@ -34,29 +68,16 @@ fn a_killed_run_resumes_after_its_last_finished_level_with_the_same_numbers() {
     let _ = std::fs::remove_dir_all(&root);
     std::fs::create_dir_all(&root).unwrap();
     let manifest = root.join("resumed.toml");
-    std::fs::write(&manifest, long_with_saved_meshes()).unwrap();
+    std::fs::write(&manifest, small_with_saved_meshes()).unwrap();
     // the reference: never stopped
     let whole = root.join("whole");
     assert!(run(&whole, &manifest).status.success());
-    // killed once 8 levels are kept
+    // killed once 6 levels are kept
     let stopped = root.join("stopped");
     let partial = stopped.join("resumed/.partial/long.json");
-    let mut child = Command::new(bin())
-        .args(["run", manifest.to_str().unwrap(), "--results", stopped.to_str().unwrap()])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let started = Instant::now();
-    while checkpoint_levels(&partial) < 8 {
-        assert!(child.try_wait().unwrap().is_none(), "the run finished before it could be stopped");
-        assert!(started.elapsed() < Duration::from_secs(300), "no checkpoint of 8 levels after 300 s");
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    child.kill().unwrap(); // SIGKILL: no handler runs
-    child.wait().unwrap();
+    stopped_at(&root, &["run", manifest.to_str().unwrap(), "--results", stopped.to_str().unwrap()], &partial, 6);
     let kept = checkpoint_levels(&partial);
-    assert!((8..22).contains(&kept), "{kept}");
+    assert!((6..12).contains(&kept), "{kept}");
     assert!(!stopped.join("resumed/runs/long.json").exists());
     let out = run(&stopped, &manifest);
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -64,7 +85,7 @@ fn a_killed_run_resumes_after_its_last_finished_level_with_the_same_numbers() {
     assert!(stderr.contains(&format!("resuming after level {}", kept - 1)), "{stderr}");
     let file = |r: &Path| r.join("resumed/runs/long.json");
     assert_eq!(without_measurements(file(&stopped)), without_measurements(file(&whole)));
-    for l in [3, 21] {
+    for l in [3, 11] {
         for ext in ["vtu", "json"] {
             let name = format!("resumed/meshes/long_level{l}.{ext}");
             assert_eq!(std::fs::read(stopped.join(&name)).unwrap(), std::fs::read(whole.join(&name)).unwrap(), "{name}");
@@ -77,23 +98,9 @@ fn a_killed_run_resumes_after_its_last_finished_level_with_the_same_numbers() {
 #[test]
 fn a_checkpoint_is_resumed_only_as_written_by_this_code() {
     let dir = scratch("resume-checkpoint-is-resumed");
-    std::fs::write(dir.join("long.toml"), LONG).unwrap();
+    std::fs::write(dir.join("long.toml"), SMALL).unwrap();
     let partial = dir.join("killed/long/.partial/long.json");
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_signorini"))
-        .current_dir(&dir)
-        .args(["run", "long.toml", "--results", "killed"])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    let started = std::time::Instant::now();
-    while checkpoint_levels(&partial) < 6 {
-        assert!(child.try_wait().unwrap().is_none(), "the run finished before it could be stopped");
-        assert!(started.elapsed().as_secs() < 300, "no checkpoint of 6 levels after 300 s");
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
-    child.kill().unwrap();
-    child.wait().unwrap();
+    stopped_at(&dir, &["run", "long.toml", "--results", "killed"], &partial, 6);
     let text = std::fs::read_to_string(&partial).unwrap();
     let kept: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(kept["sha256"].as_str().map(str::len), Some(64), "{}", &text[..text.len().min(400)]);
@@ -122,7 +129,7 @@ fn a_checkpoint_is_resumed_only_as_written_by_this_code() {
         }
         let record: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(results.join("long/runs/long.json")).unwrap()).unwrap();
-        assert_eq!(record["levels"].as_array().unwrap().len(), 22);
+        assert_eq!(record["levels"].as_array().unwrap().len(), 12);
         eta1.push(record["levels"][0]["eta1"].as_f64().unwrap());
     }
     assert!(eta1.iter().all(|&e| e == eta1[0] && e != 0.1234), "{eta1:?}");

@@ -754,22 +754,26 @@ fn a_run_whose_problem_file_changed_is_a_changed_spec_naming_the_file() {
 
 // ---- no concurrent process undoes a run (real processes, both orders)
 
-/// A study whose one run takes a second or two (Example 7.1, 19 adaptive levels from
-/// structured:8), so that a second process reliably starts while it computes.
+/// A study of one small run (Example 7.1, 8 adaptive levels from structured:8): started with
+/// [`spawn`], every change to its files waits 50 ms, so it is in progress for seconds (a second
+/// process reliably starts while it runs) at the cost in computing of a fraction of a second.
 const LONG: &str = r#"description = "store test: one run of a few seconds"
 [defaults]
 problem = "ex71"
 mesh = "structured:8"
 [[run]]
 id = "a"
-levels = 19
+levels = 8
 theta = 0.5
 "#;
 
+/// `signorini args` in `dir`, in the background, every change to its files paused 50 ms
+/// ([`signorini::base::failpoint`]).
 fn spawn(dir: &Path, args: &[&str]) -> std::process::Child {
     Command::new(env!("CARGO_BIN_EXE_signorini"))
         .current_dir(dir)
         .args(args)
+        .env(signorini::base::failpoint::PAUSE_ENV, "50")
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
@@ -1166,7 +1170,7 @@ fn an_input_file_edited_while_the_study_runs_is_refused_by_name_not_stored_under
 fn a_record_edited_while_another_run_commits_is_refused_not_rendered_into_levels_csv() {
     let (dir, _) = stored("laundered");
     let study = results_of(&dir);
-    let m = manifest(&dir, &format!("{TWO_RUNS_ONE_SAVING}\n[[run]]\nid = \"c\"\nmesh = \"structured:8\"\nlevels = 19\ntheta = 0.5\n"));
+    let m = manifest(&dir, &format!("{TWO_RUNS_ONE_SAVING}\n[[run]]\nid = \"c\"\nmesh = \"structured:8\"\nlevels = 8\ntheta = 0.5\n"));
     let child = spawn(&dir, &["run", m, "--results", "results", "--jobs", "1"]);
     appears(&study.join(".partial/c.json"));
     let a = std::fs::read_to_string(study.join("runs/a.json")).unwrap();

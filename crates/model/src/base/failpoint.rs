@@ -13,12 +13,16 @@
 use std::path::Path;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Duration;
 
 /// The environment variable that sets the change to stop before (1 = the first).
 pub const ENV: &str = "SIGNORINI_FAILPOINT";
 
 /// The exit status of a process stopped at its failpoint.
 pub const EXIT: i32 = 86;
+
+/// The environment variable that sets the wait before every change, in milliseconds.
+pub const PAUSE_ENV: &str = "SIGNORINI_FAILPOINT_PAUSE_MS";
 
 static CHANGES: AtomicUsize = AtomicUsize::new(0);
 
@@ -27,9 +31,18 @@ fn stop_at() -> Option<usize> {
     *AT.get_or_init(|| std::env::var(ENV).ok().and_then(|v| v.trim().parse().ok()).filter(|&k| k > 0))
 }
 
+fn pause() -> Option<Duration> {
+    static PAUSE: OnceLock<Option<Duration>> = OnceLock::new();
+    *PAUSE.get_or_init(|| std::env::var(PAUSE_ENV).ok().and_then(|v| v.trim().parse().ok()).map(Duration::from_millis))
+}
+
 /// The next change to the filesystem: `what` (`write`, `rename`, `remove`, `create folder`, ...)
-/// on `path`. With the failpoint set to this change's number, the process stops here.
+/// on `path`. With the pause set, it waits that long first; with the failpoint set to this
+/// change's number, the process stops here.
 pub fn step(what: &str, path: &Path) {
+    if let Some(pause) = pause() {
+        std::thread::sleep(pause);
+    }
     let k = CHANGES.fetch_add(1, Ordering::SeqCst) + 1;
     if stop_at() == Some(k) {
         eprintln!("failpoint: stopped before change {k}: {what} {}", path.display());
