@@ -77,9 +77,8 @@ fn uniform_rate(p: &dyn Problem) -> f64 {
     };
     let mesh_spec = signorini::mesh::MeshSpec::parse("structured:4").unwrap();
     let field = reference::compute(p, &mesh_spec, &spec, &mut |_| std::ops::ControlFlow::Continue(())).unwrap().unwrap();
-    let exact = |x: [f64; 2]| field.eval(x);
     let config = AdaptConfig { levels: 9, refine: Refine::Uniform, ..Default::default() };
-    let out = adapt::run(p, mesh(p, "structured:4"), &config, Some(&exact), &mut |_| std::ops::ControlFlow::Continue(())).unwrap();
+    let out = adapt::run(p, mesh(p, "structured:4"), &config, Some(&field), &mut |_| std::ops::ControlFlow::Continue(())).unwrap();
     let (mut h, mut e) = (Vec::new(), Vec::new());
     for r in out.records.iter().filter(|r| r.level >= 2 && r.level % 2 == 0) {
         h.push(r.h_max);
