@@ -4,9 +4,10 @@
 //!
 //! `cargo run --release --example own_problem`
 
-use signorini::adapt::{self, AdaptConfig, AdaptTermination};
+use signorini::adapt::{self, AdaptTermination};
 use signorini::mesh::MeshSpec;
 use signorini::problems::{Material, Part, Problem, contact_bottom_dirichlet_top};
+use signorini::settings::adapt::AdaptConfig;
 use std::ops::ControlFlow;
 
 /// The block [0, 1]^2: contact on the bottom y = 0, pushed at the top y = 1, free sides.

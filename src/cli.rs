@@ -2,12 +2,12 @@
 //! ([`signorini::commands`]): the defaults are the library's, the estimator's values its enums.
 
 use clap::{Parser, Subcommand};
-use signorini::adapt::AdaptConfig;
 use signorini::commands::{adapt::AdaptOptions, solve::SolveOptions};
-use signorini::contact::PdasOptions;
-use signorini::contact::sampling::Sampling;
-use signorini::estimate::{ContactTerm, EstimatorConfig, LogFactor};
 use signorini::mesh::MeshSpec;
+use signorini::settings::adapt::AdaptConfig;
+use signorini::settings::estimator::{ContactTerm, EstimatorConfig, LogFactor};
+use signorini::settings::pdas::PdasOptions;
+use signorini::settings::sampling::Sampling;
 
 #[derive(Parser)]
 #[command(name = "signorini", version, about = "P2 finite elements for the Signorini problem and its supremum-norm a posteriori estimator")]
@@ -169,7 +169,7 @@ impl Command {
 }
 
 /// The estimator's flags. Each argument's id is the setting's key (`estimator.c0`, as
-/// [`estimate::ConfigError`] names it), its default the library's ([`EstimatorConfig::default`]),
+/// [`ConfigError`](signorini::settings::estimator::ConfigError) names it), its default the library's ([`EstimatorConfig::default`]),
 /// its values the library's enums ([`clap::ValueEnum`]).
 #[derive(clap::Args)]
 pub struct EstimatorArgs {

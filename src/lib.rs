@@ -21,14 +21,17 @@
 //! This crate re-exports every floor under its own name
 //! (`signorini::mesh`, `signorini::study`) and the most used modules under a short one
 //! (`signorini::solve`, `signorini::estimate`, `signorini::cholesky`): the users' prelude, for
-//! examples, tests and user programs. Code inside the crates never uses it.
+//! examples, tests and user programs. Code inside the crates never uses it. The store's `study/`
+//! (manifests, the results folder's store, provenance) shares its name with the harness's
+//! `signorini::study`: it is `signorini_store::study`.
 
 pub mod commands;
 
 pub use signorini_claims::{analysis, plot};
-pub use signorini_harness::{records, report, study};
+pub use signorini_harness::{report, study};
 pub use signorini_model::{base, level, mesh, problems, settings};
 pub use signorini_numerics::{adapt, contact, estimator, fem, sparse};
+pub use signorini_store::records;
 
 pub use analysis::{claims, hertz, verdict};
 pub use base::{element, memory};

@@ -5,7 +5,7 @@ mod cli;
 
 use anyhow::Result;
 use cli::{Cli, Command, flag_of};
-use signorini::adapt::{Caveat, LevelRecord};
+use signorini::adapt::Caveat;
 use signorini::commands::adapt::{self, AdaptInterrupted, AdaptObserver};
 use signorini::commands::drift::{self, Drift, DriftInterrupted, DriftRequest};
 use signorini::commands::output::{self, stdout_write, wrote, wrote_all};
@@ -14,6 +14,7 @@ use signorini::commands::run::{self, RunFlags};
 use signorini::commands::threads::start_threads;
 use signorini::commands::workspace::Workspace;
 use signorini::commands::{figures, report, solve};
+use signorini::level::record::LevelRecord;
 use signorini::study;
 use signorini_claims::say;
 use std::path::Path;
@@ -164,7 +165,7 @@ fn main() -> ExitCode {
             libc::signal(libc::SIGPIPE, libc::SIG_DFL);
         }
     }
-    if let Err(e) = signorini::ordering::forced() {
+    if let Err(e) = signorini::settings::ordering::forced() {
         say!("error: {e}");
         return ExitCode::from(2);
     }

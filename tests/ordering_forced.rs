@@ -5,14 +5,15 @@
 
 use signorini::assembly::{self, DofMap};
 use signorini::mesh::{MeshSpec, P2Nodes};
-use signorini::ordering::{self, Method, fill_reducing};
+use signorini::ordering::{self, fill_reducing};
 use signorini::problems::Ex72;
+use signorini::settings::ordering::{FORCE_ENV, Method};
 
 #[test]
 fn a_forced_ordering_applies_outside_automatic_only() {
     // SAFETY: set before anything in this process reads the environment or starts a thread
     // (the one test of this binary, first statement)
-    unsafe { std::env::set_var(ordering::FORCE_ENV, "minimum-degree") };
+    unsafe { std::env::set_var(FORCE_ENV, "minimum-degree") };
     // a uniform mesh: nested dissection needs about half the flops of AMD, so the automatic
     // choice differs from the forced one
     let mesh = MeshSpec::parse("structured:48").unwrap().build(&Ex72).unwrap();

@@ -14,10 +14,11 @@
 use anyhow::Result;
 use clap::Parser;
 use signorini::assembly::{self, DofMap};
-use signorini::contact::{ContactSolver, PdasOptions};
+use signorini::contact::ContactSolver;
 use signorini::mesh::{MeshSpec, P2Nodes};
 use signorini::problems::Ex72;
 use signorini::records;
+use signorini::settings::pdas::PdasOptions;
 use signorini::solve;
 use std::time::Instant;
 
@@ -191,7 +192,8 @@ fn cold_solve(n: usize) -> Result<ColdRun> {
 /// `run` of the deep study computed afresh in this process into a temporary results directory
 /// (removed after): wall time, peak memory and the levels' own times from its record.
 fn adaptive_run(run: &str) -> Result<AdaptiveRun> {
-    use signorini::study::{self, manifest::Manifest};
+    use signorini::study;
+    use signorini_store::study::manifest::Manifest;
     let manifest = Manifest::load(std::path::Path::new(DEEP_MANIFEST))?;
     let index = manifest.runs.iter().position(|p| p.spec.id == run).ok_or_else(|| {
         let known: Vec<&str> = manifest.runs.iter().map(|p| p.spec.id.as_str()).collect();

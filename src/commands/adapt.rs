@@ -4,9 +4,11 @@
 
 use super::places::check_writable;
 use super::solve::{Names, validate};
-use crate::adapt::{self, AdaptConfig, Caveat, LevelRecord, Refine};
-use crate::estimate::EstimatorConfig;
+use crate::adapt::{self, Caveat};
+use crate::level::record::LevelRecord;
 use crate::mesh::MeshSpec;
+use crate::settings::adapt::{AdaptConfig, Refine};
+use crate::settings::estimator::EstimatorConfig;
 use crate::{norms, problems, report, study};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};

@@ -8,6 +8,7 @@ use super::places::{check_target, is_tracked_results};
 use super::workspace::Workspace;
 use crate::study;
 use anyhow::{Context, Result, bail};
+use signorini_store::study::{manifest, store};
 use std::path::{Path, PathBuf};
 
 /// What `drift` checks, as the command line's flags say it.
@@ -52,7 +53,7 @@ pub struct Checked {
 
 /// `drift --accept`: rerun the studies in full (every run checked first) and rewrite their results.
 fn accept_studies(accept: &[String], experiments: &std::path::Path, results: &std::path::Path) -> Result<()> {
-    let manifests = study::manifest::declared(experiments, accept)?;
+    let manifests = manifest::declared(experiments, accept)?;
     for m in &manifests {
         m.check_runs()?;
     }
@@ -70,7 +71,7 @@ fn accept_studies(accept: &[String], experiments: &std::path::Path, results: &st
 /// `drift --accept STUDY` refused by a lock another process holds: the advice in drift's terms
 /// (the lock's own speaks of `--wait`, which drift has not; the run's of `--fresh`).
 fn accept_advice(e: anyhow::Error, study: &str) -> anyhow::Error {
-    match e.chain().find_map(|c| c.downcast_ref::<study::store::Held>()) {
+    match e.chain().find_map(|c| c.downcast_ref::<store::Held>()) {
         Some(held) => anyhow::anyhow!(
             "drift --accept {study}: {} is being written by {} (the lock is {}); --accept reruns the whole study and waits for no process: nothing was changed. Let that process finish (or stop it), then run `signorini drift --accept {study}` again",
             held.what,
@@ -181,7 +182,7 @@ pub fn check(request: &DriftRequest) -> Result<Drift> {
         // drift's interface takes an io::Result: the typed error's message travels in it
         // CLAIMS.md is compared only when every study is, so a folder at fault has each fault in
         // a row of the report already; rows drawn from records no one can trust are not compared
-        let Ok(shelf) = study::store::Shelf::open_folder(r, &manifests) else {
+        let Ok(shelf) = store::Shelf::open_folder(r, &manifests) else {
             return Ok(crate::records::read_text(&r.join("CLAIMS.md")).unwrap_or_default());
         };
         crate::claims::claims(&shelf, roles).map(|c| crate::claims::markdown_for(&c, r)).map_err(std::io::Error::other)

@@ -3,8 +3,8 @@
 
 use super::places::{is_tracked_results, output_folder};
 use super::workspace::Workspace;
-use crate::study;
 use anyhow::{Result, bail};
+use signorini_store::study::store::Shelf;
 use std::path::PathBuf;
 
 /// `report`: the study pages, with the defaults of a scratch folder when --results names one.
@@ -25,7 +25,7 @@ pub fn write(
         bail!("--results {}: this is a file; report reads the study folders of a results folder: give a folder's path", results.display());
     }
     if wait {
-        study::store::Shelf::wait_for_writers(&results)?;
+        Shelf::wait_for_writers(&results)?;
     }
     let under = |tracked_default: &str, scratch: &str| if tracked { tracked_default.into() } else { results.join(scratch) };
     let figures = figures.map_or_else(|| under("figures", "figures"), |f| f.to_path_buf());
@@ -51,6 +51,6 @@ pub fn write(
         advice += &format!(" --experiments {}", experiments.display());
     }
     let drift = crate::page::DriftReports::read(&files, drift_report.is_some(), &advice)?;
-    let shelf = study::store::Shelf::open_folder(&results, &workspace.manifests)?;
+    let shelf = Shelf::open_folder(&results, &workspace.manifests)?;
     crate::page::write_pages(&shelf, &figures, &out, studies, &drift, &workspace.roles)
 }

@@ -3,6 +3,8 @@
 
 use crate::study;
 use anyhow::{Result, bail};
+use signorini_store::study::manifest::Manifest;
+use signorini_store::study::store::Store;
 
 /// The switches of `signorini run` that shape what a run does with the store.
 #[derive(Clone, Copy, Debug, Default)]
@@ -33,7 +35,7 @@ pub fn run_studies(
     let results = results.unwrap_or_else(|| if quick { "target/quick-results".into() } else { "results".into() });
     // parse and check every run of every manifest first: a mistake in the last one should not
     // cost the first one's run
-    let parsed = manifests.iter().map(|m| study::manifest::Manifest::load(m)).collect::<Result<Vec<_>, _>>()?;
+    let parsed = manifests.iter().map(|m| Manifest::load(m)).collect::<Result<Vec<_>, _>>()?;
     for manifest in &parsed {
         manifest.check_runs()?;
     }
@@ -97,8 +99,8 @@ pub fn run_studies(
 /// Manifests given together that declare the same study declare the same runs: otherwise the
 /// second would be refused (or with --replace would replace the first's runs) only after the
 /// first had computed, so the conflict is refused before anything is, naming both files.
-fn check_one_declaration(manifests: &[study::manifest::Manifest], quick: bool) -> Result<()> {
-    let runs = |m: &study::manifest::Manifest| {
+fn check_one_declaration(manifests: &[Manifest], quick: bool) -> Result<()> {
+    let runs = |m: &Manifest| {
         let mut specs: Vec<_> = m.runs.iter().map(|p| study::effective_spec(p, quick)).collect();
         specs.sort_by(|a, b| a.id.cmp(&b.id));
         specs
@@ -120,8 +122,8 @@ fn check_one_declaration(manifests: &[study::manifest::Manifest], quick: bool) -
 /// `run --quick` into a folder that holds the full form of a run: its quick form (the first
 /// `quick_levels` levels) is another spec, and replacing the full run with it would throw the
 /// full run away, so the refusal says so and points at another folder rather than at --replace.
-fn check_quick_beside_full(manifest: &study::manifest::Manifest, results: &std::path::Path) -> Result<()> {
-    let store = study::store::Store::new(results, &manifest.study);
+fn check_quick_beside_full(manifest: &Manifest, results: &std::path::Path) -> Result<()> {
+    let store = Store::new(results, &manifest.study);
     let stored = store.records().unwrap_or_default();
     let full = manifest.runs.iter().find(|p| {
         let (full, quick) = (study::effective_spec(p, false), study::effective_spec(p, true));
@@ -145,7 +147,7 @@ fn check_quick_beside_full(manifest: &study::manifest::Manifest, results: &std::
 
 /// A shard must hold at least one run of the manifests given (each manifest's runs are dealt
 /// out to the shards in order); a manifest of which it holds none gets a note.
-fn check_shard(manifests: &[study::manifest::Manifest], (k, n): (usize, usize)) -> Result<()> {
+fn check_shard(manifests: &[Manifest], (k, n): (usize, usize)) -> Result<()> {
     let counts: Vec<(&str, usize, usize)> =
         manifests.iter().map(|m| (m.study.as_str(), m.runs.len(), (0..m.runs.len()).filter(|i| i % n == k - 1).count())).collect();
     if counts.iter().all(|c| c.2 == 0) {

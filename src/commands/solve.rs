@@ -2,10 +2,12 @@
 //! it, with its error, estimate and KKT report; `export` writes it for the NGSolve cross-check.
 
 use super::places::{check_target, output_folder};
-use crate::adapt::{self, AdaptConfig};
-use crate::contact::PdasOptions;
-use crate::estimate::{self, EstimatorConfig};
+use crate::adapt;
+use crate::estimate;
 use crate::mesh::MeshSpec;
+use crate::settings::adapt::AdaptConfig;
+use crate::settings::estimator::{ConfigError, EstimatorConfig};
+use crate::settings::pdas::PdasOptions;
 use crate::{norms, problems, report, solve};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
@@ -38,7 +40,7 @@ pub struct SolveOptions {
 /// Validate the loop's settings as manifests do (the same functions), naming each setting as
 /// `names` does: every setting, and `max_ndof` against the initial mesh `spec`.
 pub fn validate(config: &AdaptConfig, spec: &MeshSpec, names: Names) -> Result<()> {
-    let flag = |e: estimate::ConfigError| anyhow::anyhow!("{}: expected {}, got {}", names(e.key), e.expected, e.got);
+    let flag = |e: ConfigError| anyhow::anyhow!("{}: expected {}, got {}", names(e.key), e.expected, e.got);
     config.validate().map_err(flag)?;
     config.check_initial(spec.ndof()?, &spec.to_string()).map_err(flag)
 }

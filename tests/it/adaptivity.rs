@@ -9,11 +9,12 @@
 
 use crate::common;
 use common::*;
-use signorini::adapt::{self, AdaptConfig, Level};
-use signorini::adapt::{LevelRecord, Refine};
-use signorini::estimate::{ContactTerm, EstimatorConfig};
+use signorini::adapt::{self, Level};
+use signorini::level::record::LevelRecord;
 use signorini::mesh::{Mesh, dist};
 use signorini::problems::{Ex71, Ex72, Exact, Part, Problem};
+use signorini::settings::adapt::{AdaptConfig, Refine};
+use signorini::settings::estimator::{ContactTerm, EstimatorConfig};
 use std::ops::ControlFlow;
 use std::time::Instant;
 

@@ -6,7 +6,7 @@
 
 use signorini::claims::{self, Claim, Criterion, RowKind, Verdict, terms};
 use signorini::records::RunRecord;
-use signorini::study::store::Shelf;
+use signorini_store::study::store::Shelf;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
@@ -34,7 +34,7 @@ fn has_reference_part(c: &Criterion) -> bool {
 
 /// Multiply `f`'s value at every level of `r` by (NDF / NDF_0)^power: its rate in NDF moves by
 /// -power (its trend by +power).
-fn scale_by_ndof(r: &mut RunRecord, power: f64, f: impl Fn(&mut signorini::adapt::LevelRecord) -> Vec<&mut f64>) {
+fn scale_by_ndof(r: &mut RunRecord, power: f64, f: impl Fn(&mut signorini::level::record::LevelRecord) -> Vec<&mut f64>) {
     let n0 = r.levels.first().map_or(1.0, |l| l.ndof as f64);
     for l in &mut r.levels {
         let factor = (l.ndof as f64 / n0).powf(power);
@@ -45,7 +45,7 @@ fn scale_by_ndof(r: &mut RunRecord, power: f64, f: impl Fn(&mut signorini::adapt
 }
 
 /// Every error and estimator quantity a rate row fits.
-fn rated(l: &mut signorini::adapt::LevelRecord) -> Vec<&mut f64> {
+fn rated(l: &mut signorini::level::record::LevelRecord) -> Vec<&mut f64> {
     let t = &mut l.terms;
     let mut out: Vec<&mut f64> = vec![
         &mut t.eta1,

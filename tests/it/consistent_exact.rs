@@ -326,7 +326,7 @@ fn a_refined_mesh_keeps_the_body_force_verdict_of_its_unchanged_triangles() {
 #[test]
 fn the_adaptive_loop_inherits_the_body_force_findings() {
     let mesh = crate::common::mesh(&Ex71, "structured:8");
-    let config = signorini::adapt::AdaptConfig { levels: 4, ..Default::default() };
+    let config = signorini::settings::adapt::AdaptConfig { levels: 4, ..Default::default() };
     let out = signorini::adapt::run(&Ex71, mesh, &config, None, &mut |_| std::ops::ControlFlow::Continue(())).unwrap();
     let findings = out.solution.body_force.expect("Example 7.1 has an exact solution");
     assert!(4 * findings.inherited() > out.mesh.n_triangles(), "{} of {}", findings.inherited(), out.mesh.n_triangles());

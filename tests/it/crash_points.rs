@@ -10,8 +10,8 @@
 //!   drift check's comparison finds no difference).
 
 use crate::common::{copy_tree, scratch, signorini_in};
-use signorini::study::manifest::Manifest;
-use signorini::study::store::Store;
+use signorini_store::study::manifest::Manifest;
+use signorini_store::study::store::Store;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -139,7 +139,7 @@ fn files(dir: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 fn reproducible(record: &signorini::records::RunRecord) -> serde_json::Value {
     let mut v = serde_json::to_value(&record.levels).unwrap();
     for level in v.as_array_mut().unwrap() {
-        level.as_object_mut().unwrap().retain(|k, _| !signorini::adapt::is_measurement(k));
+        level.as_object_mut().unwrap().retain(|k, _| !signorini::level::record::is_measurement(k));
     }
     serde_json::json!({ "run": record.run, "levels": v })
 }

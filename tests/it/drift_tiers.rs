@@ -8,8 +8,9 @@
 
 use signorini::records::StudyDir;
 use signorini::study::drift::{self, DriftOptions};
-use signorini::study::manifest::Manifest;
-use signorini::study::{self, RunOptions, store};
+use signorini::study::{self, RunOptions};
+use signorini_store::study::manifest::Manifest;
+use signorini_store::study::store;
 use std::path::{Path, PathBuf};
 
 const DEEP: &str = r#"description = "a deep study in miniature"
@@ -137,7 +138,7 @@ fn a_change_of_the_stored_history_is_caught_by_every_test_run() {
     // level 2 (past c's quick prefix) marked everywhere: level 3's mesh is no longer the one stored
     edit_run(&root, &m, "c", |r| {
         let h = &mut r.history.as_mut().unwrap().levels[2];
-        h.marks = signorini::adapt::Flags::encode(&vec![true; h.n_elements]);
+        h.marks = signorini::level::history::Flags::encode(&vec![true; h.n_elements]);
     });
     let opts = DriftOptions {
         quick: false,
@@ -154,7 +155,7 @@ fn a_change_of_the_stored_history_is_caught_by_every_test_run() {
     // and a change inside the prefix is caught by the rerun itself
     edit_run(&root, &m, "c", |r| {
         let h = &mut r.history.as_mut().unwrap().levels[0];
-        h.marks = signorini::adapt::Flags::encode(&vec![false; h.n_elements]);
+        h.marks = signorini::level::history::Flags::encode(&vec![false; h.n_elements]);
     });
     let rows = drift_rows(&root, &m, false);
     assert!(rows.contains(&("c".to_string(), Some(0), "history.marks".to_string())), "{rows:?}");

@@ -6,9 +6,9 @@
 use crate::common;
 use common::*;
 use signorini::adapt;
-use signorini::contact::sampling::Sampling;
 use signorini::norms;
 use signorini::problems::{Ex71, Ex72, Exact, Patch, Problem};
+use signorini::settings::sampling::Sampling;
 
 #[test]
 fn p2_field_has_no_error_on_gamma_c() {

@@ -10,10 +10,12 @@
 
 use crate::common;
 use common::*;
-use signorini::contact::sampling::Sampling;
-use signorini::estimate::{self, ContactTerm, EstimatorConfig, LogFactor, Terms};
+use signorini::estimate;
+use signorini::level::terms::Terms;
 use signorini::mesh::Mesh;
 use signorini::problems::{Ex71, Ex72, Exact, Material, Part, Patch, Problem};
+use signorini::settings::estimator::{ContactTerm, EstimatorConfig, LogFactor};
+use signorini::settings::sampling::Sampling;
 
 /// The four estimator configurations that differ in what eta_1..eta_5 are (the log factor and
 /// C_0 do not enter eta_1..eta_5, but they enter eta_h and the estimate, which are checked too).

@@ -2,12 +2,13 @@
 //! eta_5 keeps the tensile normal stress at full-contact nodes, which the variant without
 //! full-contact nodes drops; eta_7 is taken over a subset of the paper's Lambda_h^C.
 
-use signorini::adapt::Refine;
-use signorini::adapt::{self, AdaptConfig, Level};
-use signorini::contact::PdasOptions;
-use signorini::estimate::{self, ContactTerm, Estimate, EstimatorConfig};
+use signorini::adapt::{self, Level};
+use signorini::estimate::{self, Estimate};
 use signorini::mesh::{Mesh, MeshSpec};
 use signorini::problems::{Ex71, Fb, Problem};
+use signorini::settings::adapt::{AdaptConfig, Refine};
+use signorini::settings::estimator::{ContactTerm, EstimatorConfig};
+use signorini::settings::pdas::PdasOptions;
 use std::ops::ControlFlow;
 
 fn estimates(problem: &dyn Problem, mesh: &str) -> (Mesh, [Estimate; 3]) {

@@ -2,10 +2,11 @@
 //! the SVGs carry the axis and legend text, and studies without results are skipped, not errors.
 //! The figures are left in `target/tmp/figures-test/figures/` for a look.
 
-use signorini::adapt::{LevelRecord, Refine};
-use signorini::estimate::{ContactTerm, EstimatorConfig, LogFactor};
+use signorini::level::record::LevelRecord;
 use signorini::plot::{self, FIGURES};
 use signorini::records::{MeshSnapshot, RunRecord, RunSpec, StudyDir, write_json};
+use signorini::settings::adapt::Refine;
+use signorini::settings::estimator::{ContactTerm, EstimatorConfig, LogFactor};
 use std::path::{Path, PathBuf};
 
 fn level(level: usize, ndof: usize, err: Option<f64>, c0: f64, eta: [f64; 7]) -> LevelRecord {
@@ -161,7 +162,7 @@ fn mesh_snapshot() -> MeshSnapshot {
     }
     let contact_nodes = ys
         .iter()
-        .map(|&y| signorini::contact::solve::ContactSample { x: [1.0, y], lambda: 0.0, pressure: 0.0, active: (y - 0.5).abs() < 0.22 })
+        .map(|&y| signorini::level::sample::ContactSample { x: [1.0, y], lambda: 0.0, pressure: 0.0, active: (y - 0.5).abs() < 0.22 })
         .collect();
     MeshSnapshot {
         study: "ex72".into(),
@@ -276,8 +277,8 @@ fn full_results(results: &Path) {
 /// The hertz study: one run of the repository's Hertz problem file (found through the provenance's
 /// manifest, as for stored results), its last level with contact nodes sampling Hertz's pressure.
 fn hertz_results(results: &Path) {
-    use signorini::contact::solve::ContactSample;
     use signorini::hertz::Hertz;
+    use signorini::level::sample::ContactSample;
     use signorini::problems::Material;
     let mut r = run("adaptive", "problems/hertz.toml", Refine::Adaptive);
     r.missing = never;

@@ -459,7 +459,7 @@ fn contact_zone_arc_length_along_a_curve() {
 /// meshes stay as they are.
 #[test]
 fn manifest_mesh_paths_are_relative_to_the_manifest() {
-    use signorini::study::manifest::{Manifest, resolve_mesh};
+    use signorini_store::study::manifest::{Manifest, resolve_mesh};
     let text = |mesh: &str| format!("[defaults]\nproblem = \"ex71\"\nlevels = 2\nmesh = \"{mesh}\"\n[[run]]\nid = \"a\"\n");
     // the manifest reads the mesh (its hash is part of the run's spec): put one where it points
     let root = std::env::temp_dir().join(format!("signorini-mesh-paths-{}", std::process::id()));
@@ -558,7 +558,7 @@ fn hertz_mesh_gives_one_contact_interval_around_the_lowest_point() {
         }
     }
     let m = MeshSpec::Gmsh(meshes_dir().join("hertz.msh")).build(&Pressed).unwrap();
-    let config = signorini::adapt::AdaptConfig { levels: 4, ..Default::default() };
+    let config = signorini::settings::adapt::AdaptConfig { levels: 4, ..Default::default() };
     let out = signorini::adapt::run(&Pressed, m, &config, None, &mut |_| std::ops::ControlFlow::Continue(())).unwrap();
     let (m, sol) = (&out.mesh, &out.solution);
     for e in m.boundary.iter().filter(|e| e.curve.is_some()) {

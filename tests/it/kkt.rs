@@ -19,8 +19,8 @@ fn kkt_holds_for_both_examples() {
 /// hide every contact force from eta_7) leaves the forces counted as positive as they were.
 #[test]
 fn inactive_forces_stay_below_their_round_off_bound_on_adaptive_levels() {
-    use signorini::adapt::Refine;
-    use signorini::adapt::{self, AdaptConfig, Level};
+    use signorini::adapt::{self, Level};
+    use signorini::settings::adapt::{AdaptConfig, Refine};
     use std::ops::ControlFlow;
     for name in problems::KNOWN {
         let p = problems::by_name(name).unwrap();
@@ -38,7 +38,7 @@ fn inactive_forces_stay_below_their_round_off_bound_on_adaptive_levels() {
 /// (`study::reference::replay` starts from the active set the loop's solve ended with).
 #[test]
 fn warm_start_from_the_solution_converges_in_one_iteration() {
-    use signorini::contact::{PdasOptions, Strategy};
+    use signorini::settings::pdas::{PdasOptions, Strategy};
     let p = problems::Ex72;
     let m = mesh(&p, "structured:32");
     for strategy in [Strategy::Schur, Strategy::Refactor] {
@@ -58,7 +58,7 @@ fn warm_start_from_the_solution_converges_in_one_iteration() {
 
 #[test]
 fn schur_and_refactor_strategies_agree() {
-    use signorini::contact::{PdasOptions, Strategy};
+    use signorini::settings::pdas::{PdasOptions, Strategy};
     for (problem, spec) in
         [(&problems::Ex72 as &dyn Problem, "structured:24"), (&problems::Ex71, "structured:12"), (&problems::Ex72, "symmetric:16")]
     {
@@ -87,8 +87,9 @@ fn schur_and_refactor_strategies_agree() {
 #[test]
 fn non_converged_active_set_method_returns_its_last_iterate() {
     use signorini::assembly::{self, DofMap};
-    use signorini::contact::{ContactSolver, PdasOptions, PdasTermination, Strategy};
+    use signorini::contact::{ContactSolver, PdasTermination};
     use signorini::mesh::P2Nodes;
+    use signorini::settings::pdas::{PdasOptions, Strategy};
     let p = problems::Ex72;
     let m = mesh(&p, "structured:16");
     let nodes = P2Nodes::new(&m);
@@ -113,7 +114,8 @@ fn non_converged_active_set_method_returns_its_last_iterate() {
 /// An active set seen before: the iteration stops with `Cycling` and the iterate that led there.
 #[test]
 fn cycling_active_set_method_returns_its_last_iterate() {
-    use signorini::contact::{PdasOptions, PdasTermination, pdas};
+    use signorini::contact::{PdasTermination, pdas};
+    use signorini::settings::pdas::PdasOptions;
     let g = [0.5];
     // inactive -> the node penetrates (next: active); active -> negative force (next: inactive)
     let mut step = |a: &[bool]| Ok(if a[0] { (vec![0.5], vec![-1.0]) } else { (vec![1.5], vec![0.0]) });
@@ -151,7 +153,7 @@ fn two_bodies(shift: [f64; 2]) -> signorini::mesh::Mesh {
 }
 
 fn solve_err(m: &signorini::mesh::Mesh) -> signorini::solve::SolveError {
-    let sol = signorini::solve::solve(m, &problems::Ex72, &signorini::contact::PdasOptions::default(), &mut |_| {});
+    let sol = signorini::solve::solve(m, &problems::Ex72, &signorini::settings::pdas::PdasOptions::default(), &mut |_| {});
     sol.err().expect("a body that can move rigidly is refused")
 }
 
@@ -185,7 +187,7 @@ fn a_problem_file_whose_dirichlet_part_matches_nothing_is_refused() {
     std::fs::write(&file, text.replace("dirichlet = \"x < 1e-12\"", "dirichlet = \"x < -1\"")).unwrap();
     let problem = signorini::problems::by_name(file.to_str().unwrap()).unwrap();
     let m = mesh(problem.as_ref(), "structured:8");
-    let err = signorini::solve::solve(&m, problem.as_ref(), &signorini::contact::PdasOptions::default(), &mut |_| {}).err().unwrap();
+    let err = signorini::solve::solve(&m, problem.as_ref(), &signorini::settings::pdas::PdasOptions::default(), &mut |_| {}).err().unwrap();
     let msg = err.to_string();
     assert!(msg.contains("the body can move rigidly") && msg.contains("has no Dirichlet node"), "{msg}");
     assert!(msg.contains("0 Dirichlet, 8 contact, 24 Neumann") && msg.contains("parts.dirichlet = \"x < -1\""), "{msg}");
@@ -206,8 +208,9 @@ fn a_problem_file_whose_dirichlet_part_matches_nothing_is_refused() {
 fn the_kkt_certificate_names_each_violated_condition() {
     use signorini::assembly::{self, DofMap};
     use signorini::certify::{KktInput, TOLERANCE, certify};
-    use signorini::contact::{ContactSolver, PdasOptions};
+    use signorini::contact::ContactSolver;
     use signorini::mesh::P2Nodes;
+    use signorini::settings::pdas::PdasOptions;
     let p = problems::Ex72;
     let m = mesh(&p, "structured:16");
     let nodes = P2Nodes::new(&m);
@@ -284,7 +287,7 @@ fn every_solve_is_certified_at_round_off() {
 /// counts as positive.
 #[test]
 fn contact_force_bounds_are_near_the_round_off_two_solves_show() {
-    use signorini::contact::active_set::{PdasOptions, Strategy};
+    use signorini::settings::pdas::{PdasOptions, Strategy};
     let p = problems::by_name("fb").unwrap();
     let mut m = mesh(p.as_ref(), "structured:4");
     for _ in 0..LEVELS {

@@ -6,8 +6,9 @@
 //! level is solved.
 
 use crate::common::{mesh, run_edited, scratch, signorini_in};
-use signorini::adapt::{self, AdaptConfig, AdaptError, AdaptTermination, Level, Refine, Start};
+use signorini::adapt::{self, AdaptError, AdaptTermination, Level, Start};
 use signorini::problems::Fb;
+use signorini::settings::adapt::{AdaptConfig, Refine};
 use std::ops::ControlFlow;
 
 /// `stop_ndof` above `max_ndof` (a stop no level can reach, since no level above `max_ndof` is
@@ -203,8 +204,8 @@ fn an_estimate_at_round_off_marks_nothing_and_says_so() {
 #[test]
 fn the_command_line_and_the_manifests_default_to_the_librarys_values() {
     use clap::ValueEnum;
-    use signorini::adapt::AdaptConfig;
     use signorini::mesh::MeshSpec;
+    use signorini::settings::adapt::AdaptConfig;
     let (a, e) = (AdaptConfig::default(), AdaptConfig::default().estimator);
     let name = |v: Option<clap::builder::PossibleValue>| v.unwrap().get_name().to_string();
     let expected = [
@@ -225,7 +226,7 @@ fn the_command_line_and_the_manifests_default_to_the_librarys_values() {
     }
     let manifest = dir.join("defaults.toml");
     std::fs::write(&manifest, "[defaults]\nproblem = \"ex71\"\nlevels = 3\n\n[[run]]\nid = \"a\"\n").unwrap();
-    let m = signorini::study::manifest::Manifest::load(&manifest).unwrap();
+    let m = signorini_store::study::manifest::Manifest::load(&manifest).unwrap();
     let run = &m.runs[0].spec;
     assert_eq!((run.mesh.as_str(), run.theta, run.refine, run.estimator), (MeshSpec::DEFAULT, a.theta, a.refine, e));
     std::fs::remove_dir_all(&dir).unwrap();

@@ -4,7 +4,7 @@
 use proptest::prelude::*;
 use signorini::mesh::MeshSpec;
 use signorini::report::parse_probe;
-use signorini::study::manifest::Manifest;
+use signorini_store::study::manifest::Manifest;
 use std::path::Path;
 
 /// Strings that look like numbers, and some that almost do.

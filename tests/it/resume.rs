@@ -57,7 +57,7 @@ fn run(results: &Path, manifest: &Path) -> std::process::Output {
 fn without_measurements(file: PathBuf) -> serde_json::Value {
     let mut v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(file).unwrap()).unwrap();
     for l in v["levels"].as_array_mut().unwrap() {
-        l.as_object_mut().unwrap().retain(|k, _| !signorini::adapt::is_measurement(k));
+        l.as_object_mut().unwrap().retain(|k, _| !signorini::level::record::is_measurement(k));
     }
     v
 }

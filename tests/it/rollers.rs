@@ -6,9 +6,9 @@
 
 use crate::common;
 use common::*;
-use signorini::adapt::Refine;
-use signorini::adapt::{self, AdaptConfig};
+use signorini::adapt;
 use signorini::problems::{FileProblem, Problem};
+use signorini::settings::adapt::{AdaptConfig, Refine};
 use signorini::study::reference;
 use std::path::Path;
 
@@ -73,7 +73,7 @@ fn uniform_rate(p: &dyn Problem) -> f64 {
     let spec = signorini::records::ReferenceSpec {
         theta: 0.5,
         min_ndof: 200_000,
-        contact_term: signorini::estimate::ContactTerm::WithoutFullContact,
+        contact_term: signorini::settings::estimator::ContactTerm::WithoutFullContact,
     };
     let mesh_spec = signorini::mesh::MeshSpec::parse("structured:4").unwrap();
     let field = reference::compute(p, &mesh_spec, &spec, &mut |_| std::ops::ControlFlow::Continue(())).unwrap().unwrap();

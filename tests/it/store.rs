@@ -5,9 +5,10 @@
 
 use crate::common::{fixture_path, scratch};
 use signorini::records::StudyDir;
-use signorini::study::manifest::Manifest;
-use signorini::study::store::Store;
-use signorini::study::{check_complete, drift};
+use signorini::study::drift;
+use signorini_store::study::check_complete;
+use signorini_store::study::manifest::Manifest;
+use signorini_store::study::store::Store;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};

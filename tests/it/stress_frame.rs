@@ -1,13 +1,15 @@
-//! The two readings of sigma-hat in eta_4, eta_5 (`estimate::StressFrame`): on Example 7.1's
+//! The two readings of sigma-hat in eta_4, eta_5 (`settings::estimator::StressFrame`): on Example 7.1's
 //! bottom edge (n = (0, -1)) the Cartesian reading swaps the tangential and normal stresses, on
 //! Example 7.2's right edge (n = (1, 0)) both readings agree; the other terms never change.
 
 use crate::common;
 
-use signorini::estimate::{self, EstimatorConfig, StressFrame};
+use signorini::estimate;
+use signorini::level::terms::Terms;
 use signorini::problems::{Ex71, Ex72, Problem};
+use signorini::settings::estimator::{EstimatorConfig, StressFrame};
 
-fn both(problem: &dyn Problem) -> (estimate::Terms, estimate::Terms) {
+fn both(problem: &dyn Problem) -> (Terms, Terms) {
     let mesh = common::mesh(problem, "structured:8");
     let sol = common::solve_on(problem, &mesh);
     let normal = estimate::estimate(&mesh, problem, &sol, &EstimatorConfig::default()).terms;

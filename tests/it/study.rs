@@ -6,7 +6,7 @@ use crate::common::{fixture_path, scratch};
 use common::parse_err;
 
 use signorini::records::{RunRecord, StudyDir};
-use signorini::study::manifest::{Manifest, ManifestError};
+use signorini_store::study::manifest::{Manifest, ManifestError};
 use std::path::Path;
 use std::process::Command;
 
@@ -21,7 +21,7 @@ fn signorini(args: &[&str]) -> (bool, String) {
 fn numbers(r: &RunRecord) -> serde_json::Value {
     let mut v = serde_json::to_value(r).unwrap();
     for l in v["levels"].as_array_mut().unwrap() {
-        l.as_object_mut().unwrap().retain(|k, _| !signorini::adapt::is_measurement(k));
+        l.as_object_mut().unwrap().retain(|k, _| !signorini::level::record::is_measurement(k));
     }
     v
 }
@@ -148,7 +148,7 @@ fn stored_reference_replays_to_the_computed_one() {
     let mut marks = altered.history.levels[level].marks.decode().unwrap();
     let first_unmarked = marks.iter().position(|m| !m).unwrap();
     marks[first_unmarked] = true;
-    altered.history.levels[level].marks = signorini::adapt::Flags::encode(&marks);
+    altered.history.levels[level].marks = signorini::level::history::Flags::encode(&marks);
     let e = reference::replay(problem.as_ref(), &mesh_spec, reference_spec, &altered, &m.drift)
         .err()
         .expect("altered marks do not replay")

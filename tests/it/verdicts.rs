@@ -4,10 +4,11 @@
 //! synthetic records (and say "no data" without them).
 
 use crate::common::scratch;
-use signorini::adapt::{LevelRecord, Refine};
 use signorini::claims::{self, Verdict};
-use signorini::estimate::EstimatorConfig;
+use signorini::level::record::LevelRecord;
 use signorini::records::{MeshSnapshot, RunRecord, RunSpec, StudyDir, write_json};
+use signorini::settings::adapt::Refine;
+use signorini::settings::estimator::EstimatorConfig;
 use signorini::verdict::{self, RateReport, RateVerdict, refinement};
 
 /// Deterministic pseudo-random numbers, roughly standard normal (sum of 12 uniforms - 6).
@@ -212,7 +213,7 @@ fn synthetic_levels(rate: f64, growth: f64, n: usize) -> Vec<LevelRecord> {
                 h_min: h,
                 zone_min: Some(a + 0.7 * h),
                 zone_max: Some(1.0),
-                terms: signorini::estimate::Terms { l_h: 1.0, eta_h: estimate / 0.45, c0: 0.45, estimate, ..Default::default() },
+                terms: signorini::level::terms::Terms { l_h: 1.0, eta_h: estimate / 0.45, c0: 0.45, estimate, ..Default::default() },
                 h_free_boundary: Some(0.5 * (ndof as f64).powf(-0.75)),
                 err_quadrature: Some(err),
                 err_dense: Some(1.1 * err),

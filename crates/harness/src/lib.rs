@@ -1,7 +1,7 @@
 //! The harness above the solver and the store: the runner of declared studies, their reference
 //! solutions, the drift check, and what a solve reports. The records, manifests and the results
-//! folder's store are the store crate's (`signorini-store`), re-exported here under the paths
-//! this crate uses for them (`records`, `study::manifest`, `study::store`).
+//! folder's store are the store crate's (`signorini-store`: `records`, `study::manifest`,
+//! `study::store`).
 //!
 //! Floors, top first; code uses only its own floor and the floors below, and the crates below
 //! (`tests/it/layers.rs` checks the floors inside this crate, the compiler the crates):
@@ -18,6 +18,3 @@
 
 pub mod report;
 pub mod study;
-
-// the records of runs, from the store crate, under the path this crate uses for them
-pub use ::store::records;

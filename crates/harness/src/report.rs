@@ -4,12 +4,14 @@
 
 use ::store::records;
 use anyhow::Result;
+use model::level::terms::Terms;
 use model::mesh::locate::Locator;
 use model::mesh::{Mesh, io};
+use model::settings::estimator::EstimatorConfig;
 use numerics::contact::PdasIteration;
 use numerics::contact::norms::LinfError;
 use numerics::contact::solve::{ContactInterval, DiscreteSolution, Kkt, SolveTimings};
-use numerics::estimator::estimate::{Estimate, EstimatorConfig, Terms};
+use numerics::estimator::estimate::Estimate;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -130,8 +132,8 @@ impl SolveReport {
             roundoff_floor: sol.roundoff,
             error,
             error_sampling: NormPoints {
-                quadrature: numerics::contact::sampling::Sampling::Quadrature.describe(),
-                dense: numerics::contact::sampling::Sampling::Dense.describe(),
+                quadrature: model::settings::sampling::Sampling::Quadrature.describe(),
+                dense: model::settings::sampling::Sampling::Dense.describe(),
             },
             estimator: estimate.terms,
             estimator_config: estimate.config,

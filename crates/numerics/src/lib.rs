@@ -2,9 +2,9 @@
 //! elasticity with frictionless unilateral contact, solved by a primal–dual active set method,
 //! the supremum-norm a posteriori estimator of Khandelwal, Porwal and Wadhawan, and the adaptive
 //! loop SOLVE -> ESTIMATE -> MARK -> REFINE. Nothing here knows of studies or results folders.
-//! Problems, meshes, settings and level records are the model crate's (`signorini-model`); the
-//! settings and level records are re-exported where the loop, the contact solve and the
-//! estimator had them (`adapt::LevelRecord`, `contact::PdasOptions`, `estimate::EstimatorConfig`).
+//! Problems, meshes, settings and level records are the model crate's (`signorini-model`), named
+//! there (`model::level::record::LevelRecord`, `model::settings::pdas::PdasOptions`,
+//! `model::settings::estimator::EstimatorConfig`).
 //!
 //! Floors, one folder each, top first; code uses only its own floor and the floors below
 //! (`tests/it/layers.rs` checks it, and that no two files use each other):

@@ -16,11 +16,11 @@
 use super::{load, peak_rss_mb, run_child};
 use anyhow::{Context, Result};
 use signorini::assembly::{self, DofMap};
-use signorini::contact::active_set::Strategy;
 use signorini::mesh::{Mesh, MeshSpec, P2Nodes};
+use signorini::settings::pdas::Strategy;
 use signorini::sparse::anatomy::{FillCount, NodeGraph};
-use signorini::study::manifest::Manifest;
 use signorini::{cholesky, records, symbolic};
+use signorini_store::study::manifest::Manifest;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -183,7 +183,7 @@ struct Built {
     problem: Box<dyn signorini::problems::Problem>,
     run: String,
     level: Option<usize>,
-    stored: Option<signorini::adapt::LevelRecord>,
+    stored: Option<signorini::level::record::LevelRecord>,
 }
 
 fn build(case: &str, ndof: f64) -> Result<Built> {

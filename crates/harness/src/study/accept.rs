@@ -6,9 +6,9 @@
 //! it does not replace removed. Stopped before the swap (an interrupt, a kill, a failed run) the
 //! stored study is as it was; stopped during it, the next writer of the study completes it.
 
-use super::store::{Store, owned};
 use super::{Manifest, RunOptions};
 use ::store::records::{StudyDir, journal::Journal};
+use ::store::study::store::{Store, owned};
 use anyhow::{Context, Result, bail};
 use std::path::{Path, PathBuf};
 

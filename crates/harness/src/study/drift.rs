@@ -31,11 +31,11 @@
 //! folder holding none is an error. Their provenance must match too ([`compare_provenance`]):
 //! records made from an edited manifest, problem file or mesh are reported as such.
 
-use super::manifest::DERIVED;
-use super::manifest::{DriftSpec, Manifest, Tolerance};
-use super::store::Store;
 use ::store::records::RunRecord;
-use numerics::adapt::LevelRecord;
+use ::store::study::manifest::DERIVED;
+use ::store::study::manifest::{DriftSpec, Manifest, Tolerance};
+use ::store::study::store::Store;
+use model::level::record::LevelRecord;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -185,7 +185,7 @@ fn compare_level(
     keys.sort();
     keys.dedup();
     for key in keys {
-        if numerics::adapt::is_measurement(key) {
+        if model::level::record::is_measurement(key) {
             continue; // timings and memory are never compared
         }
         let (sv, fv) = (s.get(key), f.get(key));
@@ -298,7 +298,7 @@ pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], q
         };
         // the spec: the stored full spec, shortened to the quick form where quick
         let expected_spec =
-            super::effective_spec(&super::manifest::PlannedRun { spec: s.run.clone(), quick_levels: planned.quick_levels }, quick);
+            super::effective_spec(&::store::study::manifest::PlannedRun { spec: s.run.clone(), quick_levels: planned.quick_levels }, quick);
         if expected_spec != f.run {
             out.push(row(
                 study,
@@ -379,7 +379,8 @@ fn compare_histories(study: &str, stored: &RunRecord, fresh: &RunRecord, out: &m
         (Some(s), Some(f)) => (s, f),
         (None, None) => return,
         (s, f) => {
-            let text = |h: Option<&numerics::adapt::History>| h.map_or("(missing)".to_string(), |h| format!("{} levels", h.levels.len()));
+            let text =
+                |h: Option<&model::level::history::History>| h.map_or("(missing)".to_string(), |h| format!("{} levels", h.levels.len()));
             out.push(row(study, id, None, "history", text(s.as_ref()), text(f.as_ref()), None, "exact".into()));
             return;
         }
@@ -391,7 +392,10 @@ fn compare_histories(study: &str, stored: &RunRecord, fresh: &RunRecord, out: &m
 
 /// The first level at which two refinement histories differ, as far as the shorter goes: the
 /// level, what differs (`mesh`, `marks`, `initial_active`) and the two sides, for a row.
-fn first_history_difference(s: &numerics::adapt::History, f: &numerics::adapt::History) -> Option<(usize, &'static str, String, String)> {
+fn first_history_difference(
+    s: &model::level::history::History,
+    f: &model::level::history::History,
+) -> Option<(usize, &'static str, String, String)> {
     s.levels.iter().zip(&f.levels).find_map(|(a, b)| {
         if a.mesh != b.mesh || a.n_elements != b.n_elements {
             Some((a.level, "mesh", format!("{} elements, {}", a.n_elements, a.mesh), format!("{} elements, {}", b.n_elements, b.mesh)))
@@ -534,19 +538,19 @@ pub fn table(rows: &[DriftRow]) -> String {
     s
 }
 
-use super::store::first_difference;
+use ::store::study::store::first_difference;
 
 /// The views of a study's stored records, checked against what the records render
-/// ([`super::store::check::summary_faults`]): `levels.csv` byte for byte and `provenance.json`'s
+/// ([`::store::study::store::check::summary_faults`]): `levels.csv` byte for byte and `provenance.json`'s
 /// list of runs. A hand edit, a bad merge or a study interrupted before its summaries were
 /// rewritten is drift.
 pub fn check_derived(store: &Store, runs: &[RunRecord]) -> Vec<DriftRow> {
-    super::store::check::summary_faults(store.dir(), store.study(), runs).iter().map(|f| fault_row(store, f)).collect()
+    ::store::study::store::check::summary_faults(store.dir(), store.study(), runs).iter().map(|f| fault_row(store, f)).collect()
 }
 
-/// A fault of the stored folder ([`super::store::Store::check`]) as a row of drift: the file
+/// A fault of the stored folder ([`::store::study::store::Store::check`]) as a row of drift: the file
 /// (relative to the study folder) and what is wrong with it.
-fn fault_row(store: &Store, f: &super::store::Fault) -> DriftRow {
+fn fault_row(store: &Store, f: &::store::study::store::Fault) -> DriftRow {
     let (study, dir) = (store.study(), store.dir());
     let file = f.file.strip_prefix(&dir.root).unwrap_or(&f.file).display().to_string();
     let field = if f.record.is_some() { "store".to_string() } else { file.clone() };
@@ -567,7 +571,7 @@ fn fault_row(store: &Store, f: &super::store::Fault) -> DriftRow {
 pub struct DriftOptions {
     /// Rerun the quick forms (prefixes of the stored runs) instead of the full studies.
     pub quick: bool,
-    /// Rerun deep studies ([`super::manifest::DeepTier`]) to the end; without it they are rerun
+    /// Rerun deep studies ([`::store::study::manifest::DeepTier`]) to the end; without it they are rerun
     /// in their tiers.
     pub deep: bool,
     /// Compare with the records already in this results folder instead of rerunning (how
@@ -599,7 +603,7 @@ pub struct DriftReport {
     #[serde(default)]
     pub self_comparison: bool,
     /// With `against`: the studies whose records there are byte-identical to the stored ones,
-    /// timings (`t_*`) included ([`compared_a_copy`](super::compared_a_copy)): a copy of the stored folder, not a rerun.
+    /// timings (`t_*`) included ([`compared_a_copy`](::store::study::compared_a_copy)): a copy of the stored folder, not a rerun.
     #[serde(default)]
     pub copies: Vec<String>,
 }
@@ -663,7 +667,7 @@ fn listed(names: &[String]) -> String {
 /// (with `named`, the studies were named one by one and each must be there), and the names of
 /// those it does not. A folder holding none of them is an error: there is nothing to compare.
 pub fn select_against(dir: &Path, manifests: &[Manifest], named: bool) -> anyhow::Result<(Vec<Manifest>, Vec<String>)> {
-    let held = super::held_by(dir, manifests).map_err(|e| anyhow::anyhow!("--against {}: {e}", dir.display()))?;
+    let held = ::store::study::held_by(dir, manifests).map_err(|e| anyhow::anyhow!("--against {}: {e}", dir.display()))?;
     if named && !held.absent.is_empty() {
         anyhow::bail!(
             "--against {}: the folder does not hold {} (it holds: {}); nothing of {} to compare",
@@ -689,7 +693,7 @@ pub fn select_against(dir: &Path, manifests: &[Manifest], named: bool) -> anyhow
 /// meshes the runs were made with (by hash). Records made from an edited manifest or problem
 /// file differ even where every number agrees.
 pub fn compare_provenance(study: &str, stored: &Store, fresh: &Store) -> Vec<DriftRow> {
-    use super::provenance::Provenance;
+    use ::store::study::provenance::Provenance;
     let read = |d: &Store| d.provenance().ok();
     let tol = "exact (what the runs were made with)";
     let (Some(s), Some(f)) = (read(stored), read(fresh)) else {
@@ -756,7 +760,7 @@ pub fn check(
         }
     };
     let mut report = DriftReport {
-        date: super::provenance::utc_now(),
+        date: ::store::study::provenance::utc_now(),
         quick: opts.quick,
         against: opts.against.as_ref().map(|p| p.display().to_string()),
         studies: Vec::new(),
@@ -773,10 +777,10 @@ pub fn check(
         .collect();
     // held until the comparisons end: another drift in this checkout waits rather than
     // starting over the reruns this one compares
-    let _scratch = if opts.against.is_none() { Some(super::store::scratch_folder(&opts.scratch)?) } else { None };
+    let _scratch = if opts.against.is_none() { Some(::store::study::store::scratch_folder(&opts.scratch)?) } else { None };
     for (m, _) in &planned {
         let stored = Store::of(&opts.results, m);
-        if let Some(why) = stored.provenance().ok().and_then(|p| super::provenance::history_fault_of(&p, &m.file)) {
+        if let Some(why) = stored.provenance().ok().and_then(|p| ::store::study::provenance::history_fault_of(&p, &m.file)) {
             anyhow::bail!(
                 "{}: {why}. The drift check compares with results of known code; rerun the study on a commit of this history (`signorini drift --accept {}`) and commit its results",
                 stored.dir().root.display(),
@@ -820,7 +824,7 @@ pub fn check(
             serde_json::json!({ "study": m.study, "runs": fresh.len(), "drift": c.rows.len(), "quick": quick, "records": hashes(&stored) });
         if opts.against.is_some() {
             entry["against_records"] = serde_json::to_value(hashes(&fresh))?;
-            if super::compared_a_copy(&entry) {
+            if ::store::study::compared_a_copy(&entry) {
                 report.copies.push(m.study.clone());
             }
         }

@@ -21,15 +21,14 @@ pub mod drift;
 pub mod progress;
 pub mod reference;
 
-// the declared studies as stored, from the store crate, under the paths this crate uses for them
-pub use ::store::study::{Held, check_complete, compared_a_copy, held_by, manifest, provenance, store, stored_problem};
-
 use ::store::records::{Batch, MeshSnapshot, RunRecord, RunSpec};
+use ::store::study::{manifest, provenance, store};
 use anyhow::{Context, Result, bail};
 use manifest::Manifest;
 use model::mesh::MeshSpec;
 use model::problems;
-use numerics::adapt::{self, AdaptConfig, Level};
+use model::settings::adapt::AdaptConfig;
+use numerics::adapt::{self, Level};
 use progress::Progress;
 use reference::ReferenceField;
 use std::collections::HashMap;
@@ -139,8 +138,9 @@ pub fn effective_spec(planned: &manifest::PlannedRun, quick: bool) -> RunSpec {
 /// ([`interrupt`]) the run in progress is dropped and an [`Interrupted`] error says what was kept.
 ///
 /// ```rust
-/// use signorini_harness::study::{self, RunOptions, manifest::Manifest};
+/// use signorini_harness::study::{self, RunOptions};
 /// use std::path::Path;
+/// use store::study::manifest::Manifest;
 ///
 /// let text = r#"
 /// description = "two short runs"
@@ -160,7 +160,7 @@ pub fn effective_spec(planned: &manifest::PlannedRun, quick: bool) -> RunSpec {
 /// let opts = RunOptions { quick: false, shard: None, fresh: true, replace: false, results: results.clone(), progress: false, wait_for_lock: false };
 /// let ran = study::run_study(&manifest, &opts).unwrap();
 /// assert_eq!(ran, ["adaptive", "uniform"]);
-/// let runs = signorini_harness::records::StudyDir::new(&results, &manifest.study).read_runs().unwrap();
+/// let runs = store::records::StudyDir::new(&results, &manifest.study).read_runs().unwrap();
 /// assert_eq!(runs.iter().map(|r| r.levels.len()).collect::<Vec<_>>(), [3, 2]);
 /// std::fs::remove_dir_all(&results).unwrap();
 /// ```
@@ -722,7 +722,7 @@ fn loop_of(
             let kept_level = keep_level(study, spec, run, meshes, &level, prepared).and_then(|()| {
                 kept.levels.push(r.clone());
                 kept.history.levels.push(level.history.clone());
-                kept.next_active = level.next_active.map(numerics::adapt::Flags::encode);
+                kept.next_active = level.next_active.map(model::level::history::Flags::encode);
                 if level.continues { run.keep(&kept) } else { Ok(()) }
             });
             if let Err(e) = kept_level {

@@ -5,13 +5,14 @@
 
 use ::store::records::{Rebuild, ReferenceSpec};
 use model::base::element::{self, N_NODES};
+use model::level::history::Flags;
 use model::mesh::{
     Mesh, MeshSpec,
     locate::{Hit, Locator},
 };
 use model::problems::Problem;
-use numerics::adapt::{self, AdaptConfig};
-use numerics::adapt::{Flags, Refine};
+use model::settings::adapt::{AdaptConfig, Refine};
+use numerics::adapt;
 use numerics::contact::norms::Displacement;
 
 /// A P2 field on a mesh with an R*-tree for point location ([`Locator`]).
@@ -89,7 +90,7 @@ pub enum ReferenceError {
 /// The adaptive loop of a reference solution: the maximum strategy with `spec.theta`, the
 /// estimator with `spec.contact_term` (otherwise the defaults), as many levels as it takes.
 fn config_of(spec: &ReferenceSpec) -> AdaptConfig {
-    let estimator = numerics::estimator::estimate::EstimatorConfig { contact_term: spec.contact_term, ..Default::default() };
+    let estimator = model::settings::estimator::EstimatorConfig { contact_term: spec.contact_term, ..Default::default() };
     AdaptConfig { levels: REFERENCE_LEVELS, refine: Refine::Adaptive, theta: spec.theta, estimator, ..Default::default() }
 }
 
@@ -102,7 +103,7 @@ pub fn compute(
     problem: &dyn Problem,
     mesh_spec: &MeshSpec,
     spec: &ReferenceSpec,
-    on_level: &mut dyn FnMut(&numerics::adapt::LevelRecord) -> std::ops::ControlFlow<()>,
+    on_level: &mut dyn FnMut(&model::level::record::LevelRecord) -> std::ops::ControlFlow<()>,
 ) -> Result<Option<ReferenceField>, ReferenceError> {
     let mesh = mesh_spec.build(problem).map_err(|e| adapt::AdaptError::Solve(e.into()))?;
     let config = config_of(spec);
@@ -147,7 +148,7 @@ pub fn replay(
     mesh_spec: &MeshSpec,
     spec: &ReferenceSpec,
     record: &Rebuild,
-    tolerances: &crate::study::manifest::DriftSpec,
+    tolerances: &::store::study::manifest::DriftSpec,
 ) -> Result<ReferenceField, ReferenceError> {
     use adapt::replay::ReplayError;
     let mesh0 = mesh_spec.build(problem).map_err(|e| adapt::AdaptError::Solve(e.into()))?;

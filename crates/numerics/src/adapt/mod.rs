@@ -9,10 +9,6 @@
 pub mod replay;
 mod roundoff;
 
-pub use model::level::history::{self, BadFlags, Flags, History, LevelHistory};
-pub use model::level::record::{LevelRecord, float_fields, is_measurement};
-pub use model::settings::adapt::{AdaptConfig, Refine};
-
 pub use roundoff::{
     Cause, Caveat, Conditioned, Drowned, NO_DEFORMATION, RESOLVED_DEFORMATION, RESOLVED_FORCES, ROUNDOFF_ESTIMATE, Resolution, TRANSLATED,
     Unresolved, WARNED_FORCES, WARNED_SHAPE, deformation, force_roundoff, resolution,
@@ -21,10 +17,15 @@ pub use roundoff::{
 use crate::contact::consistent::BodyForceFindings;
 use crate::contact::norms::{self, Reference};
 use crate::contact::solve::{self, DiscreteSolution, SolveError};
-use crate::estimator::estimate::{self, ConfigError, Estimate};
+use crate::estimator::estimate::{self, Estimate};
+use model::level::history::{Flags, History, LevelHistory};
+use model::level::record::LevelRecord;
+use model::level::terms::NotFinite;
 use model::mesh::Mesh;
 use model::mesh::refine::{self, Refinement};
 use model::problems::Problem;
+use model::settings::adapt::{AdaptConfig, Refine};
+use model::settings::estimator::ConfigError;
 use std::ops::ControlFlow;
 use std::time::Instant;
 
@@ -43,7 +44,7 @@ pub enum AdaptError {
     SolveAt { level: usize, ndof: usize, error: Box<SolveError> },
     /// The estimate of level `level` is not a finite number (nothing of that level is kept).
     #[error("level {level}: {error}")]
-    Estimate { level: usize, error: estimate::NotFinite },
+    Estimate { level: usize, error: NotFinite },
     /// The next level would not fit in memory: levels `0..level` were solved (and seen by the
     /// observer), level `level` was not.
     #[error("stopped before level {level} ({}): {error}", if *level == 0 { "no level was solved".to_string() } else { format!("levels 0 to {} were solved", level - 1) })]
@@ -347,9 +348,10 @@ pub fn solve_level(
 /// `config` must be valid ([`AdaptConfig::validate`]); at least level 0 is always solved.
 ///
 /// ```rust
-/// use signorini_numerics::adapt::{self, AdaptConfig, AdaptTermination};
+/// use signorini_numerics::adapt::{self, AdaptTermination};
 /// use model::mesh::MeshSpec;
 /// use model::problems::{self, Problem};
+/// use model::settings::adapt::AdaptConfig;
 /// use std::ops::ControlFlow;
 ///
 /// let problem = problems::by_name("ex71").unwrap();

@@ -4,11 +4,13 @@
 //! drift check's replay tier compares with the stored record of a deep level, and how an
 //! interrupted run resumes ([`resume`]).
 
-use super::BadFlags;
-use super::{AdaptConfig, AdaptError, History, LevelRecord, Solved, Start};
+use super::{AdaptError, Solved, Start};
 use crate::contact::norms::Reference;
+use model::level::history::{BadFlags, History};
+use model::level::record::LevelRecord;
 use model::mesh::{Mesh, refine};
 use model::problems::Problem;
+use model::settings::adapt::AdaptConfig;
 
 /// A history that does not rebuild the run it belongs to.
 #[derive(Debug, thiserror::Error)]

@@ -43,9 +43,8 @@ use crate::sparse::ordering::OrderingChoice;
 use crate::sparse::symbolic::{self, Placement, Symbolic};
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
+use model::settings::pdas::{PdasOptions, Strategy};
 use std::time::Instant;
-
-pub use model::settings::pdas::{PdasOptions, SCHUR_MAX_CONTACT, Strategy};
 
 /// Why the contact solve failed.
 #[derive(Debug, thiserror::Error)]

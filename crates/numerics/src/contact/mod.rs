@@ -14,9 +14,4 @@ pub mod plausible;
 pub mod point;
 pub mod solve;
 
-pub use model::settings::sampling;
-
-pub use active_set::{
-    ContactError, ContactSolver, NormalIterate, Pair, PdasIteration, PdasOptions, PdasOutput, PdasTermination, SCHUR_MAX_CONTACT, Strategy,
-    Timings, pdas,
-};
+pub use active_set::{ContactError, ContactSolver, NormalIterate, Pair, PdasIteration, PdasOutput, PdasTermination, Timings, pdas};

@@ -3,9 +3,9 @@
 //! quadrature points of every element (the paper's way), on a dense barycentric lattice of every
 //! element, and over the nodal values only (which is not the L-infinity norm).
 
-use crate::contact::sampling::Sampling;
 use crate::contact::solve::DiscreteSolution;
 use model::mesh::Mesh;
+use model::settings::sampling::Sampling;
 use rayon::prelude::*;
 
 /// ||u - u_h||_Linf three ways (max over both components).

@@ -4,15 +4,15 @@
 
 use crate::contact::certify::{self, Certificate, KktError, KktInput, RigidMotionError};
 use crate::contact::consistent::BodyForceFindings;
-use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasOptions, PdasTermination, Strategy, Timings};
+use crate::contact::{ContactError, ContactSolver, PdasIteration, PdasTermination, Timings};
 use crate::fem::assembly::{self, DofMap, System};
 use model::base::element::{self, Affine};
+use model::level::sample::ContactSample;
 use model::mesh::locate::Locator;
 use model::mesh::{Mesh, MeshError, P2Nodes};
 use model::problems::Problem;
+use model::settings::pdas::{PdasOptions, Strategy};
 use std::time::Instant;
-
-pub use model::level::sample::ContactSample;
 
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {
@@ -208,9 +208,9 @@ pub struct Kkt {
 /// to [`certify::TOLERANCE`] ([`crate::contact::certify`]).
 ///
 /// ```rust
-/// use signorini_numerics::contact::PdasOptions;
 /// use model::mesh::MeshSpec;
 /// use model::problems::{Ex72, Problem};
+/// use model::settings::pdas::PdasOptions;
 ///
 /// let mesh = MeshSpec::parse("structured:8").unwrap().build(&Ex72).unwrap();
 /// let sol = signorini_numerics::contact::solve::solve(&mesh, &Ex72, &PdasOptions::default(), &mut |_| {}).unwrap();

@@ -32,16 +32,14 @@ pub mod repair;
 
 use crate::contact::solve::DiscreteSolution;
 use model::base::element::EDGE_VERTICES;
+use model::level::terms::Terms;
 use model::mesh::{Mesh, dist};
 use model::problems::{Part, Problem};
+use model::settings::estimator::{ContactTerm, EstimatorConfig};
 use rayon::prelude::*;
 
 /// Gauss points per edge for the "quadrature" sampling of edge terms.
-pub use model::c0_paper;
-pub use model::level::terms::{NotFinite, Terms};
-pub use model::settings::estimator::{C0_PAPER, ConfigError, ContactTerm, EstimatorConfig, LogFactor, StressFrame};
-
-pub const EDGE_GAUSS: usize = crate::contact::sampling::EDGE_GAUSS;
+pub const EDGE_GAUSS: usize = model::settings::sampling::EDGE_GAUSS;
 
 /// The estimate and the per-element indicators used for marking.
 #[derive(Clone, Debug)]
@@ -63,10 +61,11 @@ pub struct Estimate {
 /// Evaluate the estimator on a discrete solution.
 ///
 /// ```rust
-/// use signorini_numerics::contact::PdasOptions;
-/// use signorini_numerics::estimator::estimate::{self, EstimatorConfig};
+/// use signorini_numerics::estimator::estimate;
 /// use model::mesh::MeshSpec;
 /// use model::problems::{Ex71, Problem};
+/// use model::settings::estimator::EstimatorConfig;
+/// use model::settings::pdas::PdasOptions;
 ///
 /// let mesh = MeshSpec::parse("structured:4").unwrap().build(&Ex71).unwrap();
 /// let sol = signorini_numerics::contact::solve::solve(&mesh, &Ex71, &PdasOptions::default(), &mut |_| {}).unwrap();

@@ -91,9 +91,9 @@ impl NodeGraph {
 mod tests {
     use super::*;
     use crate::fem::assembly::{self, DofMap};
-    use crate::sparse::ordering::Method;
     use model::mesh::{MeshSpec, P2Nodes, refine};
     use model::problems::Ex71;
+    use model::settings::ordering::Method;
 
     /// Example 7.1 on structured:8, refined `rounds` times towards Gamma_C (y = 0).
     fn system(rounds: usize) -> (SymCsc, usize, Vec<[f64; 2]>) {

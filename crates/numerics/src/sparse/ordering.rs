@@ -39,6 +39,7 @@
 
 use super::etree::Adjacency;
 use crate::sparse::csc::SymCsc;
+use model::settings::ordering::{Method, forced};
 use rayon::prelude::*;
 use std::sync::atomic::AtomicU8;
 use std::sync::atomic::Ordering::Relaxed;
@@ -177,14 +178,12 @@ impl OrderingChoice {
     }
 }
 
-pub use model::settings::ordering::{FORCE_ENV, Method, forced};
-
 thread_local! {
-    /// Set while [`automatic`] runs: [`FORCE_ENV`] does not apply on this thread.
+    /// Set while [`automatic`] runs: [`FORCE_ENV`](model::settings::ordering::FORCE_ENV) does not apply on this thread.
     static AUTOMATIC: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
-/// Run `f` with the automatic ordering whatever [`FORCE_ENV`] says (on this thread, where the
+/// Run `f` with the automatic ordering whatever [`FORCE_ENV`](model::settings::ordering::FORCE_ENV) says (on this thread, where the
 /// solves of `f` order their unknowns). The reference solutions of a study are computed so: a
 /// round-off measurement perturbs the runs it measures, against a reference that stays what the
 /// stored results were computed with. Forced on the reference as well, the ordering can tip a
@@ -240,7 +239,7 @@ pub const GRADED: f64 = 3.0;
 /// 512-2048; 0.87-2.0 on fb as written, graded 128-512; 0.68-0.96 from 257k nodes up on fb
 /// without full-contact nodes and repaired, graded 16; 0.80-1.16 on those runs of Example 7.1).
 /// The rule is a function of the mesh only (never of timing or threads).
-/// [`FORCE_ENV`] overrides it: a forced AMD is computed whatever the mesh.
+/// [`FORCE_ENV`](model::settings::ordering::FORCE_ENV) overrides it: a forced AMD is computed whatever the mesh.
 pub fn fill_reducing(matrix: &SymCsc, n_order: usize, coords: &[[f64; 2]]) -> (Vec<usize>, OrderingChoice) {
     fill_reducing_then(matrix, n_order, coords, |graph, node_order| {
         let mut order = graph.unknowns(node_order);

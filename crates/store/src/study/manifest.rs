@@ -19,7 +19,7 @@
 //! contact_term = "as_written"   # or "without_full_contact"
 //! log_factor = "squared"        # or "linear", "one"
 //! sampling = "quadrature"       # or "dense"
-//! stress_frame = "normal"       # or "cartesian": how eta_4, eta_5 read sigma-hat (estimate::StressFrame)
+//! stress_frame = "normal"       # or "cartesian": how eta_4, eta_5 read sigma-hat (settings::estimator::StressFrame)
 //! [defaults.reference]       # optional: errors against a finer adaptive solution
 //! theta = 0.5
 //! min_ndof = 640000

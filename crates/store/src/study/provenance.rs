@@ -21,7 +21,7 @@ pub struct Provenance {
     pub machine: Machine,
     pub threads: usize,
     /// The fill-reducing ordering: `auto` unless forced through `SIGNORINI_ORDERING` (a
-    /// round-off measurement; see `ordering::FORCE_ENV`).
+    /// round-off measurement; see `settings::ordering::FORCE_ENV`).
     #[serde(default = "auto")]
     pub ordering: String,
     /// UTC, ISO 8601.

@@ -15,7 +15,7 @@
 //! would be certified). The points depend on the mesh, but every value of the data the
 //! discrete problem sees is checked (a bump in the Dirichlet data between sampled midpoints
 //! passes on the meshes that put no point in it). On Neumann edges the estimator's edge points (both
-//! samplings, [`crate::contact::sampling::Sampling::edge_parameters`]) are checked too: it reads
+//! samplings, [`model::settings::sampling::Sampling::edge_parameters`]) are checked too: it reads
 //! the traction there.
 //!
 //! The contact conditions are not data the discrete problem reads between its nodes, yet an
@@ -62,7 +62,7 @@ pub const CONTACT_DENSITY: usize = 4096;
 /// edge points under both samplings), and on a contact edge also equal pieces no longer than
 /// `spacing`.
 fn parameters(p: [f64; 2], q: [f64; 2], part: Part, spacing: f64) -> Vec<f64> {
-    use crate::contact::sampling::Sampling;
+    use model::settings::sampling::Sampling;
     let mut s = vec![0.0, 1.0, 0.5];
     s.extend(edge_points(p, q).into_iter().map(|(t, _, _)| t));
     if part == Part::Neumann {

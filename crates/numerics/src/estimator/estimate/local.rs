@@ -3,13 +3,13 @@
 //! residual f + div sigma(u_h) (eta_1), the boundary residuals on Neumann and contact edges
 //! (eta_3, eta_4, eta_5, eta_6, eta_7) and the interior traction jumps (eta_2).
 
-use super::{EstimatorConfig, StressFrame};
-use crate::contact::sampling::Sampling;
 use crate::contact::solve::DiscreteSolution;
 use crate::fem::assembly::edge_basis;
 use model::base::element::{self, Affine, EDGE_VERTICES, N_NODES};
 use model::mesh::Mesh;
 use model::problems::{Material, Part, Problem};
+use model::settings::estimator::{EstimatorConfig, StressFrame};
+use model::settings::sampling::Sampling;
 use rayon::prelude::*;
 
 /// Local (per element) quantities before they are gathered on patches.
