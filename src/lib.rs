@@ -22,8 +22,8 @@
 //! (`signorini::mesh`, `signorini::study`) and the most used modules under a short one
 //! (`signorini::solve`, `signorini::estimate`, `signorini::cholesky`): the users' prelude, for
 //! examples, tests and user programs. Code inside the crates never uses it. The store's `study/`
-//! (manifests, the results folder's store, provenance) shares its name with the harness's
-//! `signorini::study`: it is `signorini_store::study`.
+//! shares its name with the harness's `signorini::study`; its modules are here under their own
+//! names (`signorini::manifest`, `signorini::store`, `signorini::provenance`).
 
 pub mod commands;
 
@@ -32,6 +32,7 @@ pub use signorini_harness::{report, study};
 pub use signorini_model::{base, level, mesh, problems, settings};
 pub use signorini_numerics::{adapt, contact, estimator, fem, sparse};
 pub use signorini_store::records;
+pub use signorini_store::study::{check_complete, manifest, provenance, store};
 
 pub use analysis::{claims, hertz, verdict};
 pub use base::{element, memory};

@@ -6,7 +6,7 @@
 
 use signorini::claims::{self, Claim, Criterion, RowKind, Verdict, terms};
 use signorini::records::RunRecord;
-use signorini_store::study::store::Shelf;
+use signorini::store::Shelf;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 

@@ -5,7 +5,7 @@
 //! Makefile's and `cargo run`'s binary).
 
 use crate::common::{scratch, signorini_in, signorini_in_repo};
-use signorini_store::study::manifest::Manifest;
+use signorini::manifest::Manifest;
 use std::path::Path;
 use std::process::Command;
 

@@ -10,8 +10,8 @@
 //!   drift check's comparison finds no difference).
 
 use crate::common::{copy_tree, scratch, signorini_in};
-use signorini_store::study::manifest::Manifest;
-use signorini_store::study::store::Store;
+use signorini::manifest::Manifest;
+use signorini::store::Store;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

@@ -1,10 +1,10 @@
 //! The drift check reports what moved, with the right row, and passes an unperturbed copy.
 
 use crate::common::{LONG, TWO_SHORT_RUNS, checkpoint_levels, output_in, scratch, signorini_in, stored_study};
+use signorini::manifest::Manifest;
 use signorini::records::{RunRecord, StudyDir};
 use signorini::study::drift::{DECADES, ORDER_OF_MAGNITUDE, compare_study, observed_rate};
 use signorini::study::{self, RunOptions};
-use signorini_store::study::manifest::Manifest;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -121,7 +121,7 @@ fn rate_floors_are_one_sided() {
 /// Every declared study with its stored records.
 fn declared() -> Vec<(Manifest, Vec<RunRecord>)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    signorini_store::study::manifest::declared(&root.join("experiments"), &[])
+    signorini::manifest::declared(&root.join("experiments"), &[])
         .unwrap()
         .into_iter()
         .map(|m| {
@@ -203,9 +203,9 @@ fn declared_tolerances_catch_a_relative_change_of_1e_5_wherever_round_off_allows
 fn stored_views_match_the_records() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("results");
     for (m, stored) in declared() {
-        let rows = signorini::study::drift::check_derived(&signorini_store::study::store::Store::new(&root, &m.study), &stored);
+        let rows = signorini::study::drift::check_derived(&signorini::store::Store::new(&root, &m.study), &stored);
         assert!(rows.is_empty(), "{}: {rows:?}", m.study);
-        signorini_store::study::check_complete(&m, &root).unwrap();
+        signorini::check_complete(&m, &root).unwrap();
     }
 }
 
@@ -256,7 +256,7 @@ fn drift_command_fails_on_perturbed_record_csv_or_claims() {
     let (ok, text) = drift();
     assert!(!ok && text.contains(&format!("{key}.json")) && text.contains("replays to"), "{text}");
     // and the store's own check says the runs were measured against another reference
-    let checked = signorini_store::study::store::Store::new(&res, "tiny").check().unwrap();
+    let checked = signorini::store::Store::new(&res, "tiny").check().unwrap();
     assert!(checked.faults_text().contains("measured against a reference of"), "{}", checked.faults_text());
     std::fs::write(dir.reference_file(&key), &reference).unwrap();
     assert!(drift().0);
@@ -433,7 +433,7 @@ fn drift_advises_drift_when_interrupted_or_refused_by_a_lock() {
     let dir = scratch("drift-drift-advice");
     stored_study(&dir, "exp/long.toml", LONG, "res");
     // M4: a run of the study holds its lock (here: this test, through the library)
-    let store = signorini_store::study::store::Store::new(&dir.join("res"), "long");
+    let store = signorini::store::Store::new(&dir.join("res"), "long");
     let held = store.lock_run("long", false).unwrap();
     let (code, out, err) = signorini_in(&dir, &["drift", "--experiments", "exp", "--results", "res", "--accept", "long"]);
     assert_ne!(code, 0, "{out}");

@@ -6,11 +6,11 @@
 //! once more by every test run: a change of that level's numbers, or of the history itself, is
 //! caught without rerunning the levels before it.
 
+use signorini::manifest::Manifest;
 use signorini::records::StudyDir;
+use signorini::store;
 use signorini::study::drift::{self, DriftOptions};
 use signorini::study::{self, RunOptions};
-use signorini_store::study::manifest::Manifest;
-use signorini_store::study::store;
 use std::path::{Path, PathBuf};
 
 const DEEP: &str = r#"description = "a deep study in miniature"

@@ -459,7 +459,7 @@ fn contact_zone_arc_length_along_a_curve() {
 /// meshes stay as they are.
 #[test]
 fn manifest_mesh_paths_are_relative_to_the_manifest() {
-    use signorini_store::study::manifest::{Manifest, resolve_mesh};
+    use signorini::manifest::{Manifest, resolve_mesh};
     let text = |mesh: &str| format!("[defaults]\nproblem = \"ex71\"\nlevels = 2\nmesh = \"{mesh}\"\n[[run]]\nid = \"a\"\n");
     // the manifest reads the mesh (its hash is part of the run's spec): put one where it points
     let root = std::env::temp_dir().join(format!("signorini-mesh-paths-{}", std::process::id()));

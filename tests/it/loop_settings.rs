@@ -226,7 +226,7 @@ fn the_command_line_and_the_manifests_default_to_the_librarys_values() {
     }
     let manifest = dir.join("defaults.toml");
     std::fs::write(&manifest, "[defaults]\nproblem = \"ex71\"\nlevels = 3\n\n[[run]]\nid = \"a\"\n").unwrap();
-    let m = signorini_store::study::manifest::Manifest::load(&manifest).unwrap();
+    let m = signorini::manifest::Manifest::load(&manifest).unwrap();
     let run = &m.runs[0].spec;
     assert_eq!((run.mesh.as_str(), run.theta, run.refine, run.estimator), (MeshSpec::DEFAULT, a.theta, a.refine, e));
     std::fs::remove_dir_all(&dir).unwrap();

@@ -5,8 +5,8 @@
 use crate::common;
 use crate::common::{fixture, one_run_manifest, scratch, signorini_in_time};
 use common::parse_err;
+use signorini::manifest::Manifest;
 use signorini::settings::adapt::AdaptConfig;
-use signorini_store::study::manifest::Manifest;
 use std::path::Path;
 
 const BASE: &str = "[defaults]\nproblem = \"ex71\"\nlevels = 24\n";
@@ -129,7 +129,7 @@ fn every_declared_study_still_parses() {
 /// `./p.toml` is no changed input against a run stored with `p.toml`.
 #[test]
 fn a_path_spelt_another_way_is_the_same_spec() {
-    use signorini_store::study::manifest::spelled;
+    use signorini::manifest::spelled;
     assert_eq!(spelled("./problems/hertz.toml"), "problems/hertz.toml");
     assert_eq!(spelled("problems/./../problems//hertz.toml"), "problems/hertz.toml");
     assert_eq!(spelled("../shared/p.toml"), "../shared/p.toml");
@@ -170,7 +170,7 @@ fn a_run_id_that_hides_its_record_or_clashes_by_case_is_refused() {
     // what the id check still accepts
     for id in ["b.2", "B_2-x", "0"] {
         let text = fixture("tiny.toml").replace(r#"id = "b""#, &format!("id = {id:?}"));
-        signorini_store::study::manifest::Manifest::parse(std::path::Path::new("experiments/tiny.toml"), &text).unwrap();
+        signorini::manifest::Manifest::parse(std::path::Path::new("experiments/tiny.toml"), &text).unwrap();
     }
 }
 

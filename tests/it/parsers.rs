@@ -2,9 +2,9 @@
 //! input: never a panic, and every rejection names what was wrong.
 
 use proptest::prelude::*;
+use signorini::manifest::Manifest;
 use signorini::mesh::MeshSpec;
 use signorini::report::parse_probe;
-use signorini_store::study::manifest::Manifest;
 use std::path::Path;
 
 /// Strings that look like numbers, and some that almost do.

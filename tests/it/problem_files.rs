@@ -367,8 +367,8 @@ fn unknown_problem_lists_the_built_ins_and_says_a_file_is_accepted() {
 /// the provenance names the file and its SHA-256.
 #[test]
 fn manifests_resolve_problem_files_relative_to_themselves() {
+    use signorini::manifest::Manifest;
     use signorini::study::{self, RunOptions};
-    use signorini_store::study::manifest::Manifest;
     let root = std::env::temp_dir().join(format!("signorini-problem-files-{}", std::process::id()));
     let (experiments, results) = (root.join("experiments"), root.join("results"));
     std::fs::create_dir_all(experiments.join("problems")).unwrap();
@@ -413,7 +413,7 @@ fn manifests_resolve_problem_files_relative_to_themselves() {
 /// Built-in studies keep their provenance as before: no `problem_files` key.
 #[test]
 fn built_in_problems_add_nothing_to_the_provenance() {
-    let m = signorini_store::study::manifest::Manifest::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/ex72.toml")).unwrap();
+    let m = signorini::manifest::Manifest::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/ex72.toml")).unwrap();
     assert!(m.problem_files().is_empty());
 }
 

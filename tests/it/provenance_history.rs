@@ -22,8 +22,8 @@ fn every_stored_provenance_names_a_commit_in_the_history_of_head() {
     for entry in std::fs::read_dir(repo.join("results")).unwrap().flatten() {
         let file = entry.path().join("provenance.json");
         let Ok(text) = std::fs::read_to_string(&file) else { continue };
-        let prov: signorini_store::study::provenance::Provenance = serde_json::from_str(&text).unwrap();
-        assert_eq!(signorini_store::study::provenance::history_fault(&prov, repo), None, "{}", file.display());
+        let prov: signorini::provenance::Provenance = serde_json::from_str(&text).unwrap();
+        assert_eq!(signorini::provenance::history_fault(&prov, repo), None, "{}", file.display());
         assert!(prov.git_commit.is_some(), "{} names no commit", file.display());
         checked += 1;
     }

@@ -6,7 +6,7 @@
 
 use crate::common::{copy_dir, parse_err, scratch, signorini_in};
 use signorini::analysis::roles::{self, NEEDED};
-use signorini_store::study::manifest::{self, Manifest};
+use signorini::manifest::{self, Manifest};
 use std::path::{Path, PathBuf};
 
 fn repo() -> &'static Path {

@@ -4,11 +4,11 @@
 //! describe exactly them, and `figures` refuses it.
 
 use crate::common::{fixture_path, scratch};
+use signorini::check_complete;
+use signorini::manifest::Manifest;
 use signorini::records::StudyDir;
+use signorini::store::Store;
 use signorini::study::drift;
-use signorini_store::study::check_complete;
-use signorini_store::study::manifest::Manifest;
-use signorini_store::study::store::Store;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};

@@ -1079,7 +1079,7 @@ fn report_of_one_study_refuses_another_at_fault_that_its_claims_read() {
 /// save is refused even when a file of that name is there.
 #[test]
 fn the_shelf_hands_out_only_what_the_check_read() {
-    use signorini_store::study::store::{Shelf, ShelfError, Store};
+    use signorini::store::{Shelf, ShelfError, Store};
     let d = scratch("store-integrity-shelf-lib");
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let results = d.join("results");

@@ -5,8 +5,8 @@ use crate::common;
 use crate::common::{fixture_path, scratch};
 use common::parse_err;
 
+use signorini::manifest::{Manifest, ManifestError};
 use signorini::records::{RunRecord, StudyDir};
-use signorini_store::study::manifest::{Manifest, ManifestError};
 use std::path::Path;
 use std::process::Command;
 

@@ -62,7 +62,7 @@ pub fn assert_inactive_forces_within_roundoff(sol: &DiscreteSolution, name: &str
 
 /// The error a bad manifest text gives, checked to name the file first.
 pub fn parse_err(text: &str) -> String {
-    match signorini_store::study::manifest::Manifest::parse(std::path::Path::new("experiments/bad_case.toml"), text) {
+    match signorini::manifest::Manifest::parse(std::path::Path::new("experiments/bad_case.toml"), text) {
         Ok(_) => panic!("accepted a bad manifest:\n{text}"),
         Err(e) => {
             let s = e.to_string();
@@ -91,13 +91,13 @@ pub fn roles() -> &'static signorini::analysis::roles::Roles {
 /// The checked view of a results folder as `figures` and `report` open it: every declared study
 /// and every study the folder holds, each through the store's integrity check (a folder that
 /// does not exist holds none). A folder at fault panics with the check's message.
-pub fn shelf(results: &std::path::Path) -> signorini_store::study::store::Shelf {
-    use signorini_store::study::store::Shelf;
+pub fn shelf(results: &std::path::Path) -> signorini::store::Shelf {
+    use signorini::store::Shelf;
     if !results.exists() {
         return Shelf::open(results, std::iter::empty()).unwrap();
     }
     let experiments = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
-    let manifests = signorini_store::study::manifest::declared(&experiments, &[]).unwrap();
+    let manifests = signorini::manifest::declared(&experiments, &[]).unwrap();
     Shelf::open_folder(results, &manifests).unwrap_or_else(|e| panic!("{e:#}"))
 }
 
@@ -106,9 +106,9 @@ pub fn shelf(results: &std::path::Path) -> signorini_store::study::store::Shelf 
 /// study, saving the levels whose snapshot is there (each snapshot of its run and level, with
 /// the level's NDF, beside a VTU), and the summaries `levels.csv` and `provenance.json` rendered
 /// from the records (a provenance already there keeps its manifest). Then open it ([`shelf`]).
-pub fn sealed(results: &std::path::Path) -> signorini_store::study::store::Shelf {
+pub fn sealed(results: &std::path::Path) -> signorini::store::Shelf {
     use signorini::records::{MeshSnapshot, StudyDir, write_atomic, write_json};
-    for study in signorini_store::study::store::Shelf::in_folder(results).unwrap_or_default() {
+    for study in signorini::store::Shelf::in_folder(results).unwrap_or_default() {
         let dir = StudyDir::new(results, &study);
         let mut runs = dir.read_runs().unwrap();
         for r in &mut runs {
@@ -136,7 +136,7 @@ pub fn sealed(results: &std::path::Path) -> signorini_store::study::store::Shelf
             .and_then(|v| v["manifest"].as_str().map(String::from))
             .unwrap_or_else(|| format!("experiments/{study}.toml"));
         let ids = runs.iter().map(|r| r.run.id.clone()).collect();
-        let p = signorini_store::study::provenance::collect(&study, std::path::Path::new(&manifest), b"", false, ids, &[]);
+        let p = signorini::provenance::collect(&study, std::path::Path::new(&manifest), b"", false, ids, &[]);
         write_json(&dir.provenance_file(), &p).unwrap();
     }
     shelf(results)
