@@ -2,27 +2,20 @@
 //! last finished level, not from level 0, and ends with the same numbers and history as a run
 //! that was never stopped; the checkpoint it resumed from is gone once the run has landed.
 
-use crate::common::{checkpoint_levels, scratch, signorini_in};
+use crate::common::{LONG, checkpoint_levels, scratch, signorini_in};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// A study of one run of 12 small levels, stopped part way: started with [`stopped_at`], which
-/// makes every change to its files wait 50 ms, so it is still in progress when it is killed,
-/// at the cost in computing of a run of a second.
-const SMALL: &str = r#"description = "one run to be stopped part way"
-[defaults]
-problem = "ex71"
-mesh = "structured:4"
-theta = 0.5
-[[run]]
-id = "long"
-levels = 12
-"#;
-
-/// [`SMALL`] with two of its levels' meshes saved.
+/// [`LONG`] cut to 12 levels, two of its levels' meshes saved: started with [`stopped_at`],
+/// which makes every change to its files wait 50 ms, it is still in progress when it is
+/// killed, at the cost in computing of a run of a second.
 fn small_with_saved_meshes() -> String {
-    format!("{SMALL}save_levels = [3, 11]\n")
+    format!("{}save_levels = [3, 11]\n", small())
+}
+
+fn small() -> String {
+    LONG.replace("levels = 22", "levels = 12")
 }
 
 fn bin() -> &'static str {
@@ -98,7 +91,7 @@ fn a_killed_run_resumes_after_its_last_finished_level_with_the_same_numbers() {
 #[test]
 fn a_checkpoint_is_resumed_only_as_written_by_this_code() {
     let dir = scratch("resume-checkpoint-is-resumed");
-    std::fs::write(dir.join("long.toml"), SMALL).unwrap();
+    std::fs::write(dir.join("long.toml"), small()).unwrap();
     let partial = dir.join("killed/long/.partial/long.json");
     stopped_at(&dir, &["run", "long.toml", "--results", "killed"], &partial, 6);
     let text = std::fs::read_to_string(&partial).unwrap();
