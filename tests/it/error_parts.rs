@@ -30,6 +30,9 @@ fn parts_never_exceed_the_whole_and_gamma_c_is_sampled_on_its_edge() {
     let right = norms::linf_error_where(&m, &sol, &u, Sampling::Dense, &|x| x[0] >= 0.5).unwrap();
     let contact = norms::linf_error_contact(&m, &sol, &u).unwrap();
     assert!(right <= whole && right > 0.0);
+    // the record's pair, from one evaluation per lattice point: the same two numbers
+    let (error, kept) = norms::linf_error_with(&m, &sol, &u, &|x| x[0] >= 0.5);
+    assert_eq!((error.linf_dense, kept), (whole, Some(right)));
     // the lattice contains the edge points at 1/6 spacing; Gamma_C is sampled at 1/12 spacing,
     // so it may exceed the lattice maximum only slightly
     assert!(contact > 0.0 && contact <= 1.5 * whole, "{contact:e} vs {whole:e}");
