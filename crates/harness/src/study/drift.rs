@@ -32,9 +32,9 @@
 //! records made from an edited manifest, problem file or mesh are reported as such.
 
 use ::store::records::RunRecord;
-use ::store::study::manifest::DERIVED;
-use ::store::study::manifest::{DriftSpec, Manifest, Tolerance};
+use ::store::study::manifest::{DERIVED, DriftSpec, Manifest, Tolerance};
 use ::store::study::store::Store;
+use ::store::study::{manifest, provenance, store};
 use model::level::record::LevelRecord;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -297,8 +297,7 @@ pub fn compare(manifest: &Manifest, stored: &[RunRecord], fresh: &[RunRecord], q
             }
         };
         // the spec: the stored full spec, shortened to the quick form where quick
-        let expected_spec =
-            super::effective_spec(&::store::study::manifest::PlannedRun { spec: s.run.clone(), quick_levels: planned.quick_levels }, quick);
+        let expected_spec = super::effective_spec(&manifest::PlannedRun { spec: s.run.clone(), quick_levels: planned.quick_levels }, quick);
         if expected_spec != f.run {
             out.push(row(
                 study,
@@ -538,19 +537,19 @@ pub fn table(rows: &[DriftRow]) -> String {
     s
 }
 
-use ::store::study::store::first_difference;
+use store::first_difference;
 
 /// The views of a study's stored records, checked against what the records render
-/// ([`::store::study::store::check::summary_faults`]): `levels.csv` byte for byte and `provenance.json`'s
+/// ([`store::check::summary_faults`]): `levels.csv` byte for byte and `provenance.json`'s
 /// list of runs. A hand edit, a bad merge or a study interrupted before its summaries were
 /// rewritten is drift.
 pub fn check_derived(store: &Store, runs: &[RunRecord]) -> Vec<DriftRow> {
-    ::store::study::store::check::summary_faults(store.dir(), store.study(), runs).iter().map(|f| fault_row(store, f)).collect()
+    store::check::summary_faults(store.dir(), store.study(), runs).iter().map(|f| fault_row(store, f)).collect()
 }
 
-/// A fault of the stored folder ([`::store::study::store::Store::check`]) as a row of drift: the file
+/// A fault of the stored folder ([`store::Store::check`]) as a row of drift: the file
 /// (relative to the study folder) and what is wrong with it.
-fn fault_row(store: &Store, f: &::store::study::store::Fault) -> DriftRow {
+fn fault_row(store: &Store, f: &store::Fault) -> DriftRow {
     let (study, dir) = (store.study(), store.dir());
     let file = f.file.strip_prefix(&dir.root).unwrap_or(&f.file).display().to_string();
     let field = if f.record.is_some() { "store".to_string() } else { file.clone() };
@@ -571,7 +570,7 @@ fn fault_row(store: &Store, f: &::store::study::store::Fault) -> DriftRow {
 pub struct DriftOptions {
     /// Rerun the quick forms (prefixes of the stored runs) instead of the full studies.
     pub quick: bool,
-    /// Rerun deep studies ([`::store::study::manifest::DeepTier`]) to the end; without it they are rerun
+    /// Rerun deep studies ([`manifest::DeepTier`]) to the end; without it they are rerun
     /// in their tiers.
     pub deep: bool,
     /// Compare with the records already in this results folder instead of rerunning (how
@@ -693,7 +692,7 @@ pub fn select_against(dir: &Path, manifests: &[Manifest], named: bool) -> anyhow
 /// meshes the runs were made with (by hash). Records made from an edited manifest or problem
 /// file differ even where every number agrees.
 pub fn compare_provenance(study: &str, stored: &Store, fresh: &Store) -> Vec<DriftRow> {
-    use ::store::study::provenance::Provenance;
+    use provenance::Provenance;
     let read = |d: &Store| d.provenance().ok();
     let tol = "exact (what the runs were made with)";
     let (Some(s), Some(f)) = (read(stored), read(fresh)) else {
@@ -760,7 +759,7 @@ pub fn check(
         }
     };
     let mut report = DriftReport {
-        date: ::store::study::provenance::utc_now(),
+        date: provenance::utc_now(),
         quick: opts.quick,
         against: opts.against.as_ref().map(|p| p.display().to_string()),
         studies: Vec::new(),
@@ -777,10 +776,10 @@ pub fn check(
         .collect();
     // held until the comparisons end: another drift in this checkout waits rather than
     // starting over the reruns this one compares
-    let _scratch = if opts.against.is_none() { Some(::store::study::store::scratch_folder(&opts.scratch)?) } else { None };
+    let _scratch = if opts.against.is_none() { Some(store::scratch_folder(&opts.scratch)?) } else { None };
     for (m, _) in &planned {
         let stored = Store::of(&opts.results, m);
-        if let Some(why) = stored.provenance().ok().and_then(|p| ::store::study::provenance::history_fault_of(&p, &m.file)) {
+        if let Some(why) = stored.provenance().ok().and_then(|p| provenance::history_fault_of(&p, &m.file)) {
             anyhow::bail!(
                 "{}: {why}. The drift check compares with results of known code; rerun the study on a commit of this history (`signorini drift --accept {}`) and commit its results",
                 stored.dir().root.display(),
